@@ -1,0 +1,54 @@
+/*
+   petscbinbcsr.h: public interface of the binbcsr plug-in for PETSc 3.18.
+
+   Types
+     MATBINBCSR ("binbcsr")   BIN-CSR (block size 1) / BIN-BCSR (block size 3) sparse matrix;
+                              picks MATSEQBINBCSR or MATMPIBINBCSR by communicator size.
+     KSPMCG     ("mcg")       merged (single-reduction) preconditioned conjugate gradient.
+
+   Use from a program linked against libpetscbinbcsr:  PetscCall(PetscBinBCSRRegisterAll());
+   Use from any stock PETSc program:  -dll_append /path/to/libpetscbinbcsr.so
+*/
+#ifndef PETSCBINBCSR_H
+#define PETSCBINBCSR_H
+
+#include <petscmat.h>
+#include <petscksp.h>
+
+#define MATBINBCSR    "binbcsr"
+#define MATSEQBINBCSR "seqbinbcsr"
+#define MATMPIBINBCSR "mpibinbcsr"
+#define KSPMCG        "mcg"
+
+/* How matrix values are stored. Products always accumulate in double. */
+typedef enum {
+  MAT_BINBCSR_PRECISION_DOUBLE = 0,
+  MAT_BINBCSR_PRECISION_SINGLE = 1
+} MatBinBCSRPrecision;
+PETSC_EXTERN const char *const MatBinBCSRPrecisions[];
+
+/* Registers MATBINBCSR, MATSEQBINBCSR, MATMPIBINBCSR and KSPMCG (idempotent). */
+PETSC_EXTERN PetscErrorCode PetscBinBCSRRegisterAll(void);
+/* Entry point that PETSc's -dll_append / -dll_prepend loader calls. */
+PETSC_EXTERN PetscErrorCode PetscDLLibraryRegister_petscbinbcsr(void);
+
+/* Rows (block rows) per bin; options: -mat_binbcsr_bin_width. Set before the first final assembly.
+   No-op on matrices of other types. */
+PETSC_EXTERN PetscErrorCode MatBinBCSRSetBinWidth(Mat, PetscInt);
+PETSC_EXTERN PetscErrorCode MatBinBCSRGetBinWidth(Mat, PetscInt *);
+/* Value storage; option -mat_binbcsr_precision double|single. May be changed at any time
+   (values are converted). No-op on matrices of other types. */
+PETSC_EXTERN PetscErrorCode MatBinBCSRSetPrecision(Mat, MatBinBCSRPrecision);
+PETSC_EXTERN PetscErrorCode MatBinBCSRGetPrecision(Mat, MatBinBCSRPrecision *);
+
+/* y = A x and *xdoty = the local (this rank's rows, unreduced) part of x^T y, in one pass over A when
+   the matrix type provides it (composed "MatMultDotLocal_C"), otherwise MatMult and a local dot.
+   The caller reduces the dot across ranks, typically together with other dots. */
+PETSC_EXTERN PetscErrorCode MatMultDotLocal(Mat, Vec, Vec, PetscScalar *);
+
+/* KSPMCG: run exactly n iterations per solve, computing no norm (n = 0: off, use the tolerances).
+   Option -ksp_mcg_fixed_iterations n. */
+PETSC_EXTERN PetscErrorCode KSPMCGSetFixedIterations(KSP, PetscInt);
+PETSC_EXTERN PetscErrorCode KSPMCGGetFixedIterations(KSP, PetscInt *);
+
+#endif

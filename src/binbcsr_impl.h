@@ -1,0 +1,20 @@
+/* Private declarations shared by the parts of the plug-in: constructors that the registration
+   calls and the -log_view events of the hot kernels. */
+#ifndef BINBCSR_IMPL_H
+#define BINBCSR_IMPL_H
+
+#include <petscbinbcsr.h>
+#include <petsc/private/petscimpl.h>
+
+PETSC_EXTERN PetscErrorCode MatCreate_SeqBinBCSR(Mat);
+PETSC_EXTERN PetscErrorCode MatCreate_MPIBinBCSR(Mat);
+PETSC_EXTERN PetscErrorCode KSPCreate_MCG(KSP);
+
+/* Registered once by PetscBinBCSRRegisterAll(). */
+PETSC_EXTERN PetscLogEvent MAT_BinBCSR_BuildLayout; /* first final assembly: staging -> bins */
+PETSC_EXTERN PetscLogEvent MAT_BinBCSR_SetValuesCOO; /* slot refill by gather */
+PETSC_EXTERN PetscLogEvent MAT_BinBCSR_MultDot;      /* y = A x fused with x.y */
+PETSC_EXTERN PetscLogEvent KSP_MCG_FusedUpdate;      /* x, r, z (Jacobi), p, s updates + local dots */
+PETSC_EXTERN PetscLogEvent KSP_MCG_Reduction;        /* the one global reduction per iteration */
+
+#endif

@@ -1,0 +1,70 @@
+/* Public setters and getters of MATBINBCSR: dispatch to the composed implementation of the actual
+   type (seq or mpi), and do nothing on other types so user code can call them unconditionally. */
+#include "binbcsr_impl.h"
+
+PetscErrorCode MatBinBCSRSetBinWidth(Mat A, PetscInt bw)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidLogicalCollectiveInt(A, bw, 2);
+  PetscTryMethod(A, "MatBinBCSRSetBinWidth_C", (Mat, PetscInt), (A, bw));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatBinBCSRGetBinWidth(Mat A, PetscInt *bw)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidIntPointer(bw, 2);
+  *bw = 0;
+  PetscTryMethod(A, "MatBinBCSRGetBinWidth_C", (Mat, PetscInt *), (A, bw));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatBinBCSRSetPrecision(Mat A, MatBinBCSRPrecision p)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidLogicalCollectiveEnum(A, p, 2);
+  PetscTryMethod(A, "MatBinBCSRSetPrecision_C", (Mat, MatBinBCSRPrecision), (A, p));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatBinBCSRGetPrecision(Mat A, MatBinBCSRPrecision *p)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidPointer(p, 2);
+  *p = MAT_BINBCSR_PRECISION_DOUBLE;
+  PetscTryMethod(A, "MatBinBCSRGetPrecision_C", (Mat, MatBinBCSRPrecision *), (A, p));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatMultDotLocal(Mat A, Vec x, Vec y, PetscScalar *xdoty)
+{
+  PetscErrorCode (*fused)(Mat, Vec, Vec, PetscScalar *) = nullptr;
+
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidHeaderSpecific(x, VEC_CLASSID, 2);
+  PetscValidHeaderSpecific(y, VEC_CLASSID, 3);
+  PetscValidScalarPointer(xdoty, 4);
+  PetscCall(PetscObjectQueryFunction((PetscObject)A, "MatMultDotLocal_C", &fused));
+  if (fused) {
+    PetscCall(fused(A, x, y, xdoty));
+  } else {
+    const PetscScalar *xa, *ya;
+    PetscInt           n;
+    PetscScalar        sum = 0;
+    PetscCall(MatMult(A, x, y));
+    PetscCall(VecGetLocalSize(x, &n));
+    PetscCall(VecGetArrayRead(x, &xa));
+    PetscCall(VecGetArrayRead(y, &ya));
+    for (PetscInt i = 0; i < n; i++) sum += xa[i] * ya[i];
+    PetscCall(VecRestoreArrayRead(x, &xa));
+    PetscCall(VecRestoreArrayRead(y, &ya));
+    PetscCall(PetscLogFlops(2.0 * n));
+    *xdoty = sum;
+  }
+  PetscFunctionReturn(0);
+}

@@ -1,0 +1,36 @@
+#include "binbcsr_impl.h"
+
+PetscLogEvent MAT_BinBCSR_BuildLayout  = 0;
+PetscLogEvent MAT_BinBCSR_SetValuesCOO = 0;
+PetscLogEvent MAT_BinBCSR_MultDot      = 0;
+PetscLogEvent KSP_MCG_FusedUpdate      = 0;
+PetscLogEvent KSP_MCG_Reduction        = 0;
+
+const char *const MatBinBCSRPrecisions[] = {"double", "single", "MatBinBCSRPrecision", "MAT_BINBCSR_PRECISION_", nullptr};
+
+static PetscBool registered = PETSC_FALSE;
+
+PetscErrorCode PetscBinBCSRRegisterAll(void)
+{
+  PetscFunctionBegin;
+  if (registered) PetscFunctionReturn(0);
+  registered = PETSC_TRUE;
+  PetscCall(MatRegister(MATSEQBINBCSR, MatCreate_SeqBinBCSR));
+  PetscCall(MatRegister(MATMPIBINBCSR, MatCreate_MPIBinBCSR));
+  PetscCall(MatRegisterRootName(MATBINBCSR, MATSEQBINBCSR, MATMPIBINBCSR));
+  PetscCall(KSPRegister(KSPMCG, KSPCreate_MCG));
+  PetscCall(PetscLogEventRegister("BinBCSRBuildLay", MAT_CLASSID, &MAT_BinBCSR_BuildLayout));
+  PetscCall(PetscLogEventRegister("BinBCSRSetCOO", MAT_CLASSID, &MAT_BinBCSR_SetValuesCOO));
+  PetscCall(PetscLogEventRegister("BinBCSRMultDot", MAT_CLASSID, &MAT_BinBCSR_MultDot));
+  PetscCall(PetscLogEventRegister("MCGFusedUpdate", KSP_CLASSID, &KSP_MCG_FusedUpdate));
+  PetscCall(PetscLogEventRegister("MCGReduction", KSP_CLASSID, &KSP_MCG_Reduction));
+  PetscFunctionReturn(0);
+}
+
+/* Called by PETSc's dynamic library loader (-dll_append libpetscbinbcsr.so). */
+PetscErrorCode PetscDLLibraryRegister_petscbinbcsr(void)
+{
+  PetscFunctionBegin;
+  PetscCall(PetscBinBCSRRegisterAll());
+  PetscFunctionReturn(0);
+}
