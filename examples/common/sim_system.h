@@ -1,0 +1,68 @@
+// The PETSc layer shared by every simulation driver (FEM, rigid bodies, cloth): one symmetric linear
+// system of 3x3 blocks whose sparsity pattern is fixed when the scene is built and whose values are
+// refilled in place every step.
+//
+//   BlockSystem sys;
+//   BlockSystemCreate(comm, n_global, n_local, coo_block_row, coo_block_col, &sys);   // once
+//   loop: BlockSystemSetValues(&sys, block_values);                                  // 9 per COO block
+//         BlockSystemSolve(&sys, rhs_local, sol_local, &stats);
+//   BlockSystemDestroy(&sys);
+//
+// The pattern is given as a COO list of 3x3 blocks (global block indices; duplicates are summed, so
+// every element can list its own blocks; a rank may list blocks of rows it does not own). The list
+// is expanded once to 9 scalar COO entries per block, row-major, so the values a driver writes
+// (block k at block_values[9k..9k+8], row-major) go to MatSetValuesCOO without any copy. Matrix
+// types that implement COO natively (aij, binbcsr) take that path; others (baij, sell, ...) get one
+// MatSetValuesBlocked per block after MatZeroEntries, which is correct and much faster than PETSc's
+// scalar fallback.
+//
+// Options (all read here, so every driver accepts them): -mat_type aij|baij|sell|binbcsr|...,
+// -ksp_type cg|pipecg|mcg|..., -pc_type (default jacobi), -ksp_max_it, -ksp_rtol, and every option
+// of those types. A -mat_type that needs a GPU this PETSc was not built for (aijcusparse, ...) is a
+// clear PETSC_ERR_SUP error.
+#pragma once
+#include <petscksp.h>
+#include <vector>
+
+struct BlockSystem {
+  Mat      A   = nullptr; // block size 3, rows [row_begin, row_end) (scalar rows) on this rank
+  KSP      ksp = nullptr;
+  Vec      x = nullptr, b = nullptr;
+  PetscInt n_block_rows_global = 0, n_block_rows_local = 0;
+  PetscInt row_begin = 0, row_end = 0;  // scalar row range owned by this rank
+  PetscInt n_coo_blocks = 0;            // blocks this rank contributes (length of the COO list)
+  PetscBool native_coo = PETSC_FALSE;   // the type implements MatSetValuesCOO itself
+  std::vector<PetscInt> coo_block_row, coo_block_col; // kept for the fallback path and for dumps
+  const PetscScalar *last_values = nullptr; // the caller's array from the last SetValues (for dumps)
+};
+
+struct SolveStats {
+  PetscInt           iterations = 0;
+  PetscReal          residual_norm = 0;  // as the KSP reports it (0 when the KSP computes none)
+  KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
+  double             ms = 0;             // wall-clock milliseconds of KSPSolve
+};
+
+// n_block_rows_local may be PETSC_DECIDE. Call after PetscInitialize and plug-in registration.
+PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, PetscInt n_block_rows_local,
+                                 const std::vector<PetscInt> &coo_block_row,
+                                 const std::vector<PetscInt> &coo_block_col, BlockSystem *sys);
+
+// block_values: 9 * n_coo_blocks values, block k row-major at [9k, 9k+9). Summed over duplicates,
+// replacing the previous values. The array is remembered (not copied) for BlockSystemDumpMatrix: keep
+// it alive until the next call or the dump.
+PetscErrorCode BlockSystemSetValues(BlockSystem *sys, const PetscScalar *block_values);
+
+// Solves A sol = rhs for this rank's rows (3 * n_block_rows_local scalars each). sol_local is also
+// the initial guess when the KSP was told -ksp_initial_guess_nonzero. A KSP that does not converge
+// is not an error here: stats->reason says what happened; the caller decides.
+PetscErrorCode BlockSystemSolve(BlockSystem *sys, const PetscScalar *rhs_local, PetscScalar *sol_local,
+                                SolveStats *stats);
+
+// Writes the current matrix in PETSc binary format (loadable as aij with MatLoad), whatever its type.
+PetscErrorCode BlockSystemDumpMatrix(BlockSystem *sys, const char *path);
+
+// Nonzeros stored (scalar entries of the pattern, summed over ranks) and the Mat type's name.
+PetscErrorCode BlockSystemGetInfo(BlockSystem *sys, PetscInt *nnz, const char **mat_type, const char **ksp_type);
+
+PetscErrorCode BlockSystemDestroy(BlockSystem *sys);
