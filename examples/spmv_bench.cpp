@@ -1,0 +1,459 @@
+// spmv_bench: MatMult timed for PETSc's built-in formats and MATBINBCSR (double and single storage) on
+// the same matrices in the same run, against a STREAM-triad bandwidth measured in the same run.
+//
+//   spmv_bench [-stencil_sizes 16,32,48] [-f FILE]... [-formats aij,baij,sbaij,sell,binbcsr,binbcsr_single]
+//              [-repeats 7] [-min_batch_ms 20] [-csv FILE] [-stats_only] [-stream_elements N]
+//
+// Matrices: the 27-point 3x3-block stencil (examples/common/stencil.h) on an n^3 node grid for each
+// n of -stencil_sizes (0 = none), and every PETSc binary file given with -f (repeatable, or a comma
+// list; the block size comes from the file's .info, -matload_block_size, or -bs).
+// Under mpiexec the same types are used in their mpi forms (rows split by PETSc's default layout).
+//
+// Timing: the formats are timed round-robin (one batch of MatMults per format per round, -repeats
+// rounds) so that load from other processes hits them alike; a batch is long enough to last
+// -min_batch_ms. Per MatMult: min and median over the rounds.
+// GFlop/s = 2 nnz / t with nnz the nonzeros of the full matrix (also for sbaij, which stores half).
+// Bytes model (GB/s): the matrix's stored arrays read once (values, column indices, row/bin offsets,
+// padding included) + x read once + y written once; no cache reuse of x beyond that and no halo.
+//   aij:     nnz (8 + 4) + 4 (rows + 1)
+//   baij:    blocks (8 bs^2 + 4) + 4 (block rows + 1)
+//   sbaij:   upper blocks incl. diagonal (8 bs^2 + 4) + 4 (block rows + 1)
+//   sell:    padded slots (8 + 4) + 4 (slices + 1), slices of 8 rows padded to their longest row
+//   binbcsr: padded blocks (s bs^2 + 4) + 4 (bins + 1), s = 8 (double) or 4 (single), bins of
+//            bin_width (block) rows padded to their longest row
+//   + 8 N (x) + 8 N (y)
+#include <petscbinbcsr.h>
+
+#include "common/stencil.h"
+#include "common/stream.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace {
+
+struct FormatSpec {
+  std::string label; // column in the table: aij, baij, ..., binbcsr_single
+  std::string type;  // the MatType root name
+  bool        single = false;
+};
+
+// Where a matrix comes from: a stencil grid or a binary file.
+struct MatrixSource {
+  std::string name;
+  bool        is_file = false;
+  StencilGrid grid;
+  std::string path;
+};
+
+// Shape of a matrix, measured once on its aij form (row lengths in scalars; block rows for padding).
+struct MatrixStats {
+  PetscInt              rows = 0, bs = 1;
+  double                nnz = 0, upper_blocks = 0, blocks = 0, sell_slots = 0;
+  PetscInt              max_row = 0, min_row = 0;
+  double                avg_row = 0;
+  std::vector<PetscInt> block_row_len; // local block rows, in blocks (for binbcsr padding)
+};
+
+struct Candidate {
+  FormatSpec          spec;
+  Mat                 A = nullptr;
+  std::string         actual_type, note;
+  PetscInt            inner = 1;
+  std::vector<double> per_mult; // seconds per MatMult, one per round
+  double              bytes = 0, padding = -1, padding_info = -1, rel_err = 0;
+  PetscInt            bin_width = 0;
+};
+
+std::vector<std::string> SplitList(const std::string &s)
+{
+  std::vector<std::string> out;
+  size_t                   start = 0;
+  while (start <= s.size()) {
+    size_t end = s.find(',', start);
+    if (end == std::string::npos) end = s.size();
+    if (end > start) out.push_back(s.substr(start, end - start));
+    start = end + 1;
+  }
+  return out;
+}
+
+std::string LastErrorText()
+{
+  const char *text = nullptr;
+  char       *specific = nullptr;
+  PetscErrorMessage(PETSC_ERR_SUP, &text, &specific);
+  std::string s = specific ? specific : (text ? text : "error");
+  while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
+  return s;
+}
+
+// Runs f with errors returned instead of printed and aborted; a format that is not there (yet), or
+// refuses the matrix, becomes a row with a note instead of ending the benchmark.
+template <class F>
+PetscErrorCode Try(F f, std::string *note)
+{
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, nullptr));
+  const PetscErrorCode ierr = f();
+  PetscCall(PetscPopErrorHandler());
+  if (ierr) *note = LastErrorText();
+  return 0;
+}
+
+PetscErrorCode LoadAIJ(MPI_Comm comm, const std::string &path, PetscInt bs, Mat *A)
+{
+  PetscViewer viewer;
+
+  PetscFunctionBegin;
+  PetscCall(PetscViewerBinaryOpen(comm, path.c_str(), FILE_MODE_READ, &viewer));
+  PetscCall(MatCreate(comm, A));
+  PetscCall(MatSetType(*A, MATAIJ));
+  if (bs > 0) PetscCall(MatSetBlockSize(*A, bs));
+  PetscCall(MatLoad(*A, viewer));
+  PetscCall(PetscViewerDestroy(&viewer));
+  PetscFunctionReturn(0);
+}
+
+// One pass over the aij rows: scalar row lengths, SELL slots, block row lengths, upper blocks.
+PetscErrorCode MeasureStats(Mat aij, MatrixStats *st)
+{
+  PetscInt rstart, rend;
+  MPI_Comm comm = PetscObjectComm((PetscObject)aij);
+
+  PetscFunctionBegin;
+  PetscCall(MatGetSize(aij, &st->rows, nullptr));
+  PetscCall(MatGetBlockSize(aij, &st->bs));
+  PetscCall(MatGetOwnershipRange(aij, &rstart, &rend));
+  const PetscInt bs = st->bs;
+  PetscInt       maxr = 0, minr = PETSC_MAX_INT, slice_max = 0;
+  double         nnz = 0, sell = 0, blocks = 0, upper = 0;
+  std::vector<PetscInt> bcols;
+  st->block_row_len.clear();
+  for (PetscInt r = rstart; r < rend; ++r) {
+    PetscInt        ncols;
+    const PetscInt *cols;
+    PetscCall(MatGetRow(aij, r, &ncols, &cols, nullptr));
+    maxr = std::max(maxr, ncols);
+    minr = std::min(minr, ncols);
+    nnz += ncols;
+    slice_max = std::max(slice_max, ncols);
+    if ((r - rstart) % 8 == 7 || r == rend - 1) {
+      sell += 8.0 * slice_max;
+      slice_max = 0;
+    }
+    for (PetscInt c = 0; c < ncols; ++c) bcols.push_back(cols[c] / bs);
+    PetscCall(MatRestoreRow(aij, r, &ncols, &cols, nullptr));
+    if ((r - rstart) % bs == bs - 1) {
+      std::sort(bcols.begin(), bcols.end());
+      bcols.erase(std::unique(bcols.begin(), bcols.end()), bcols.end());
+      const PetscInt brow = r / bs;
+      st->block_row_len.push_back((PetscInt)bcols.size());
+      blocks += (double)bcols.size();
+      for (PetscInt c : bcols) upper += (c >= brow);
+      bcols.clear();
+    }
+  }
+  double sums[5] = {nnz, sell, blocks, upper, (double)(rend - rstart)};
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, sums, 5, MPI_DOUBLE, MPI_SUM, comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &maxr, 1, MPIU_INT, MPI_MAX, comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &minr, 1, MPIU_INT, MPI_MIN, comm));
+  st->nnz          = sums[0];
+  st->sell_slots   = sums[1];
+  st->blocks       = sums[2];
+  st->upper_blocks = sums[3];
+  st->max_row      = maxr;
+  st->min_row      = minr;
+  st->avg_row      = sums[0] / (double)st->rows;
+  PetscFunctionReturn(0);
+}
+
+// Stored blocks of BIN-(B)CSR with bins of bin_width local block rows, each padded to its longest row.
+double BinnedBlocks(const MatrixStats &st, PetscInt bin_width, MPI_Comm comm, double *bins)
+{
+  double         slots = 0, nb = 0;
+  const PetscInt n     = (PetscInt)st.block_row_len.size();
+  for (PetscInt start = 0; start < n; start += bin_width) {
+    const PetscInt end     = std::min(n, start + bin_width);
+    PetscInt       longest = 0;
+    for (PetscInt r = start; r < end; ++r) longest = std::max(longest, st.block_row_len[r]);
+    slots += (double)longest * (double)(end - start);
+    nb += 1;
+  }
+  double s[2] = {slots, nb};
+  MPI_Allreduce(MPI_IN_PLACE, s, 2, MPI_DOUBLE, MPI_SUM, comm);
+  *bins = s[1];
+  return s[0];
+}
+
+double ModelBytes(const Candidate &c, const MatrixStats &st, MPI_Comm comm, double *padding)
+{
+  const double bs = (double)st.bs, nbrows = (double)st.rows / bs, vec = 16.0 * st.rows;
+  *padding        = -1;
+  if (c.spec.type == "aij") return st.nnz * 12 + 4 * (st.rows + 1) + vec;
+  if (c.spec.type == "baij") return st.blocks * (8 * bs * bs + 4) + 4 * (nbrows + 1) + vec;
+  if (c.spec.type == "sbaij") return st.upper_blocks * (8 * bs * bs + 4) + 4 * (nbrows + 1) + vec;
+  if (c.spec.type == "sell") return st.sell_slots * 12 + 4 * (std::ceil(st.rows / 8.0) + 1) + vec;
+  if (c.spec.type == "binbcsr") {
+    double       bins;
+    const double slots = BinnedBlocks(st, std::max<PetscInt>(1, c.bin_width), comm, &bins);
+    *padding           = 100.0 * (slots - st.blocks) / st.blocks;
+    return slots * ((c.spec.single ? 4 : 8) * bs * bs + 4) + 4 * (bins + 1) + vec;
+  }
+  return 0;
+}
+
+PetscErrorCode BuildCandidate(MPI_Comm comm, const MatrixSource &src, Mat aij_file, Candidate *c)
+{
+  PetscFunctionBegin;
+  if (src.is_file) {
+    if (c->spec.type == "aij") PetscCall(MatDuplicate(aij_file, MAT_COPY_VALUES, &c->A));
+    else PetscCall(MatConvert(aij_file, c->spec.type.c_str(), MAT_INITIAL_MATRIX, &c->A));
+  } else {
+    PetscCall(CreateStencilMatrix(comm, src.grid, c->spec.type.c_str(), nullptr, &c->A));
+  }
+  if (c->spec.single) {
+    MatBinBCSRPrecision p;
+    PetscCall(MatBinBCSRSetPrecision(c->A, MAT_BINBCSR_PRECISION_SINGLE));
+    PetscCall(MatBinBCSRGetPrecision(c->A, &p));
+    PetscCheck(p == MAT_BINBCSR_PRECISION_SINGLE, comm, PETSC_ERR_SUP, "single storage not available");
+  }
+  if (c->spec.type == "binbcsr") PetscCall(MatBinBCSRGetBinWidth(c->A, &c->bin_width));
+  MatType t;
+  PetscCall(MatGetType(c->A, &t));
+  c->actual_type = t;
+  PetscFunctionReturn(0);
+}
+
+double Median(std::vector<double> v)
+{
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
+
+double Min(const std::vector<double> &v) { return v.empty() ? 0 : *std::min_element(v.begin(), v.end()); }
+
+struct Settings {
+  std::vector<FormatSpec> formats;
+  PetscInt                repeats      = 7;
+  PetscReal               min_batch_ms = 20;
+  PetscBool               stats_only   = PETSC_FALSE;
+  FILE                   *csv          = nullptr;
+  double                  triad_GBs    = 0;
+  PetscInt                file_bs      = 0;
+};
+
+PetscErrorCode BenchMatrix(MPI_Comm comm, const MatrixSource &src, const Settings &set)
+{
+  Mat         aij_file = nullptr, reference = nullptr;
+  MatrixStats st;
+
+  PetscFunctionBegin;
+  if (src.is_file) {
+    PetscCall(LoadAIJ(comm, src.path, set.file_bs, &aij_file));
+    PetscBool symmetric = PETSC_FALSE;
+    PetscCall(MatIsSymmetric(aij_file, 0.0, &symmetric));
+    if (symmetric) PetscCall(MatSetOption(aij_file, MAT_SYMMETRIC, PETSC_TRUE));
+    reference = aij_file;
+  } else {
+    PetscCall(CreateStencilMatrix(comm, src.grid, MATAIJ, nullptr, &reference));
+  }
+  PetscCall(MeasureStats(reference, &st));
+
+  std::vector<Candidate> cands;
+  for (const FormatSpec &f : set.formats) {
+    Candidate c;
+    c.spec = f;
+    if (f.type == "sbaij" && src.is_file) {
+      PetscBool known = PETSC_FALSE, sym = PETSC_FALSE;
+      PetscCall(MatIsSymmetricKnown(aij_file, &known, &sym));
+      if (!known || !sym) c.note = "matrix not symmetric";
+    }
+    if (c.note.empty()) PetscCall(Try([&] { return BuildCandidate(comm, src, aij_file, &c); }, &c.note));
+    if (!c.note.empty() && c.A) {
+      PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, nullptr));
+      (void)MatDestroy(&c.A);
+      PetscCall(PetscPopErrorHandler());
+      c.A = nullptr;
+    }
+    cands.push_back(c);
+  }
+
+  // Reference product (aij, double) and a first product of each format: correctness, warm-up, and
+  // how many products make one batch.
+  Vec x, y_ref, y;
+  PetscCall(MatCreateVecs(reference, &x, &y_ref));
+  PetscCall(VecDuplicate(y_ref, &y));
+  {
+    PetscInt lo, hi;
+    PetscScalar *xa;
+    PetscCall(VecGetOwnershipRange(x, &lo, &hi));
+    PetscCall(VecGetArray(x, &xa));
+    for (PetscInt i = lo; i < hi; ++i) xa[i - lo] = 1.0 + 0.5 * std::sin(0.1 * (double)i);
+    PetscCall(VecRestoreArray(x, &xa));
+  }
+  PetscCall(MatMult(reference, x, y_ref));
+  PetscReal ref_norm;
+  PetscCall(VecNorm(y_ref, NORM_INFINITY, &ref_norm));
+
+  for (Candidate &c : cands) {
+    if (!c.A) continue;
+    c.bytes = ModelBytes(c, st, comm, &c.padding);
+    if (c.spec.type == "binbcsr") {
+      MatInfo info;
+      PetscCall(MatGetInfo(c.A, MAT_GLOBAL_SUM, &info));
+      if (info.nz_allocated > 0 && info.nz_used > 0) c.padding_info = 100.0 * (info.nz_allocated - info.nz_used) / info.nz_used;
+    }
+    if (set.stats_only) continue;
+    PetscCall(Try(
+      [&]() -> PetscErrorCode {
+        PetscCall(MatMult(c.A, x, y));
+        PetscCall(MatMult(c.A, x, y));
+        PetscCall(VecAXPY(y, -1.0, y_ref));
+        PetscReal d;
+        PetscCall(VecNorm(y, NORM_INFINITY, &d));
+        c.rel_err = d / ref_norm;
+        PetscCallMPI(MPI_Barrier(comm));
+        double t0 = MPI_Wtime();
+        PetscCall(MatMult(c.A, x, y));
+        double t = MPI_Wtime() - t0;
+        PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &t, 1, MPI_DOUBLE, MPI_MAX, comm));
+        c.inner = std::max<PetscInt>(1, (PetscInt)std::ceil(set.min_batch_ms * 1e-3 / std::max(t, 1e-9)));
+        return 0;
+      },
+      &c.note));
+  }
+
+  for (PetscInt round = 0; round < (set.stats_only ? 0 : set.repeats); ++round) {
+    for (Candidate &c : cands) {
+      if (!c.A || !c.note.empty()) continue;
+      PetscCallMPI(MPI_Barrier(comm));
+      const double t0 = MPI_Wtime();
+      for (PetscInt k = 0; k < c.inner; ++k) PetscCall(MatMult(c.A, x, y));
+      double t = (MPI_Wtime() - t0) / (double)c.inner;
+      PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &t, 1, MPI_DOUBLE, MPI_MAX, comm));
+      c.per_mult.push_back(t);
+    }
+  }
+
+  // Report.
+  PetscMPIInt size;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(PetscPrintf(comm, "\n== %s: %" PetscInt_FMT " rows, nnz %.0f, bs %" PetscInt_FMT ", row length max %" PetscInt_FMT " min %" PetscInt_FMT " avg %.1f, %d rank(s)\n", src.name.c_str(), st.rows, st.nnz, st.bs, st.max_row, st.min_row, st.avg_row, size));
+  double t_aij = 0, t_baij = 0, b_baij = 0;
+  for (const Candidate &c : cands) {
+    if (c.spec.label == "aij" && !c.per_mult.empty()) t_aij = Min(c.per_mult);
+    if (c.spec.label == "baij" && !c.per_mult.empty()) t_baij = Min(c.per_mult);
+    if (c.spec.label == "baij" && c.A) b_baij = c.bytes;
+  }
+  PetscCall(PetscPrintf(comm, "%-15s %-11s %9s %9s %8s %8s %7s %9s %7s %7s %7s %7s %9s\n", "format", "type", "ms(min)", "ms(med)", "GFlop/s", "GB/s", "%triad", "MB", "/baijB", "x aij", "x baij", "pad%", "rel.err"));
+  for (const Candidate &c : cands) {
+    if (!c.A || !c.note.empty()) {
+      PetscCall(PetscPrintf(comm, "%-15s skipped: %s\n", c.spec.label.c_str(), c.note.empty() ? "not created" : c.note.c_str()));
+      if (set.csv) PetscCall(PetscFPrintf(comm, set.csv, "%s,%s,%" PetscInt_FMT ",%.0f,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%.2f,%d,,,,,,,,,,,,,skipped\n", src.name.c_str(), c.spec.label.c_str(), st.rows, st.nnz, st.bs, st.max_row, st.min_row, st.avg_row, size));
+      continue;
+    }
+    const double tmin = Min(c.per_mult), tmed = Median(c.per_mult);
+    const double gflops = tmin > 0 ? 2.0 * st.nnz / tmin * 1e-9 : 0, gbs = tmin > 0 ? c.bytes / tmin * 1e-9 : 0;
+    const double frac = set.triad_GBs > 0 ? 100.0 * gbs / set.triad_GBs : 0;
+    char         pad[32] = "-", xa[16] = "-", xb[16] = "-", rb[16] = "-";
+    if (c.padding >= 0) std::snprintf(pad, sizeof pad, "%.1f", c.padding);
+    if (t_aij > 0 && tmin > 0) std::snprintf(xa, sizeof xa, "%.2f", t_aij / tmin);
+    if (t_baij > 0 && tmin > 0) std::snprintf(xb, sizeof xb, "%.2f", t_baij / tmin);
+    if (b_baij > 0) std::snprintf(rb, sizeof rb, "%.2f", c.bytes / b_baij);
+    PetscCall(PetscPrintf(comm, "%-15s %-11s %9.4f %9.4f %8.2f %8.2f %7.1f %9.1f %7s %7s %7s %7s %9.1e\n", c.spec.label.c_str(), c.actual_type.c_str(), tmin * 1e3, tmed * 1e3, gflops, gbs, frac, c.bytes * 1e-6, rb, xa, xb, pad, c.rel_err));
+    if (set.csv)
+      PetscCall(PetscFPrintf(comm, set.csv, "%s,%s,%" PetscInt_FMT ",%.0f,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%.2f,%d,%s,%.6f,%.6f,%.4f,%.4f,%.2f,%.0f,%s,%s,%s,%s,%.3e,ok\n", src.name.c_str(), c.spec.label.c_str(), st.rows, st.nnz, st.bs, st.max_row, st.min_row, st.avg_row, size, c.actual_type.c_str(), tmin * 1e3, tmed * 1e3, gflops, gbs, frac, c.bytes, rb, xa, xb, c.padding >= 0 ? pad : "", c.rel_err));
+    if (c.padding >= 0 && c.padding_info >= 0 && std::fabs(c.padding - c.padding_info) > 0.5)
+      PetscCall(PetscPrintf(comm, "  note: %s reports %.1f%% padding through MatGetInfo (model above: %.1f%%)\n", c.spec.label.c_str(), c.padding_info, c.padding));
+  }
+
+  for (Candidate &c : cands) PetscCall(MatDestroy(&c.A));
+  PetscCall(VecDestroy(&x));
+  PetscCall(VecDestroy(&y));
+  PetscCall(VecDestroy(&y_ref));
+  PetscCall(MatDestroy(&reference));
+  PetscFunctionReturn(0);
+}
+
+} // namespace
+
+int main(int argc, char **argv)
+{
+  // -f may be repeated: PETSc's options database keeps only the last one, so collect them first.
+  std::vector<std::string> files;
+  for (int i = 1; i + 1 < argc; ++i)
+    if (!std::strcmp(argv[i], "-f"))
+      for (const std::string &p : SplitList(argv[i + 1])) files.push_back(p);
+
+  PetscCall(PetscInitialize(&argc, &argv, nullptr, "MatMult benchmark: PETSc formats and MATBINBCSR.\n"));
+  PetscCall(PetscBinBCSRRegisterAll());
+  MPI_Comm comm = PETSC_COMM_WORLD;
+
+  Settings set;
+  char     buf[PETSC_MAX_PATH_LEN] = "";
+  PetscBool flg;
+  PetscCall(PetscOptionsGetString(nullptr, nullptr, "-formats", buf, sizeof buf, &flg));
+  const std::string formats = flg ? buf : "aij,baij,sbaij,sell,binbcsr,binbcsr_single";
+  for (const std::string &f : SplitList(formats)) {
+    FormatSpec spec;
+    spec.label = f;
+    spec.type  = f;
+    if (f == "binbcsr_single") {
+      spec.type   = "binbcsr";
+      spec.single = true;
+    }
+    PetscCheck(spec.type == "aij" || spec.type == "baij" || spec.type == "sbaij" || spec.type == "sell" || spec.type == "binbcsr", comm, PETSC_ERR_ARG_WRONG, "Unknown format %s: use aij, baij, sbaij, sell, binbcsr, binbcsr_single", f.c_str());
+    set.formats.push_back(spec);
+  }
+  PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-repeats", &set.repeats, nullptr));
+  PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-min_batch_ms", &set.min_batch_ms, nullptr));
+  PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-stats_only", &set.stats_only, nullptr));
+  PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-bs", &set.file_bs, nullptr));
+  PetscCheck(set.repeats > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-repeats must be positive");
+
+  std::vector<MatrixSource> sources;
+  PetscInt                  sizes[16], nsizes = 16;
+  PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-stencil_sizes", sizes, &nsizes, &flg));
+  if (!flg) {
+    nsizes   = 3;
+    sizes[0] = 16;
+    sizes[1] = 32;
+    sizes[2] = 48;
+  }
+  for (PetscInt i = 0; i < nsizes; ++i) {
+    if (sizes[i] <= 0) continue;
+    MatrixSource s;
+    s.grid.nx = s.grid.ny = s.grid.nz = sizes[i];
+    s.name = "stencil" + std::to_string(sizes[i]);
+    sources.push_back(s);
+  }
+  for (const std::string &p : files) {
+    MatrixSource s;
+    s.is_file = true;
+    s.path    = p;
+    s.name    = p.substr(p.find_last_of('/') == std::string::npos ? 0 : p.find_last_of('/') + 1);
+    sources.push_back(s);
+  }
+
+  PetscCall(PetscOptionsGetString(nullptr, nullptr, "-csv", buf, sizeof buf, &flg));
+  if (flg) {
+    PetscCall(PetscFOpen(comm, buf, "w", &set.csv));
+    PetscCall(PetscFPrintf(comm, set.csv, "matrix,format,rows,nnz,bs,max_row,min_row,avg_row,ranks,type,ms_min,ms_median,gflops,gbs,pct_triad,bytes,bytes_vs_baij,speedup_vs_aij,speedup_vs_baij,padding_pct,rel_err,status\n"));
+  }
+
+  StreamResult stream;
+  if (!set.stats_only) {
+    PetscCall(MeasureStreamTriadFromOptions(comm, &stream));
+    set.triad_GBs = stream.best_GBs;
+    PetscCall(PetscPrintf(comm, "STREAM triad: %.2f GB/s best, %.2f GB/s median (%d rank(s), %.0f MB per array in all, %" PetscInt_FMT " repeats)\n", stream.best_GBs, stream.median_GBs, stream.ranks, 8e-6 * (double)stream.elements_per_rank * stream.ranks, stream.repeats));
+  }
+  PetscCall(PetscPrintf(comm, "Bytes model: stored matrix arrays (padding included) + x + y, each once; GFlop/s = 2 nnz / t; ms per MatMult\n"));
+  for (const MatrixSource &s : sources) PetscCall(BenchMatrix(comm, s, set));
+  if (set.csv) PetscCall(PetscFClose(comm, set.csv));
+  PetscCall(PetscFinalize());
+  return 0;
+}
