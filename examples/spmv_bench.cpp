@@ -343,6 +343,11 @@ PetscErrorCode BenchMatrix(MPI_Comm comm, const MatrixSource &src, const Setting
   PetscMPIInt size;
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(PetscPrintf(comm, "\n== %s: %" PetscInt_FMT " rows, nnz %.0f, bs %" PetscInt_FMT ", row length max %" PetscInt_FMT " min %" PetscInt_FMT " avg %.1f, %d rank(s)\n", src.name.c_str(), st.rows, st.nnz, st.bs, st.max_row, st.min_row, st.avg_row, size));
+  {
+    double aij_bytes = 12.0 * st.nnz;
+    const double llc = (double)LastLevelCacheBytes();
+    if (llc > 0 && aij_bytes < 2 * llc) PetscCall(PetscPrintf(comm, "   (aij values+indices %.0f MB vs %.0f MB last-level cache: partly cache-resident, %%triad may exceed 100)\n", aij_bytes * 1e-6, llc * 1e-6));
+  }
   double t_aij = 0, t_baij = 0, b_baij = 0;
   for (const Candidate &c : cands) {
     if (c.spec.label == "aij" && !c.per_mult.empty()) t_aij = Min(c.per_mult);
