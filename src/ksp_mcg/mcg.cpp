@@ -1,16 +1,147 @@
-/* KSPMCG (placeholder until implemented). */
-#include "binbcsr_impl.h"
+/* KSPMCG ("mcg"): merged preconditioned conjugate gradient with one global reduction per iteration
+   (Chronopoulos-Gear formulation; the iteration is in mcg_solve.cpp). This file holds the object:
+   creation, options, view, setup and the fixed-iteration setters. */
+#include "mcg_impl.h"
 
-PetscErrorCode KSPCreate_MCG(KSP ksp)
+static PetscErrorCode KSPSetUp_MCG(KSP ksp)
 {
   PetscFunctionBegin;
-  SETERRQ(PetscObjectComm((PetscObject)ksp), PETSC_ERR_SUP, "KSPMCG is not implemented yet");
+  /* r, u = M^-1 r, w = A u, p, s = A p */
+  PetscCall(KSPSetWorkVecs(ksp, 5));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode KSPReset_MCG(KSP ksp)
+{
+  KSP_MCG *mcg = (KSP_MCG *)ksp->data;
+
+  PetscFunctionBegin;
+  PetscCall(VecDestroy(&mcg->dinv));
+  mcg->dinv_id    = 0;
+  mcg->dinv_state = 0;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode KSPDestroy_MCG(KSP ksp)
+{
+  PetscFunctionBegin;
+  PetscCall(KSPReset_MCG(ksp));
+  PetscCall(KSPDestroyDefault(ksp));
+  PetscCall(PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGSetFixedIterations_C", nullptr));
+  PetscCall(PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGGetFixedIterations_C", nullptr));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode KSPView_MCG(KSP ksp, PetscViewer viewer)
+{
+  KSP_MCG  *mcg = (KSP_MCG *)ksp->data;
+  PetscBool iascii;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &iascii));
+  if (!iascii) PetscFunctionReturn(0);
+  PetscCall(PetscViewerASCIIPrintf(viewer, "  merged CG (Chronopoulos-Gear): one global reduction per iteration\n"));
+  if (mcg->fixed_its > 0) PetscCall(PetscViewerASCIIPrintf(viewer, "  fixed iterations: %" PetscInt_FMT " per solve, no convergence test (tolerances ignored)\n", mcg->fixed_its));
+  else PetscCall(PetscViewerASCIIPrintf(viewer, "  fixed iterations: off (tolerances decide); true-residual check before claiming convergence: %s\n", mcg->verify ? "on" : "off"));
+  if (ksp->setupstage == KSP_SETUP_NEW && !mcg->dinv && !mcg->why_generic[0]) {
+    PetscCall(PetscViewerASCIIPrintf(viewer, "  fused preconditioner (jacobi/none in the vector pass): %s; decided at the first solve\n", mcg->allow_fused ? "allowed" : "off"));
+  } else {
+    switch (mcg->how) {
+    case MCG_PC_JACOBI:
+      PetscCall(PetscViewerASCIIPrintf(viewer, "  fast path: on, Jacobi fused into the vector pass (own D^-1 from MatGetDiagonal%s)\n", mcg->dinv_zeros ? ", zero diagonal entries replaced as PCJACOBI does" : ""));
+      break;
+    case MCG_PC_NONE:
+      PetscCall(PetscViewerASCIIPrintf(viewer, "  fast path: on, no preconditioner, one fused vector pass\n"));
+      break;
+    default:
+      PetscCall(PetscViewerASCIIPrintf(viewer, "  fast path: off (%s): PCApply between two fused vector passes\n", mcg->why_generic));
+    }
+    PetscCall(PetscViewerASCIIPrintf(viewer, "  matrix product fused with u.Au: %s\n", mcg->mat_fused ? "yes (matrix type provides MatMultDotLocal)" : "no (MatMult, then a local dot)"));
+  }
+  if (mcg->true_checks) PetscCall(PetscViewerASCIIPrintf(viewer, "  last solve: %" PetscInt_FMT " true-residual checks, %" PetscInt_FMT " restarts, true residual norm %g\n", mcg->true_checks, mcg->restarts, (double)mcg->true_rnorm));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode KSPMCGSetFixedIterations_MCG(KSP ksp, PetscInt n)
+{
+  KSP_MCG *mcg = (KSP_MCG *)ksp->data;
+
+  PetscFunctionBegin;
+  PetscCheck(n >= 0, PetscObjectComm((PetscObject)ksp), PETSC_ERR_ARG_OUTOFRANGE, "Fixed iteration count must be >= 0 (0 turns it off), not %" PetscInt_FMT, n);
+  mcg->fixed_its = n;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode KSPMCGGetFixedIterations_MCG(KSP ksp, PetscInt *n)
+{
+  PetscFunctionBegin;
+  *n = ((KSP_MCG *)ksp->data)->fixed_its;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode KSPSetFromOptions_MCG(KSP ksp, PetscOptionItems *PetscOptionsObject)
+{
+  KSP_MCG  *mcg = (KSP_MCG *)ksp->data;
+  PetscInt  n   = mcg->fixed_its;
+  PetscBool flg;
+
+  PetscFunctionBegin;
+  PetscOptionsHeadBegin(PetscOptionsObject, "KSP MCG (merged CG) options");
+  PetscCall(PetscOptionsInt("-ksp_mcg_fixed_iterations", "Run exactly this many iterations per solve, no convergence test (0: off)", "KSPMCGSetFixedIterations", n, &n, &flg));
+  if (flg) PetscCall(KSPMCGSetFixedIterations(ksp, n));
+  PetscCall(PetscOptionsBool("-ksp_mcg_fused_pc", "Apply PCJACOBI/PCNONE inside the fused vector pass", "", mcg->allow_fused, &mcg->allow_fused, nullptr));
+  PetscCall(PetscOptionsBool("-ksp_mcg_verify_residual", "Confirm convergence on the true residual b - A x, restarting if it fails", "", mcg->verify, &mcg->verify, nullptr));
+  PetscCall(PetscOptionsReal("-ksp_mcg_stagnation", "Each restart must shrink the true residual by this factor", "", mcg->stagnation, &mcg->stagnation, nullptr));
+  PetscOptionsHeadEnd();
+  PetscFunctionReturn(0);
+}
+
+/*MC
+   KSPMCG - "mcg": merged preconditioned conjugate gradient for symmetric positive definite systems.
+
+   Chronopoulos-Gear formulation: one global reduction (of r.z, z.Az, r.r, z.z together) per
+   iteration; the matrix product accumulates z.Az (MatMultDotLocal()); one vector pass updates p, s,
+   x, r, applies PCJACOBI or PCNONE and accumulates the local dots. Other PCs go through PCApply.
+
+   Options:
++  -ksp_mcg_fixed_iterations <n> - exactly n iterations per solve, no convergence test (0: off)
+.  -ksp_mcg_fused_pc <bool> - fuse jacobi/none into the vector pass (default true)
+.  -ksp_mcg_verify_residual <bool> - confirm convergence on b - A x (default true)
+-  -ksp_mcg_stagnation <f> - a restart from the true residual must shrink it by f (default 0.5)
+M*/
+PetscErrorCode KSPCreate_MCG(KSP ksp)
+{
+  KSP_MCG *mcg;
+
+  PetscFunctionBegin;
+  PetscCall(PetscNew(&mcg));
+  mcg->allow_fused = PETSC_TRUE;
+  mcg->verify      = PETSC_TRUE;
+  mcg->stagnation  = 0.5;
+  mcg->true_rnorm  = -1.0;
+  ksp->data        = (void *)mcg;
+  PetscCall(KSPSetSupportedNorm(ksp, KSP_NORM_PRECONDITIONED, PC_LEFT, 3));
+  PetscCall(KSPSetSupportedNorm(ksp, KSP_NORM_UNPRECONDITIONED, PC_LEFT, 2));
+  PetscCall(KSPSetSupportedNorm(ksp, KSP_NORM_NATURAL, PC_LEFT, 2));
+  PetscCall(KSPSetSupportedNorm(ksp, KSP_NORM_NONE, PC_LEFT, 1));
+  ksp->ops->setup          = KSPSetUp_MCG;
+  ksp->ops->solve          = KSPSolve_MCG;
+  ksp->ops->reset          = KSPReset_MCG;
+  ksp->ops->destroy        = KSPDestroy_MCG;
+  ksp->ops->view           = KSPView_MCG;
+  ksp->ops->setfromoptions = KSPSetFromOptions_MCG;
+  ksp->ops->buildsolution  = KSPBuildSolutionDefault;
+  ksp->ops->buildresidual  = KSPBuildResidualDefault;
+  PetscCall(PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGSetFixedIterations_C", KSPMCGSetFixedIterations_MCG));
+  PetscCall(PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGGetFixedIterations_C", KSPMCGGetFixedIterations_MCG));
   PetscFunctionReturn(0);
 }
 
 PetscErrorCode KSPMCGSetFixedIterations(KSP ksp, PetscInt n)
 {
   PetscFunctionBegin;
+  PetscValidHeaderSpecific(ksp, KSP_CLASSID, 1);
+  PetscValidLogicalCollectiveInt(ksp, n, 2);
   PetscTryMethod(ksp, "KSPMCGSetFixedIterations_C", (KSP, PetscInt), (ksp, n));
   PetscFunctionReturn(0);
 }
@@ -18,6 +149,8 @@ PetscErrorCode KSPMCGSetFixedIterations(KSP ksp, PetscInt n)
 PetscErrorCode KSPMCGGetFixedIterations(KSP ksp, PetscInt *n)
 {
   PetscFunctionBegin;
+  PetscValidHeaderSpecific(ksp, KSP_CLASSID, 1);
+  PetscValidIntPointer(n, 2);
   *n = 0;
   PetscTryMethod(ksp, "KSPMCGGetFixedIterations_C", (KSP, PetscInt *), (ksp, n));
   PetscFunctionReturn(0);

@@ -1,0 +1,41 @@
+/* KSPMCG private data, shared by mcg.cpp (object, options, view) and mcg_solve.cpp (the iteration). */
+#ifndef BINBCSR_MCG_IMPL_H
+#define BINBCSR_MCG_IMPL_H
+
+#include "binbcsr_impl.h"
+#include <petsc/private/kspimpl.h>
+
+/* How z = M^-1 r is applied. The fused kinds apply it inside the vector pass of the iteration. */
+typedef enum {
+  MCG_PC_GENERIC = 0, /* PCApply between two vector passes */
+  MCG_PC_JACOBI  = 1, /* fused: z = D^-1 r with D^-1 built by KSPMCG exactly as PCJACOBI builds it */
+  MCG_PC_NONE    = 2  /* fused: z = r */
+} MCGPreconditioning;
+
+typedef struct {
+  /* user settings */
+  PetscInt  fixed_its;     /* > 0: exactly this many iterations, no convergence test */
+  PetscBool allow_fused;   /* -ksp_mcg_fused_pc: apply jacobi/none inside the vector pass */
+  PetscBool verify;        /* -ksp_mcg_verify_residual: confirm convergence on b - A x */
+  PetscReal stagnation;    /* a restart must shrink the true residual by this factor, else give up */
+
+  /* chosen at each solve */
+  MCGPreconditioning how;
+  char               why_generic[160]; /* why the fused path was not taken (for KSPView) */
+  PetscBool          mat_fused;        /* Amat composes "MatMultDotLocal_C" */
+
+  /* Jacobi diagonal owned by KSPMCG, rebuilt when the preconditioning matrix changes */
+  Vec              dinv;
+  PetscObjectId    dinv_id;
+  PetscObjectState dinv_state;
+  PetscInt         dinv_zeros; /* global number of zero diagonal entries found at the last build */
+
+  /* what the last solve did (for KSPView and PetscInfo) */
+  PetscInt  restarts;        /* residual replacements after a failed true-residual check */
+  PetscReal true_rnorm;      /* norm of b - A x at the last check, -1 when none was made */
+  PetscInt  true_checks;     /* number of true-residual checks of the last solve */
+} KSP_MCG;
+
+PETSC_INTERN PetscErrorCode KSPSolve_MCG(KSP);
+
+#endif

@@ -1,0 +1,410 @@
+/* KSPMCG iteration: preconditioned conjugate gradient in the Chronopoulos-Gear formulation
+   (A.T. Chronopoulos, C.W. Gear, "s-step iterative methods for symmetric linear systems",
+   J. Comput. Appl. Math. 25 (1989)), which needs ONE global reduction per iteration.
+
+   With u = M^-1 r, w = A u, gamma = r.u, delta = u.w, iteration k does
+
+     beta  = gamma_k / gamma_{k-1}                (0 at the first iteration or after a restart)
+     pAp   = delta_k - beta^2 pAp_{k-1}           (= p.Ap by A-conjugacy; = delta at the start)
+     alpha = gamma_k / pAp
+     p = u + beta p;  s = w + beta s;  x += alpha p;  r -= alpha s;  u = M^-1 r      (one pass)
+     w = A u  and the local u.w                                                        (one pass)
+     reduce {r.u, u.w, r.r, u.u} together                                          (one reduction)
+
+   which is CG (Hestenes-Stiefel) in exact arithmetic: s = A p is carried by recurrence instead of
+   being a product. The norms r.r and u.u ride along in the same reduction, so every norm type costs
+   the same. With PCJACOBI (diagonal) or PCNONE the preconditioner is applied inside the vector pass
+   ("fused" path); any other PC is applied with PCApply between two vector passes ("generic" path),
+   still with one reduction per iteration. The product uses MatMultDotLocal(), which runs the matrix
+   type's fused product-and-dot kernel when the type composes one (binbcsr does). */
+#include "mcg_impl.h"
+#include "mcg_kernels.h"
+
+/* Decides how z = M^-1 r is applied in this solve, and why not fused when it is not. */
+static PetscErrorCode MCGChoosePath(KSP ksp, Mat Amat)
+{
+  KSP_MCG     *mcg = (KSP_MCG *)ksp->data;
+  PC           pc  = ksp->pc;
+  PetscBool    isjacobi, isnone;
+  MatNullSpace nullsp = nullptr;
+  PetscErrorCode (*fused)(Mat, Vec, Vec, PetscScalar *) = nullptr;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectQueryFunction((PetscObject)Amat, "MatMultDotLocal_C", &fused));
+  mcg->mat_fused      = (fused && !ksp->transpose_solve) ? PETSC_TRUE : PETSC_FALSE;
+  mcg->how            = MCG_PC_GENERIC;
+  mcg->why_generic[0] = 0;
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCJACOBI, &isjacobi));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCNONE, &isnone));
+  PetscCall(MatGetNullSpace(Amat, &nullsp));
+  if (!mcg->allow_fused) {
+    PetscCall(PetscSNPrintf(mcg->why_generic, sizeof(mcg->why_generic), "turned off (-ksp_mcg_fused_pc 0)"));
+  } else if (ksp->transpose_solve) {
+    PetscCall(PetscSNPrintf(mcg->why_generic, sizeof(mcg->why_generic), "transpose solve"));
+  } else if (nullsp) {
+    /* KSP_PCApply() removes the operator's null space from z; keep that behaviour */
+    PetscCall(PetscSNPrintf(mcg->why_generic, sizeof(mcg->why_generic), "the operator has a null space"));
+  } else if (isnone) {
+    mcg->how = MCG_PC_NONE;
+  } else if (isjacobi) {
+    PCJacobiType type;
+    PetscCall(PCJacobiGetType(pc, &type));
+    if (type == PC_JACOBI_DIAGONAL) mcg->how = MCG_PC_JACOBI;
+    else PetscCall(PetscSNPrintf(mcg->why_generic, sizeof(mcg->why_generic), "jacobi type %s is applied with PCApply", PCJacobiTypes[type]));
+  } else {
+    PetscCall(PetscSNPrintf(mcg->why_generic, sizeof(mcg->why_generic), "PC type %s is applied with PCApply", ((PetscObject)pc)->type_name ? ((PetscObject)pc)->type_name : "(unset)"));
+  }
+  PetscFunctionReturn(0);
+}
+
+/* D^-1 built the way PCSetUp_Jacobi builds it (PETSc 3.18): reciprocal of the diagonal (zeros stay
+   zero), absolute value if -pc_jacobi_abs, and zeros replaced by 1 when -pc_jacobi_fixdiagonal (the
+   default) unless the matrix is known to be SPD. Rebuilt when the preconditioning matrix or its state
+   changes, except when the PC is told to reuse its preconditioner. */
+static PetscErrorCode MCGUpdateDiagonal(KSP ksp)
+{
+  KSP_MCG         *mcg = (KSP_MCG *)ksp->data;
+  PC               pc  = ksp->pc;
+  Mat              Pmat;
+  PetscObjectId    id;
+  PetscObjectState state;
+  PetscBool        reuse, useabs, fixdiag, isset, isspd;
+  PetscInt         n, zeros = 0;
+  PetscScalar     *d;
+
+  PetscFunctionBegin;
+  PetscCall(PCGetOperators(pc, nullptr, &Pmat));
+  PetscCall(PetscObjectGetId((PetscObject)Pmat, &id));
+  PetscCall(PetscObjectStateGet((PetscObject)Pmat, &state));
+  PetscCall(PCGetReusePreconditioner(pc, &reuse));
+  if (mcg->dinv && (reuse || (id == mcg->dinv_id && state == mcg->dinv_state))) PetscFunctionReturn(0);
+  if (mcg->dinv) {
+    PetscInt nd, nm;
+    PetscCall(VecGetLocalSize(mcg->dinv, &nd));
+    PetscCall(MatGetLocalSize(Pmat, &nm, nullptr));
+    if (nd != nm) PetscCall(VecDestroy(&mcg->dinv));
+  }
+  if (!mcg->dinv) PetscCall(MatCreateVecs(Pmat, &mcg->dinv, nullptr));
+  PetscCall(MatGetDiagonal(Pmat, mcg->dinv));
+  PetscCall(VecReciprocal(mcg->dinv));
+  PetscCall(PCJacobiGetUseAbs(pc, &useabs));
+  if (useabs) PetscCall(VecAbs(mcg->dinv));
+  PetscCall(PCJacobiGetFixDiagonal(pc, &fixdiag));
+  PetscCall(MatIsSPDKnown(Pmat, &isset, &isspd));
+  PetscCall(VecGetLocalSize(mcg->dinv, &n));
+  PetscCall(VecGetArray(mcg->dinv, &d));
+  for (PetscInt i = 0; i < n; i++) {
+    if (d[i] == (PetscScalar)0.0) {
+      zeros++;
+      if (fixdiag && (!isset || !isspd)) d[i] = 1.0;
+    }
+  }
+  PetscCall(VecRestoreArray(mcg->dinv, &d));
+  PetscCall(MPIU_Allreduce(&zeros, &mcg->dinv_zeros, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)ksp)));
+  if (mcg->dinv_zeros) PetscCall(PetscInfo(ksp, "Zero detected in diagonal of matrix (%" PetscInt_FMT " entries), using %s at those locations as PCJACOBI does\n", mcg->dinv_zeros, fixdiag && (!isset || !isspd) ? "1" : "0"));
+  mcg->dinv_id    = id;
+  mcg->dinv_state = state;
+  PetscFunctionReturn(0);
+}
+
+/* The one global reduction of an iteration: sums the local dots over the KSP's communicator. */
+static PetscErrorCode MCGReduce(KSP ksp, PetscScalar *dots, PetscMPIInt count)
+{
+  PetscFunctionBegin;
+  PetscCall(PetscLogEventBegin(KSP_MCG_Reduction, ksp, 0, 0, 0));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, dots, count, MPIU_SCALAR, MPIU_SUM, PetscObjectComm((PetscObject)ksp)));
+  PetscCall(PetscLogEventEnd(KSP_MCG_Reduction, ksp, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/* w = A u and the local u.w. */
+static PetscErrorCode MCGMatMultDot(KSP ksp, Mat A, Vec u, Vec w, PetscScalar *uw)
+{
+  PetscFunctionBegin;
+  if (!ksp->transpose_solve) {
+    PetscCall(MatMultDotLocal(A, u, w, uw));
+  } else {
+    const PetscScalar *ua, *wa;
+    PetscInt           n;
+    PetscScalar        sum = 0;
+    PetscCall(KSP_MatMult(ksp, A, u, w));
+    PetscCall(VecGetLocalSize(u, &n));
+    PetscCall(VecGetArrayRead(u, &ua));
+    PetscCall(VecGetArrayRead(w, &wa));
+    for (PetscInt i = 0; i < n; i++) sum += ua[i] * wa[i];
+    PetscCall(VecRestoreArrayRead(u, &ua));
+    PetscCall(VecRestoreArrayRead(w, &wa));
+    PetscCall(PetscLogFlops(2.0 * n));
+    *uw = sum;
+  }
+  PetscFunctionReturn(0);
+}
+
+/* u = M^-1 r and the local r.u, r.r, u.u (start of a solve, restart, true-residual check). */
+static PetscErrorCode MCGPrecondition(KSP ksp, Vec R, Vec U, PetscScalar *dots)
+{
+  KSP_MCG           *mcg = (KSP_MCG *)ksp->data;
+  const PetscScalar *r, *dinv = nullptr;
+  PetscScalar       *u, local[MCG_NDOTS] = {0, 0, 0, 0};
+  PetscInt           n;
+
+  PetscFunctionBegin;
+  if (mcg->how == MCG_PC_GENERIC) PetscCall(KSP_PCApply(ksp, R, U));
+  PetscCall(PetscLogEventBegin(KSP_MCG_FusedUpdate, ksp, 0, 0, 0));
+  PetscCall(VecGetLocalSize(R, &n));
+  PetscCall(VecGetArrayRead(R, &r));
+  if (mcg->how == MCG_PC_GENERIC) {
+    const PetscScalar *uc;
+    PetscCall(VecGetArrayRead(U, &uc));
+    for (PetscInt i = 0; i < n; i++) mcg_dots_index<PetscScalar>(i, r, uc, local);
+    PetscCall(VecRestoreArrayRead(U, &uc));
+  } else {
+    if (mcg->how == MCG_PC_JACOBI) PetscCall(VecGetArrayRead(mcg->dinv, &dinv));
+    PetscCall(VecGetArrayWrite(U, &u));
+    for (PetscInt i = 0; i < n; i++) mcg_precondition_index<PetscScalar>(i, r, dinv, u, local);
+    PetscCall(VecRestoreArrayWrite(U, &u));
+    if (dinv) PetscCall(VecRestoreArrayRead(mcg->dinv, &dinv));
+  }
+  PetscCall(VecRestoreArrayRead(R, &r));
+  PetscCall(PetscLogFlops(7.0 * n));
+  PetscCall(PetscLogEventEnd(KSP_MCG_FusedUpdate, ksp, 0, 0, 0));
+  dots[MCG_DOT_RU] = local[MCG_DOT_RU];
+  dots[MCG_DOT_RR] = local[MCG_DOT_RR];
+  dots[MCG_DOT_UU] = local[MCG_DOT_UU];
+  PetscFunctionReturn(0);
+}
+
+/* The vector pass of an iteration: p, s, x, r updated, u = M^-1 r, local r.u, r.r, u.u. */
+static PetscErrorCode MCGUpdate(KSP ksp, PetscScalar alpha, PetscScalar beta, Vec X, Vec R, Vec U, Vec W, Vec P, Vec S, PetscScalar *dots)
+{
+  KSP_MCG           *mcg = (KSP_MCG *)ksp->data;
+  const PetscScalar *w, *dinv = nullptr;
+  PetscScalar       *x, *r, *u, *p, *s;
+  PetscInt           n;
+
+  PetscFunctionBegin;
+  PetscCall(PetscLogEventBegin(KSP_MCG_FusedUpdate, ksp, 0, 0, 0));
+  PetscCall(VecGetLocalSize(R, &n));
+  PetscCall(VecGetArray(X, &x));
+  PetscCall(VecGetArray(R, &r));
+  PetscCall(VecGetArray(U, &u));
+  PetscCall(VecGetArrayRead(W, &w));
+  PetscCall(VecGetArray(P, &p));
+  PetscCall(VecGetArray(S, &s));
+  if (mcg->how == MCG_PC_GENERIC) {
+    for (PetscInt i = 0; i < n; i++) mcg_update_index_nopc<PetscScalar>(i, alpha, beta, u, w, p, s, x, r);
+  } else {
+    PetscScalar local[MCG_NDOTS] = {0, 0, 0, 0};
+    if (mcg->how == MCG_PC_JACOBI) PetscCall(VecGetArrayRead(mcg->dinv, &dinv));
+    for (PetscInt i = 0; i < n; i++) mcg_update_index<PetscScalar>(i, alpha, beta, u, w, p, s, x, r, dinv, local);
+    if (dinv) PetscCall(VecRestoreArrayRead(mcg->dinv, &dinv));
+    dots[MCG_DOT_RU] = local[MCG_DOT_RU];
+    dots[MCG_DOT_RR] = local[MCG_DOT_RR];
+    dots[MCG_DOT_UU] = local[MCG_DOT_UU];
+  }
+  PetscCall(VecRestoreArray(S, &s));
+  PetscCall(VecRestoreArray(P, &p));
+  PetscCall(VecRestoreArrayRead(W, &w));
+  PetscCall(VecRestoreArray(U, &u));
+  PetscCall(VecRestoreArray(R, &r));
+  PetscCall(VecRestoreArray(X, &x));
+  PetscCall(PetscLogFlops((mcg->how == MCG_PC_GENERIC ? 8.0 : 15.0) * n));
+  PetscCall(PetscLogEventEnd(KSP_MCG_FusedUpdate, ksp, 0, 0, 0));
+  /* generic path: the PC is applied to the new r, then one more pass for the local dots */
+  if (mcg->how == MCG_PC_GENERIC) PetscCall(MCGPrecondition(ksp, R, U, dots));
+  PetscFunctionReturn(0);
+}
+
+/* The norm the KSP's norm type asks for, from the reduced dots: free, no extra reduction. */
+static PetscReal MCGNorm(KSP ksp, const PetscScalar *dots)
+{
+  switch (ksp->normtype) {
+  case KSP_NORM_PRECONDITIONED:
+    return PetscSqrtReal(PetscAbsScalar(dots[MCG_DOT_UU]));
+  case KSP_NORM_UNPRECONDITIONED:
+    return PetscSqrtReal(PetscAbsScalar(dots[MCG_DOT_RR]));
+  case KSP_NORM_NATURAL:
+    return PetscSqrtReal(PetscAbsScalar(dots[MCG_DOT_RU]));
+  default:
+    return 0.0;
+  }
+}
+
+/* NaN or Inf in any reduced dot: KSP_DIVERGED_NANORINF (or KSP_DIVERGED_PC_FAILED when the PC
+   reports a failure), as KSPCG reports it. A macro because KSPCheckDot() returns from the solve. */
+#define MCGCheckDots(ksp, dots) \
+  do { \
+    for (int k_ = 0; k_ < MCG_NDOTS; k_++) KSPCheckDot(ksp, (dots)[k_]); \
+  } while (0)
+
+/* r = b - A x computed from scratch, u = M^-1 r, and the reduced r.u, r.r, u.u (no product yet). */
+static PetscErrorCode MCGTrueResidual(KSP ksp, Mat Amat, Vec X, Vec B, Vec R, Vec U, PetscScalar *dots)
+{
+  PetscFunctionBegin;
+  PetscCall(KSP_MatMult(ksp, Amat, X, R));
+  PetscCall(VecAYPX(R, -1.0, B));
+  PetscCall(MCGPrecondition(ksp, R, U, dots));
+  dots[MCG_DOT_UW] = 0;
+  PetscCall(MCGReduce(ksp, dots, MCG_NDOTS));
+  PetscFunctionReturn(0);
+}
+
+static PetscBool MCGIsToleranceClaim(KSPConvergedReason reason)
+{
+  return (reason == KSP_CONVERGED_RTOL || reason == KSP_CONVERGED_ATOL || reason == KSP_CONVERGED_RTOL_NORMAL || reason == KSP_CONVERGED_ATOL_NORMAL) ? PETSC_TRUE : PETSC_FALSE;
+}
+
+PetscErrorCode KSPSolve_MCG(KSP ksp)
+{
+  KSP_MCG    *mcg = (KSP_MCG *)ksp->data;
+  Mat         Amat, Pmat;
+  Vec         X, B, R, U, W, P, S;
+  PetscBool   diagonalscale;
+  PetscScalar dots[MCG_NDOTS];
+  PetscScalar gamma, gamma_old = 1.0, delta, pAp = 0.0, alpha, beta;
+  PetscReal   dp, last_true = PETSC_MAX_REAL;
+  PetscBool   fresh = PETSC_TRUE; /* p and s start from zero: first iteration or after a restart */
+  PetscInt    i, max_its;
+
+  PetscFunctionBegin;
+  PetscCall(PCGetDiagonalScale(ksp->pc, &diagonalscale));
+  PetscCheck(!diagonalscale, PetscObjectComm((PetscObject)ksp), PETSC_ERR_SUP, "Krylov method %s does not support diagonal scaling", ((PetscObject)ksp)->type_name);
+  X = ksp->vec_sol;
+  B = ksp->vec_rhs;
+  R = ksp->work[0];
+  U = ksp->work[1];
+  W = ksp->work[2];
+  P = ksp->work[3];
+  S = ksp->work[4];
+  PetscCall(PCGetOperators(ksp->pc, &Amat, &Pmat));
+  PetscCall(MCGChoosePath(ksp, Amat));
+  if (mcg->how == MCG_PC_JACOBI) PetscCall(MCGUpdateDiagonal(ksp));
+  max_its           = mcg->fixed_its > 0 ? mcg->fixed_its : ksp->max_it;
+  mcg->restarts     = 0;
+  mcg->true_checks  = 0;
+  mcg->true_rnorm   = -1.0;
+  ksp->its          = 0;
+
+  /* r = b - A x, u = M^-1 r, w = A u, and the first reduction */
+  if (!ksp->guess_zero) {
+    PetscCall(KSP_MatMult(ksp, Amat, X, R));
+    PetscCall(VecAYPX(R, -1.0, B));
+  } else {
+    PetscCall(VecCopy(B, R));
+  }
+  /* the PC may have failed in KSPSetUp on some ranks only: make every rank see it in the dots */
+  if (ksp->reason == KSP_DIVERGED_PC_FAILED) PetscCall(VecSetInf(R));
+  PetscCall(MCGPrecondition(ksp, R, U, dots));
+  PetscCall(MCGMatMultDot(ksp, Amat, U, W, &dots[MCG_DOT_UW]));
+  PetscCall(MCGReduce(ksp, dots, MCG_NDOTS));
+  MCGCheckDots(ksp, dots);
+  gamma = dots[MCG_DOT_RU];
+  delta = dots[MCG_DOT_UW];
+
+  dp = MCGNorm(ksp, dots);
+  PetscCall(KSPLogResidualHistory(ksp, dp));
+  PetscCall(KSPMonitor(ksp, 0, dp));
+  ksp->rnorm = dp;
+  if (mcg->fixed_its <= 0) {
+    PetscCall((*ksp->converged)(ksp, 0, dp, &ksp->reason, ksp->cnvP));
+    if (ksp->reason) PetscFunctionReturn(0);
+  }
+
+  i = 0;
+  while (PETSC_TRUE) {
+    if (i >= max_its) {
+      ksp->reason = mcg->fixed_its > 0 ? KSP_CONVERGED_ITS : KSP_DIVERGED_ITS;
+      break;
+    }
+    /* breakdowns are reported, never divided by */
+    if (gamma == (PetscScalar)0.0) {
+      if (dots[MCG_DOT_RR] == (PetscScalar)0.0) {
+        ksp->reason = KSP_CONVERGED_ATOL;
+        PetscCall(PetscInfo(ksp, "Converged: the residual is exactly zero\n"));
+      } else {
+        PetscCheck(!ksp->errorifnotconverged, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "KSPMCG breakdown: r.M^-1 r = 0 with r != 0 (singular preconditioner)");
+        ksp->reason = KSP_DIVERGED_BREAKDOWN;
+        PetscCall(PetscInfo(ksp, "Breakdown: r.M^-1 r = 0 with r != 0 (singular preconditioner)\n"));
+      }
+      break;
+    }
+    if (PetscRealPart(gamma) < 0.0) {
+      PetscCheck(!ksp->errorifnotconverged, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "Diverged due to indefinite preconditioner, r.M^-1 r = %g", (double)PetscRealPart(gamma));
+      ksp->reason = KSP_DIVERGED_INDEFINITE_PC;
+      PetscCall(PetscInfo(ksp, "Diverging due to indefinite preconditioner, r.M^-1 r = %g\n", (double)PetscRealPart(gamma)));
+      break;
+    }
+    beta = fresh ? 0.0 : gamma / gamma_old;
+    pAp  = fresh ? delta : delta - beta * beta * pAp;
+    if (!(PetscRealPart(pAp) > 0.0)) { /* also catches NaN */
+      PetscCheck(!ksp->errorifnotconverged, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "Diverged due to indefinite matrix, p.Ap = %g", (double)PetscRealPart(pAp));
+      ksp->reason = KSP_DIVERGED_INDEFINITE_MAT;
+      PetscCall(PetscInfo(ksp, "Diverging due to indefinite or negative definite matrix, p.Ap = %g\n", (double)PetscRealPart(pAp)));
+      break;
+    }
+    alpha = gamma / pAp;
+    if (fresh) {
+      PetscCall(VecSet(P, 0.0));
+      PetscCall(VecSet(S, 0.0));
+    }
+
+    ksp->its = i + 1;
+    PetscCall(MCGUpdate(ksp, alpha, beta, X, R, U, W, P, S, dots));
+    PetscCall(MCGMatMultDot(ksp, Amat, U, W, &dots[MCG_DOT_UW]));
+    PetscCall(MCGReduce(ksp, dots, MCG_NDOTS));
+    MCGCheckDots(ksp, dots);
+    gamma_old = gamma;
+    gamma     = dots[MCG_DOT_RU];
+    delta     = dots[MCG_DOT_UW];
+    fresh     = PETSC_FALSE;
+    i++;
+
+    dp         = MCGNorm(ksp, dots);
+    ksp->rnorm = dp;
+    PetscCall(KSPLogResidualHistory(ksp, dp));
+    PetscCall(KSPMonitor(ksp, i, dp));
+    if (mcg->fixed_its > 0) continue;
+    PetscCall((*ksp->converged)(ksp, i, dp, &ksp->reason, ksp->cnvP));
+
+    /* The recursively updated r drifts from b - A x by rounding. Before claiming a tolerance was met,
+       check it on b - A x; if it was not, restart from the true residual, and stop with a breakdown
+       when restarts no longer make progress (the attainable accuracy is reached). */
+    if (mcg->verify && MCGIsToleranceClaim(ksp->reason)) {
+      KSPConvergedReason claim = ksp->reason, check = KSP_CONVERGED_ITERATING;
+      PetscReal          true_dp;
+
+      PetscCall(MCGTrueResidual(ksp, Amat, X, B, R, U, dots));
+      MCGCheckDots(ksp, dots);
+      mcg->true_checks++;
+      true_dp         = MCGNorm(ksp, dots);
+      mcg->true_rnorm = true_dp;
+      PetscCall((*ksp->converged)(ksp, i, true_dp, &check, ksp->cnvP));
+      if (check > 0) {
+        ksp->reason = claim;
+        ksp->rnorm  = true_dp;
+        break;
+      }
+      if (!(true_dp < mcg->stagnation * last_true)) {
+        PetscCheck(!ksp->errorifnotconverged, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "KSPMCG: true residual norm %g stagnates above the tolerance (attainable accuracy reached)", (double)true_dp);
+        ksp->reason = KSP_DIVERGED_BREAKDOWN;
+        ksp->rnorm  = true_dp;
+        PetscCall(PetscInfo(ksp, "True residual norm %g stagnates above the tolerance after %" PetscInt_FMT " restarts: attainable accuracy reached\n", (double)true_dp, mcg->restarts));
+        break;
+      }
+      PetscCall(PetscInfo(ksp, "Recursive residual %g met the tolerance but the true residual is %g: restarting from the true residual\n", (double)dp, (double)true_dp));
+      last_true   = true_dp;
+      ksp->reason = KSP_CONVERGED_ITERATING;
+      ksp->rnorm  = true_dp;
+      mcg->restarts++;
+      dots[MCG_DOT_UW] = 0;
+      PetscCall(MCGMatMultDot(ksp, Amat, U, W, &dots[MCG_DOT_UW]));
+      PetscCall(MCGReduce(ksp, &dots[MCG_DOT_UW], 1));
+      MCGCheckDots(ksp, dots);
+      gamma = dots[MCG_DOT_RU];
+      delta = dots[MCG_DOT_UW];
+      fresh = PETSC_TRUE;
+    }
+    if (ksp->reason) break;
+  }
+  PetscFunctionReturn(0);
+}

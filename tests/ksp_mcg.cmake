@@ -1,0 +1,24 @@
+# KSPMCG: stock PETSc tutorials loaded with -dll_append converge with -ksp_type mcg in the same number
+# of iterations as -ksp_type cg (+-1), serial and under MPI.
+binbcsr_stock_example(stock_ksp_ex4 ksp/ksp/tutorials/ex4.c)
+binbcsr_stock_example(stock_ksp_ex72 ksp/ksp/tutorials/ex72.c)
+
+set(MCG_COMPARE ${CMAKE_CURRENT_SOURCE_DIR}/ksp_mcg/compare_its.sh)
+set(MCG_SPD ${PETSC_DATAFILES_DIR}/matrices/spd-real-int32-float64)
+
+# compare_its.sh SLACK LAUNCHER... -- PROGRAM ARGS...: runs the program with -ksp_type cg and with
+# -ksp_type mcg, reads the iteration counts (-ksp_converged_reason) and compares.
+add_test(NAME ksp_mcg_stock_ex4
+         COMMAND ${MCG_COMPARE} 1 -- $<TARGET_FILE:stock_ksp_ex4> -bs 3 -m 20 -n 20 -pc_type jacobi -dll_append ${PLUGIN})
+add_test(NAME ksp_mcg_stock_ex4_nopc
+         COMMAND ${MCG_COMPARE} 1 -- $<TARGET_FILE:stock_ksp_ex4> -bs 3 -pc_type none -dll_append ${PLUGIN})
+add_test(NAME ksp_mcg_stock_ex72
+         COMMAND ${MCG_COMPARE} 1 -- $<TARGET_FILE:stock_ksp_ex72> -f0 ${MCG_SPD} -pc_type jacobi -dll_append ${PLUGIN})
+add_test(NAME ksp_mcg_stock_ex72_bjacobi
+         COMMAND ${MCG_COMPARE} 1 -- $<TARGET_FILE:stock_ksp_ex72> -f0 ${MCG_SPD} -dll_append ${PLUGIN})
+add_test(NAME ksp_mcg_stock_ex4_np2
+         COMMAND ${MCG_COMPARE} 1 ${MPIEXEC_CMD} -n 2 -- $<TARGET_FILE:stock_ksp_ex4> -bs 3 -m 20 -n 20 -pc_type jacobi -dll_append ${PLUGIN})
+add_test(NAME ksp_mcg_stock_ex72_np2
+         COMMAND ${MCG_COMPARE} 1 ${MPIEXEC_CMD} -n 2 -- $<TARGET_FILE:stock_ksp_ex72> -f0 ${MCG_SPD} -pc_type jacobi -dll_append ${PLUGIN})
+set_tests_properties(ksp_mcg_stock_ex4 ksp_mcg_stock_ex4_nopc ksp_mcg_stock_ex72 ksp_mcg_stock_ex72_bjacobi PROPERTIES LABELS "ksp_mcg")
+set_tests_properties(ksp_mcg_stock_ex4_np2 ksp_mcg_stock_ex72_np2 PROPERTIES LABELS "ksp_mcg;mpi" PROCESSORS 2)
