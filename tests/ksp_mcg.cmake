@@ -22,3 +22,7 @@ add_test(NAME ksp_mcg_stock_ex72_np2
          COMMAND ${MCG_COMPARE} 1 ${MPIEXEC_CMD} -n 2 -- $<TARGET_FILE:stock_ksp_ex72> -f0 ${MCG_SPD} -pc_type jacobi -dll_append ${PLUGIN})
 set_tests_properties(ksp_mcg_stock_ex4 ksp_mcg_stock_ex4_nopc ksp_mcg_stock_ex72 ksp_mcg_stock_ex72_bjacobi PROPERTIES LABELS "ksp_mcg")
 set_tests_properties(ksp_mcg_stock_ex4_np2 ksp_mcg_stock_ex72_np2 PROPERTIES LABELS "ksp_mcg;mpi" PROCESSORS 2)
+
+# The unit tests are written for any communicator size: run them on two ranks as well.
+add_test(NAME unit_ksp_mcg_np2 COMMAND ${MPIEXEC_CMD} -n 2 $<TARGET_FILE:test_ksp_mcg>)
+set_tests_properties(unit_ksp_mcg_np2 PROPERTIES LABELS "ksp_mcg;mpi" PROCESSORS 2)

@@ -1,0 +1,137 @@
+#include "mcg_test_problems.h"
+#include <cmath>
+
+namespace mcg_test {
+
+Mat block_laplacian(PetscInt nx, PetscInt ny, const char *mattype)
+{
+  const PetscInt    bs = 3, nodes = nx * ny;
+  const PetscScalar K[3][3] = {{4, 1, 0}, {1, 3, 1}, {0, 1, 2}};
+  PetscInt          local_nodes = PETSC_DECIDE, global_nodes = nodes, start;
+  Mat               A;
+  PetscSplitOwnership(PETSC_COMM_WORLD, &local_nodes, &global_nodes);
+  MPI_Scan(&local_nodes, &start, 1, MPIU_INT, MPI_SUM, PETSC_COMM_WORLD);
+  start -= local_nodes;
+  MatCreate(PETSC_COMM_WORLD, &A);
+  MatSetSizes(A, bs * local_nodes, bs * local_nodes, PETSC_DETERMINE, PETSC_DETERMINE);
+  MatSetType(A, mattype);
+  MatSetBlockSize(A, bs);
+  MatSeqAIJSetPreallocation(A, 5 * bs, nullptr);
+  MatMPIAIJSetPreallocation(A, 5 * bs, nullptr, 4 * bs, nullptr);
+  MatSetUp(A);
+  MatSetOption(A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE);
+  auto scale = [&](PetscInt node) { return 1.0 + 0.5 * std::sin(0.37 * node); };
+  for (PetscInt node = start; node < start + local_nodes; node++) {
+    const PetscInt i = node % nx, j = node / nx;
+    const PetscInt nb[5][2] = {{i, j}, {i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
+    for (int k = 0; k < 5; k++) {
+      const PetscInt ni = nb[k][0], nj = nb[k][1];
+      if (ni < 0 || nj < 0 || ni >= nx || nj >= ny) continue;
+      const PetscInt other = nj * nx + ni;
+      const PetscScalar lap = k == 0 ? 4.0 + 1.0 : -1.0; // shifted Laplacian: SPD, moderately conditioned
+      for (PetscInt a = 0; a < bs; a++)
+        for (PetscInt b = 0; b < bs; b++) {
+          const PetscScalar v = lap * K[a][b] * scale(node) * scale(other);
+          if (v != 0.0) MatSetValue(A, bs * node + a, bs * other + b, v, INSERT_VALUES);
+        }
+    }
+  }
+  MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY);
+  MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY);
+  return A;
+}
+
+Mat diagonal(const std::vector<PetscScalar> &d)
+{
+  PetscMPIInt rank;
+  Mat         A;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  const PetscInt n = (PetscInt)d.size(), local = rank == 0 ? n : 0;
+  MatCreateAIJ(PETSC_COMM_WORLD, local, local, n, n, 1, nullptr, 0, nullptr, &A);
+  if (rank == 0)
+    for (PetscInt i = 0; i < n; i++) MatSetValue(A, i, i, d[i], INSERT_VALUES);
+  MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY);
+  MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY);
+  return A;
+}
+
+Vec rhs(Mat A, bool ramp, PetscScalar value)
+{
+  Vec      b;
+  PetscInt lo, hi;
+  MatCreateVecs(A, nullptr, &b);
+  VecGetOwnershipRange(b, &lo, &hi);
+  for (PetscInt i = lo; i < hi; i++) VecSetValue(b, i, ramp ? value * (1.0 + std::cos(1.3 * i)) : value, INSERT_VALUES);
+  VecAssemblyBegin(b);
+  VecAssemblyEnd(b);
+  return b;
+}
+
+static std::vector<PetscScalar> gather(Vec x)
+{
+  VecScatter         sc;
+  Vec                all;
+  PetscInt           n;
+  const PetscScalar *a;
+  VecScatterCreateToAll(x, &sc, &all);
+  VecScatterBegin(sc, x, all, INSERT_VALUES, SCATTER_FORWARD);
+  VecScatterEnd(sc, x, all, INSERT_VALUES, SCATTER_FORWARD);
+  VecGetSize(all, &n);
+  VecGetArrayRead(all, &a);
+  std::vector<PetscScalar> out(a, a + n);
+  VecRestoreArrayRead(all, &a);
+  VecScatterDestroy(&sc);
+  VecDestroy(&all);
+  return out;
+}
+
+Result solve(Mat A, Vec b, const Solve &s, Vec x0)
+{
+  Result    r;
+  KSP       ksp;
+  PC        pc;
+  Vec       x;
+  PetscInt  nhist;
+  PetscReal hist[4096];
+  const PetscReal *h;
+
+  VecDuplicate(b, &x);
+  if (x0) VecCopy(x0, x);
+  else VecSet(x, 0.0);
+  KSPCreate(PETSC_COMM_WORLD, &ksp);
+  KSPSetOperators(ksp, A, A);
+  KSPSetType(ksp, s.type.c_str());
+  KSPGetPC(ksp, &pc);
+  PCSetType(pc, s.pc.c_str());
+  KSPSetTolerances(ksp, s.rtol, 1e-50, PETSC_DEFAULT, s.max_it);
+  if (s.norm != KSP_NORM_DEFAULT) KSPSetNormType(ksp, s.norm);
+  if (x0) KSPSetInitialGuessNonzero(ksp, PETSC_TRUE);
+  KSPSetResidualHistory(ksp, hist, 4096, PETSC_TRUE);
+  if (s.fixed_its) KSPMCGSetFixedIterations(ksp, s.fixed_its);
+  PetscOptionsInsertString(nullptr, s.options);
+  KSPSetFromOptions(ksp);
+  r.err = KSPSolve(ksp, b, x);
+  KSPGetConvergedReason(ksp, &r.reason);
+  KSPGetIterationNumber(ksp, &r.its);
+  KSPGetResidualNorm(ksp, &r.rnorm);
+  KSPGetResidualHistory(ksp, &h, &nhist);
+  r.history.assign(h, h + nhist);
+  r.x = gather(x);
+  PetscOptionsClear(nullptr);
+  KSPDestroy(&ksp);
+  VecDestroy(&x);
+  return r;
+}
+
+PetscReal rel_diff(const std::vector<PetscScalar> &a, const std::vector<PetscScalar> &b)
+{
+  PetscReal d = 0, n = 0;
+  for (size_t i = 0; i < a.size() && i < b.size(); i++) {
+    d += PetscRealPart((a[i] - b[i]) * (a[i] - b[i]));
+    n += PetscRealPart(b[i] * b[i]);
+  }
+  if (a.size() != b.size()) return PETSC_MAX_REAL;
+  return n > 0 ? std::sqrt(d / n) : std::sqrt(d);
+}
+
+} // namespace mcg_test

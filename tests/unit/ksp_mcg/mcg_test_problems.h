@@ -1,0 +1,40 @@
+// Small SPD and not-SPD systems for the KSPMCG tests, and a solve helper that records what a solve did.
+// Everything lives on PETSC_COMM_WORLD so the same tests run serially and under mpiexec.
+#pragma once
+#include <petscbinbcsr.h>
+#include <string>
+#include <vector>
+
+namespace mcg_test {
+
+// 3x3-block operator on an nx x ny grid: (5-point Laplacian) (x) K + shift, with K a fixed SPD 3x3
+// block, then scaled symmetrically by a smoothly varying diagonal so that Jacobi matters. SPD.
+Mat block_laplacian(PetscInt nx, PetscInt ny, const char *mattype = MATAIJ);
+// Diagonal matrix with the given diagonal (rank 0 owns everything, other ranks nothing).
+Mat diagonal(const std::vector<PetscScalar> &d);
+// Vector compatible with A, every entry equal to `value` (or 1, 2, 3, ... when value is NaN-free
+// and `ramp` is set: a right-hand side with every eigen-component present).
+Vec rhs(Mat A, bool ramp = true, PetscScalar value = 1.0);
+
+struct Solve {
+  std::string            type, pc;
+  KSPNormType            norm      = KSP_NORM_DEFAULT;
+  PetscReal              rtol      = 1e-10;
+  PetscInt               max_it    = 1000;
+  PetscInt               fixed_its = 0;  // mcg only
+  const char            *options   = ""; // extra options, inserted before KSPSetFromOptions
+};
+struct Result {
+  PetscErrorCode         err = 0;
+  KSPConvergedReason     reason = KSP_CONVERGED_ITERATING;
+  PetscInt               its    = -1;
+  PetscReal              rnorm  = -1;
+  std::vector<PetscReal> history;
+  std::vector<PetscScalar> x;      // gathered on every rank
+};
+// Solves A x = b from x0 (zero when x0 is null) with the given settings.
+Result solve(Mat A, Vec b, const Solve &s, Vec x0 = nullptr);
+// ||a - b|| / ||b|| of two gathered vectors.
+PetscReal rel_diff(const std::vector<PetscScalar> &a, const std::vector<PetscScalar> &b);
+
+} // namespace mcg_test
