@@ -46,14 +46,21 @@
 #include "binbcsr_impl.h"
 #include <petsc/private/matimpl.h>
 
-struct BinBCSRStaging; /* the pattern and values while the matrix is being filled for the first time */
+struct BinBCSRStaging; /* the pattern and values while the matrix is being filled for the first time
+                          (private to binbcsr.cpp: per block row, sorted block columns and values) */
 
 typedef struct {
   /* configuration */
   PetscInt            bw;        /* bin width: (block) rows per bin */
   MatBinBCSRPrecision precision; /* value storage; products accumulate in double */
+  PetscInt            nonew;     /* 0: new nonzeros allowed (only before the layout exists);
+                                    1: new locations silently ignored (MAT_NEW_NONZERO_LOCATIONS false);
+                                   -1: error (MAT_NEW_NONZERO_LOCATION_ERR); -2: error beyond the
+                                    preallocation (MAT_NEW_NONZERO_ALLOCATION_ERR). Once the layout
+                                    exists a new location is an error unless nonew == 1. */
+  PetscBool           roworiented; /* MAT_ROW_ORIENTED for MatSetValues(Blocked) */
 
-  /* the bin layout: valid once built (first final assembly) */
+  /* the bin layout: valid once built (first final assembly, MatSetPreallocationCOO, MatConvert) */
   PetscBool  built;
   PetscInt   bs, bs2;      /* block size and its square */
   PetscInt   mbs, nbs;     /* block rows, block columns */
@@ -61,19 +68,31 @@ typedef struct {
   PetscInt  *bin_start;    /* [nbins + 1]: first slot of each bin (a multiple of bw) */
   PetscInt  *row_nz;       /* [mbs]: stored blocks of each row, padding excluded */
   PetscInt  *diag_slot;    /* [mbs]: slot of the diagonal block, -1 if the row has none */
-  PetscInt  *col;          /* [nslots]: block column of each slot */
+  PetscInt  *col;          /* [nslots]: block column of each slot (32-bit: PETSc here has 32-bit PetscInt) */
   PetscInt   nslots;       /* bin_start[nbins] */
   PetscInt   nz;           /* stored blocks (sum of row_nz) */
+  PetscInt   max_row_nz;   /* longest row, in blocks */
   MatScalar *val;          /* [nslots * bs2] when precision is double, else NULL */
   float     *valf;         /* [nslots * bs2] when precision is single, else NULL */
 
-  struct BinBCSRStaging *staging; /* non-NULL until the layout is built */
+  struct BinBCSRStaging *staging; /* non-NULL between MatSetUp/preallocation and the layout build */
 
-  /* COO assembly: slot-entry v (v = s * bs2 + e in the value-index space) sums the COO entries
-     coo_perm[coo_jmap[v] .. coo_jmap[v+1]-1]. */
-  PetscCount  coo_n;
-  PetscCount *coo_jmap;
-  PetscCount *coo_perm;
+  /* COO assembly: value index v (v = BinBCSRValueIndex(s, e, bw, bs2)) is the sum of the COO entries
+     coo_perm[coo_jmap[v] .. coo_jmap[v+1]-1]; coo_jmap has nslots*bs2 + 1 entries. 32-bit indices
+     (checked at preallocation) halve the bytes the refill streams. */
+  PetscCount coo_n;
+  PetscInt  *coo_jmap;
+  PetscInt  *coo_perm;
+
+  /* scratch */
+  PetscBool    getrowactive;
+  PetscInt    *rowbuf_cols; /* [max_row_nz * bs] for MatGetRow */
+  PetscScalar *rowbuf_vals;
+  MatScalar   *idiag;       /* [mbs * bs2] MatInvertBlockDiagonal result (column-major blocks, as BAIJ) */
+
+  /* Viewers other than ASCII (binary, ...): binbcsr_ops.cpp may set this hook in
+     MatSeqBinBCSRSetOps_Ops; ops->view (binbcsr.cpp) handles ASCII and forwards the rest here. */
+  PetscErrorCode (*view_other)(Mat, PetscViewer);
 } Mat_SeqBinBCSR;
 
 /* Lane of slot s, and the index into val/valf of entry e of slot s. */
@@ -83,9 +102,56 @@ static inline PetscInt BinBCSRValueIndex(PetscInt s, PetscInt e, PetscInt bw, Pe
   const PetscInt l = s % bw;
   return (s - l) * bs2 + e * bw + l;
 }
+/* Slot of entry k of block row r (k < row_nz[r] for a real entry). */
+static inline PetscInt BinBCSRSlot(const Mat_SeqBinBCSR *a, PetscInt r, PetscInt k)
+{
+  return a->bin_start[r / a->bw] + k * a->bw + r % a->bw;
+}
+/* Value at value index v, whatever the storage precision. */
+static inline PetscScalar BinBCSRGetValue(const Mat_SeqBinBCSR *a, PetscInt v) { return a->val ? a->val[v] : (PetscScalar)a->valf[v]; }
+static inline void        BinBCSRSetValue(Mat_SeqBinBCSR *a, PetscInt v, PetscScalar x)
+{
+  if (a->val) a->val[v] = x;
+  else a->valf[v] = (float)x;
+}
+
+/* Slot of block (brow, bcol), -1 if the pattern has no such block (binary search in the lane). */
+PETSC_INTERN PetscInt MatSeqBinBCSRFindSlot(const Mat_SeqBinBCSR *, PetscInt brow, PetscInt bcol);
+
+/* Builds (or rebuilds) the bin layout from a block CSR pattern: bi[mbs+1], bj sorted and unique in
+   each row. Values are zero, in the current precision. Drops staging and any COO map; increases the
+   nonzero state. Used by assembly, COO preallocation, MatConvert and available to MatLoad. */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRBuildLayout(Mat, const PetscInt bi[], const PetscInt bj[]);
+
+/* Before the layout exists: zero the staged values, keeping the staged pattern (MatZeroEntries). */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRStagingZeroValues(Mat);
+
+/* ASCII MatView (info formats and the default entry listing). */
+PETSC_INTERN PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat, PetscViewer);
 
 /* Filled by the second part of the implementation (binbcsr_ops.cpp); called at the end of
    MatCreate_SeqBinBCSR so both parts contribute to one ops table. */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRSetOps_Ops(Mat);
+
+/* Parts of binbcsr.cpp's ops table implemented in the other files of this folder. */
+PETSC_INTERN PetscErrorCode MatMult_SeqBinBCSR(Mat, Vec, Vec);
+PETSC_INTERN PetscErrorCode MatMultAdd_SeqBinBCSR(Mat, Vec, Vec, Vec);
+PETSC_INTERN PetscErrorCode MatMultTranspose_SeqBinBCSR(Mat, Vec, Vec);
+PETSC_INTERN PetscErrorCode MatMultTransposeAdd_SeqBinBCSR(Mat, Vec, Vec, Vec);
+PETSC_INTERN PetscErrorCode MatMultDotLocal_SeqBinBCSR(Mat, Vec, Vec, PetscScalar *);
+PETSC_INTERN PetscErrorCode MatGetDiagonal_SeqBinBCSR(Mat, Vec);
+PETSC_INTERN PetscErrorCode MatInvertBlockDiagonal_SeqBinBCSR(Mat, const PetscScalar **);
+PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat, PetscCount, const PetscInt[], const PetscInt[]);
+PETSC_INTERN PetscErrorCode MatSetValuesCOO_SeqBinBCSR(Mat, const PetscScalar[], InsertMode);
+PETSC_INTERN PetscErrorCode MatGetRow_SeqBinBCSR(Mat, PetscInt, PetscInt *, PetscInt **, PetscScalar **);
+PETSC_INTERN PetscErrorCode MatRestoreRow_SeqBinBCSR(Mat, PetscInt, PetscInt *, PetscInt **, PetscScalar **);
+PETSC_INTERN PetscErrorCode MatDuplicate_SeqBinBCSR(Mat, MatDuplicateOption, Mat *);
+PETSC_INTERN PetscErrorCode MatCopy_SeqBinBCSR(Mat, Mat, MatStructure);
+PETSC_INTERN PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat, MatType, MatReuse, Mat *);
+PETSC_INTERN PetscErrorCode MatConvert_SeqBinBCSR_SeqAIJ(Mat, MatType, MatReuse, Mat *);
+PETSC_INTERN PetscErrorCode MatConvert_SeqBinBCSR_SeqBAIJ(Mat, MatType, MatReuse, Mat *);
+PETSC_INTERN PetscErrorCode MatView_SeqBinBCSR(Mat, PetscViewer);
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRDestroyCOO(Mat_SeqBinBCSR *);
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRDuplicateStaging(Mat, Mat, PetscBool copyvalues);
 
 #endif

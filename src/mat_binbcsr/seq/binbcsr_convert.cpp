@@ -1,0 +1,354 @@
+/* MATSEQBINBCSR rows, copies, conversions and ASCII views. */
+#include "binbcsr.h"
+#include <petscviewer.h>
+#include <algorithm>
+#include <vector>
+
+PetscErrorCode MatGetRow_SeqBinBCSR(Mat A, PetscInt row, PetscInt *nz, PetscInt **idx, PetscScalar **v)
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+
+  PetscFunctionBegin;
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatGetRow needs an assembled MATSEQBINBCSR matrix");
+  PetscCheck(row >= 0 && row < A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", row, A->rmap->n);
+  PetscCheck(!a->getrowactive, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatRestoreRow the previous row first");
+  const PetscInt bs = a->bs, br = row / bs, ri = row % bs, n = a->row_nz[br];
+  for (PetscInt k = 0; k < n; k++) {
+    const PetscInt s = BinBCSRSlot(a, br, k);
+    for (PetscInt j = 0; j < bs; j++) {
+      a->rowbuf_cols[k * bs + j] = a->col[s] * bs + j;
+      a->rowbuf_vals[k * bs + j] = BinBCSRGetValue(a, BinBCSRValueIndex(s, ri * bs + j, a->bw, a->bs2));
+    }
+  }
+  if (nz) *nz = n * bs;
+  if (idx) *idx = n ? a->rowbuf_cols : nullptr;
+  if (v) *v = n ? a->rowbuf_vals : nullptr;
+  a->getrowactive = PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatRestoreRow_SeqBinBCSR(Mat A, PetscInt row, PetscInt *nz, PetscInt **idx, PetscScalar **v)
+{
+  PetscFunctionBegin;
+  (void)row;
+  (void)nz;
+  ((Mat_SeqBinBCSR *)A->data)->getrowactive = PETSC_FALSE;
+  if (idx) *idx = nullptr;
+  if (v) *v = nullptr;
+  PetscFunctionReturn(0);
+}
+
+/* B gets A's layout (and values if copyvalues), in A's precision. B is a fresh MATSEQBINBCSR. */
+static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues)
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data, *b = (Mat_SeqBinBCSR *)B->data;
+  const size_t    nv = (size_t)a->nslots * a->bs2;
+
+  PetscFunctionBegin;
+  b->bw          = a->bw;
+  b->precision   = a->precision;
+  b->nonew       = a->nonew;
+  b->roworiented = a->roworiented;
+  b->bs          = a->bs;
+  b->bs2         = a->bs2;
+  b->mbs         = a->mbs;
+  b->nbs         = a->nbs;
+  if (a->built) {
+    b->nbins      = a->nbins;
+    b->nslots     = a->nslots;
+    b->nz         = a->nz;
+    b->max_row_nz = a->max_row_nz;
+    PetscCall(PetscMalloc1(a->nbins + 1, &b->bin_start));
+    PetscCall(PetscArraycpy(b->bin_start, a->bin_start, a->nbins + 1));
+    PetscCall(PetscMalloc1(a->mbs, &b->row_nz));
+    PetscCall(PetscArraycpy(b->row_nz, a->row_nz, a->mbs));
+    PetscCall(PetscMalloc1(a->mbs, &b->diag_slot));
+    PetscCall(PetscArraycpy(b->diag_slot, a->diag_slot, a->mbs));
+    PetscCall(PetscMalloc1(a->nslots, &b->col));
+    PetscCall(PetscArraycpy(b->col, a->col, a->nslots));
+    if (a->val) {
+      PetscCall(PetscMalloc1(nv, &b->val));
+      if (copyvalues) PetscCall(PetscArraycpy(b->val, a->val, nv));
+      else PetscCall(PetscArrayzero(b->val, nv));
+    } else {
+      PetscCall(PetscMalloc1(nv, &b->valf));
+      if (copyvalues) PetscCall(PetscArraycpy(b->valf, a->valf, nv));
+      else PetscCall(PetscArrayzero(b->valf, nv));
+    }
+    PetscCall(PetscMalloc2((size_t)a->max_row_nz * a->bs, &b->rowbuf_cols, (size_t)a->max_row_nz * a->bs, &b->rowbuf_vals));
+    if (a->coo_jmap) { /* the copy can be refilled with MatSetValuesCOO too */
+      b->coo_n = a->coo_n;
+      PetscCall(PetscMalloc1(nv + 1, &b->coo_jmap));
+      PetscCall(PetscArraycpy(b->coo_jmap, a->coo_jmap, nv + 1));
+      PetscCall(PetscMalloc1(a->coo_jmap[nv], &b->coo_perm));
+      PetscCall(PetscArraycpy(b->coo_perm, a->coo_perm, a->coo_jmap[nv]));
+    }
+    b->built = PETSC_TRUE;
+  } else PetscCall(MatSeqBinBCSRDuplicateStaging(A, B, copyvalues));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatDuplicate_SeqBinBCSR(Mat A, MatDuplicateOption op, Mat *M)
+{
+  Mat B;
+
+  PetscFunctionBegin;
+  PetscCall(MatCreate(PetscObjectComm((PetscObject)A), &B));
+  PetscCall(MatSetSizes(B, A->rmap->n, A->cmap->n, A->rmap->N, A->cmap->N));
+  PetscCall(MatSetBlockSizesFromMats(B, A, A));
+  PetscCall(MatSetType(B, ((PetscObject)A)->type_name));
+  PetscCall(PetscLayoutSetUp(B->rmap));
+  PetscCall(PetscLayoutSetUp(B->cmap));
+  PetscCall(MatSeqBinBCSRCopyLayout(A, B, op == MAT_COPY_VALUES ? PETSC_TRUE : PETSC_FALSE));
+  B->preallocated = PETSC_TRUE;
+  B->assembled    = A->assembled;
+  B->nonzerostate = A->nonzerostate;
+  *M              = B;
+  PetscFunctionReturn(0);
+}
+
+/* Same pattern: copy values (converting precision); otherwise row by row through MatSetValues. */
+PetscErrorCode MatCopy_SeqBinBCSR(Mat A, Mat B, MatStructure str)
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  PetscBool       same = PETSC_FALSE, isbin;
+
+  PetscFunctionBegin;
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatCopy needs an assembled MATSEQBINBCSR matrix");
+  PetscCall(PetscObjectTypeCompare((PetscObject)B, MATSEQBINBCSR, &isbin));
+  if (isbin) {
+    Mat_SeqBinBCSR *b = (Mat_SeqBinBCSR *)B->data;
+    PetscCheck(b->bs == a->bs || !b->built, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP, "Block sizes differ: %" PetscInt_FMT " and %" PetscInt_FMT, a->bs, b->bs);
+    if (b->built && b->bw == a->bw && b->mbs == a->mbs && b->nbs == a->nbs && b->nslots == a->nslots) {
+      same = (PetscBool)(str == SAME_NONZERO_PATTERN);
+      if (!same) {
+        PetscCall(PetscArraycmp(a->bin_start, b->bin_start, a->nbins + 1, &same));
+        if (same) PetscCall(PetscArraycmp(a->row_nz, b->row_nz, a->mbs, &same));
+        if (same) PetscCall(PetscArraycmp(a->col, b->col, a->nslots, &same));
+      }
+    }
+    if (same) {
+      const size_t nv = (size_t)a->nslots * a->bs2;
+      if (a->val && b->val) PetscCall(PetscArraycpy(b->val, a->val, nv));
+      else if (a->valf && b->valf) PetscCall(PetscArraycpy(b->valf, a->valf, nv));
+      else if (a->val)
+        for (size_t i = 0; i < nv; i++) b->valf[i] = (float)a->val[i];
+      else
+        for (size_t i = 0; i < nv; i++) b->val[i] = (MatScalar)a->valf[i];
+      PetscCall(PetscObjectStateIncrease((PetscObject)B));
+      PetscFunctionReturn(0);
+    }
+  }
+  /* different pattern or type: B's own pattern rules apply (a frozen BinBCSR pattern must hold A's) */
+  if (isbin && ((Mat_SeqBinBCSR *)B->data)->built) {
+    Mat_SeqBinBCSR *b = (Mat_SeqBinBCSR *)B->data;
+    if (b->val) PetscCall(PetscArrayzero(b->val, (size_t)b->nslots * b->bs2));
+    else PetscCall(PetscArrayzero(b->valf, (size_t)b->nslots * b->bs2));
+  } else if (!isbin && B->assembled) PetscCall(MatZeroEntries(B));
+  for (PetscInt r = 0; r < A->rmap->n; r++) {
+    PetscInt           n;
+    const PetscInt    *cols;
+    const PetscScalar *vals;
+    PetscCall(MatGetRow(A, r, &n, &cols, &vals));
+    PetscCall(MatSetValues(B, 1, &r, n, cols, vals, INSERT_VALUES));
+    PetscCall(MatRestoreRow(A, r, &n, &cols, &vals));
+  }
+  PetscCall(MatAssemblyBegin(B, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(B, MAT_FINAL_ASSEMBLY));
+  PetscFunctionReturn(0);
+}
+
+/* Any matrix with MatGetRow -> MATSEQBINBCSR, with the source's block size (1 if its row and column
+   block sizes differ or do not divide the sizes). */
+PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat A, MatType type, MatReuse reuse, Mat *newmat)
+{
+  Mat                   B;
+  PetscInt              bs = A->rmap->bs, m = A->rmap->n, mbs, *bi, *bj;
+  std::vector<PetscInt> rowcols;
+
+  PetscFunctionBegin;
+  if (bs < 1 || bs != A->cmap->bs || m % bs || A->cmap->n % bs) bs = 1;
+  mbs = m / bs;
+  if (reuse == MAT_REUSE_MATRIX) {
+    B = *newmat;
+    PetscCheck(B->rmap->bs == bs || bs == 1, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP, "Block size of the reused matrix %" PetscInt_FMT " differs from %" PetscInt_FMT, B->rmap->bs, bs);
+  } else {
+    PetscCall(MatCreate(PetscObjectComm((PetscObject)A), &B));
+    PetscCall(MatSetSizes(B, A->rmap->n, A->cmap->n, A->rmap->N, A->cmap->N));
+    PetscCall(MatSetBlockSize(B, bs));
+    PetscCall(MatSetType(B, type));
+    /* -mat_binbcsr_bin_width / _precision apply to converted matrices too (not MatSetFromOptions:
+       -mat_type would change the type) */
+    PetscObjectOptionsBegin((PetscObject)B);
+    PetscCall((*B->ops->setfromoptions)(B, PetscOptionsObject));
+    PetscOptionsEnd();
+  }
+  bs = PetscAbs(B->rmap->bs);
+  mbs = m / bs;
+  /* block pattern: the union of the block columns of each block row's point rows */
+  PetscCall(PetscMalloc1(mbs + 1, &bi));
+  bi[0] = 0;
+  std::vector<PetscInt> all;
+  for (PetscInt br = 0; br < mbs; br++) {
+    rowcols.clear();
+    for (PetscInt i = 0; i < bs; i++) {
+      PetscInt        n, r = br * bs + i;
+      const PetscInt *cols;
+      PetscCall(MatGetRow(A, r, &n, &cols, nullptr));
+      for (PetscInt k = 0; k < n; k++) rowcols.push_back(cols[k] / bs);
+      PetscCall(MatRestoreRow(A, r, &n, &cols, nullptr));
+    }
+    std::sort(rowcols.begin(), rowcols.end());
+    rowcols.erase(std::unique(rowcols.begin(), rowcols.end()), rowcols.end());
+    all.insert(all.end(), rowcols.begin(), rowcols.end());
+    bi[br + 1] = (PetscInt)all.size();
+  }
+  PetscCall(PetscMalloc1(all.size(), &bj));
+  std::copy(all.begin(), all.end(), bj);
+  PetscCall(MatSeqBinBCSRBuildLayout(B, bi, bj));
+  {
+    Mat_SeqBinBCSR *b = (Mat_SeqBinBCSR *)B->data;
+    for (PetscInt r = 0; r < m; r++) {
+      PetscInt           n, br = r / bs, k = 0;
+      const PetscInt    *cols;
+      const PetscScalar *vals;
+      PetscCall(MatGetRow(A, r, &n, &cols, &vals));
+      for (PetscInt p = 0; p < n; p++) { /* both sorted: walk the block row */
+        const PetscInt bc = cols[p] / bs;
+        while (bj[bi[br] + k] != bc) k++;
+        BinBCSRSetValue(b, BinBCSRValueIndex(BinBCSRSlot(b, br, k), (r % bs) * bs + cols[p] % bs, b->bw, b->bs2), vals[p]);
+      }
+      PetscCall(MatRestoreRow(A, r, &n, &cols, &vals));
+    }
+  }
+  PetscCall(PetscFree(bi));
+  PetscCall(PetscFree(bj));
+  PetscCall(MatAssemblyBegin(B, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(B, MAT_FINAL_ASSEMBLY));
+  if (reuse == MAT_INPLACE_MATRIX) PetscCall(MatHeaderReplace(A, &B));
+  else *newmat = B;
+  PetscFunctionReturn(0);
+}
+
+/* MATSEQBINBCSR -> seqaij (bs 1 rows) or seqbaij (bs x bs blocks). */
+static PetscErrorCode MatConvert_SeqBinBCSR_XAIJ(Mat A, MatType newtype, MatReuse reuse, Mat *newmat, PetscBool blocked)
+{
+  Mat_SeqBinBCSR *a  = (Mat_SeqBinBCSR *)A->data;
+  const PetscInt  bs = a->bs, bs2 = a->bs2;
+  Mat             B;
+  PetscInt       *nnz, *cols;
+  PetscScalar    *vals;
+
+  PetscFunctionBegin;
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatConvert needs an assembled MATSEQBINBCSR matrix");
+  if (reuse == MAT_REUSE_MATRIX) {
+    B = *newmat;
+    PetscCall(MatZeroEntries(B));
+  } else {
+    PetscCall(MatCreate(PetscObjectComm((PetscObject)A), &B));
+    PetscCall(MatSetSizes(B, A->rmap->n, A->cmap->n, A->rmap->N, A->cmap->N));
+    PetscCall(MatSetBlockSizesFromMats(B, A, A));
+    PetscCall(MatSetType(B, newtype));
+    if (blocked) PetscCall(MatSeqBAIJSetPreallocation(B, bs, 0, a->row_nz));
+    else {
+      PetscCall(PetscMalloc1(A->rmap->n, &nnz));
+      for (PetscInt r = 0; r < A->rmap->n; r++) nnz[r] = a->row_nz[r / bs] * bs;
+      PetscCall(MatSeqAIJSetPreallocation(B, 0, nnz));
+      PetscCall(PetscFree(nnz));
+    }
+  }
+  PetscCall(PetscMalloc2((size_t)a->max_row_nz * bs, &cols, (size_t)a->max_row_nz * bs2, &vals));
+  for (PetscInt br = 0; br < a->mbs; br++) {
+    const PetscInt n = a->row_nz[br];
+    for (PetscInt k = 0; k < n; k++) cols[k] = a->col[BinBCSRSlot(a, br, k)];
+    /* the block row as a row-major (bs) x (n*bs) array */
+    for (PetscInt k = 0; k < n; k++) {
+      const PetscInt s = BinBCSRSlot(a, br, k);
+      for (PetscInt i = 0; i < bs; i++)
+        for (PetscInt j = 0; j < bs; j++) vals[i * n * bs + k * bs + j] = BinBCSRGetValue(a, BinBCSRValueIndex(s, i * bs + j, a->bw, bs2));
+    }
+    if (blocked) PetscCall(MatSetValuesBlocked(B, 1, &br, n, cols, vals, INSERT_VALUES));
+    else {
+      for (PetscInt k = n - 1; k >= 0; k--) /* expand block columns in place, back to front */
+        for (PetscInt j = bs - 1; j >= 0; j--) cols[k * bs + j] = cols[k] * bs + j;
+      for (PetscInt i = 0; i < bs; i++) {
+        const PetscInt r = br * bs + i;
+        PetscCall(MatSetValues(B, 1, &r, n * bs, cols, vals + i * n * bs, INSERT_VALUES));
+      }
+    }
+  }
+  PetscCall(PetscFree2(cols, vals));
+  PetscCall(MatAssemblyBegin(B, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(B, MAT_FINAL_ASSEMBLY));
+  if (reuse == MAT_INPLACE_MATRIX) PetscCall(MatHeaderReplace(A, &B));
+  else *newmat = B;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatConvert_SeqBinBCSR_SeqAIJ(Mat A, MatType newtype, MatReuse reuse, Mat *newmat)
+{
+  PetscFunctionBegin;
+  PetscCall(MatConvert_SeqBinBCSR_XAIJ(A, newtype, reuse, newmat, PETSC_FALSE));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatConvert_SeqBinBCSR_SeqBAIJ(Mat A, MatType newtype, MatReuse reuse, Mat *newmat)
+{
+  PetscFunctionBegin;
+  PetscCall(MatConvert_SeqBinBCSR_XAIJ(A, newtype, reuse, newmat, PETSC_TRUE));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
+{
+  Mat_SeqBinBCSR   *a = (Mat_SeqBinBCSR *)A->data;
+  PetscViewerFormat format;
+
+  PetscFunctionBegin;
+  PetscCall(PetscViewerGetFormat(viewer, &format));
+  if (format == PETSC_VIEWER_ASCII_FACTOR_INFO) PetscFunctionReturn(0);
+  if (format == PETSC_VIEWER_ASCII_INFO || format == PETSC_VIEWER_ASCII_INFO_DETAIL) {
+    const size_t vbytes = (size_t)a->nslots * a->bs2 * (a->precision == MAT_BINBCSR_PRECISION_DOUBLE ? sizeof(MatScalar) : sizeof(float));
+    const size_t ibytes = (size_t)a->nslots * sizeof(PetscInt) + (size_t)(a->nbins + 1) * sizeof(PetscInt);
+    PetscCall(PetscViewerASCIIPrintf(viewer, "%s, block size %" PetscInt_FMT ", bin width %" PetscInt_FMT ", values in %s precision (double accumulation)\n", a->bs == 1 ? "BIN-CSR" : "BIN-BCSR", a->bs, a->bw, MatBinBCSRPrecisions[a->precision]));
+    if (!a->built) {
+      PetscCall(PetscViewerASCIIPrintf(viewer, "bin layout not built yet (built at the first final assembly)\n"));
+      PetscFunctionReturn(0);
+    }
+    PetscCall(PetscViewerASCIIPrintf(viewer, "bins %" PetscInt_FMT ", stored blocks %" PetscInt_FMT ", slots %" PetscInt_FMT " (padding overhead %.2f%%), longest row %" PetscInt_FMT " blocks\n", a->nbins, a->nz, a->nslots, a->nz ? 100.0 * (double)(a->nslots - a->nz) / (double)a->nz : 0.0, a->max_row_nz));
+    PetscCall(PetscViewerASCIIPrintf(viewer, "bytes: values %zu, indices %zu (column per slot and bin offsets)%s\n", vbytes, ibytes, a->coo_jmap ? ", COO map present" : ""));
+    PetscFunctionReturn(0);
+  }
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatView of the entries needs an assembled matrix");
+  PetscCall(PetscViewerASCIIUseTabs(viewer, PETSC_FALSE));
+  for (PetscInt r = 0; r < A->rmap->n; r++) {
+    const PetscInt bs = a->bs, br = r / bs, ri = r % bs;
+    PetscCall(PetscViewerASCIIPrintf(viewer, "row %" PetscInt_FMT ":", r));
+    for (PetscInt k = 0; k < a->row_nz[br]; k++) {
+      const PetscInt s = BinBCSRSlot(a, br, k);
+      for (PetscInt j = 0; j < bs; j++) PetscCall(PetscViewerASCIIPrintf(viewer, " (%" PetscInt_FMT ", %g) ", a->col[s] * bs + j, (double)BinBCSRGetValue(a, BinBCSRValueIndex(s, ri * bs + j, a->bw, a->bs2))));
+    }
+    PetscCall(PetscViewerASCIIPrintf(viewer, "\n"));
+  }
+  PetscCall(PetscViewerASCIIUseTabs(viewer, PETSC_TRUE));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatView_SeqBinBCSR(Mat A, PetscViewer viewer)
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  PetscBool       isascii;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &isascii));
+  if (isascii) PetscCall(MatView_SeqBinBCSR_ASCII(A, viewer));
+  else if (a->view_other) PetscCall(a->view_other(A, viewer));
+  else {
+    /* any other viewer: through an AIJ copy */
+    Mat B;
+    PetscCall(MatConvert(A, MATSEQAIJ, MAT_INITIAL_MATRIX, &B));
+    PetscCall(MatView(B, viewer));
+    PetscCall(MatDestroy(&B));
+  }
+  PetscFunctionReturn(0);
+}

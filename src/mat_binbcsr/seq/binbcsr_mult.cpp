@@ -1,0 +1,330 @@
+/* MATSEQBINBCSR products: y = A x (+ z), y = A^T x (+ z), the fused y = A x with x.y, the diagonal and
+   its block inverse. The CPU drivers here loop over bins; the per-lane arithmetic is
+   src/mat_binbcsr/binbcsr_kernels.h. */
+#include "binbcsr.h"
+#include "../binbcsr_kernels.h"
+#include <petsc/private/kernels/blockinvert.h>
+
+namespace
+{
+
+/* Everything a bin sweep reads, as plain pointers. */
+template <typename V>
+struct BinSweep {
+  const PetscInt *bin_start, *col;
+  const V        *val;
+  PetscInt        nbins, mbs, bs;
+};
+
+/* y[rows of the bins] = z + A x, and *dot += x.y over the rows when dot is non-null.
+   BW is the bin width as a constant: the lanes' accumulators stay in registers and the inner loop
+   over the lanes becomes SIMD (column indices and values are unit-stride across lanes). */
+template <int BS, int BW, typename V>
+void mult_bins_fixed(const BinSweep<V> &m, const double *x, const double *z, double *y, double *dot)
+{
+  constexpr int BS2 = BS * BS;
+  double        d   = 0.0;
+  for (PetscInt b = 0; b < m.nbins; b++) {
+    const PetscInt  s0  = m.bin_start[b];
+    const PetscInt  len = (m.bin_start[b + 1] - s0) / BW;
+    const PetscInt *c   = m.col + s0;
+    const V        *t   = m.val + (size_t)s0 * BS2;
+    double          acc[BS][BW];
+    for (int i = 0; i < BS; i++)
+      for (int l = 0; l < BW; l++) acc[i][l] = 0.0;
+    for (PetscInt k = 0; k < len; k++, c += BW, t += BW * BS2) {
+#pragma omp simd
+      for (int l = 0; l < BW; l++) {
+        double xc[BS], yl[BS];
+        for (int j = 0; j < BS; j++) xc[j] = x[(size_t)c[l] * BS + j];
+        for (int i = 0; i < BS; i++) yl[i] = acc[i][l];
+        binbcsr::slot_mult<BS, V>(t + l, BW, BS, xc, yl);
+        for (int i = 0; i < BS; i++) acc[i][l] = yl[i];
+      }
+    }
+    const PetscInt r0 = b * BW, nl = PetscMin((PetscInt)BW, m.mbs - r0);
+    for (PetscInt l = 0; l < nl; l++) {
+      for (int i = 0; i < BS; i++) {
+        const size_t p  = (size_t)(r0 + l) * BS + i;
+        const double yv = (z ? z[p] : 0.0) + acc[i][l];
+        y[p]            = yv;
+        if (dot) d += x[p] * yv;
+      }
+    }
+  }
+  if (dot) *dot += d;
+}
+
+/* Any bin width and block size: one lane at a time through the lane kernel. */
+template <int BS, typename V>
+void mult_bins_any(const BinSweep<V> &m, PetscInt bw, const double *x, const double *z, double *y, double *dot, double *acc)
+{
+  const PetscInt bs = BS ? BS : m.bs, bs2 = bs * bs;
+  double         d  = 0.0;
+  for (PetscInt b = 0; b < m.nbins; b++) {
+    const PetscInt s0 = m.bin_start[b], len = (m.bin_start[b + 1] - s0) / bw;
+    for (PetscInt l = 0; l < bw && b * bw + l < m.mbs; l++) {
+      const PetscInt r = b * bw + l;
+      for (PetscInt i = 0; i < bs; i++) acc[i] = z ? z[r * bs + i] : 0.0;
+      binbcsr::lane_mult<BS, V, PetscInt>(m.val + (size_t)s0 * bs2, m.col + s0, (int)len, (int)bw, (int)bs, (int)l, x, acc);
+      for (PetscInt i = 0; i < bs; i++) {
+        y[r * bs + i] = acc[i];
+        if (dot) d += x[r * bs + i] * acc[i];
+      }
+    }
+  }
+  if (dot) *dot += d;
+}
+
+template <int BS, typename V>
+void mult_dispatch_bw(const BinSweep<V> &m, PetscInt bw, const double *x, const double *z, double *y, double *dot, double *acc)
+{
+  switch (bw) {
+  case 4:
+    mult_bins_fixed<BS, 4, V>(m, x, z, y, dot);
+    break;
+  case 8:
+    mult_bins_fixed<BS, 8, V>(m, x, z, y, dot);
+    break;
+  case 16:
+    mult_bins_fixed<BS, 16, V>(m, x, z, y, dot);
+    break;
+  case 32:
+    mult_bins_fixed<BS, 32, V>(m, x, z, y, dot);
+    break;
+  default:
+    mult_bins_any<BS, V>(m, bw, x, z, y, dot, acc);
+  }
+}
+
+template <typename V>
+void mult_dispatch(const Mat_SeqBinBCSR *a, const V *val, const double *x, const double *z, double *y, double *dot, double *acc)
+{
+  const BinSweep<V> m = {a->bin_start, a->col, val, a->nbins, a->mbs, a->bs};
+  if (dot) *dot = 0.0;
+  if (a->bs == 3) mult_dispatch_bw<3, V>(m, a->bw, x, z, y, dot, acc);
+  else if (a->bs == 1) mult_dispatch_bw<1, V>(m, a->bw, x, z, y, dot, acc);
+  else mult_bins_any<0, V>(m, a->bw, x, z, y, dot, acc);
+}
+
+/* y += A^T x (y holds z or zero on entry). Scatter: rows are visited lane by lane. */
+template <int BS, typename V>
+void mult_transpose_bins(const Mat_SeqBinBCSR *a, const V *val, const double *x, double *y)
+{
+  const PetscInt bs = BS ? BS : a->bs, bs2 = bs * bs, bw = a->bw;
+  for (PetscInt b = 0; b < a->nbins; b++) {
+    const PetscInt s0 = a->bin_start[b];
+    for (PetscInt l = 0; l < bw && b * bw + l < a->mbs; l++) {
+      const PetscInt r = b * bw + l;
+      binbcsr::lane_mult_transpose<BS, V, PetscInt>(val + (size_t)s0 * bs2, a->col + s0, (int)a->row_nz[r], (int)bw, (int)bs, (int)l, x + (size_t)r * bs, y);
+    }
+  }
+}
+
+template <typename V>
+void mult_transpose_dispatch(const Mat_SeqBinBCSR *a, const V *val, const double *x, double *y)
+{
+  if (a->bs == 3) mult_transpose_bins<3, V>(a, val, x, y);
+  else if (a->bs == 1) mult_transpose_bins<1, V>(a, val, x, y);
+  else mult_transpose_bins<0, V>(a, val, x, y);
+}
+
+} // namespace
+
+/* y = z + A x (z may be null, may alias y); dot: optional local x.y. */
+static PetscErrorCode MatMultKernel_SeqBinBCSR(Mat A, Vec xx, Vec zz, Vec yy, PetscScalar *dot)
+{
+  Mat_SeqBinBCSR    *a = (Mat_SeqBinBCSR *)A->data;
+  const PetscScalar *x, *z = nullptr;
+  PetscScalar       *y, *acc = nullptr;
+
+  PetscFunctionBegin;
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
+  { /* the lane-by-lane path (other block sizes or bin widths) needs bs accumulators */
+    const PetscBool fixed = (PetscBool)((a->bs == 1 || a->bs == 3) && (a->bw == 4 || a->bw == 8 || a->bw == 16 || a->bw == 32));
+    if (!fixed) PetscCall(PetscMalloc1(a->bs, &acc));
+  }
+  PetscCall(VecGetArrayRead(xx, &x));
+  if (zz == yy) {
+    PetscCall(VecGetArray(yy, &y));
+    z = y;
+  } else {
+    if (zz) PetscCall(VecGetArrayRead(zz, &z));
+    PetscCall(VecGetArrayWrite(yy, &y));
+  }
+  if (a->val) mult_dispatch<double>(a, a->val, x, z, y, dot, acc);
+  else mult_dispatch<float>(a, a->valf, x, z, y, dot, acc);
+  PetscCall(VecRestoreArrayRead(xx, &x));
+  if (zz == yy) PetscCall(VecRestoreArray(yy, &y));
+  else {
+    if (zz) PetscCall(VecRestoreArrayRead(zz, &z));
+    PetscCall(VecRestoreArrayWrite(yy, &y));
+  }
+  PetscCall(PetscFree(acc));
+  PetscCall(PetscLogFlops(2.0 * a->nz * a->bs2 - (zz ? 0.0 : (double)A->rmap->n) + (dot ? 2.0 * A->rmap->n : 0.0)));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatMult_SeqBinBCSR(Mat A, Vec x, Vec y)
+{
+  PetscFunctionBegin;
+  PetscCall(MatMultKernel_SeqBinBCSR(A, x, nullptr, y, nullptr));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatMultAdd_SeqBinBCSR(Mat A, Vec x, Vec z, Vec y)
+{
+  PetscFunctionBegin;
+  PetscCall(MatMultKernel_SeqBinBCSR(A, x, z, y, nullptr));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatMultDotLocal_SeqBinBCSR(Mat A, Vec x, Vec y, PetscScalar *xdoty)
+{
+  PetscInt nx, ny;
+
+  PetscFunctionBegin;
+  PetscCheck(A->assembled, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Not for unassembled matrix");
+  PetscCheck(x != y, PETSC_COMM_SELF, PETSC_ERR_ARG_IDN, "x and y must be different vectors");
+  PetscCall(VecGetLocalSize(x, &nx));
+  PetscCall(VecGetLocalSize(y, &ny));
+  PetscCheck(nx == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Mat A,Vec x: local dim %" PetscInt_FMT " %" PetscInt_FMT, A->cmap->n, nx);
+  PetscCheck(ny == A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Mat A,Vec y: local dim %" PetscInt_FMT " %" PetscInt_FMT, A->rmap->n, ny);
+  PetscCheck(A->rmap->n == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "x.y needs a square matrix");
+  PetscCall(PetscLogEventBegin(MAT_BinBCSR_MultDot, A, x, y, 0));
+  PetscCall(MatMultKernel_SeqBinBCSR(A, x, nullptr, y, xdoty));
+  PetscCall(PetscLogEventEnd(MAT_BinBCSR_MultDot, A, x, y, 0));
+  PetscCall(PetscObjectStateIncrease((PetscObject)y));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatMultTransposeKernel_SeqBinBCSR(Mat A, Vec xx, Vec zz, Vec yy)
+{
+  Mat_SeqBinBCSR    *a = (Mat_SeqBinBCSR *)A->data;
+  const PetscScalar *x;
+  PetscScalar       *y;
+
+  PetscFunctionBegin;
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
+  if (zz && zz != yy) PetscCall(VecCopy(zz, yy));
+  else if (!zz) PetscCall(VecSet(yy, 0.0));
+  PetscCall(VecGetArrayRead(xx, &x));
+  PetscCall(VecGetArray(yy, &y));
+  if (a->val) mult_transpose_dispatch<double>(a, a->val, x, y);
+  else mult_transpose_dispatch<float>(a, a->valf, x, y);
+  PetscCall(VecRestoreArrayRead(xx, &x));
+  PetscCall(VecRestoreArray(yy, &y));
+  PetscCall(PetscLogFlops(2.0 * a->nz * a->bs2));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatMultTranspose_SeqBinBCSR(Mat A, Vec x, Vec y)
+{
+  PetscFunctionBegin;
+  PetscCall(MatMultTransposeKernel_SeqBinBCSR(A, x, nullptr, y));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatMultTransposeAdd_SeqBinBCSR(Mat A, Vec x, Vec z, Vec y)
+{
+  PetscFunctionBegin;
+  PetscCall(MatMultTransposeKernel_SeqBinBCSR(A, x, z, y));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatGetDiagonal_SeqBinBCSR(Mat A, Vec v)
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  PetscScalar    *d;
+  PetscInt        n;
+
+  PetscFunctionBegin;
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
+  PetscCall(VecGetLocalSize(v, &n));
+  PetscCheck(n == A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Nonconforming matrix and vector: %" PetscInt_FMT " rows, vector of %" PetscInt_FMT, A->rmap->n, n);
+  PetscCall(VecGetArrayWrite(v, &d));
+  for (PetscInt r = 0; r < a->mbs; r++) {
+    const PetscInt s = a->diag_slot[r];
+    for (PetscInt i = 0; i < a->bs; i++) d[r * a->bs + i] = s < 0 ? 0.0 : BinBCSRGetValue(a, BinBCSRValueIndex(s, i * a->bs + i, a->bw, a->bs2));
+  }
+  PetscCall(VecRestoreArrayWrite(v, &d));
+  PetscFunctionReturn(0);
+}
+
+/* In-place inverse of one bs x bs block by Gauss-Jordan with partial pivoting on [m | I] (block sizes
+   without a PETSc kernel); aug holds bs * 2bs scalars. Returns false on a zero pivot. */
+static PetscBool InvertBlockGeneric(PetscInt bs, MatScalar *m, MatScalar *aug)
+{
+  const PetscInt w = 2 * bs;
+  for (PetscInt i = 0; i < bs; i++)
+    for (PetscInt j = 0; j < bs; j++) {
+      aug[i * w + j]      = m[i * bs + j];
+      aug[i * w + bs + j] = (i == j) ? 1.0 : 0.0;
+    }
+  for (PetscInt k = 0; k < bs; k++) {
+    PetscInt  p   = k;
+    PetscReal big = PetscAbsScalar(aug[k * w + k]);
+    for (PetscInt i = k + 1; i < bs; i++)
+      if (PetscAbsScalar(aug[i * w + k]) > big) {
+        big = PetscAbsScalar(aug[i * w + k]);
+        p   = i;
+      }
+    if (big < PETSC_MACHINE_EPSILON) return PETSC_FALSE;
+    if (p != k)
+      for (PetscInt j = 0; j < w; j++) {
+        const MatScalar t = aug[k * w + j];
+        aug[k * w + j]    = aug[p * w + j];
+        aug[p * w + j]    = t;
+      }
+    const MatScalar inv = 1.0 / aug[k * w + k];
+    for (PetscInt j = 0; j < w; j++) aug[k * w + j] *= inv;
+    for (PetscInt i = 0; i < bs; i++) {
+      if (i == k) continue;
+      const MatScalar f = aug[i * w + k];
+      if (f != 0.0)
+        for (PetscInt j = 0; j < w; j++) aug[i * w + j] -= f * aug[k * w + j];
+    }
+  }
+  for (PetscInt i = 0; i < bs; i++)
+    for (PetscInt j = 0; j < bs; j++) m[i * bs + j] = aug[i * w + bs + j];
+  return PETSC_TRUE;
+}
+
+PetscErrorCode MatInvertBlockDiagonal_SeqBinBCSR(Mat A, const PetscScalar **values)
+{
+  Mat_SeqBinBCSR *a  = (Mat_SeqBinBCSR *)A->data;
+  const PetscInt  bs = a->bs, bs2 = a->bs2;
+  PetscBool       allowzeropivot = PetscNot(A->erroriffailure), zeropivot = PETSC_FALSE;
+  MatScalar      *aug;
+
+  PetscFunctionBegin;
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
+  if (!a->idiag) PetscCall(PetscMalloc1((size_t)a->mbs * bs2, &a->idiag));
+  PetscCall(PetscMalloc1(2 * bs2, &aug));
+  for (PetscInt r = 0; r < a->mbs; r++) {
+    MatScalar     *d = a->idiag + (size_t)r * bs2;
+    const PetscInt s = a->diag_slot[r];
+    /* the block, transposed into BAIJ's column-major order */
+    for (PetscInt i = 0; i < bs; i++)
+      for (PetscInt j = 0; j < bs; j++) d[j * bs + i] = s < 0 ? 0.0 : BinBCSRGetValue(a, BinBCSRValueIndex(s, i * bs + j, a->bw, bs2));
+    PetscBool zp = PETSC_FALSE;
+    if (bs == 1) {
+      zp = PetscAbsScalar(d[0]) < PETSC_MACHINE_EPSILON ? PETSC_TRUE : PETSC_FALSE;
+      if (!zp) d[0] = 1.0 / d[0];
+    } else if (bs == 3) {
+      PetscCall(PetscKernel_A_gets_inverse_A_3(d, 0.0, PETSC_TRUE, &zp));
+    } else {
+      zp = InvertBlockGeneric(bs, d, aug) ? PETSC_FALSE : PETSC_TRUE;
+    }
+    if (zp) {
+      PetscCheck(allowzeropivot, PETSC_COMM_SELF, PETSC_ERR_MAT_LU_ZRPVT, "Zero pivot in the diagonal block of block row %" PetscInt_FMT, r);
+      zeropivot                      = PETSC_TRUE;
+      A->factorerror_zeropivot_row   = r * bs;
+      A->factorerror_zeropivot_value = 0.0;
+    }
+  }
+  if (zeropivot) A->factorerrortype = MAT_FACTOR_NUMERIC_ZEROPIVOT;
+  PetscCall(PetscFree(aug));
+  if (values) *values = a->idiag;
+  PetscFunctionReturn(0);
+}

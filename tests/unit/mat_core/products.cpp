@@ -1,0 +1,109 @@
+// MatMult, MatMultAdd, MatMultTranspose(+Add) and MatMultDotLocal of MATSEQBINBCSR against seqaij, on
+// random, FEM-like and wild patterns, several bin widths, block sizes and both precisions.
+#include "support.h"
+
+using namespace mat_core;
+
+namespace
+{
+
+void check_products(const Pattern &p, PetscInt bw, MatBinBCSRPrecision prec)
+{
+  Mat ref = build(p, MATSEQAIJ);
+  Mat A   = build(p, MATSEQBINBCSR, bw, prec);
+  // float storage rounds each value by at most FLT_EPSILON/2 relative
+  const double unit = prec == MAT_BINBCSR_PRECISION_SINGLE ? FLT_EPSILON / 2 : 0.0;
+  Vec          x = make_vec(p.n, 1), z = make_vec(p.m, 2), y, yref;
+  Vec          xt = make_vec(p.m, 3), zt = make_vec(p.n, 4), yt, ytref;
+  REQUIRE(VecDuplicate(z, &y) == 0);
+  REQUIRE(VecDuplicate(z, &yref) == 0);
+  REQUIRE(VecDuplicate(zt, &yt) == 0);
+  REQUIRE(VecDuplicate(zt, &ytref) == 0);
+  const auto xv = values(x), xtv = values(xt);
+
+  SECTION("mult")
+  {
+    REQUIRE(MatMult(A, x, y) == 0);
+    REQUIRE(MatMult(ref, x, yref) == 0);
+    check_close(values(y), values(yref), mult_bound(p, xv, unit, false));
+  }
+  SECTION("mult add, separate and in place")
+  {
+    REQUIRE(MatMultAdd(A, x, z, y) == 0);
+    REQUIRE(MatMultAdd(ref, x, z, yref) == 0);
+    check_close(values(y), values(yref), mult_bound(p, xv, unit, false));
+    REQUIRE(VecCopy(z, y) == 0);
+    REQUIRE(MatMultAdd(A, x, y, y) == 0);
+    check_close(values(y), values(yref), mult_bound(p, xv, unit, false));
+  }
+  SECTION("transpose")
+  {
+    REQUIRE(MatMultTranspose(A, xt, yt) == 0);
+    REQUIRE(MatMultTranspose(ref, xt, ytref) == 0);
+    check_close(values(yt), values(ytref), mult_bound(p, xtv, unit, true));
+    REQUIRE(MatMultTransposeAdd(A, xt, zt, yt) == 0);
+    REQUIRE(MatMultTransposeAdd(ref, xt, zt, ytref) == 0);
+    check_close(values(yt), values(ytref), mult_bound(p, xtv, unit, true));
+    REQUIRE(VecCopy(zt, yt) == 0);
+    REQUIRE(MatMultTransposeAdd(A, xt, yt, yt) == 0);
+    check_close(values(yt), values(ytref), mult_bound(p, xtv, unit, true));
+  }
+  if (p.m == p.n) {
+    SECTION("fused mult and local dot")
+    {
+      PetscScalar dot = -1, dotref;
+      REQUIRE(MatMultDotLocal(A, x, y, &dot) == 0);
+      REQUIRE(MatMult(ref, x, yref) == 0);
+      const auto yb = mult_bound(p, xv, unit, false);
+      check_close(values(y), values(yref), yb);
+      REQUIRE(VecDot(yref, x, &dotref) == 0);
+      double dbound = 0;
+      for (size_t i = 0; i < xv.size(); i++) dbound += std::fabs(xv[i]) * yb[i] + 1e-14 * std::fabs(xv[i] * values(yref)[i]);
+      CHECK(std::fabs(dot - dotref) <= dbound + 1e-12);
+    }
+  }
+  VecDestroy(&x);
+  VecDestroy(&z);
+  VecDestroy(&y);
+  VecDestroy(&yref);
+  VecDestroy(&xt);
+  VecDestroy(&zt);
+  VecDestroy(&yt);
+  VecDestroy(&ytref);
+  MatDestroy(&A);
+  MatDestroy(&ref);
+}
+
+} // namespace
+
+TEST_CASE("products on random patterns, bs 1 and 3, bin widths, both precisions", "[mat_core][mult]")
+{
+  const PetscInt            bs   = GENERATE(1, 3, 2);
+  const PetscInt            bw   = GENERATE(1, 3, 4, 8, 16, 32);
+  const MatBinBCSRPrecision prec = GENERATE(MAT_BINBCSR_PRECISION_DOUBLE, MAT_BINBCSR_PRECISION_SINGLE);
+  CAPTURE(bs, bw, prec);
+  check_products(random_pattern(37, 37, bs, 9, 11 + bs), bw, prec); // 37: not a multiple of any width
+  check_products(random_pattern(23, 41, bs, 6, 5 + bs), bw, prec);  // rectangular
+}
+
+TEST_CASE("products on a FEM-like 3x3 block stencil", "[mat_core][mult]")
+{
+  const PetscInt            bw   = GENERATE(4, 8, 16);
+  const MatBinBCSRPrecision prec = GENERATE(MAT_BINBCSR_PRECISION_DOUBLE, MAT_BINBCSR_PRECISION_SINGLE);
+  CAPTURE(bw, prec);
+  check_products(fem_pattern(5, 4, 3), bw, prec);
+}
+
+TEST_CASE("products with rows of 1 and 500 blocks in one bin, a single row, an empty matrix", "[mat_core][mult]")
+{
+  const PetscInt bs = GENERATE(1, 3);
+  const PetscInt bw = GENERATE(4, 8, 5);
+  CAPTURE(bs, bw);
+  check_products(wild_pattern(600, bs, 500), bw, MAT_BINBCSR_PRECISION_DOUBLE);
+  check_products(wild_pattern(600, bs, 500), bw, MAT_BINBCSR_PRECISION_SINGLE);
+  check_products(random_pattern(1, 1, bs, 1, 3), bw, MAT_BINBCSR_PRECISION_DOUBLE);
+  Pattern empty;
+  empty.m = empty.n = 4 * bs;
+  empty.bs          = bs;
+  check_products(empty, bw, MAT_BINBCSR_PRECISION_DOUBLE);
+}
