@@ -508,6 +508,24 @@ static PetscErrorCode MatSetFromOptions_SeqBinBCSR(Mat A, PetscOptionItems *Pets
   PetscFunctionReturn(0);
 }
 
+/* Minimal MatGetInfo so that programs asking for it work before binbcsr_ops.cpp provides the full one
+   (MatSeqBinBCSRSetOps_Ops runs after this table is filled and may replace it). */
+static PetscErrorCode MatGetInfo_SeqBinBCSR_Basic(Mat A, MatInfoType flag, MatInfo *info)
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+
+  PetscFunctionBegin;
+  (void)flag;
+  PetscCall(PetscMemzero(info, sizeof(*info)));
+  info->block_size   = (PetscLogDouble)a->bs;
+  info->nz_used      = a->built ? (PetscLogDouble)a->nz * a->bs2 : 0;
+  info->nz_allocated = a->built ? (PetscLogDouble)a->nslots * a->bs2 : 0;
+  info->nz_unneeded  = info->nz_allocated - info->nz_used;
+  info->assemblies   = (PetscLogDouble)A->num_ass;
+  info->memory       = 0;
+  PetscFunctionReturn(0);
+}
+
 static const char *const composed_names[] = {"MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatSeqAIJSetPreallocation_C", "MatSeqBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatConvert_seqbinbcsr_seqaij_C", "MatConvert_seqbinbcsr_seqbaij_C"};
 
 static PetscErrorCode MatDestroy_SeqBinBCSR(Mat A)
@@ -562,6 +580,7 @@ PetscErrorCode MatCreate_SeqBinBCSR(Mat A)
   A->ops->view                = MatView_SeqBinBCSR;
   A->ops->convertfrom         = MatConvertFrom_SeqBinBCSR;
   A->ops->setfromoptions      = MatSetFromOptions_SeqBinBCSR;
+  A->ops->getinfo             = MatGetInfo_SeqBinBCSR_Basic;
 
   PetscCall(PetscObjectChangeTypeName((PetscObject)A, MATSEQBINBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRSetBinWidth_C", MatBinBCSRSetBinWidth_SeqBinBCSR));
