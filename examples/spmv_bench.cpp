@@ -19,8 +19,8 @@
 //   baij:    blocks (8 bs^2 + 4) + 4 (block rows + 1)
 //   sbaij:   upper blocks incl. diagonal (8 bs^2 + 4) + 4 (block rows + 1)
 //   sell:    padded slots (8 + 4) + 4 (slices + 1), slices of 8 rows padded to their longest row
-//   binbcsr: padded blocks (s bs^2 + 4) + 4 (bins + 1), s = 8 (double) or 4 (single), bins of
-//            bin_width (block) rows padded to their longest row
+//   binbcsr: slots (s bs^2 + 4) + 4 (bins + 1), s = 8 (double) or 4 (single); slots = sum over bins
+//            of bin_width x the bin's longest (block) row; padding overhead = slots / blocks - 1
 //   + 8 N (x) + 8 N (y)
 #include <petscbinbcsr.h>
 
@@ -171,7 +171,8 @@ PetscErrorCode MeasureStats(Mat aij, MatrixStats *st)
   PetscFunctionReturn(0);
 }
 
-// Stored blocks of BIN-(B)CSR with bins of bin_width local block rows, each padded to its longest row.
+// Stored blocks (slots) of BIN-(B)CSR: bins of bin_width local block rows, each padded to its longest
+// row, the last bin completed with phantom lanes (as src/mat_binbcsr/seq/binbcsr.h lays them out).
 double BinnedBlocks(const MatrixStats &st, PetscInt bin_width, MPI_Comm comm, double *bins)
 {
   double         slots = 0, nb = 0;
@@ -180,7 +181,7 @@ double BinnedBlocks(const MatrixStats &st, PetscInt bin_width, MPI_Comm comm, do
     const PetscInt end     = std::min(n, start + bin_width);
     PetscInt       longest = 0;
     for (PetscInt r = start; r < end; ++r) longest = std::max(longest, st.block_row_len[r]);
-    slots += (double)longest * (double)(end - start);
+    slots += (double)longest * (double)bin_width; // the last bin is completed with phantom lanes
     nb += 1;
   }
   double s[2] = {slots, nb};
