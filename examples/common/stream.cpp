@@ -26,7 +26,7 @@ __attribute__((noinline)) void Triad(double *__restrict a, const double *__restr
 
 } // namespace
 
-PetscErrorCode MeasureStreamTriad(MPI_Comm comm, PetscInt n, PetscInt repeats, StreamResult *result)
+PetscErrorCode TriadArraysCreate(MPI_Comm comm, PetscInt n, TriadArrays *t)
 {
   PetscMPIInt size;
 
@@ -37,38 +37,60 @@ PetscErrorCode MeasureStreamTriad(MPI_Comm comm, PetscInt n, PetscInt repeats, S
     const size_t total = std::max<size_t>(4 * llc / sizeof(double), (size_t)32 << 20); // elements per array, all ranks
     n = (PetscInt)(total / (size_t)size);
   }
-  if (repeats <= 0) repeats = 10;
-
-  double *a, *b, *c;
-  PetscCall(PetscMalloc3(n, &a, n, &b, n, &c));
+  PetscCall(PetscMalloc3(n, &t->a, n, &t->b, n, &t->c));
   for (PetscInt i = 0; i < n; ++i) { // first touch by the rank that uses the pages
-    a[i] = 0.0;
-    b[i] = 1.0;
-    c[i] = 2.0;
+    t->a[i] = 0.0;
+    t->b[i] = 1.0;
+    t->c[i] = 2.0;
   }
-  Triad(a, b, c, 3.0, n); // warm-up: page faults and TLB out of the timings
+  Triad(t->a, t->b, t->c, 3.0, n); // warm-up: page faults and TLB out of the timings
+  t->n     = n;
+  t->bytes = 3.0 * sizeof(double) * (double)n * size;
+  PetscFunctionReturn(0);
+}
 
+PetscErrorCode TriadArraysRun(MPI_Comm comm, TriadArrays *t, double *seconds)
+{
+  PetscFunctionBegin;
+  PetscCallMPI(MPI_Barrier(comm));
+  const double t0 = MPI_Wtime();
+  Triad(t->a, t->b, t->c, 3.0, t->n);
+  double s = MPI_Wtime() - t0;
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_MAX, comm));
+  *seconds = s;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode TriadArraysDestroy(TriadArrays *t)
+{
+  PetscFunctionBegin;
+  if (t->a) {
+    volatile double sink = t->a[t->n / 2]; // keeps the stores observable
+    (void)sink;
+  }
+  PetscCall(PetscFree3(t->a, t->b, t->c));
+  t->n = 0;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MeasureStreamTriad(MPI_Comm comm, PetscInt n, PetscInt repeats, StreamResult *result)
+{
+  PetscMPIInt size;
+  TriadArrays t;
+
+  PetscFunctionBegin;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  if (repeats <= 0) repeats = 10;
+  PetscCall(TriadArraysCreate(comm, n, &t));
   std::vector<double> seconds((size_t)repeats);
-  for (PetscInt r = 0; r < repeats; ++r) {
-    PetscCallMPI(MPI_Barrier(comm));
-    const double t0 = MPI_Wtime();
-    Triad(a, b, c, 3.0, n);
-    double t = MPI_Wtime() - t0;
-    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &t, 1, MPI_DOUBLE, MPI_MAX, comm));
-    seconds[(size_t)r] = t;
-  }
-  // Keeps the stores observable.
-  volatile double sink = a[n / 2];
-  (void)sink;
-  PetscCall(PetscFree3(a, b, c));
-
+  for (PetscInt r = 0; r < repeats; ++r) PetscCall(TriadArraysRun(comm, &t, &seconds[(size_t)r]));
   std::sort(seconds.begin(), seconds.end());
-  const double bytes = 3.0 * sizeof(double) * (double)n * size;
-  result->best_GBs          = bytes / seconds.front() * 1e-9;
-  result->median_GBs        = bytes / seconds[seconds.size() / 2] * 1e-9;
-  result->elements_per_rank = n;
+  result->best_GBs          = t.bytes / seconds.front() * 1e-9;
+  result->median_GBs        = t.bytes / seconds[seconds.size() / 2] * 1e-9;
+  result->elements_per_rank = t.n;
   result->repeats           = repeats;
   result->ranks             = size;
+  PetscCall(TriadArraysDestroy(&t));
   PetscFunctionReturn(0);
 }
 

@@ -14,6 +14,19 @@ struct StreamResult {
   int      ranks     = 1;
 };
 
+// The arrays of one rank, for callers that interleave triad passes with other measurements (so that
+// both see the same load from other processes).
+struct TriadArrays {
+  double  *a = nullptr, *b = nullptr, *c = nullptr;
+  PetscInt n = 0;      // elements per array on this rank
+  double   bytes = 0;  // bytes one pass moves, all ranks together
+};
+// n <= 0: the default size below. Allocates and first-touches.
+PetscErrorCode TriadArraysCreate(MPI_Comm comm, PetscInt n, TriadArrays *t);
+// One timed pass on every rank at once; *seconds = the slowest rank's time.
+PetscErrorCode TriadArraysRun(MPI_Comm comm, TriadArrays *t, double *seconds);
+PetscErrorCode TriadArraysDestroy(TriadArrays *t);
+
 // elements_per_rank <= 0: each of the three arrays, summed over the ranks, is 4x the last-level
 // cache (at least 32 Mi doubles in all), as STREAM's rules ask. repeats <= 0: 10.
 PetscErrorCode MeasureStreamTriad(MPI_Comm comm, PetscInt elements_per_rank, PetscInt repeats, StreamResult *result);
