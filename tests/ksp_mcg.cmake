@@ -26,3 +26,8 @@ set_tests_properties(ksp_mcg_stock_ex4_np2 ksp_mcg_stock_ex72_np2 PROPERTIES LAB
 # The unit tests are written for any communicator size: run them on two ranks as well.
 add_test(NAME unit_ksp_mcg_np2 COMMAND ${MPIEXEC_CMD} -n 2 $<TARGET_FILE:test_ksp_mcg>)
 set_tests_properties(unit_ksp_mcg_np2 PROPERTIES LABELS "ksp_mcg;mpi" PROCESSORS 2)
+
+# solve_bench is a benchmark program; this only checks that it runs end to end on a tiny grid.
+add_test(NAME ksp_mcg_solve_bench_smoke
+         COMMAND solve_bench -stencil_n 4 -repeats 1 -history_its 10 -csv solve_bench_smoke.csv -history_csv solve_bench_smoke_history.csv)
+set_tests_properties(ksp_mcg_solve_bench_smoke PROPERTIES LABELS "ksp_mcg;bench")
