@@ -20,7 +20,15 @@ add_test(NAME ksp_mcg_stock_ex4_np2
          COMMAND ${MCG_COMPARE} 1 ${MPIEXEC_CMD} -n 2 -- $<TARGET_FILE:stock_ksp_ex4> -bs 3 -m 20 -n 20 -pc_type jacobi -dll_append ${PLUGIN})
 add_test(NAME ksp_mcg_stock_ex72_np2
          COMMAND ${MCG_COMPARE} 1 ${MPIEXEC_CMD} -n 2 -- $<TARGET_FILE:stock_ksp_ex72> -f0 ${MCG_SPD} -pc_type jacobi -dll_append ${PLUGIN})
-set_tests_properties(ksp_mcg_stock_ex4 ksp_mcg_stock_ex4_nopc ksp_mcg_stock_ex72 ksp_mcg_stock_ex72_bjacobi PROPERTIES LABELS "ksp_mcg")
+# the same with binbcsr storage (double and single values); the fused product is used by mcg
+add_test(NAME ksp_mcg_stock_ex4_binbcsr
+         COMMAND ${MCG_COMPARE} 1 -- $<TARGET_FILE:stock_ksp_ex4> -bs 3 -m 20 -n 20 -mat_type binbcsr -pc_type jacobi -dll_append ${PLUGIN})
+add_test(NAME ksp_mcg_stock_ex4_binbcsr_single
+         COMMAND ${MCG_COMPARE} 1 -- $<TARGET_FILE:stock_ksp_ex4> -bs 3 -m 20 -n 20 -mat_type binbcsr -mat_binbcsr_precision single -pc_type jacobi -dll_append ${PLUGIN})
+add_test(NAME ksp_mcg_stock_ex72_binbcsr
+         COMMAND ${MCG_COMPARE} 1 -- $<TARGET_FILE:stock_ksp_ex72> -f0 ${MCG_SPD} -matload_block_size 3 -mat_convert_type binbcsr -pc_type jacobi -dll_append ${PLUGIN})
+set_tests_properties(ksp_mcg_stock_ex4 ksp_mcg_stock_ex4_nopc ksp_mcg_stock_ex72 ksp_mcg_stock_ex72_bjacobi
+                     ksp_mcg_stock_ex4_binbcsr ksp_mcg_stock_ex4_binbcsr_single ksp_mcg_stock_ex72_binbcsr PROPERTIES LABELS "ksp_mcg")
 set_tests_properties(ksp_mcg_stock_ex4_np2 ksp_mcg_stock_ex72_np2 PROPERTIES LABELS "ksp_mcg;mpi" PROCESSORS 2)
 
 # The unit tests are written for any communicator size: run them on two ranks as well.

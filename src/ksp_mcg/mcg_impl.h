@@ -23,6 +23,7 @@ typedef struct {
   MCGPreconditioning how;
   char               why_generic[160]; /* why the fused path was not taken (for KSPView) */
   PetscBool          mat_fused;        /* Amat composes "MatMultDotLocal_C" */
+  PetscBool          single_storage;   /* Amat stores its values in single precision */
 
   /* Jacobi diagonal owned by KSPMCG, rebuilt when the preconditioning matrix changes */
   Vec              dinv;

@@ -278,6 +278,13 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
   S = ksp->work[4];
   PetscCall(PCGetOperators(ksp->pc, &Amat, &Pmat));
   PetscCall(MCGChoosePath(ksp, Amat));
+  {
+    MatBinBCSRPrecision precision;
+    PetscCall(MatBinBCSRGetPrecision(Amat, &precision));
+    mcg->single_storage = precision == MAT_BINBCSR_PRECISION_SINGLE ? PETSC_TRUE : PETSC_FALSE;
+    if (mcg->single_storage && ksp->rtol < 1e-6)
+      PetscCall(PetscInfo(ksp, "rtol %g with single-precision matrix storage: residuals are relative to the rounded operator; against double-precision values expect a floor near 1e-7\n", (double)ksp->rtol));
+  }
   if (mcg->how == MCG_PC_JACOBI) PetscCall(MCGUpdateDiagonal(ksp));
   max_its           = mcg->fixed_its > 0 ? mcg->fixed_its : ksp->max_it;
   mcg->restarts     = 0;
