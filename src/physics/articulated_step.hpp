@@ -1,0 +1,57 @@
+// One time step of an articulated scene with impulse-based ball joints (Bender & Schmitt 2006, Weinstein,
+// Teran & Fedkiw 2006), every impulse solve going through J M^-1 J^T lambda = rhs:
+//   1. A = J M^-1 J^T at the current orientations (pattern fixed, values refilled).
+//   2. Velocity post-stabilisation of the previous step: solve A mu = -J v once and apply (J v = 0).
+//   3. Free velocity update (gravity, implicit gyroscopic term).
+//   4. Prediction/correction: predict connector positions after dt with the current velocities, C(x~);
+//      if max |C| >= joint_tol, solve A lambda = -C(x~)/dt, apply the impulses, predict again.
+//   5. Advance positions with the corrected velocities: the joint error after the step is the last
+//      predicted one.
+// Kinematic loops can make A singular. The solver's failure (or a correction that makes the error grow)
+// marks the scene singular; from then on A + eps * diag(A) is used (Tikhonov regularisation, eps =
+// regularisation), which keeps A SPD and the prediction/correction loop still drives C to zero wherever
+// the joints are consistent.
+#pragma once
+#include "physics/block_solver.hpp"
+#include "physics/joint_matrix.hpp"
+
+namespace physics {
+
+struct ArticulatedParams {
+  double dt                     = 1.0 / 60.0;
+  double joint_tol              = 1e-6; // metres
+  int    max_corrections        = 20;
+  int    max_halvings           = 8;    // backtracking steps when a correction makes the error grow
+  double regularisation         = 1e-6; // relative to the diagonal, used once A is found singular
+  bool   velocity_stabilisation = true;
+  bool   regularise_from_start  = false;
+  bool   refresh_matrix         = false; // refill A at the predicted orientations for every correction after the first
+};
+
+struct ArticulatedStepReport {
+  int    corrections       = 0;     // impulse solves in the prediction/correction loop
+  int    linear_solves     = 0;     // all solves, stabilisation included
+  int    linear_iterations = 0;     // summed over the solves
+  double velocity_error    = 0;     // max |J v| before stabilisation
+  double joint_error       = 0;     // max |C| after the step
+  bool   converged         = false; // joint_error < joint_tol
+  bool   singular_detected = false; // this step found A singular and switched to regularisation
+  bool   stalled           = false; // a correction could not reduce the error
+};
+
+struct ArticulatedSolver {
+  JointMatrixPattern  pattern;
+  std::vector<double> block_values;
+  bool                regularised = false;
+  std::vector<double> rhs, impulses, errors; // scratch
+};
+
+ArticulatedSolver make_articulated_solver(const ArticulatedScene &scene, const ArticulatedParams &params);
+
+// Empty string if the parameters are usable, otherwise what is wrong.
+std::string validate_params(const ArticulatedParams &params);
+
+ArticulatedStepReport articulated_step(ArticulatedScene &scene, ArticulatedSolver &solver, const ArticulatedParams &params,
+                                       const BlockLinearSolver &linear_solver);
+
+} // namespace physics

@@ -1,0 +1,20 @@
+// The physics library's view of a linear solver for a fixed-pattern 3x3-block system: the drivers plug in
+// PETSc (any -mat_type/-ksp_type), the tests may plug in a reference solver. Kept free of PETSc on purpose.
+#pragma once
+#include <functional>
+#include <vector>
+
+namespace physics {
+
+struct LinearSolveResult {
+  int  iterations = 0;
+  bool converged  = true; // false when the solver reports divergence (breakdown, indefinite, max its)
+};
+
+struct BlockLinearSolver {
+  // New values for the pattern the solver was built with: 9 per COO block, row-major.
+  std::function<void(const std::vector<double> &block_values)> set_matrix;
+  std::function<LinearSolveResult(const std::vector<double> &rhs, std::vector<double> &solution)> solve;
+};
+
+} // namespace physics

@@ -1,0 +1,39 @@
+// The joint system matrix A = J M^-1 J^T of ball joints: one 3x3 block row per joint, a nonzero block
+// (j, k) wherever joints j and k share a body. The pattern (COO list of blocks, both triangles) is
+// built once; the values are refilled in place every step from the bodies' current orientations.
+#pragma once
+#include "physics/articulated_scene.hpp"
+
+#include <vector>
+
+namespace physics {
+
+struct JointMatrixPattern {
+  int              n_joints = 0;
+  std::vector<int> block_row, block_col; // COO of 3x3 blocks, row-sorted, no duplicates
+  std::vector<int> diagonal_block;       // COO index of block (j, j)
+  // For every body with joints: its joints, the sign of each (+1 if the body is end a), and the COO
+  // index of each (joint p, joint q) pair, p-major. Flattened over bodies.
+  std::vector<int> body_of_group, group_start; // group g covers joints group_start[g]..group_start[g+1]-1
+  std::vector<int> group_joint, group_sign;
+  std::vector<int> pair_start, pair_block;     // pair_block[pair_start[g] + p*n_g + q]
+};
+
+JointMatrixPattern build_joint_matrix_pattern(const ArticulatedScene &scene);
+
+// Block contribution of one body to A: the velocity change of the point at world arm r1 per unit impulse at
+// arm r2, (1/m) I - [r1]x I^-1 [r2]x.
+Eigen::Matrix3d body_coupling_block(double mass, const Eigen::Matrix3d &inverse_inertia_world, const Eigen::Vector3d &r1,
+                                    const Eigen::Vector3d &r2);
+
+// Fills 9 values per COO block (row-major) for the scene's current orientations. regularisation > 0
+// adds regularisation * (mean diagonal entry of the block) * I to each diagonal block.
+// `orientations`, when given, replaces the bodies' orientations (the matrix at predicted positions).
+void fill_joint_matrix(const ArticulatedScene &scene, const JointMatrixPattern &pattern, double regularisation,
+                       std::vector<double> &block_values, const std::vector<Eigen::Quaterniond> *orientations = nullptr);
+
+// y = A x with the block values (reference product for tests and diagnostics).
+void joint_matrix_multiply(const JointMatrixPattern &pattern, const std::vector<double> &block_values, const std::vector<double> &x,
+                           std::vector<double> &y);
+
+} // namespace physics

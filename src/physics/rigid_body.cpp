@@ -1,0 +1,67 @@
+#include "physics/rigid_body.hpp"
+
+namespace physics {
+
+Eigen::Matrix3d box_inertia(double mass, const Eigen::Vector3d &size)
+{
+  const Eigen::Vector3d s2 = size.cwiseProduct(size);
+  return (mass / 12.0 * Eigen::Vector3d(s2.y() + s2.z(), s2.x() + s2.z(), s2.x() + s2.y())).asDiagonal();
+}
+
+Eigen::Matrix3d world_inverse_inertia(const RigidBody &body)
+{
+  const Eigen::Matrix3d R = body.orientation.toRotationMatrix();
+  return R * body.inertia_body.inverse() * R.transpose();
+}
+
+Eigen::Quaterniond rotated(const Eigen::Quaterniond &q, const Eigen::Vector3d &angular_velocity, double dt)
+{
+  const double angle = angular_velocity.norm() * dt;
+  if (angle < 1e-300) return q;
+  Eigen::Quaterniond r(Eigen::AngleAxisd(angle, angular_velocity.normalized()));
+  Eigen::Quaterniond out = r * q;
+  out.normalize();
+  return out;
+}
+
+static Eigen::Matrix3d cross_matrix(const Eigen::Vector3d &a)
+{
+  Eigen::Matrix3d m;
+  m << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
+  return m;
+}
+
+void apply_unconstrained_velocity_update(RigidBody &body, const Eigen::Vector3d &gravity, double dt)
+{
+  body.velocity += dt * gravity;
+  // Solve I (w' - w) + dt w' x (I w') = 0 in the body frame with one Newton step from w (Catto 2015):
+  // explicit treatment of the gyroscopic term adds energy to bodies spinning about unstable axes.
+  const Eigen::Matrix3d  R  = body.orientation.toRotationMatrix();
+  const Eigen::Matrix3d &I  = body.inertia_body;
+  const Eigen::Vector3d  wb = R.transpose() * body.angular_velocity;
+  const Eigen::Vector3d  residual = dt * wb.cross(I * wb);
+  const Eigen::Matrix3d  jacobian = I + dt * (cross_matrix(wb) * I - cross_matrix(I * wb));
+  const Eigen::Vector3d  wb_new   = wb - jacobian.partialPivLu().solve(residual);
+  body.angular_velocity           = R * wb_new;
+}
+
+void advance_positions(RigidBody &body, double dt)
+{
+  body.position += dt * body.velocity;
+  body.orientation = rotated(body.orientation, body.angular_velocity, dt);
+}
+
+double mechanical_energy(const RigidBody &body, const Eigen::Vector3d &gravity)
+{
+  const Eigen::Matrix3d R = body.orientation.toRotationMatrix();
+  const Eigen::Vector3d wb = R.transpose() * body.angular_velocity;
+  return 0.5 * body.mass * body.velocity.squaredNorm() + 0.5 * wb.dot(body.inertia_body * wb) - body.mass * gravity.dot(body.position);
+}
+
+void apply_impulse(RigidBody &body, const Eigen::Matrix3d &inverse_inertia_world, const Eigen::Vector3d &arm, const Eigen::Vector3d &impulse)
+{
+  body.velocity += impulse / body.mass;
+  body.angular_velocity += inverse_inertia_world * arm.cross(impulse);
+}
+
+} // namespace physics
