@@ -26,7 +26,7 @@ struct BridgeOptions {
   double plank_length = 0.5;
   double plank_width  = 0.3;
   double plank_mass   = 10.0;
-  double sag          = 3.0;
+  double sag          = 10.0;
 };
 ArticulatedScene make_bridge(const BridgeOptions &opt);
 

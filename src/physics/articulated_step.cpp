@@ -94,11 +94,11 @@ ArticulatedStepReport articulated_step(ArticulatedScene &scene, ArticulatedSolve
     report.singular_detected = true;
     refill();
   };
-  // A failed solve on the unregularised matrix means A is (numerically) singular: regularise and retry.
+  // A breakdown on the unregularised matrix means A is (numerically) singular: regularise and retry.
   auto solve = [&]() {
     LinearSolveResult r = linear_solver.solve(s.rhs, s.impulses);
     report.linear_solves++, report.linear_iterations += r.iterations;
-    if (!r.converged && !s.regularised) {
+    if (r.breakdown && !s.regularised) {
       switch_to_regularised();
       r = linear_solver.solve(s.rhs, s.impulses);
       report.linear_solves++, report.linear_iterations += r.iterations;

@@ -7,8 +7,8 @@
 //      if max |C| >= joint_tol, solve A lambda = -C(x~)/dt, apply the impulses, predict again.
 //   5. Advance positions with the corrected velocities: the joint error after the step is the last
 //      predicted one.
-// Kinematic loops can make A singular. The solver's failure (or a correction that makes the error grow)
-// marks the scene singular; from then on A + eps * diag(A) is used (Tikhonov regularisation, eps =
+// Kinematic loops can make A singular. A solver breakdown (CG: indefinite or zero curvature) marks the
+// scene singular; from then on A + eps * diag(A) is used (Tikhonov regularisation, eps =
 // regularisation), which keeps A SPD and the prediction/correction loop still drives C to zero wherever
 // the joints are consistent.
 #pragma once

@@ -8,7 +8,8 @@ namespace physics {
 
 struct LinearSolveResult {
   int  iterations = 0;
-  bool converged  = true; // false when the solver reports divergence (breakdown, indefinite, max its)
+  bool converged  = true;  // false when the solver reports any divergence (max iterations included)
+  bool breakdown  = false; // the solver found the matrix singular or indefinite (the evidence for loops)
 };
 
 struct BlockLinearSolver {

@@ -1,0 +1,233 @@
+// Articulated rigid bodies with impulse-based ball joints (physics/articulated_step.hpp); every joint
+// impulse solve J M^-1 J^T lambda = rhs goes through PETSc with the configured -mat_type/-ksp_type/-pc_type.
+//
+//   articulated -options_file options/chain.opts [-steps N] [-dt H] [-mat_type binbcsr] [-ksp_type mcg]
+//
+// Scenes (-scene): chain (-chain_links, -chain_length, -chain_angle, -chain_mass_first, -chain_mass_last),
+// bridge (-bridge_chains, -bridge_links, -bridge_tie_every, -bridge_sag), loop (four-bar linkage).
+// Solver options: -joint_tol (m), -max_corrections, -joint_regularisation, -joint_refresh,
+// -velocity_stabilisation. Output: a progress line every -progress_every steps, -vtk PREFIX (.vtu per
+// -vtk_every steps plus PREFIX.pvd), -dump_matrix FILE (J M^-1 J^T of the first step, PETSc binary), and a
+// final `summary key=value ...` line.
+#include "common/replicated_solver.h"
+#include "common/summary.h"
+#include "physics/articulated_scenes.hpp"
+#include "physics/articulated_step.hpp"
+#include "physics/kinematic_loops.hpp"
+#include "physics/vtk_writer.hpp"
+
+#include <petscbinbcsr.h>
+
+#include <cmath>
+#include <cstring>
+
+static PetscErrorCode BuildScene(MPI_Comm comm, std::string &name, physics::ArticulatedScene &scene)
+{
+  char      buf[64] = "chain";
+  PetscBool set;
+  PetscFunctionBegin;
+  PetscCall(PetscOptionsGetString(nullptr, nullptr, "-scene", buf, sizeof buf, &set));
+  name = buf;
+  try {
+    if (name == "chain") {
+      physics::ChainOptions o;
+      PetscInt              links = o.links;
+      PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-chain_links", &links, nullptr));
+      o.links = (int)links;
+      PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-chain_length", &o.link_length, nullptr));
+      PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-chain_width", &o.link_width, nullptr));
+      PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-chain_angle", &o.angle, nullptr));
+      PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-chain_mass_first", &o.mass_first, nullptr));
+      PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-chain_mass_last", &o.mass_last, nullptr));
+      PetscCheck(o.mass_first > 0 && o.mass_last > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "link masses must be positive, got %g and %g",
+                 (double)o.mass_first, (double)o.mass_last);
+      scene = physics::make_chain(o);
+    } else if (name == "bridge") {
+      physics::BridgeOptions o;
+      PetscInt               chains = o.chains, links = o.links, tie = o.tie_every;
+      PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-bridge_chains", &chains, nullptr));
+      PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-bridge_links", &links, nullptr));
+      PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-bridge_tie_every", &tie, nullptr));
+      PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-bridge_sag", &o.sag, nullptr));
+      o.chains = (int)chains, o.links = (int)links, o.tie_every = (int)tie;
+      scene = physics::make_bridge(o);
+    } else if (name == "loop") {
+      scene = physics::make_four_bar();
+      PetscReal spin = 2.0;
+      PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-loop_crank_speed", &spin, nullptr));
+      scene.bodies[0].angular_velocity = Eigen::Vector3d(0, 0, spin);
+    } else {
+      SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "unknown -scene %s (chain, bridge, loop)", buf);
+    }
+  } catch (const std::invalid_argument &e) {
+    SETERRQ(comm, PETSC_ERR_ARG_OUTOFRANGE, "scene %s: %s", buf, e.what());
+  }
+  const std::string problem = physics::validate_scene(scene);
+  PetscCheck(problem.empty(), comm, PETSC_ERR_ARG_WRONG, "scene %s: %s", buf, problem.c_str());
+  PetscFunctionReturn(0);
+}
+
+// Bodies as boxes (8 corners, one hexahedron each) or as points (-vtk_points, for huge scenes).
+static bool WriteFrame(const std::string &path, const physics::ArticulatedScene &scene, bool as_points)
+{
+  physics::VtkScene vtk;
+  physics::VtkPointField speed{"speed", 1, {}};
+  if (as_points) {
+    vtk.cell_type = physics::VtkCellType::Vertex, vtk.nodes_per_cell = 1;
+    for (size_t i = 0; i < scene.bodies.size(); ++i) {
+      for (int k = 0; k < 3; ++k) vtk.points.push_back(scene.bodies[i].position[k]);
+      vtk.connectivity.push_back((int)i);
+      speed.values.push_back(scene.bodies[i].velocity.norm());
+    }
+  } else {
+    vtk.cell_type = physics::VtkCellType::Hexahedron, vtk.nodes_per_cell = 8;
+    const int corner[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}};
+    for (size_t i = 0; i < scene.bodies.size(); ++i) {
+      const physics::RigidBody &b = scene.bodies[i];
+      for (int c = 0; c < 8; ++c) {
+        const Eigen::Vector3d local(corner[c][0] * scene.body_sizes[i].x() / 2, corner[c][1] * scene.body_sizes[i].y() / 2, corner[c][2] * scene.body_sizes[i].z() / 2);
+        const Eigen::Vector3d p = b.position + b.orientation * local;
+        for (int k = 0; k < 3; ++k) vtk.points.push_back(p[k]);
+        vtk.connectivity.push_back((int)(8 * i + c));
+        speed.values.push_back(b.velocity.norm());
+      }
+    }
+  }
+  vtk.point_fields.push_back(speed);
+  return physics::write_vtu(path, vtk);
+}
+
+int main(int argc, char **argv)
+{
+  PetscCall(PetscInitialize(&argc, &argv, nullptr, nullptr));
+  PetscCall(PetscBinBCSRRegisterAll());
+  MPI_Comm comm = PETSC_COMM_WORLD;
+  int      rank, size;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+
+  std::string               scene_name;
+  physics::ArticulatedScene scene;
+  PetscCall(BuildScene(comm, scene_name, scene));
+
+  physics::ArticulatedParams params;
+  PetscInt                   steps = 100, progress_every = 1, vtk_every = 1, max_corr = params.max_corrections;
+  PetscBool                  vel_stab = PETSC_TRUE, refresh = PETSC_FALSE, vtk_points = PETSC_FALSE, set_vtk, set_dump;
+  char                       vtk_prefix[PETSC_MAX_PATH_LEN] = "", dump_path[PETSC_MAX_PATH_LEN] = "";
+  PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-steps", &steps, nullptr));
+  PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-dt", &params.dt, nullptr));
+  PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-joint_tol", &params.joint_tol, nullptr));
+  PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-max_corrections", &max_corr, nullptr));
+  params.max_corrections = (int)max_corr;
+  PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-joint_regularisation", &params.regularisation, nullptr));
+  PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-joint_refresh", &refresh, nullptr));
+  PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-velocity_stabilisation", &vel_stab, nullptr));
+  params.refresh_matrix         = refresh;
+  params.velocity_stabilisation = vel_stab;
+  PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-progress_every", &progress_every, nullptr));
+  PetscCall(PetscOptionsGetString(nullptr, nullptr, "-vtk", vtk_prefix, sizeof vtk_prefix, &set_vtk));
+  PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-vtk_every", &vtk_every, nullptr));
+  PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-vtk_points", &vtk_points, nullptr));
+  PetscCall(PetscOptionsGetString(nullptr, nullptr, "-dump_matrix", dump_path, sizeof dump_path, &set_dump));
+  const std::string bad = physics::validate_params(params);
+  PetscCheck(bad.empty(), comm, PETSC_ERR_ARG_OUTOFRANGE, "%s (-dt %g, -joint_tol %g, -max_corrections %d)", bad.c_str(), (double)params.dt,
+             (double)params.joint_tol, params.max_corrections);
+  PetscCheck(steps >= 0 && progress_every >= 1 && vtk_every >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-steps must be >= 0, -progress_every and -vtk_every >= 1");
+  PetscCheck(!scene.joints.empty(), comm, PETSC_ERR_ARG_WRONG, "scene %s has no joints: nothing to solve", scene_name.c_str());
+
+  physics::ArticulatedSolver solver = physics::make_articulated_solver(scene, params);
+  const size_t               loops  = physics::loop_closing_joints(scene).size();
+  ReplicatedSolver           rs;
+  PetscCall(ReplicatedSolverCreate(comm, solver.pattern.n_joints, solver.pattern.block_row, solver.pattern.block_col, &rs));
+  const physics::BlockLinearSolver linear = ReplicatedSolverAdapter(&rs);
+  PetscInt    nnz;
+  const char *mat_type, *ksp_type;
+  PetscCall(BlockSystemGetInfo(&rs.sys, &nnz, &mat_type, &ksp_type));
+  PetscCall(PetscPrintf(comm, "articulated: scene %s, %zu bodies, %zu joints (%zu rows), %zu loops, %" PetscInt_FMT " nonzeros, mat %s, ksp %s, %d ranks\n",
+                        scene_name.c_str(), scene.bodies.size(), scene.joints.size(), 3 * scene.joints.size(), loops, nnz, mat_type, ksp_type, size));
+
+  std::vector<std::pair<std::string, double>> frames;
+  auto write_frame = [&](PetscInt n) -> PetscErrorCode {
+    PetscFunctionBegin;
+    if (set_vtk && rank == 0 && n % vtk_every == 0) {
+      char path[PETSC_MAX_PATH_LEN + 32];
+      std::snprintf(path, sizeof path, "%s_%05d.vtu", vtk_prefix, (int)n);
+      PetscCheck(WriteFrame(path, scene, vtk_points), PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "cannot write %s", path);
+      const char *base = std::strrchr(path, '/');
+      frames.push_back({base ? base + 1 : path, n * params.dt});
+      PetscCheck(physics::write_pvd(std::string(vtk_prefix) + ".pvd", frames), PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "cannot write %s.pvd", vtk_prefix);
+    }
+    PetscFunctionReturn(0);
+  };
+  PetscCall(write_frame(0));
+
+  const double e0 = physics::total_energy(scene);
+  double       e_max = e0, worst_error = 0, worst_velocity = 0, step_ms_total = 0;
+  long long    corrections = 0, max_corrections_seen = 0, unconverged = 0, stalled = 0, singular_steps = 0, nan_steps = 0;
+  for (PetscInt n = 1; n <= steps; ++n) {
+    const long long its0 = rs.iterations, solves0 = rs.solves;
+    const double    solve0 = rs.solve_ms, t0 = WallTime();
+    const physics::ArticulatedStepReport r = physics::articulated_step(scene, solver, params, linear);
+    const double step_ms = 1e3 * (WallTime() - t0);
+    PetscCall(rs.error);
+    step_ms_total += step_ms;
+    bool finite = true;
+    for (const physics::RigidBody &b : scene.bodies) finite &= b.position.allFinite() && b.velocity.allFinite() && b.angular_velocity.allFinite();
+    nan_steps += !finite;
+    corrections += r.corrections;
+    max_corrections_seen = std::max<long long>(max_corrections_seen, r.corrections);
+    unconverged += !r.converged;
+    stalled += r.stalled;
+    singular_steps += r.singular_detected;
+    worst_error    = std::max(worst_error, r.joint_error);
+    worst_velocity = std::max(worst_velocity, r.velocity_error);
+    const double energy = physics::total_energy(scene);
+    e_max               = std::max(e_max, energy);
+    if (n % progress_every == 0 || n == steps)
+      PetscCall(PetscPrintf(comm, "step %" PetscInt_FMT " t=%.4f corrections=%d solves=%lld cg_its=%lld joint_err=%.3e vel_err=%.3e energy=%.6e ms=%.2f solve_ms=%.2f%s%s\n",
+                            n, n * params.dt, r.corrections, rs.solves - solves0, rs.iterations - its0, r.joint_error, r.velocity_error, energy, step_ms,
+                            rs.solve_ms - solve0, r.converged ? "" : " UNCONVERGED", r.singular_detected ? " SINGULAR->regularised" : ""));
+    if (n == 1 && set_dump) PetscCall(BlockSystemDumpMatrix(&rs.sys, dump_path));
+    PetscCall(write_frame(n));
+    if (!finite) break;
+  }
+
+  SummaryLine s;
+  s.add("program", std::string("articulated"));
+  s.add("scene", scene_name);
+  s.add("ranks", (long long)size);
+  s.add("bodies", (long long)scene.bodies.size());
+  s.add("joints", (long long)scene.joints.size());
+  s.add("rows", (long long)(3 * scene.joints.size()));
+  s.add("nnz", (long long)nnz);
+  s.add("loops", (long long)loops);
+  s.add("mat_type", std::string(mat_type));
+  s.add("ksp_type", std::string(ksp_type));
+  s.add("steps", (long long)steps);
+  s.add("dt", params.dt);
+  s.add("ms_per_step", steps ? step_ms_total / steps : 0.0);
+  s.add("solve_ms", steps ? rs.solve_ms / steps : 0.0);
+  s.add("setvalues_ms", steps ? rs.setvalues_ms / steps : 0.0);
+  s.add("solves", rs.solves);
+  s.add("cg_its", rs.solves ? (double)rs.iterations / rs.solves : 0.0);
+  s.add("cg_its_per_step", steps ? (double)rs.iterations / steps : 0.0);
+  s.add("corrections_per_step", steps ? (double)corrections / steps : 0.0);
+  s.add("corrections_max", max_corrections_seen);
+  s.add("unconverged_steps", unconverged);
+  s.add("stalled_steps", stalled);
+  s.add("diverged_solves", rs.diverged_solves);
+  s.add("regularised", (long long)solver.regularised);
+  s.add("singular_detections", singular_steps);
+  s.add("joint_error_max", worst_error);
+  s.add("joint_error_final", physics::max_joint_error(scene));
+  s.add("velocity_error_max", worst_velocity);
+  s.add("energy_initial", e0);
+  s.add("energy_final", physics::total_energy(scene));
+  s.add("energy_growth_max", e_max - e0);
+  s.add("nan", nan_steps);
+  PetscCall(PrintSummary(comm, s));
+
+  PetscCall(ReplicatedSolverDestroy(&rs));
+  PetscCall(PetscFinalize());
+  return 0;
+}

@@ -1,0 +1,123 @@
+#include "common/replicated_solver.h"
+
+#include "physics/partition.hpp"
+
+#include <numeric>
+
+PetscErrorCode ReplicatedSolverCreate(MPI_Comm comm, PetscInt n_blocks, const std::vector<int> &block_row, const std::vector<int> &block_col,
+                                      ReplicatedSolver *rs)
+{
+  PetscFunctionBegin;
+  rs->comm     = comm;
+  rs->n_blocks = n_blocks;
+  PetscCallMPI(MPI_Comm_size(comm, &rs->size));
+  PetscCallMPI(MPI_Comm_rank(comm, &rs->rank));
+  rs->new_of_old.resize(n_blocks);
+  std::iota(rs->new_of_old.begin(), rs->new_of_old.end(), 0);
+  rs->row_offsets = {0, (int)n_blocks};
+  if (rs->size > 1) {
+    std::vector<std::pair<int, int>> edges;
+    for (size_t k = 0; k < block_row.size(); ++k)
+      if (block_row[k] < block_col[k]) edges.push_back({block_row[k], block_col[k]});
+    try {
+      const physics::Renumbering r = physics::partition_graph(physics::graph_from_edges((int)n_blocks, edges), rs->size);
+      rs->new_of_old  = r.new_of_old;
+      rs->row_offsets = r.part_offsets;
+    } catch (const std::exception &e) {
+      SETERRQ(comm, PETSC_ERR_LIB, "partitioning the block rows failed: %s", e.what());
+    }
+  }
+  rs->old_of_new.resize(n_blocks);
+  for (PetscInt i = 0; i < n_blocks; ++i) rs->old_of_new[rs->new_of_old[i]] = (int)i;
+  const int begin = rs->row_offsets[rs->rank], end = rs->row_offsets[rs->rank + 1];
+  std::vector<PetscInt> rows, cols;
+  for (size_t k = 0; k < block_row.size(); ++k) {
+    const int r = rs->new_of_old[block_row[k]];
+    if (r < begin || r >= end) continue;
+    rs->local_blocks.push_back(k);
+    rows.push_back(r);
+    cols.push_back(rs->new_of_old[block_col[k]]);
+  }
+  PetscCall(BlockSystemCreate(comm, n_blocks, end - begin, rows, cols, &rs->sys));
+  rs->local_values.resize(9 * rs->local_blocks.size());
+  rs->rhs_local.resize(3 * (end - begin));
+  rs->sol_local.assign(3 * (end - begin), 0.0);
+  rs->sol_all.resize(3 * n_blocks);
+  for (int p = 0; p < rs->size; ++p) {
+    rs->counts.push_back(3 * (rs->row_offsets[p + 1] - rs->row_offsets[p]));
+    rs->displs.push_back(3 * rs->row_offsets[p]);
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode SetMatrix(ReplicatedSolver *rs, const std::vector<double> &values)
+{
+  PetscFunctionBegin;
+  const double t0 = MPI_Wtime();
+  if (rs->size == 1) {
+    rs->all_values = &values; // identical order: no copy
+    PetscCall(BlockSystemSetValues(&rs->sys, values.data()));
+  } else {
+    for (size_t i = 0; i < rs->local_blocks.size(); ++i)
+      for (int k = 0; k < 9; ++k) rs->local_values[9 * i + k] = values[9 * rs->local_blocks[i] + k];
+    PetscCall(BlockSystemSetValues(&rs->sys, rs->local_values.data()));
+  }
+  rs->setvalues_ms += 1e3 * (MPI_Wtime() - t0);
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode Solve(ReplicatedSolver *rs, const std::vector<double> &rhs, std::vector<double> &sol)
+{
+  PetscFunctionBegin;
+  const int begin = rs->row_offsets[rs->rank], end = rs->row_offsets[rs->rank + 1];
+  sol.resize(3 * rs->n_blocks);
+  if (rs->size == 1) {
+    PetscCall(BlockSystemSolve(&rs->sys, rhs.data(), sol.data(), &rs->last));
+  } else {
+    for (int i = begin; i < end; ++i)
+      for (int k = 0; k < 3; ++k) rs->rhs_local[3 * (i - begin) + k] = rhs[3 * rs->old_of_new[i] + k];
+    PetscCall(BlockSystemSolve(&rs->sys, rs->rhs_local.data(), rs->sol_local.data(), &rs->last));
+    PetscCallMPI(MPI_Allgatherv(rs->sol_local.data(), 3 * (end - begin), MPIU_SCALAR, rs->sol_all.data(), rs->counts.data(), rs->displs.data(),
+                                MPIU_SCALAR, rs->comm));
+    for (PetscInt i = 0; i < rs->n_blocks; ++i)
+      for (int k = 0; k < 3; ++k) sol[3 * i + k] = rs->sol_all[3 * rs->new_of_old[i] + k];
+  }
+  rs->solves++;
+  rs->iterations += rs->last.iterations;
+  rs->solve_ms += rs->last.ms;
+  if (rs->last.reason < 0) rs->worst_reason = rs->last.reason, rs->diverged_solves++;
+  PetscFunctionReturn(0);
+}
+
+physics::BlockLinearSolver ReplicatedSolverAdapter(ReplicatedSolver *rs)
+{
+  physics::BlockLinearSolver s;
+  s.set_matrix = [rs](const std::vector<double> &values) {
+    if (!rs->error) rs->error = SetMatrix(rs, values);
+  };
+  s.solve = [rs](const std::vector<double> &rhs, std::vector<double> &sol) {
+    physics::LinearSolveResult r;
+    if (!rs->error) rs->error = Solve(rs, rhs, sol);
+    if (rs->error) {
+      sol.assign(3 * rs->n_blocks, 0.0);
+      r.converged = false;
+      return r;
+    }
+    r.iterations = (int)rs->last.iterations;
+    r.converged  = rs->last.reason > 0;
+    // Breakdown or indefiniteness of CG on J M^-1 J^T is how a singular (loop) matrix shows up; running
+    // out of iterations is not (fixed-iteration runs end that way on purpose).
+    r.breakdown = rs->last.reason == KSP_DIVERGED_BREAKDOWN || rs->last.reason == KSP_DIVERGED_BREAKDOWN_BICG ||
+                  rs->last.reason == KSP_DIVERGED_INDEFINITE_PC || rs->last.reason == KSP_DIVERGED_INDEFINITE_MAT ||
+                  rs->last.reason == KSP_DIVERGED_NANORINF || rs->last.reason == KSP_DIVERGED_DTOL;
+    return r;
+  };
+  return s;
+}
+
+PetscErrorCode ReplicatedSolverDestroy(ReplicatedSolver *rs)
+{
+  PetscFunctionBegin;
+  PetscCall(BlockSystemDestroy(&rs->sys));
+  PetscFunctionReturn(0);
+}

@@ -1,0 +1,37 @@
+// Runs a physics::BlockLinearSolver on a BlockSystem when every rank holds the whole physics state (the
+// articulated and cloth drivers): the physics assembles all block values and right-hand sides, the solve is
+// distributed. With P > 1 ranks the block rows are partitioned with METIS (physics/partition.hpp) over the
+// pattern's graph and renumbered so each rank owns a contiguous range; each rank hands its own rows' blocks
+// to the BlockSystem and the solution is gathered back to every rank (MPI_Allgatherv), in physics order.
+#pragma once
+#include "common/sim_system.h"
+#include "physics/block_solver.hpp"
+
+#include <vector>
+
+struct ReplicatedSolver {
+  BlockSystem              sys;
+  MPI_Comm                 comm = MPI_COMM_NULL;
+  int                      size = 1, rank = 0;
+  PetscInt                 n_blocks = 0;                  // block rows
+  std::vector<int>         new_of_old, old_of_new;        // identity on one rank
+  std::vector<int>         row_offsets;                   // block rows per rank, size + 1 entries
+  std::vector<size_t>      local_blocks;                  // indices into the physics COO list, this rank's rows
+  std::vector<PetscScalar> local_values, rhs_local, sol_local, sol_all;
+  std::vector<int>         counts, displs;                // scalars per rank for the gather
+  const std::vector<double> *all_values = nullptr;        // physics values of the last set_matrix (1 rank)
+  // Totals since creation (or the last reset by the caller).
+  long long solves = 0, iterations = 0;
+  double    solve_ms = 0, setvalues_ms = 0;
+  SolveStats last;
+  KSPConvergedReason worst_reason = KSP_CONVERGED_ITERATING; // most recent negative reason, if any
+  long long diverged_solves = 0;
+  PetscErrorCode error = 0; // first PETSc error inside a callback (the physics API has no error codes)
+};
+
+// block_row/block_col: the physics COO list of 3x3 blocks (both triangles, physics numbering).
+PetscErrorCode ReplicatedSolverCreate(MPI_Comm comm, PetscInt n_blocks, const std::vector<int> &block_row,
+                                      const std::vector<int> &block_col, ReplicatedSolver *rs);
+// The callbacks for the physics step; check rs->error after each step.
+physics::BlockLinearSolver ReplicatedSolverAdapter(ReplicatedSolver *rs);
+PetscErrorCode ReplicatedSolverDestroy(ReplicatedSolver *rs);

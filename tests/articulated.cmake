@@ -1,0 +1,44 @@
+# Articulated driver: scenes run to their physical checks (summary line), every matrix type gives the same
+# motion, bad input is a clear error, and MPI runs match serial ones.
+set(ART $<TARGET_FILE:articulated>)
+set(SUMMARY_CHECK ${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_check.sh)
+set(SUMMARY_SAME ${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_same.sh)
+set(OPTS ${CMAKE_SOURCE_DIR}/options)
+
+add_test(NAME articulated_chain
+         COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && joint_error_max<1e-6 && energy_growth_max<0.01*(-energy_initial) && energy_final<=energy_initial && corrections_per_step<3"
+                 -- ${ART} -options_file ${OPTS}/chain.opts -progress_every 1000)
+add_test(NAME articulated_loop
+         COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && joint_error_max<1e-6 && loops==1"
+                 -- ${ART} -options_file ${OPTS}/loop.opts -progress_every 1000)
+add_test(NAME articulated_mass_ratio_1e4
+         COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && joint_error_max<1e-6"
+                 -- ${ART} -options_file ${OPTS}/mass_ratio.opts -chain_mass_first 1e2 -chain_mass_last 1e-2 -steps 240 -progress_every 1000)
+add_test(NAME articulated_mass_ratio_1e8_finite
+         COMMAND ${SUMMARY_CHECK} "nan==0" -- ${ART} -options_file ${OPTS}/mass_ratio.opts -steps 120 -progress_every 1000)
+add_test(NAME articulated_bridge_small
+         COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && joint_error_max<1e-6 && loops==26"
+                 -- ${ART} -scene bridge -bridge_chains 6 -bridge_links 20 -bridge_tie_every 5 -bridge_sag 2 -steps 60 -ksp_rtol 1e-10 -progress_every 1000)
+set(ART_SAME "${ART} -options_file ${OPTS}/chain.opts -steps 100 -ksp_rtol 1e-12 -progress_every 1000")
+add_test(NAME articulated_same_result_mat_types
+         COMMAND ${SUMMARY_SAME} "energy_final joint_error_final corrections_per_step" 1e-6
+                 "${ART_SAME} -mat_type aij" "${ART_SAME} -mat_type baij" "${ART_SAME} -mat_type aij -ksp_type pipecg")
+add_test(NAME articulated_bad_dt
+         COMMAND ${ART} -options_file ${OPTS}/chain.opts -dt -1)
+set_tests_properties(articulated_bad_dt PROPERTIES PASS_REGULAR_EXPRESSION "time step must be positive")
+add_test(NAME articulated_bad_mass
+         COMMAND ${ART} -options_file ${OPTS}/chain.opts -chain_mass_first 0)
+set_tests_properties(articulated_bad_mass PROPERTIES PASS_REGULAR_EXPRESSION "masses must be positive")
+add_test(NAME articulated_bad_scene
+         COMMAND ${ART} -scene trampoline)
+set_tests_properties(articulated_bad_scene PROPERTIES PASS_REGULAR_EXPRESSION "unknown -scene trampoline")
+set_tests_properties(articulated_chain articulated_loop articulated_mass_ratio_1e4 articulated_mass_ratio_1e8_finite
+                     articulated_bridge_small articulated_same_result_mat_types articulated_bad_dt articulated_bad_mass
+                     articulated_bad_scene PROPERTIES LABELS "articulated" TIMEOUT 60)
+
+set(ART_MPI "${ART} -options_file ${OPTS}/loop.opts -steps 200 -ksp_rtol 1e-12 -progress_every 1000")
+string(REPLACE ";" " " MPIEXEC_LINE "${MPIEXEC_CMD}")
+add_test(NAME articulated_mpi_np2
+         COMMAND ${SUMMARY_SAME} "energy_final joint_error_final corrections_per_step" 1e-6
+                 "${ART_MPI}" "${MPIEXEC_LINE} -n 2 ${ART_MPI}" "${MPIEXEC_LINE} -n 2 ${ART_MPI} -mat_type baij")
+set_tests_properties(articulated_mpi_np2 PROPERTIES LABELS "articulated;mpi" TIMEOUT 60)
