@@ -4,8 +4,8 @@
    can call the same code from a kernel (one thread per index, dots reduced in shared memory) and the
    host loop below stays one loop over contiguous memory that the compiler vectorises.
 
-   The local dot products are accumulated into MCGLocalDots; the caller reduces them across ranks in
-   the one global reduction of the iteration. */
+   The local dot products are accumulated into scalars; the caller reduces them across ranks in the
+   one global reduction of the iteration. */
 #ifndef BINBCSR_MCG_KERNELS_H
 #define BINBCSR_MCG_KERNELS_H
 
@@ -21,24 +21,25 @@ enum { MCG_DOT_RU = 0, MCG_DOT_UW = 1, MCG_DOT_RR = 2, MCG_DOT_UU = 3, MCG_NDOTS
 /* Chronopoulos-Gear update of one index, fused with Jacobi and the local dots:
      p = u + beta p        s = w + beta s   (s tracks A p without a product)
      x = x + alpha p       r = r - alpha s
-     u = dinv * r          (dinv == nullptr: no preconditioner, u = r)
-   and adds r.u, r.r, u.u of the new r, u to dots[MCG_DOT_RU/RR/UU].
+     u = dinv * r          (Jacobi == false: no preconditioner, u = r, dinv unused)
+   and adds r.u, r.r, u.u of the new r, u to ru, rr, uu (scalars, so that a host loop can declare
+   them as an OpenMP simd reduction and a device kernel can reduce them in shared memory).
    u is read (old value) before it is written (new value), so it is updated in place. */
-template <typename Scalar>
-MCG_HOST_DEVICE inline void mcg_update_index(long i, Scalar alpha, Scalar beta, Scalar *u, const Scalar *w, Scalar *p, Scalar *s, Scalar *x, Scalar *r, const Scalar *dinv, Scalar *dots)
+template <bool Jacobi, typename Scalar>
+MCG_HOST_DEVICE inline void mcg_update_index(long i, Scalar alpha, Scalar beta, Scalar *u, const Scalar *w, Scalar *p, Scalar *s, Scalar *x, Scalar *r, const Scalar *dinv, Scalar &ru, Scalar &rr, Scalar &uu)
 {
   const Scalar pi = u[i] + beta * p[i];
   const Scalar si = w[i] + beta * s[i];
   const Scalar ri = r[i] - alpha * si;
-  const Scalar ui = dinv ? dinv[i] * ri : ri;
+  const Scalar ui = Jacobi ? dinv[i] * ri : ri;
   p[i] = pi;
   s[i] = si;
   x[i] += alpha * pi;
   r[i] = ri;
   u[i] = ui;
-  dots[MCG_DOT_RU] += ri * ui;
-  dots[MCG_DOT_RR] += ri * ri;
-  dots[MCG_DOT_UU] += ui * ui;
+  ru += ri * ui;
+  rr += ri * ri;
+  uu += ui * ui;
 }
 
 /* Same update without the preconditioner (generic path: the PC is applied afterwards by PCApply). */
@@ -54,25 +55,25 @@ MCG_HOST_DEVICE inline void mcg_update_index_nopc(long i, Scalar alpha, Scalar b
 }
 
 /* u = dinv * r (or u = r) and the local dots of r and u: the start of a solve or a restart. */
-template <typename Scalar>
-MCG_HOST_DEVICE inline void mcg_precondition_index(long i, const Scalar *r, const Scalar *dinv, Scalar *u, Scalar *dots)
+template <bool Jacobi, typename Scalar>
+MCG_HOST_DEVICE inline void mcg_precondition_index(long i, const Scalar *r, const Scalar *dinv, Scalar *u, Scalar &ru, Scalar &rr, Scalar &uu)
 {
   const Scalar ri = r[i];
-  const Scalar ui = dinv ? dinv[i] * ri : ri;
+  const Scalar ui = Jacobi ? dinv[i] * ri : ri;
   u[i] = ui;
-  dots[MCG_DOT_RU] += ri * ui;
-  dots[MCG_DOT_RR] += ri * ri;
-  dots[MCG_DOT_UU] += ui * ui;
+  ru += ri * ui;
+  rr += ri * ri;
+  uu += ui * ui;
 }
 
 /* Local dots of r and u only (generic path, after PCApply). */
 template <typename Scalar>
-MCG_HOST_DEVICE inline void mcg_dots_index(long i, const Scalar *r, const Scalar *u, Scalar *dots)
+MCG_HOST_DEVICE inline void mcg_dots_index(long i, const Scalar *r, const Scalar *u, Scalar &ru, Scalar &rr, Scalar &uu)
 {
   const Scalar ri = r[i], ui = u[i];
-  dots[MCG_DOT_RU] += ri * ui;
-  dots[MCG_DOT_RR] += ri * ri;
-  dots[MCG_DOT_UU] += ui * ui;
+  ru += ri * ui;
+  rr += ri * ri;
+  uu += ui * ui;
 }
 
 #endif

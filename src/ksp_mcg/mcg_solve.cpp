@@ -144,8 +144,8 @@ static PetscErrorCode MCGMatMultDot(KSP ksp, Mat A, Vec u, Vec w, PetscScalar *u
 static PetscErrorCode MCGPrecondition(KSP ksp, Vec R, Vec U, PetscScalar *dots)
 {
   KSP_MCG           *mcg = (KSP_MCG *)ksp->data;
-  const PetscScalar *r, *dinv = nullptr;
-  PetscScalar       *u, local[MCG_NDOTS] = {0, 0, 0, 0};
+  const PetscScalar *r;
+  PetscScalar        ru = 0, rr = 0, uu = 0;
   PetscInt           n;
 
   PetscFunctionBegin;
@@ -154,23 +154,32 @@ static PetscErrorCode MCGPrecondition(KSP ksp, Vec R, Vec U, PetscScalar *dots)
   PetscCall(VecGetLocalSize(R, &n));
   PetscCall(VecGetArrayRead(R, &r));
   if (mcg->how == MCG_PC_GENERIC) {
-    const PetscScalar *uc;
-    PetscCall(VecGetArrayRead(U, &uc));
-    for (PetscInt i = 0; i < n; i++) mcg_dots_index<PetscScalar>(i, r, uc, local);
-    PetscCall(VecRestoreArrayRead(U, &uc));
+    const PetscScalar *u;
+    PetscCall(VecGetArrayRead(U, &u));
+#pragma omp simd reduction(+ : ru, rr, uu)
+    for (PetscInt i = 0; i < n; i++) mcg_dots_index<PetscScalar>(i, r, u, ru, rr, uu);
+    PetscCall(VecRestoreArrayRead(U, &u));
   } else {
-    if (mcg->how == MCG_PC_JACOBI) PetscCall(VecGetArrayRead(mcg->dinv, &dinv));
+    PetscScalar *u;
     PetscCall(VecGetArrayWrite(U, &u));
-    for (PetscInt i = 0; i < n; i++) mcg_precondition_index<PetscScalar>(i, r, dinv, u, local);
+    if (mcg->how == MCG_PC_JACOBI) {
+      const PetscScalar *dinv;
+      PetscCall(VecGetArrayRead(mcg->dinv, &dinv));
+#pragma omp simd reduction(+ : ru, rr, uu)
+      for (PetscInt i = 0; i < n; i++) mcg_precondition_index<true, PetscScalar>(i, r, dinv, u, ru, rr, uu);
+      PetscCall(VecRestoreArrayRead(mcg->dinv, &dinv));
+    } else {
+#pragma omp simd reduction(+ : ru, rr, uu)
+      for (PetscInt i = 0; i < n; i++) mcg_precondition_index<false, PetscScalar>(i, r, nullptr, u, ru, rr, uu);
+    }
     PetscCall(VecRestoreArrayWrite(U, &u));
-    if (dinv) PetscCall(VecRestoreArrayRead(mcg->dinv, &dinv));
   }
   PetscCall(VecRestoreArrayRead(R, &r));
   PetscCall(PetscLogFlops(7.0 * n));
   PetscCall(PetscLogEventEnd(KSP_MCG_FusedUpdate, ksp, 0, 0, 0));
-  dots[MCG_DOT_RU] = local[MCG_DOT_RU];
-  dots[MCG_DOT_RR] = local[MCG_DOT_RR];
-  dots[MCG_DOT_UU] = local[MCG_DOT_UU];
+  dots[MCG_DOT_RU] = ru;
+  dots[MCG_DOT_RR] = rr;
+  dots[MCG_DOT_UU] = uu;
   PetscFunctionReturn(0);
 }
 
@@ -178,8 +187,8 @@ static PetscErrorCode MCGPrecondition(KSP ksp, Vec R, Vec U, PetscScalar *dots)
 static PetscErrorCode MCGUpdate(KSP ksp, PetscScalar alpha, PetscScalar beta, Vec X, Vec R, Vec U, Vec W, Vec P, Vec S, PetscScalar *dots)
 {
   KSP_MCG           *mcg = (KSP_MCG *)ksp->data;
-  const PetscScalar *w, *dinv = nullptr;
-  PetscScalar       *x, *r, *u, *p, *s;
+  const PetscScalar *w;
+  PetscScalar       *x, *r, *u, *p, *s, ru = 0, rr = 0, uu = 0;
   PetscInt           n;
 
   PetscFunctionBegin;
@@ -192,15 +201,17 @@ static PetscErrorCode MCGUpdate(KSP ksp, PetscScalar alpha, PetscScalar beta, Ve
   PetscCall(VecGetArray(P, &p));
   PetscCall(VecGetArray(S, &s));
   if (mcg->how == MCG_PC_GENERIC) {
+#pragma omp simd
     for (PetscInt i = 0; i < n; i++) mcg_update_index_nopc<PetscScalar>(i, alpha, beta, u, w, p, s, x, r);
+  } else if (mcg->how == MCG_PC_JACOBI) {
+    const PetscScalar *dinv;
+    PetscCall(VecGetArrayRead(mcg->dinv, &dinv));
+#pragma omp simd reduction(+ : ru, rr, uu)
+    for (PetscInt i = 0; i < n; i++) mcg_update_index<true, PetscScalar>(i, alpha, beta, u, w, p, s, x, r, dinv, ru, rr, uu);
+    PetscCall(VecRestoreArrayRead(mcg->dinv, &dinv));
   } else {
-    PetscScalar local[MCG_NDOTS] = {0, 0, 0, 0};
-    if (mcg->how == MCG_PC_JACOBI) PetscCall(VecGetArrayRead(mcg->dinv, &dinv));
-    for (PetscInt i = 0; i < n; i++) mcg_update_index<PetscScalar>(i, alpha, beta, u, w, p, s, x, r, dinv, local);
-    if (dinv) PetscCall(VecRestoreArrayRead(mcg->dinv, &dinv));
-    dots[MCG_DOT_RU] = local[MCG_DOT_RU];
-    dots[MCG_DOT_RR] = local[MCG_DOT_RR];
-    dots[MCG_DOT_UU] = local[MCG_DOT_UU];
+#pragma omp simd reduction(+ : ru, rr, uu)
+    for (PetscInt i = 0; i < n; i++) mcg_update_index<false, PetscScalar>(i, alpha, beta, u, w, p, s, x, r, nullptr, ru, rr, uu);
   }
   PetscCall(VecRestoreArray(S, &s));
   PetscCall(VecRestoreArray(P, &p));
@@ -210,8 +221,14 @@ static PetscErrorCode MCGUpdate(KSP ksp, PetscScalar alpha, PetscScalar beta, Ve
   PetscCall(VecRestoreArray(X, &x));
   PetscCall(PetscLogFlops((mcg->how == MCG_PC_GENERIC ? 8.0 : 15.0) * n));
   PetscCall(PetscLogEventEnd(KSP_MCG_FusedUpdate, ksp, 0, 0, 0));
-  /* generic path: the PC is applied to the new r, then one more pass for the local dots */
-  if (mcg->how == MCG_PC_GENERIC) PetscCall(MCGPrecondition(ksp, R, U, dots));
+  if (mcg->how == MCG_PC_GENERIC) {
+    /* the PC is applied to the new r, then one more pass for the local dots */
+    PetscCall(MCGPrecondition(ksp, R, U, dots));
+  } else {
+    dots[MCG_DOT_RU] = ru;
+    dots[MCG_DOT_RR] = rr;
+    dots[MCG_DOT_UU] = uu;
+  }
   PetscFunctionReturn(0);
 }
 
