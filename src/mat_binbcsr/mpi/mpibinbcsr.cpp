@@ -1,9 +1,368 @@
-/* MATMPIBINBCSR (placeholder until implemented). */
-#include "binbcsr_impl.h"
+/* MATMPIBINBCSR: constructor, destructor, preallocation answers, options and the bin-width /
+   precision setters (forwarded to both parts). The layout is described in mpibinbcsr.h. */
+#include "mpibinbcsr.h"
 
-PetscErrorCode MatCreate_MPIBinBCSR(Mat A)
+#include <algorithm>
+#include <cstring>
+
+static PetscErrorCode MatDestroy_MPIBinBCSR(Mat mat)
 {
   PetscFunctionBegin;
-  SETERRQ(PetscObjectComm((PetscObject)A), PETSC_ERR_SUP, "MATMPIBINBCSR is not implemented yet");
+  PetscCall(MatMPIBinBCSRResetParts(mat));
+  delete MPIBinBCSR(mat);
+  mat->data = nullptr;
+  PetscCall(PetscObjectChangeTypeName((PetscObject)mat, nullptr));
+  const char *names[] = {"MatMPIAIJSetPreallocation_C", "MatMPIBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatGetDiagonalBlock_C", "MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatConvert_mpibinbcsr_mpiaij_C"};
+  for (const char *name : names) PetscCall(PetscObjectComposeFunction((PetscObject)mat, name, (void (*)(void)) nullptr));
+  PetscFunctionReturn(0);
+}
+
+/* Creates the diagonal part from the layouts of mat; B is created when the columns are compressed. */
+static PetscErrorCode CreateDiagonalPart(Mat mat)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  PetscCall(PetscLayoutSetUp(mat->rmap));
+  PetscCall(PetscLayoutSetUp(mat->cmap));
+  PetscCheck(mat->rmap->bs == mat->cmap->bs, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_INCOMP, "MATMPIBINBCSR needs equal row and column block sizes (%" PetscInt_FMT " vs %" PetscInt_FMT ")", mat->rmap->bs, mat->cmap->bs);
+  PetscCall(MatMPIBinBCSRResetParts(mat));
+  PetscCall(MatMPIBinBCSRCreatePart(mat, mat->rmap->n, mat->cmap->n, &b->A));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode AllowNewAllocations(Mat part)
+{
+  PetscBool isbin;
+
+  PetscFunctionBegin;
+  /* AIJ-like inner types: entries beyond the preallocation are allowed (slowly), as in MatSetUp. */
+  PetscCall(PetscObjectTypeCompare((PetscObject)part, MATSEQBINBCSR, &isbin));
+  if (!isbin) PetscCall(MatSetOption(part, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatMPIAIJSetPreallocation_MPIBinBCSR(Mat mat, PetscInt d_nz, const PetscInt d_nnz[], PetscInt o_nz, const PetscInt o_nnz[])
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  (void)o_nz;
+  (void)o_nnz; /* B is sized exactly at the first final assembly */
+  PetscCall(CreateDiagonalPart(mat));
+  PetscCall(MatSeqAIJSetPreallocation(b->A, d_nz, d_nnz));
+  PetscCall(AllowNewAllocations(b->A));
+  mat->preallocated = PETSC_TRUE;
+  mat->assembled    = PETSC_FALSE;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatMPIBAIJSetPreallocation_MPIBinBCSR(Mat mat, PetscInt bs, PetscInt d_nz, const PetscInt d_nnz[], PetscInt o_nz, const PetscInt o_nnz[])
+{
+  Mat_MPIBinBCSR       *b = MPIBinBCSR(mat);
+  std::vector<PetscInt> dnnz;
+
+  PetscFunctionBegin;
+  (void)o_nz;
+  (void)o_nnz;
+  PetscCall(MatSetBlockSize(mat, PetscAbs(bs)));
+  PetscCall(CreateDiagonalPart(mat));
+  bs = mat->rmap->bs;
+  const PetscInt mbs = mat->rmap->n / bs, nbs = mat->cmap->n / bs;
+  if (d_nnz) dnnz.assign(d_nnz, d_nnz + mbs);
+  else dnnz.assign(mbs, d_nz == PETSC_DEFAULT || d_nz == PETSC_DECIDE ? PetscMin(5, nbs) : PetscMin(d_nz, nbs));
+  PetscCall(MatXAIJSetPreallocation(b->A, bs, dnnz.data(), nullptr, nullptr, nullptr));
+  PetscCall(AllowNewAllocations(b->A));
+  mat->preallocated = PETSC_TRUE;
+  mat->assembled    = PETSC_FALSE;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatSetUp_MPIBinBCSR(Mat mat)
+{
+  PetscFunctionBegin;
+  if (!mat->preallocated) PetscCall(MatMPIAIJSetPreallocation_MPIBinBCSR(mat, PETSC_DEFAULT, nullptr, PETSC_DEFAULT, nullptr));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRSetBinWidth_MPIBinBCSR(Mat mat, PetscInt bw)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  PetscCheck(bw >= 1, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_OUTOFRANGE, "bin width must be >= 1, got %" PetscInt_FMT, bw);
+  b->bin_width = bw;
+  if (b->A) PetscCall(MatBinBCSRSetBinWidth(b->A, bw));
+  if (b->B) PetscCall(MatBinBCSRSetBinWidth(b->B, bw));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRGetBinWidth_MPIBinBCSR(Mat mat, PetscInt *bw)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  *bw = b->bin_width;
+  if (b->A) PetscCall(MatBinBCSRGetBinWidth(b->A, bw));
+  if (!*bw) *bw = b->bin_width;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRSetPrecision_MPIBinBCSR(Mat mat, MatBinBCSRPrecision p)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  b->precision_set = PETSC_TRUE;
+  b->precision     = p;
+  if (b->A) PetscCall(MatBinBCSRSetPrecision(b->A, p));
+  if (b->B) PetscCall(MatBinBCSRSetPrecision(b->B, p));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRGetPrecision_MPIBinBCSR(Mat mat, MatBinBCSRPrecision *p)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  *p = b->precision;
+  if (b->A && !b->precision_set) PetscCall(MatBinBCSRGetPrecision(b->A, p));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatGetDiagonalBlock_MPIBinBCSR(Mat mat, Mat *a)
+{
+  PetscFunctionBegin;
+  *a = MPIBinBCSR(mat)->A;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatSetFromOptions_MPIBinBCSR(Mat mat, PetscOptionItems *PetscOptionsObject)
+{
+  Mat_MPIBinBCSR     *b  = MPIBinBCSR(mat);
+  PetscInt            bw = b->bin_width;
+  MatBinBCSRPrecision p  = b->precision;
+  char                inner[64];
+  PetscBool           flg;
+
+  PetscFunctionBegin;
+  PetscOptionsHeadBegin(PetscOptionsObject, "MATMPIBINBCSR options");
+  PetscCall(PetscOptionsString("-mat_mpibinbcsr_inner_type", "Type of the diagonal and off-diagonal parts", "MATMPIBINBCSR", b->inner_type, inner, sizeof(inner), &flg));
+  if (flg) {
+    PetscCheck(!b->A, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONGSTATE, "-mat_mpibinbcsr_inner_type must be set before preallocation");
+    PetscCall(PetscStrncpy(b->inner_type, inner, sizeof(b->inner_type)));
+  }
+  PetscCall(PetscOptionsInt("-mat_binbcsr_bin_width", "Rows per bin", "MatBinBCSRSetBinWidth", bw, &bw, &flg));
+  if (flg) PetscCall(MatBinBCSRSetBinWidth_MPIBinBCSR(mat, bw));
+  PetscCall(PetscOptionsEnum("-mat_binbcsr_precision", "Value storage", "MatBinBCSRSetPrecision", MatBinBCSRPrecisions, (PetscEnum)p, (PetscEnum *)&p, &flg));
+  if (flg) PetscCall(MatBinBCSRSetPrecision_MPIBinBCSR(mat, p));
+  PetscOptionsHeadEnd();
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatSetOption_MPIBinBCSR(Mat mat, MatOption op, PetscBool flg)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  switch (op) {
+  case MAT_NEW_NONZERO_LOCATIONS:
+    b->ignore_new_offdiag = flg ? PETSC_FALSE : PETSC_TRUE;
+    /* fall through */
+  case MAT_NEW_NONZERO_ALLOCATION_ERR:
+  case MAT_NEW_NONZERO_LOCATION_ERR:
+  case MAT_UNUSED_NONZERO_LOCATION_ERR:
+  case MAT_KEEP_NONZERO_PATTERN:
+  case MAT_IGNORE_ZERO_ENTRIES:
+  case MAT_USE_INODES:
+    b->part_options.emplace_back(op, flg);
+    if (b->A) PetscCall(MatSetOption(b->A, op, flg));
+    if (b->B) PetscCall(MatSetOption(b->B, op, flg));
+    break;
+  case MAT_ROW_ORIENTED:
+    b->roworiented = flg; /* our MatSetValues reads values in this order; the parts get rows */
+    break;
+  case MAT_IGNORE_OFF_PROC_ENTRIES:
+    b->donotstash = flg;
+    break;
+  case MAT_SYMMETRIC:
+  case MAT_SPD:
+  case MAT_HERMITIAN:
+  case MAT_STRUCTURALLY_SYMMETRIC:
+  case MAT_SYMMETRY_ETERNAL:
+  case MAT_STRUCTURAL_SYMMETRY_ETERNAL:
+  case MAT_SPD_ETERNAL:
+    /* a property of the whole matrix (kept by MatSetOption itself); the diagonal part inherits it */
+    if (b->A) PetscCall(MatSetOption(b->A, op, flg));
+    b->part_options.emplace_back(op, flg);
+    break;
+  default:
+    PetscCall(PetscInfo(mat, "Option %s ignored\n", MatOptions[op]));
+    break;
+  }
+  PetscFunctionReturn(0);
+}
+
+PETSC_INTERN PetscErrorCode MatMPIBinBCSRCreatePart(Mat mat, PetscInt m, PetscInt n, Mat *part)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  PetscCall(MatCreate(PETSC_COMM_SELF, part));
+  PetscCall(MatSetSizes(*part, m, n, m, n));
+  PetscCall(MatSetBlockSizes(*part, mat->rmap->bs, mat->cmap->bs));
+  PetscCall(MatSetType(*part, b->inner_type));
+  if (b->bin_width) PetscCall(MatBinBCSRSetBinWidth(*part, b->bin_width));
+  if (b->precision_set) PetscCall(MatBinBCSRSetPrecision(*part, b->precision));
+  for (const auto &[op, flg] : b->part_options) {
+    const bool wholematrix = op == MAT_SYMMETRIC || op == MAT_SPD || op == MAT_HERMITIAN || op == MAT_STRUCTURALLY_SYMMETRIC || op == MAT_SYMMETRY_ETERNAL || op == MAT_STRUCTURAL_SYMMETRY_ETERNAL || op == MAT_SPD_ETERNAL;
+    if (wholematrix && m != n) continue; /* not a property of the off-diagonal part */
+    if (wholematrix && !b->A) continue;  /* only A when created first */
+    PetscCall(MatSetOption(*part, op, flg));
+  }
+  PetscFunctionReturn(0);
+}
+
+PETSC_INTERN PetscErrorCode MatMPIBinBCSRResetParts(Mat mat)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  PetscCall(MatDestroy(&b->A));
+  PetscCall(MatDestroy(&b->B));
+  PetscCall(VecDestroy(&b->lvec));
+  PetscCall(VecScatterDestroy(&b->Mvctx));
+  PetscCall(MatMPIBinBCSRDestroyCoo(mat));
+  b->garray.clear();
+  b->b_staging.clear();
+  b->stash_row.clear();
+  b->stash_col.clear();
+  b->stash_val.clear();
+  b->compressed = PETSC_FALSE;
+  PetscFunctionReturn(0);
+}
+
+PETSC_INTERN PetscErrorCode MatMPIBinBCSRSetUpScatter(Mat mat)
+{
+  Mat_MPIBinBCSR *b  = MPIBinBCSR(mat);
+  const PetscInt  bs = mat->cmap->bs, ng = static_cast<PetscInt>(b->garray.size());
+  IS              from, to;
+  Vec             gvec;
+
+  PetscFunctionBegin;
+  PetscCall(VecDestroy(&b->lvec));
+  PetscCall(VecScatterDestroy(&b->Mvctx));
+  PetscCall(VecCreateSeq(PETSC_COMM_SELF, ng * bs, &b->lvec));
+  PetscCall(VecSetBlockSize(b->lvec, bs));
+  PetscCall(ISCreateBlock(PetscObjectComm((PetscObject)mat), bs, ng, b->garray.data(), PETSC_COPY_VALUES, &from));
+  PetscCall(ISCreateStride(PETSC_COMM_SELF, ng * bs, 0, 1, &to));
+  PetscCall(VecCreateMPIWithArray(PetscObjectComm((PetscObject)mat), bs, mat->cmap->n, mat->cmap->N, nullptr, &gvec));
+  PetscCall(VecScatterCreate(gvec, from, b->lvec, to, &b->Mvctx));
+  PetscCall(VecDestroy(&gvec));
+  PetscCall(ISDestroy(&from));
+  PetscCall(ISDestroy(&to));
+  PetscFunctionReturn(0);
+}
+
+PETSC_INTERN PetscErrorCode MatMPIBinBCSRGhostIndex(Mat mat, PetscInt gcol, PetscInt *lcol)
+{
+  Mat_MPIBinBCSR *b   = MPIBinBCSR(mat);
+  const PetscInt  bs  = mat->cmap->bs;
+  const PetscInt  blk = gcol / bs;
+  const auto      it  = std::lower_bound(b->garray.begin(), b->garray.end(), blk);
+
+  PetscFunctionBegin;
+  *lcol = (it != b->garray.end() && *it == blk) ? static_cast<PetscInt>(it - b->garray.begin()) * bs + gcol % bs : -1;
+  PetscFunctionReturn(0);
+}
+
+PETSC_INTERN PetscErrorCode MatMPIBinBCSRBuildSendSF(MPI_Comm comm, PetscInt nsend, const PetscMPIInt dest[], PetscSF *sf, PetscInt *nrecv)
+{
+  PetscMPIInt size;
+
+  PetscFunctionBegin;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  std::vector<PetscMPIInt> scount(size, 0), rcount(size), rdispl(size), offset_at_dest(size);
+  for (PetscInt q = 0; q < nsend; q++) scount[dest[q]]++;
+  PetscCallMPI(MPI_Alltoall(scount.data(), 1, MPI_INT, rcount.data(), 1, MPI_INT, comm));
+  PetscInt total = 0;
+  for (PetscMPIInt s = 0; s < size; s++) {
+    rdispl[s] = static_cast<PetscMPIInt>(total);
+    total += rcount[s];
+  }
+  /* each sender learns where its entries start in each receiver's root array */
+  PetscCallMPI(MPI_Alltoall(rdispl.data(), 1, MPI_INT, offset_at_dest.data(), 1, MPI_INT, comm));
+  PetscSFNode *remote;
+  PetscCall(PetscMalloc1(nsend, &remote));
+  for (PetscInt q = 0; q < nsend; q++) {
+    remote[q].rank  = dest[q];
+    remote[q].index = offset_at_dest[dest[q]]++;
+  }
+  PetscCall(PetscSFCreate(comm, sf));
+  PetscCall(PetscSFSetGraph(*sf, total, nsend, nullptr, PETSC_OWN_POINTER, remote, PETSC_OWN_POINTER));
+  PetscCall(PetscSFSetUp(*sf));
+  *nrecv = total;
+  PetscFunctionReturn(0);
+}
+
+/*MC
+   MATMPIBINBCSR - "mpibinbcsr": the parallel BIN-CSR / BIN-BCSR matrix. Each rank stores its rows as
+   a diagonal part and an off-diagonal part with compressed columns, both MATSEQBINBCSR; the ghost
+   exchange of MatMult is overlapped with the diagonal-part product. Chosen by -mat_type binbcsr on
+   more than one rank.
+
+   Options: -mat_binbcsr_bin_width, -mat_binbcsr_precision (forwarded to both parts),
+            -mat_mpibinbcsr_inner_type (type of the parts, default seqbinbcsr).
+M*/
+PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
+{
+  PetscFunctionBegin;
+  auto *b = new Mat_MPIBinBCSR();
+  PetscCall(PetscStrncpy(b->inner_type, MATSEQBINBCSR, sizeof(b->inner_type)));
+  mat->data = b;
+  PetscCall(PetscMemzero(mat->ops, sizeof(struct _MatOps)));
+  mat->ops->destroy             = MatDestroy_MPIBinBCSR;
+  mat->ops->setup               = MatSetUp_MPIBinBCSR;
+  mat->ops->setfromoptions      = MatSetFromOptions_MPIBinBCSR;
+  mat->ops->setoption           = MatSetOption_MPIBinBCSR;
+  mat->ops->setvalues           = MatSetValues_MPIBinBCSR;
+  mat->ops->assemblybegin       = MatAssemblyBegin_MPIBinBCSR;
+  mat->ops->assemblyend         = MatAssemblyEnd_MPIBinBCSR;
+  mat->ops->mult                = MatMult_MPIBinBCSR;
+  mat->ops->multadd             = MatMultAdd_MPIBinBCSR;
+  mat->ops->multtranspose       = MatMultTranspose_MPIBinBCSR;
+  mat->ops->multtransposeadd    = MatMultTransposeAdd_MPIBinBCSR;
+  mat->ops->getdiagonal         = MatGetDiagonal_MPIBinBCSR;
+  mat->ops->diagonalset         = MatDiagonalSet_MPIBinBCSR;
+  mat->ops->invertblockdiagonal = MatInvertBlockDiagonal_MPIBinBCSR;
+  mat->ops->scale               = MatScale_MPIBinBCSR;
+  mat->ops->shift               = MatShift_MPIBinBCSR;
+  mat->ops->zeroentries         = MatZeroEntries_MPIBinBCSR;
+  mat->ops->zerorows            = MatZeroRows_MPIBinBCSR;
+  mat->ops->zerorowscolumns     = MatZeroRowsColumns_MPIBinBCSR;
+  mat->ops->getrow              = MatGetRow_MPIBinBCSR;
+  mat->ops->restorerow          = MatRestoreRow_MPIBinBCSR;
+  mat->ops->norm                = MatNorm_MPIBinBCSR;
+  mat->ops->getinfo             = MatGetInfo_MPIBinBCSR;
+  mat->ops->view                = MatView_MPIBinBCSR;
+  mat->ops->load                = MatLoad_MPIBinBCSR;
+  mat->ops->convertfrom         = MatConvertFrom_MPIBinBCSR;
+  mat->ops->duplicate           = MatDuplicate_MPIBinBCSR;
+  mat->ops->copy                = MatCopy_MPIBinBCSR;
+  mat->assembled                = PETSC_FALSE;
+  mat->insertmode               = NOT_SET_VALUES;
+
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatMPIAIJSetPreallocation_C", MatMPIAIJSetPreallocation_MPIBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatMPIBAIJSetPreallocation_C", MatMPIBAIJSetPreallocation_MPIBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatSetPreallocationCOO_C", MatSetPreallocationCOO_MPIBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatSetValuesCOO_C", MatSetValuesCOO_MPIBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatMultDotLocal_C", MatMultDotLocal_MPIBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatGetDiagonalBlock_C", MatGetDiagonalBlock_MPIBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetBinWidth_C", MatBinBCSRSetBinWidth_MPIBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetBinWidth_C", MatBinBCSRGetBinWidth_MPIBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetPrecision_C", MatBinBCSRSetPrecision_MPIBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetPrecision_C", MatBinBCSRGetPrecision_MPIBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatConvert_mpibinbcsr_mpiaij_C", MatConvert_MPIBinBCSR_MPIAIJ));
+  PetscCall(PetscObjectChangeTypeName((PetscObject)mat, MATMPIBINBCSR));
   PetscFunctionReturn(0);
 }

@@ -1,0 +1,226 @@
+/* MATMPIBINBCSR conversion to and from other types, parallel MatLoad, MatView (per-rank info of
+   the parts; other formats through an MPIAIJ copy), MatDuplicate and MatCopy. */
+#include "mpibinbcsr.h"
+
+#include <algorithm>
+
+/* Preallocates dst (any AIJ-answering type, already sized and typed) exactly from src's rows and
+   copies them. */
+static PetscErrorCode PreallocateAndFill(Mat src, Mat dst)
+{
+  PetscInt rstart, rend;
+  PetscBool issbaij;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)src, &issbaij, MATSEQSBAIJ, MATMPISBAIJ, ""));
+  PetscCheck(!issbaij, PetscObjectComm((PetscObject)src), PETSC_ERR_SUP, "Cannot convert from SBAIJ: its rows hold only the upper triangle");
+  PetscCall(PetscLayoutSetUp(dst->rmap));
+  PetscCall(PetscLayoutSetUp(dst->cmap));
+  PetscCall(MatGetOwnershipRange(src, &rstart, &rend));
+  const PetscInt        cstart = dst->cmap->rstart, cend = dst->cmap->rend;
+  std::vector<PetscInt> dnnz(rend - rstart, 0), onnz(rend - rstart, 0);
+  for (PetscInt r = rstart; r < rend; r++) {
+    PetscInt        nz;
+    const PetscInt *cols;
+    PetscCall(MatGetRow(src, r, &nz, &cols, nullptr));
+    for (PetscInt k = 0; k < nz; k++) (cols[k] >= cstart && cols[k] < cend ? dnnz : onnz)[r - rstart]++;
+    PetscCall(MatRestoreRow(src, r, &nz, &cols, nullptr));
+  }
+  PetscCall(MatSeqAIJSetPreallocation(dst, 0, dnnz.data()));
+  PetscCall(MatMPIAIJSetPreallocation(dst, 0, dnnz.data(), 0, onnz.data()));
+  for (PetscInt r = rstart; r < rend; r++) {
+    PetscInt           nz;
+    const PetscInt    *cols;
+    const PetscScalar *vals;
+    PetscCall(MatGetRow(src, r, &nz, &cols, &vals));
+    PetscCall(MatSetValues(dst, 1, &r, nz, cols, vals, INSERT_VALUES));
+    PetscCall(MatRestoreRow(src, r, &nz, &cols, &vals));
+  }
+  PetscCall(MatAssemblyBegin(dst, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(dst, MAT_FINAL_ASSEMBLY));
+  PetscFunctionReturn(0);
+}
+
+/* Refills an existing matrix with src's values (its pattern must hold src's). */
+static PetscErrorCode RefillByRows(Mat src, Mat dst)
+{
+  PetscInt rstart, rend;
+
+  PetscFunctionBegin;
+  PetscCall(MatZeroEntries(dst));
+  PetscCall(MatGetOwnershipRange(src, &rstart, &rend));
+  for (PetscInt r = rstart; r < rend; r++) {
+    PetscInt           nz;
+    const PetscInt    *cols;
+    const PetscScalar *vals;
+    PetscCall(MatGetRow(src, r, &nz, &cols, &vals));
+    PetscCall(MatSetValues(dst, 1, &r, nz, cols, vals, INSERT_VALUES));
+    PetscCall(MatRestoreRow(src, r, &nz, &cols, &vals));
+  }
+  PetscCall(MatAssemblyBegin(dst, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(dst, MAT_FINAL_ASSEMBLY));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode CreateLike(Mat src, MatType type, Mat *M)
+{
+  PetscFunctionBegin;
+  PetscCall(MatCreate(PetscObjectComm((PetscObject)src), M));
+  PetscCall(MatSetSizes(*M, src->rmap->n, src->cmap->n, src->rmap->N, src->cmap->N));
+  PetscCall(MatSetBlockSizesFromMats(*M, src, src));
+  PetscCall(MatSetType(*M, type));
+  PetscFunctionReturn(0);
+}
+
+PETSC_INTERN PetscErrorCode MatConvert_MPIBinBCSR_MPIAIJ(Mat mat, MatType newtype, MatReuse reuse, Mat *newmat)
+{
+  Mat M;
+
+  PetscFunctionBegin;
+  (void)newtype;
+  if (reuse == MAT_REUSE_MATRIX) {
+    PetscCall(RefillByRows(mat, *newmat));
+    PetscFunctionReturn(0);
+  }
+  PetscCall(CreateLike(mat, MATMPIAIJ, &M));
+  PetscCall(PreallocateAndFill(mat, M));
+  if (reuse == MAT_INPLACE_MATRIX) PetscCall(MatHeaderReplace(mat, &M));
+  else *newmat = M;
+  PetscFunctionReturn(0);
+}
+
+/* MatConvert(any type with MatGetRow -> mpibinbcsr). */
+PETSC_INTERN PetscErrorCode MatConvertFrom_MPIBinBCSR(Mat src, MatType newtype, MatReuse reuse, Mat *newmat)
+{
+  Mat M;
+
+  PetscFunctionBegin;
+  if (reuse == MAT_REUSE_MATRIX) {
+    PetscCall(RefillByRows(src, *newmat));
+    PetscFunctionReturn(0);
+  }
+  PetscCall(CreateLike(src, newtype, &M));
+  /* the -mat_binbcsr_* options apply to converted matrices too (MatSetFromOptions could change the type) */
+  PetscObjectOptionsBegin((PetscObject)M);
+  if (M->ops->setfromoptions) PetscCall((*M->ops->setfromoptions)(M, PetscOptionsObject));
+  PetscOptionsEnd();
+  PetscCall(PreallocateAndFill(src, M));
+  if (reuse == MAT_INPLACE_MATRIX) PetscCall(MatHeaderReplace(src, &M));
+  else *newmat = M;
+  PetscFunctionReturn(0);
+}
+
+/* Reads with PETSc's own parallel MPIAIJ reader, then fills this matrix from it. */
+PETSC_INTERN PetscErrorCode MatLoad_MPIBinBCSR(Mat mat, PetscViewer viewer)
+{
+  Mat      T;
+  PetscInt bs, cbs;
+
+  PetscFunctionBegin;
+  PetscCall(MatCreate(PetscObjectComm((PetscObject)mat), &T));
+  PetscCall(MatSetSizes(T, mat->rmap->n, mat->cmap->n, mat->rmap->N, mat->cmap->N));
+  PetscCall(MatGetBlockSizes(mat, &bs, &cbs));
+  if (bs > 1 || cbs > 1) PetscCall(MatSetBlockSizes(T, bs, cbs));
+  PetscCall(MatSetType(T, MATMPIAIJ));
+  PetscCall(MatLoad(T, viewer));
+  PetscCall(MatSetSizes(mat, T->rmap->n, T->cmap->n, T->rmap->N, T->cmap->N));
+  PetscCall(MatSetBlockSizesFromMats(mat, T, T));
+  PetscCall(PreallocateAndFill(T, mat));
+  PetscCall(MatDestroy(&T));
+  PetscFunctionReturn(0);
+}
+
+PETSC_INTERN PetscErrorCode MatView_MPIBinBCSR(Mat mat, PetscViewer viewer)
+{
+  Mat_MPIBinBCSR   *b = MPIBinBCSR(mat);
+  PetscBool         iascii;
+  PetscViewerFormat format;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &iascii));
+  PetscCall(PetscViewerGetFormat(viewer, &format));
+  if (iascii && (format == PETSC_VIEWER_ASCII_INFO || format == PETSC_VIEWER_ASCII_INFO_DETAIL)) {
+    PetscMPIInt rank, size;
+    PetscViewer sv;
+    PetscCallMPI(MPI_Comm_rank(PetscObjectComm((PetscObject)mat), &rank));
+    PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)mat), &size));
+    PetscCall(PetscViewerASCIIPrintf(viewer, "MATMPIBINBCSR on %d ranks: diagonal and off-diagonal parts of type %s, block size %" PetscInt_FMT "\n", size, b->inner_type, mat->rmap->bs));
+    if (!b->A) PetscFunctionReturn(0);
+    PetscCall(PetscViewerASCIIPushSynchronized(viewer));
+    PetscCall(PetscViewerGetSubViewer(viewer, PETSC_COMM_SELF, &sv));
+    PetscCall(PetscViewerASCIIPrintf(sv, "[%d] rows %" PetscInt_FMT " to %" PetscInt_FMT ", %" PetscInt_FMT " ghost block columns\n", rank, mat->rmap->rstart, mat->rmap->rend, static_cast<PetscInt>(b->garray.size())));
+    PetscCall(PetscViewerASCIIPushTab(sv));
+    PetscCall(PetscViewerASCIIPrintf(sv, "[%d] diagonal part:\n", rank));
+    PetscCall(MatView(b->A, sv));
+    if (b->B) {
+      PetscCall(PetscViewerASCIIPrintf(sv, "[%d] off-diagonal part:\n", rank));
+      PetscCall(MatView(b->B, sv));
+    }
+    PetscCall(PetscViewerASCIIPopTab(sv));
+    PetscCall(PetscViewerRestoreSubViewer(viewer, PETSC_COMM_SELF, &sv));
+    PetscCall(PetscViewerFlush(viewer));
+    PetscCall(PetscViewerASCIIPopSynchronized(viewer));
+    PetscFunctionReturn(0);
+  }
+  /* values (ASCII, binary, draw, ...): through an MPIAIJ copy, whose viewers write every format */
+  Mat T;
+  PetscCall(MatConvert_MPIBinBCSR_MPIAIJ(mat, MATMPIAIJ, MAT_INITIAL_MATRIX, &T));
+  PetscCall(PetscObjectSetName((PetscObject)T, ((PetscObject)mat)->name));
+  PetscUseTypeMethod(T, view, viewer);
+  PetscCall(MatDestroy(&T));
+  PetscFunctionReturn(0);
+}
+
+PETSC_INTERN PetscErrorCode MatDuplicate_MPIBinBCSR(Mat mat, MatDuplicateOption op, Mat *newmat)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+  Mat             C;
+
+  PetscFunctionBegin;
+  PetscCall(CreateLike(mat, ((PetscObject)mat)->type_name, &C));
+  PetscCall(PetscLayoutSetUp(C->rmap));
+  PetscCall(PetscLayoutSetUp(C->cmap));
+  Mat_MPIBinBCSR *c = MPIBinBCSR(C);
+  PetscCall(PetscStrncpy(c->inner_type, b->inner_type, sizeof(c->inner_type)));
+  c->part_options       = b->part_options;
+  c->ignore_new_offdiag = b->ignore_new_offdiag;
+  c->donotstash         = b->donotstash;
+  c->bin_width          = b->bin_width;
+  c->precision_set      = b->precision_set;
+  c->precision          = b->precision;
+  c->garray             = b->garray;
+  c->compressed         = b->compressed;
+  c->b_staging          = b->b_staging;
+  if (op != MAT_COPY_VALUES)
+    for (auto &e : c->b_staging) e.second = 0;
+  if (b->A) PetscCall(MatDuplicate(b->A, op, &c->A));
+  if (b->B) PetscCall(MatDuplicate(b->B, op, &c->B));
+  if (b->lvec) PetscCall(VecDuplicate(b->lvec, &c->lvec));
+  if (b->Mvctx) PetscCall(VecScatterCopy(b->Mvctx, &c->Mvctx));
+  C->preallocated = mat->preallocated;
+  C->assembled    = mat->assembled;
+  C->nonzerostate = mat->nonzerostate;
+  *newmat         = C;
+  PetscFunctionReturn(0);
+}
+
+PETSC_INTERN PetscErrorCode MatCopy_MPIBinBCSR(Mat A, Mat B, MatStructure str)
+{
+  PetscBool same;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectTypeCompare((PetscObject)B, MATMPIBINBCSR, &same));
+  if (same) {
+    Mat_MPIBinBCSR *a = MPIBinBCSR(A), *b = MPIBinBCSR(B);
+    same = (a->compressed && b->compressed && a->garray == b->garray && a->B && b->B) ? PETSC_TRUE : PETSC_FALSE;
+    PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &same, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)A)));
+    if (same) {
+      PetscCall(MatCopy(a->A, b->A, str));
+      PetscCall(MatCopy(a->B, b->B, str));
+      PetscCall(PetscObjectStateIncrease((PetscObject)B));
+      PetscFunctionReturn(0);
+    }
+  }
+  PetscCall(RefillByRows(A, B));
+  PetscFunctionReturn(0);
+}
