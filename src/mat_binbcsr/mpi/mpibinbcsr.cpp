@@ -344,6 +344,7 @@ PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
   mat->ops->restorerow          = MatRestoreRow_MPIBinBCSR;
   mat->ops->norm                = MatNorm_MPIBinBCSR;
   mat->ops->getinfo             = MatGetInfo_MPIBinBCSR;
+  mat->ops->getdiagonalblock    = MatGetDiagonalBlock_MPIBinBCSR;
   mat->ops->view                = MatView_MPIBinBCSR;
   mat->ops->load                = MatLoad_MPIBinBCSR;
   mat->ops->convertfrom         = MatConvertFrom_MPIBinBCSR;

@@ -366,11 +366,19 @@ PETSC_INTERN PetscErrorCode MatNorm_MPIBinBCSR(Mat mat, NormType type, PetscReal
   const PetscInt  m    = mat->rmap->n;
 
   PetscFunctionBegin;
+  /* from the rows of the parts, so that every part type that gives rows will do */
   if (type == NORM_FROBENIUS) {
-    PetscReal na, nb = 0, local, global;
-    PetscCall(MatNorm(b->A, NORM_FROBENIUS, &na));
-    if (Ghosts(b)) PetscCall(MatNorm(b->B, NORM_FROBENIUS, &nb));
-    local = na * na + nb * nb;
+    PetscReal local = 0, global;
+    for (Mat part : {b->A, Ghosts(b) ? b->B : nullptr}) {
+      if (!part) continue;
+      for (PetscInt r = 0; r < m; r++) {
+        PetscInt           nz;
+        const PetscScalar *v;
+        PetscCall(MatGetRow(part, r, &nz, nullptr, &v));
+        for (PetscInt k = 0; k < nz; k++) local += PetscRealPart(PetscConj(v[k]) * v[k]);
+        PetscCall(MatRestoreRow(part, r, &nz, nullptr, &v));
+      }
+    }
     PetscCall(MPIU_Allreduce(&local, &global, 1, MPIU_REAL, MPIU_SUM, comm));
     *norm = PetscSqrtReal(global);
   } else if (type == NORM_INFINITY) {
