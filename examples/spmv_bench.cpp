@@ -3,6 +3,7 @@
 //
 //   spmv_bench [-stencil_sizes 16,32,48] [-f FILE]... [-formats aij,baij,sbaij,sell,binbcsr,binbcsr_single]
 //              [-repeats 7] [-min_batch_ms 20] [-csv FILE] [-stats_only] [-stream_elements N]
+//              [-save_dir DIR] (also write each stencil matrix to DIR/stencilN.bin, PETSc binary)
 //
 // Matrices: the 27-point 3x3-block stencil (examples/common/stencil.h) on an n^3 node grid for each
 // n of -stencil_sizes (0 = none), and every PETSc binary file given with -f (repeatable, or a comma
@@ -246,6 +247,7 @@ struct Settings {
   FILE                   *csv          = nullptr;
   TriadArrays            *triad        = nullptr; // one triad pass per round, beside the MatMults
   PetscInt                file_bs      = 0;
+  std::string             save_dir; // -save_dir: write each stencil matrix (aij) as a PETSc binary file
 };
 
 PetscErrorCode BenchMatrix(MPI_Comm comm, const MatrixSource &src, const Settings &set)
@@ -262,6 +264,14 @@ PetscErrorCode BenchMatrix(MPI_Comm comm, const MatrixSource &src, const Setting
     reference = aij_file;
   } else {
     PetscCall(CreateStencilMatrix(comm, src.grid, MATAIJ, nullptr, &reference));
+    if (!set.save_dir.empty()) {
+      const std::string path = set.save_dir + "/" + src.name + ".bin";
+      PetscViewer       viewer;
+      PetscCall(PetscViewerBinaryOpen(comm, path.c_str(), FILE_MODE_WRITE, &viewer));
+      PetscCall(MatView(reference, viewer)); // the .info file next to it records the block size
+      PetscCall(PetscViewerDestroy(&viewer));
+      PetscCall(PetscPrintf(comm, "wrote %s\n", path.c_str()));
+    }
   }
   PetscCall(MeasureStats(reference, &st));
 
@@ -431,6 +441,8 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-min_batch_ms", &set.min_batch_ms, nullptr));
   PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-stats_only", &set.stats_only, nullptr));
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-bs", &set.file_bs, nullptr));
+  PetscCall(PetscOptionsGetString(nullptr, nullptr, "-save_dir", buf, sizeof buf, &flg));
+  if (flg) set.save_dir = buf;
   PetscCheck(set.repeats > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-repeats must be positive");
 
   std::vector<MatrixSource> sources;
