@@ -2,13 +2,14 @@
 // nx x ny x nz node grid, 3 unknowns per node (node (i,j,k) is block row i + nx*(j + ny*k)).
 //
 // Values are deterministic and the matrix is symmetric and strictly diagonally dominant, hence SPD:
-//   off-diagonal block for the neighbour at offset d:  B = -w (I + 1/2 u u^T),  u = d/|d|,
+//   off-diagonal block for the neighbour at offset d:  B = -w (I + 1/2 u u^T),  u = |d|/|d|
+//     (componentwise absolute value: all off-diagonal entries <= 0),
 //     w = (c_p + c_q)/2 / |d|^2  with a per-node coefficient c in [1, 1.5] (so rows differ),
-//   diagonal block:  (sum over the node's neighbours of the bound 1.87 w on B's row sums
-//                     + shift c_p) I.
+//   diagonal block:  diagonal, entry a = (sum of |off-diagonal entries| of scalar row a) + shift c_p,
+//                    i.e. just strictly diagonally dominant.
 // Interior rows have 27 blocks (243 scalars), faces 18, edges 12, corners 8, as in an assembled
-// trilinear hexahedral FE mesh. The condition number grows like the grid's Laplacian (~ n^2)
-// and is capped by 1/shift.
+// trilinear hexahedral FE mesh. The condition number grows with the grid (like a stiffness
+// matrix: ~ n^2) and is capped by about 1/shift.
 #pragma once
 #include <petscmat.h>
 
