@@ -27,7 +27,11 @@ mkdir -p "$mdir"
 
 if [ "$quick" = 1 ]; then sizes=4,8,12,16; hist_its=100; rounds=1
 else sizes=4,6,8,12,16,20; hist_its=200; rounds=2; fi
-"$b/examples/spmv_bench" -stats_only -stencil_sizes $sizes -save_dir "$mdir" >/dev/null
+dfargs=()
+for f in "${drivers[@]+"${drivers[@]}"}"; do dfargs+=(-f "$f"); done
+# saves the stencils and records the nonzeros of every matrix of part 3
+"$b/examples/spmv_bench" -stats_only -formats aij -stencil_sizes $sizes -save_dir "$mdir" \
+  "${dfargs[@]+"${dfargs[@]}"}" -csv "$mdir/stats.csv" >/dev/null
 
 # combo -> ex72 options
 combo_opts() {
@@ -58,10 +62,7 @@ matrices+=("${drivers[@]+"${drivers[@]}"}")
 echo "matrix,nnz,combo,sec_per_it,speedup_vs_aij_cg" >"$out/cg_speedup.csv"
 for m in "${matrices[@]}"; do
   name=$(basename "$m" .bin)
-  nnz=$(awk -F, -v m="$name" '$1 == m || $1 == m".bin" { print $4; exit }' "$out/spmv.csv" 2>/dev/null)
-  if [ -z "$nnz" ]; then
-    nnz=$("$b/examples/spmv_bench" -stats_only -stencil_sizes 0 -f "$m" -formats aij -csv /dev/stdout 2>/dev/null | awk -F, 'NR == 2 { print $4 }')
-  fi
+  nnz=$(awk -F, -v m="$name" '$1 == m || $1 == m".bin" { print $4; exit }' "$mdir/stats.csv")
   declare -A best=()
   for r in $(seq $rounds); do
     for c in aij_cg binbcsr_cg binbcsr_mcg; do

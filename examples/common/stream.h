@@ -20,6 +20,7 @@ struct TriadArrays {
   double  *a = nullptr, *b = nullptr, *c = nullptr;
   PetscInt n = 0;      // elements per array on this rank
   double   bytes = 0;  // bytes one pass moves, all ranks together
+  bool     cpu_clock = false; // time passes with ProcessCpuSeconds instead of the wall clock
 };
 // n <= 0: the default size below. Allocates and first-touches.
 PetscErrorCode TriadArraysCreate(MPI_Comm comm, PetscInt n, TriadArrays *t);
@@ -33,6 +34,11 @@ PetscErrorCode MeasureStreamTriad(MPI_Comm comm, PetscInt elements_per_rank, Pet
 
 // Same, sizes from options -stream_elements N and -stream_repeats R.
 PetscErrorCode MeasureStreamTriadFromOptions(MPI_Comm comm, StreamResult *result);
+
+// CPU seconds this process has used (CLOCK_PROCESS_CPUTIME_ID). On a machine shared with other work,
+// a timing by this clock leaves out the time the process waited for a core (it still includes the
+// cache and memory traffic of the others).
+double ProcessCpuSeconds();
 
 // Last-level cache in bytes as the OS reports it (0 if unknown).
 size_t LastLevelCacheBytes();
