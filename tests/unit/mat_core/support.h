@@ -170,4 +170,36 @@ inline void check_close(const std::vector<PetscScalar> &got, const std::vector<P
   CHECK(bad == 0);
 }
 
+// All entries through MatGetValues (independent of MatGetRow and the products).
+inline std::vector<PetscScalar> dense(Mat A)
+{
+  PetscInt m, n;
+  REQUIRE(MatGetSize(A, &m, &n) == 0);
+  std::vector<PetscInt> rows(m), cols(n);
+  for (PetscInt i = 0; i < m; i++) rows[i] = i;
+  for (PetscInt j = 0; j < n; j++) cols[j] = j;
+  std::vector<PetscScalar> d((size_t)m * n);
+  if (m && n) REQUIRE(MatGetValues(A, m, rows.data(), n, cols.data(), d.data()) == 0);
+  return d;
+}
+
+inline std::vector<PetscScalar> dense(const Pattern &p)
+{
+  std::vector<PetscScalar> d((size_t)p.m * p.n, 0.0);
+  for (const Entry &e : p.entries) d[(size_t)e.i * p.n + e.j] = e.v;
+  return d;
+}
+
+inline void check_dense(const std::vector<PetscScalar> &got, const std::vector<PetscScalar> &ref, double rel)
+{
+  REQUIRE(got.size() == ref.size());
+  size_t bad = 0;
+  for (size_t k = 0; k < got.size(); k++)
+    if (!(std::fabs(got[k] - ref[k]) <= rel * std::fabs(ref[k]))) {
+      if (bad < 5) UNSCOPED_INFO("entry " << k << ": got " << got[k] << " ref " << ref[k]);
+      bad++;
+    }
+  CHECK(bad == 0);
+}
+
 } // namespace mat_core
