@@ -194,14 +194,17 @@ std::vector<double> row_abs_sums(Mat A)
   PetscInt m, n;
   REQUIRE(MatGetSize(A, &m, &n) == 0);
   std::vector<double> s(m, 0.0);
-  for (PetscInt i = 0; i < m; i++) {
+  bool                ok = true;
+  for (PetscInt i = 0; i < m && ok; i++) {
     PetscInt           nc;
     const PetscInt    *c;
     const PetscScalar *v;
-    REQUIRE(MatGetRow(A, i, &nc, &c, &v) == 0);
+    ok = MatGetRow(A, i, &nc, &c, &v) == 0;
+    if (!ok) break;
     for (PetscInt k = 0; k < nc; k++) s[i] += std::abs(v[k]);
-    REQUIRE(MatRestoreRow(A, i, &nc, &c, &v) == 0);
+    ok = MatRestoreRow(A, i, &nc, &c, &v) == 0;
   }
+  REQUIRE(ok);
   return s;
 }
 
@@ -221,35 +224,39 @@ Mismatch compare(Mat got, Mat want, const std::vector<double> &scale)
   REQUIRE(mg == m);
   REQUIRE(ng == n);
   REQUIRE((PetscInt)scale.size() == m);
-  Mismatch            worst;
-  std::vector<double> g(n), w(n);
-  std::vector<char>   touched(n, 0);
+  Mismatch              worst;
+  std::vector<double>   g(n), w(n);
+  std::vector<char>     touched(n, 0);
   std::vector<PetscInt> list;
-  for (PetscInt i = 0; i < m; i++) {
+  bool                  calls_ok = true, columns_ok = true; // one assertion per matrix, not per entry
+  for (PetscInt i = 0; i < m && calls_ok && columns_ok; i++) {
     PetscInt           nc;
     const PetscInt    *c;
     const PetscScalar *v;
     list.clear();
-    REQUIRE(MatGetRow(got, i, &nc, &c, &v) == 0);
+    calls_ok = calls_ok && MatGetRow(got, i, &nc, &c, &v) == 0;
+    if (!calls_ok) break;
     for (PetscInt k = 0; k < nc; k++) {
-      REQUIRE(c[k] >= 0);
-      REQUIRE(c[k] < n);
+      if (c[k] < 0 || c[k] >= n) { columns_ok = false; break; }
       if (!touched[c[k]]) { touched[c[k]] = 1; list.push_back(c[k]); g[c[k]] = w[c[k]] = 0; }
       g[c[k]] += v[k];
     }
-    REQUIRE(MatRestoreRow(got, i, &nc, &c, &v) == 0);
-    REQUIRE(MatGetRow(want, i, &nc, &c, &v) == 0);
+    calls_ok = calls_ok && MatRestoreRow(got, i, &nc, &c, &v) == 0;
+    calls_ok = calls_ok && MatGetRow(want, i, &nc, &c, &v) == 0;
+    if (!calls_ok) break;
     for (PetscInt k = 0; k < nc; k++) {
       if (!touched[c[k]]) { touched[c[k]] = 1; list.push_back(c[k]); g[c[k]] = w[c[k]] = 0; }
       w[c[k]] += v[k];
     }
-    REQUIRE(MatRestoreRow(want, i, &nc, &c, &v) == 0);
+    calls_ok = calls_ok && MatRestoreRow(want, i, &nc, &c, &v) == 0;
     for (PetscInt j : list) {
       const double r = ratio(g[j], w[j], scale[i]);
       if (r > worst.ratio || (std::isinf(r) && worst.row < 0)) worst = {r, i, j, g[j], w[j]};
       touched[j] = 0;
     }
   }
+  REQUIRE(calls_ok);
+  REQUIRE(columns_ok);
   return worst;
 }
 
