@@ -46,8 +46,10 @@ PetscErrorCode CheckMatTypeAvailable(MPI_Comm comm)
 // Exact per-row lengths of the block pattern (all ranks' contributions), computed through an aij
 // matrix of the block graph (native COO, handles off-rank entries), then handed to the preallocation
 // routines of every family (each is a no-op for the other families).
+// Also returns the number of distinct blocks over all ranks (nnz / 9). A may be null (count only).
 PetscErrorCode PreallocateFromBlockPattern(MPI_Comm comm, PetscInt n_local, PetscInt n_global,
-                                           const std::vector<PetscInt> &rows, const std::vector<PetscInt> &cols, Mat A)
+                                           const std::vector<PetscInt> &rows, const std::vector<PetscInt> &cols, Mat A,
+                                           PetscInt *n_blocks)
 {
   Mat      graph;
   PetscInt bstart, bend;
@@ -63,6 +65,15 @@ PetscErrorCode PreallocateFromBlockPattern(MPI_Comm comm, PetscInt n_local, Pets
   std::vector<PetscScalar> ones(rows.size(), 1.0);
   PetscCall(MatSetValuesCOO(graph, ones.data(), INSERT_VALUES));
   PetscCall(MatGetOwnershipRange(graph, &bstart, &bend));
+  {
+    MatInfo info;
+    PetscCall(MatGetInfo(graph, MAT_GLOBAL_SUM, &info));
+    *n_blocks = (PetscInt)info.nz_used;
+  }
+  if (!A) {
+    PetscCall(MatDestroy(&graph));
+    PetscFunctionReturn(0);
+  }
   std::vector<PetscInt> d_blocks(n_local), o_blocks(n_local), d_rows(3 * n_local), o_rows(3 * n_local);
   PetscInt d_max = 0, o_max = 0;
   for (PetscInt i = bstart; i < bend; ++i) {
@@ -144,10 +155,11 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
           cj[9 * k + 3 * r + c] = 3 * coo_block_col[k] + c;
         }
     PetscCall(MatSetPreallocationCOO(sys->A, (PetscCount)ci.size(), ci.data(), cj.data()));
+    PetscCall(PreallocateFromBlockPattern(comm, n_local, n_block_rows_global, coo_block_row, coo_block_col, nullptr, &sys->n_blocks));
   } else {
     // PETSc 3.18's generic COO preallocation cannot preallocate sell; preallocate every other type
     // from the exact row lengths instead.
-    PetscCall(PreallocateFromBlockPattern(comm, n_local, n_block_rows_global, coo_block_row, coo_block_col, sys->A));
+    PetscCall(PreallocateFromBlockPattern(comm, n_local, n_block_rows_global, coo_block_row, coo_block_col, sys->A, &sys->n_blocks));
     PetscCall(MatSetOption(sys->A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
   }
   PetscCall(MatSetOption(sys->A, MAT_SYMMETRIC, PETSC_TRUE));
@@ -256,11 +268,7 @@ PetscErrorCode BlockSystemDumpMatrix(BlockSystem *sys, const char *path)
 PetscErrorCode BlockSystemGetInfo(BlockSystem *sys, PetscInt *nnz, const char **mat_type, const char **ksp_type)
 {
   PetscFunctionBegin;
-  if (nnz) {
-    MatInfo info;
-    PetscCall(MatGetInfo(sys->A, MAT_GLOBAL_SUM, &info));
-    *nnz = (PetscInt)info.nz_used;
-  }
+  if (nnz) *nnz = 9 * sys->n_blocks;
   if (mat_type) PetscCall(MatGetType(sys->A, (MatType *)mat_type));
   if (ksp_type) PetscCall(KSPGetType(sys->ksp, (KSPType *)ksp_type));
   PetscFunctionReturn(0);

@@ -31,6 +31,7 @@ struct BlockSystem {
   PetscInt n_block_rows_global = 0, n_block_rows_local = 0;
   PetscInt row_begin = 0, row_end = 0;  // scalar row range owned by this rank
   PetscInt n_coo_blocks = 0;            // blocks this rank contributes (length of the COO list)
+  PetscInt n_blocks = 0;                // distinct blocks of the pattern over all ranks
   PetscBool native_coo = PETSC_FALSE;   // the type implements MatSetValuesCOO itself
   std::vector<PetscInt> coo_block_row, coo_block_col; // kept for the fallback path and for dumps
   const PetscScalar *last_values = nullptr; // the caller's array from the last SetValues (for dumps)
@@ -62,7 +63,7 @@ PetscErrorCode BlockSystemSolve(BlockSystem *sys, const PetscScalar *rhs_local, 
 // Writes the current matrix in PETSc binary format (loadable as aij with MatLoad), whatever its type.
 PetscErrorCode BlockSystemDumpMatrix(BlockSystem *sys, const char *path);
 
-// Nonzeros stored (scalar entries of the pattern, summed over ranks) and the Mat type's name.
+// Structural nonzeros (9 per distinct block of the pattern, over all ranks; padding not counted) and the Mat type's name.
 PetscErrorCode BlockSystemGetInfo(BlockSystem *sys, PetscInt *nnz, const char **mat_type, const char **ksp_type);
 
 PetscErrorCode BlockSystemDestroy(BlockSystem *sys);

@@ -1,0 +1,480 @@
+// Corotational FEM driver: linear or quadratic tetrahedra, implicit Euler, one linear solve per step
+// on a fixed-pattern 3x3-block matrix refilled in place (any -mat_type, any -ksp_type).
+//
+//   fem -mesh_box 1,0.1,0.1,20,2,2 -fem_order 2 -fix xmin -steps 50 -mat_type binbcsr -ksp_type mcg
+//   fem -mesh examples/meshes/armadillo.geo -mesh_size 0.08 -fem_order 2 -vtk out/arma
+//
+// Parallel runs (mpiexec -n P): every rank holds the whole mesh and state; METIS splits the nodes
+// into P contiguous ranges (src/physics/partition), each rank assembles the elements whose first
+// corner it owns (COO entries may fall in other ranks' rows), the solve is distributed, and dv is
+// gathered back to every rank.
+//
+// Fixed nodes are eliminated: their rows and columns hold only an identity diagonal block and their
+// right-hand side is 0, so dv = 0 there, the matrix stays SPD and the pattern never changes.
+#include <petscbinbcsr.h>
+
+#include "common/sim_system.h"
+#include "common/summary.h"
+#include "physics/box_mesh.hpp"
+#include "physics/corotational_assembly.hpp"
+#include "physics/fem_model.hpp"
+#include "physics/msh_reader.hpp"
+#include "physics/partition.hpp"
+#include "physics/tet_mesh.hpp"
+#include "physics/vtk_writer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <vector>
+
+static const char help[] = "Corotational FEM (P1/P2 tetrahedra), implicit Euler, matrix refilled in place.\n"
+                           "See docs/fem.md for every option.\n";
+
+namespace {
+
+struct Options {
+  char        mesh[PETSC_MAX_PATH_LEN] = "";
+  PetscReal   mesh_size                = 0; // for .geo files
+  PetscReal   box[6]                   = {1, 0.1, 0.1, 20, 2, 2};
+  PetscBool   box_set                  = PETSC_FALSE;
+  PetscInt    order                    = 1;
+  PetscBool   corotational             = PETSC_TRUE;
+  PetscBool   lumped                   = PETSC_FALSE;
+  PetscReal   young = 1e6, poisson = 0.3, density = 1000;
+  PetscReal   dt = 0.01;
+  PetscInt    steps = 10;
+  PetscReal   gravity[3] = {0, 0, -9.81};
+  PetscReal   rayleigh[2] = {0, 0};
+  char        fix[256]    = "";
+  PetscReal   fix_box[6]  = {0};
+  PetscBool   fix_box_set = PETSC_FALSE;
+  char        vtk[PETSC_MAX_PATH_LEN] = "";
+  PetscInt    vtk_every = 1;
+  char        dump[PETSC_MAX_PATH_LEN] = "";
+  PetscBool   merge   = PETSC_TRUE;
+  PetscBool   reorder = PETSC_TRUE;
+  PetscBool   quiet   = PETSC_FALSE;
+  PetscBool   is_static = PETSC_FALSE;
+  PetscReal   v0[3] = {0, 0, 0};
+  PetscReal   spin[3] = {0, 0, 0};
+  PetscReal   stretch = 1;
+  PetscReal   perturb[4] = {-1, 0, 0, 0}; // node, dx, dy, dz (rest numbering)
+};
+
+PetscErrorCode GetOptions(Options &o)
+{
+  PetscInt  n;
+  PetscBool set;
+  PetscFunctionBegin;
+  PetscOptionsBegin(PETSC_COMM_WORLD, nullptr, "FEM driver options", "fem");
+  PetscCall(PetscOptionsString("-mesh", "gmsh mesh (.msh 2.2/4.1 ASCII) or geometry (.geo, meshed by gmsh)", "", o.mesh, o.mesh,
+                               sizeof o.mesh, nullptr));
+  PetscCall(PetscOptionsReal("-mesh_size", "gmsh characteristic length for .geo input", "", o.mesh_size, &o.mesh_size, nullptr));
+  n = 6;
+  PetscCall(PetscOptionsRealArray("-mesh_box", "lx,ly,lz,nx,ny,nz: box of 6 tets per cell", "", o.box, &n, &o.box_set));
+  PetscCheck(!o.box_set || n == 6, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "-mesh_box needs lx,ly,lz,nx,ny,nz");
+  PetscCall(PetscOptionsInt("-fem_order", "1 (4-node) or 2 (10-node) tetrahedra", "", o.order, &o.order, nullptr));
+  PetscCheck(o.order == 1 || o.order == 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-fem_order must be 1 or 2");
+  PetscCall(PetscOptionsBool("-fem_corotational", "corotational (1) or plain linear (0) elasticity", "", o.corotational,
+                             &o.corotational, nullptr));
+  PetscCall(PetscOptionsBool("-fem_mass_lumped", "P2: HRZ-lumped instead of consistent mass", "", o.lumped, &o.lumped, nullptr));
+  PetscCall(PetscOptionsReal("-young", "Young's modulus (Pa)", "", o.young, &o.young, nullptr));
+  PetscCall(PetscOptionsReal("-poisson", "Poisson's ratio", "", o.poisson, &o.poisson, nullptr));
+  PetscCall(PetscOptionsReal("-density", "density (kg/m^3)", "", o.density, &o.density, nullptr));
+  PetscCall(PetscOptionsReal("-dt", "time step (s)", "", o.dt, &o.dt, nullptr));
+  PetscCall(PetscOptionsInt("-steps", "time steps (Newton iterations with -static)", "", o.steps, &o.steps, nullptr));
+  n = 3;
+  PetscCall(PetscOptionsRealArray("-gravity", "gx,gy,gz", "", o.gravity, &n, &set));
+  PetscCheck(!set || n == 3, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "-gravity needs gx,gy,gz");
+  n = 2;
+  PetscCall(PetscOptionsRealArray("-rayleigh", "alpha,beta: damping D = alpha M + beta K", "", o.rayleigh, &n, &set));
+  PetscCheck(!set || n == 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "-rayleigh needs alpha,beta");
+  PetscCall(PetscOptionsString("-fix", "none | xmin|xmax|ymin|ymax|zmin|zmax[:fraction of the extent, default 0.01]", "", o.fix,
+                               o.fix, sizeof o.fix, nullptr));
+  n = 6;
+  PetscCall(PetscOptionsRealArray("-fix_box", "x0,y0,z0,x1,y1,z1: fix the nodes in this box", "", o.fix_box, &n, &o.fix_box_set));
+  PetscCheck(!o.fix_box_set || n == 6, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "-fix_box needs x0,y0,z0,x1,y1,z1");
+  PetscCall(PetscOptionsString("-vtk", "write PREFIX_NNNN.vtu frames and PREFIX.pvd", "", o.vtk, o.vtk, sizeof o.vtk, nullptr));
+  PetscCall(PetscOptionsInt("-vtk_every", "write a frame every k steps", "", o.vtk_every, &o.vtk_every, nullptr));
+  PetscCall(PetscOptionsString("-dump_matrix", "write the first step's matrix (PETSc binary)", "", o.dump, o.dump, sizeof o.dump,
+                               nullptr));
+  PetscCall(PetscOptionsBool("-fem_merge_blocks", "sum element blocks into unique COO blocks here (1) or let the Mat do it (0)",
+                             "", o.merge, &o.merge, nullptr));
+  PetscCall(PetscOptionsBool("-fem_reorder", "METIS partition / RCM renumbering of the nodes", "", o.reorder, &o.reorder, nullptr));
+  PetscCall(PetscOptionsBool("-fem_quiet", "no progress line per step", "", o.quiet, &o.quiet, nullptr));
+  PetscCall(PetscOptionsBool("-static", "solve K(x) dx = f(x) + f_ext by Newton steps instead of time steps", "", o.is_static,
+                             &o.is_static, nullptr));
+  n = 3;
+  PetscCall(PetscOptionsRealArray("-initial_velocity", "vx,vy,vz", "", o.v0, &n, nullptr));
+  n = 3;
+  PetscCall(PetscOptionsRealArray("-initial_spin", "wx,wy,wz: rigid angular velocity about the centroid", "", o.spin, &n, nullptr));
+  PetscCall(PetscOptionsReal("-initial_stretch", "scale initial positions about the centroid", "", o.stretch, &o.stretch, nullptr));
+  n = 4;
+  PetscCall(PetscOptionsRealArray("-initial_perturb", "node,dx,dy,dz: move one node (e.g. to invert an element)", "", o.perturb,
+                                  &n, nullptr));
+  PetscOptionsEnd();
+  PetscCheck(o.dt > 0 && std::isfinite(o.dt), PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-dt must be positive");
+  PetscCheck(o.steps >= 0, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-steps must be >= 0");
+  PetscCheck(o.vtk_every >= 1, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-vtk_every must be >= 1");
+  PetscFunctionReturn(0);
+}
+
+bool file_exists(const std::string &p)
+{
+  struct stat st;
+  return stat(p.c_str(), &st) == 0;
+}
+
+// Meshes a .geo with gmsh into a cache next to the program (build/meshes), on rank 0.
+PetscErrorCode MeshGeo(MPI_Comm comm, const std::string &geo, double size, std::string *msh)
+{
+  PetscMPIInt rank;
+  char        exe[PETSC_MAX_PATH_LEN] = "";
+  PetscFunctionBegin;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCheck(file_exists(geo), comm, PETSC_ERR_FILE_OPEN, "geometry file %s not found", geo.c_str());
+  const ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
+  std::string   dir = len > 0 ? std::string(exe, len) : std::string("./fem");
+  dir               = dir.substr(0, dir.find_last_of('/')) + "/../meshes";
+  std::string base  = geo.substr(geo.find_last_of('/') + 1);
+  base              = base.substr(0, base.find_last_of('.'));
+  char sz[64];
+  std::snprintf(sz, sizeof sz, "%g", size);
+  *msh = dir + "/" + base + (size > 0 ? std::string("_h") + sz : std::string()) + ".msh";
+  int failed = 0;
+  if (!rank && !file_exists(*msh)) {
+    mkdir(dir.c_str(), 0755);
+    const std::string tmp = *msh + ".tmp." + std::to_string(getpid()) + ".msh";
+    std::string       cmd = "gmsh -3 -format msh41 -v 1 -nt 1 " + (size > 0 ? "-clmax " + std::string(sz) + " " : std::string()) +
+                      "'" + geo + "' -o '" + tmp + "' > /dev/null 2>&1";
+    failed = std::system(cmd.c_str()) != 0 || std::rename(tmp.c_str(), msh->c_str()) != 0;
+  }
+  PetscCallMPI(MPI_Bcast(&failed, 1, MPI_INT, 0, comm));
+  PetscCheck(!failed, comm, PETSC_ERR_LIB, "gmsh could not mesh %s (is gmsh installed? scripts/setup installs it)", geo.c_str());
+  PetscFunctionReturn(0);
+}
+
+// Nodes to fix, from -fix and -fix_box.
+std::vector<char> SelectFixed(const physics::TetMesh &mesh, const Options &o)
+{
+  std::vector<char> fixed(mesh.node_count(), 0);
+  const auto        bb  = physics::bounding_box(mesh);
+  std::string       fix = o.fix;
+  if (!fix.empty() && fix != "none") {
+    double      fraction = 0.01;
+    const auto  colon    = fix.find(':');
+    if (colon != std::string::npos) {
+      fraction = std::atof(fix.c_str() + colon + 1);
+      fix      = fix.substr(0, colon);
+    }
+    if (fix.size() != 4 || fix[0] < 'x' || fix[0] > 'z' || (fix.substr(1) != "min" && fix.substr(1) != "max"))
+      throw std::invalid_argument("-fix " + std::string(o.fix) + ": expected none, xmin, xmax, ymin, ymax, zmin or zmax[:fraction]");
+    const int    axis   = fix[0] - 'x';
+    const bool   is_min = fix.substr(1) == "min";
+    const double extent = bb[3 + axis] - bb[axis];
+    const double tol    = std::max(fraction, 1e-9) * extent;
+    for (int i : physics::nodes_beyond_plane(mesh, axis, is_min ? bb[axis] : bb[3 + axis], is_min ? -1 : 1, tol)) fixed[i] = 1;
+  }
+  if (o.fix_box_set)
+    for (int i : physics::nodes_in_box(mesh, {o.fix_box[0], o.fix_box[1], o.fix_box[2]}, {o.fix_box[3], o.fix_box[4], o.fix_box[5]}))
+      fixed[i] = 1;
+  return fixed;
+}
+
+// The node whose displacement is reported as "tip": farthest from the fixed nodes' centroid (or the
+// node with the largest x when nothing is fixed).
+int TipNode(const physics::TetMesh &mesh, const std::vector<char> &fixed)
+{
+  double c[3] = {0, 0, 0};
+  int    nf   = 0;
+  for (int i = 0; i < mesh.node_count(); ++i)
+    if (fixed[i]) {
+      for (int d = 0; d < 3; ++d) c[d] += mesh.nodes[3 * i + d];
+      ++nf;
+    }
+  int    best = 0;
+  double bd   = -1;
+  for (int i = 0; i < mesh.node_count(); ++i) {
+    double dist = 0;
+    if (nf)
+      for (int d = 0; d < 3; ++d) dist += std::pow(mesh.nodes[3 * i + d] - c[d] / nf, 2);
+    else dist = mesh.nodes[3 * i];
+    if (dist > bd + 1e-12) { bd = dist; best = i; }
+  }
+  return best;
+}
+
+} // namespace
+
+int main(int argc, char **argv)
+{
+  Options     o;
+  PetscMPIInt rank, size;
+
+  PetscCall(PetscInitialize(&argc, &argv, nullptr, help));
+  PetscCall(PetscBinBCSRRegisterAll());
+  MPI_Comm comm = PETSC_COMM_WORLD;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(GetOptions(o));
+
+  // ---- scene: mesh, renumbering, model, fixed nodes ------------------------------------------
+  physics::TetMesh  mesh;
+  physics::FemModel model;
+  std::vector<char> fixed;
+  std::vector<int>  part_offsets;
+  std::vector<int>  new_of_old; // input node -> node in the renumbered mesh (empty: identity)
+  std::string       mesh_name;
+  {
+    std::string msh = o.mesh;
+    if (msh.size() > 4 && msh.substr(msh.size() - 4) == ".geo") PetscCall(MeshGeo(comm, msh, o.mesh_size, &msh));
+    std::string error;
+    try {
+      if (!msh.empty()) {
+        mesh      = physics::read_msh_file(msh);
+        mesh_name = o.mesh;
+      } else {
+        mesh      = physics::make_box_mesh(o.box[0], o.box[1], o.box[2], (int)o.box[3], (int)o.box[4], (int)o.box[5]);
+        mesh_name = "box";
+      }
+      if (o.order == 2) mesh = physics::promote_to_quadratic(mesh);
+      const physics::AdjacencyGraph g = physics::graph_from_elements(mesh.node_count(), mesh.nodes_per_element(), mesh.elements);
+      physics::Renumbering          r;
+      if (o.reorder && size > 1) {
+        physics::PartitionOptions po;
+        po.local_order = physics::LocalOrder::ReverseCuthillMcKee;
+        r              = physics::partition_graph(g, size, po);
+      } else if (o.reorder) {
+        r = physics::reorder_for_locality(g, physics::LocalOrder::ReverseCuthillMcKee);
+      }
+      if (o.reorder) {
+        physics::renumber_nodes(mesh, r.new_of_old);
+        part_offsets = r.part_offsets;
+        new_of_old   = r.new_of_old;
+      }
+      if (part_offsets.size() != (size_t)size + 1) { // no partition: even contiguous split
+        part_offsets.assign(size + 1, 0);
+        for (int p = 0; p <= size; ++p) part_offsets[p] = (int)((long long)mesh.node_count() * p / size);
+      }
+      physics::FemSettings s;
+      s.young        = o.young;
+      s.poisson      = o.poisson;
+      s.density      = o.density;
+      s.corotational = o.corotational;
+      s.mass         = o.lumped ? physics::MassLumping::Lumped : physics::MassLumping::Consistent;
+      model          = physics::make_fem_model(mesh, s);
+      fixed          = SelectFixed(mesh, o);
+    } catch (const std::exception &ex) {
+      error = ex.what();
+    }
+    PetscCheck(error.empty(), comm, PETSC_ERR_USER_INPUT, "%s", error.c_str());
+  }
+  const int n_nodes = model.node_count(), npe = model.npe;
+  const int own_begin = part_offsets[rank], own_end = part_offsets[rank + 1], n_own = own_end - own_begin;
+
+  std::vector<int> my_elements;
+  for (int e = 0; e < model.element_count(); ++e) {
+    const int first = model.mesh.elements[(size_t)e * npe];
+    if (first >= own_begin && first < own_end) my_elements.push_back(e);
+  }
+  const physics::BlockPattern pattern = physics::make_block_pattern(model, my_elements, fixed, own_begin, own_end, o.merge);
+
+  BlockSystem sys;
+  PetscCall(BlockSystemCreate(comm, n_nodes, n_own, pattern.rows, pattern.cols, &sys));
+  PetscCheck(sys.row_begin == 3 * own_begin && sys.row_end == 3 * own_end, PETSC_COMM_SELF, PETSC_ERR_PLIB,
+             "matrix ownership does not match the node partition");
+
+  // ---- state --------------------------------------------------------------------------------
+  const std::vector<double> &X = model.mesh.nodes;
+  std::vector<double>        x(X), v(X.size(), 0.0);
+  {
+    double c[3] = {0, 0, 0};
+    for (int i = 0; i < n_nodes; ++i)
+      for (int d = 0; d < 3; ++d) c[d] += X[3 * i + d] / n_nodes;
+    for (int i = 0; i < n_nodes; ++i) {
+      if (fixed[i]) continue;
+      const double r[3] = {X[3 * i] - c[0], X[3 * i + 1] - c[1], X[3 * i + 2] - c[2]};
+      for (int d = 0; d < 3; ++d) x[3 * i + d] = c[d] + o.stretch * r[d];
+      v[3 * i + 0] = o.v0[0] + o.spin[1] * r[2] - o.spin[2] * r[1];
+      v[3 * i + 1] = o.v0[1] + o.spin[2] * r[0] - o.spin[0] * r[2];
+      v[3 * i + 2] = o.v0[2] + o.spin[0] * r[1] - o.spin[1] * r[0];
+    }
+    if (o.perturb[0] >= 0) {
+      // The node is named in the numbering of the input (promoted) mesh.
+      PetscCheck((PetscInt)o.perturb[0] < n_nodes, comm, PETSC_ERR_ARG_OUTOFRANGE, "-initial_perturb: node out of range");
+      int node = (int)o.perturb[0];
+      if (!new_of_old.empty()) node = new_of_old[node];
+      for (int d = 0; d < 3; ++d) x[3 * node + d] += o.perturb[1 + d];
+    }
+  }
+  const std::vector<double> f_gravity = physics::gravity_forces(model, {o.gravity[0], o.gravity[1], o.gravity[2]});
+  const physics::StepCoefficients coef =
+    o.is_static ? physics::StepCoefficients{1, 0, 0, 0, 1} : physics::implicit_euler_coefficients(o.dt, o.rayleigh[0], o.rayleigh[1]);
+  const double        rhs_gravity_scale = o.is_static ? 1.0 : o.dt;
+  std::vector<double> values, rhs_full(3 * (size_t)n_nodes), rhs_local(3 * (size_t)n_own), dv_local(3 * (size_t)n_own, 0.0),
+    dv_full(3 * (size_t)n_nodes);
+  std::vector<int> counts(size), displs(size);
+  for (int p = 0; p < size; ++p) {
+    counts[p] = 3 * (part_offsets[p + 1] - part_offsets[p]);
+    displs[p] = 3 * part_offsets[p];
+  }
+  const int tip = TipNode(model.mesh, fixed);
+
+  PetscInt    nnz;
+  const char *mat_type, *ksp_type;
+  PetscCall(BlockSystemGetInfo(&sys, &nnz, &mat_type, &ksp_type));
+  long long n_fixed = std::count(fixed.begin(), fixed.end(), 1);
+  PetscCall(PetscPrintf(comm,
+                        "fem: mesh %s order %d elements %d nodes %d dofs %d fixed nodes %lld nnz %" PetscInt_FMT
+                        " ranks %d mat %s ksp %s corotational %d mass %s\n",
+                        mesh_name.c_str(), (int)o.order, model.element_count(), n_nodes, 3 * n_nodes, n_fixed, nnz, size,
+                        mat_type, ksp_type, (int)o.corotational,
+                        o.order == 1 ? "lumped" : (o.lumped ? "hrz" : "consistent")));
+
+  std::vector<std::pair<std::string, double>> frames;
+  auto write_frame = [&](int step) {
+    if (rank || !o.vtk[0]) return;
+    physics::VtkScene scene;
+    scene.points         = x;
+    scene.cell_type      = npe == 4 ? physics::VtkCellType::Tetra : physics::VtkCellType::QuadraticTetra;
+    scene.nodes_per_cell = npe;
+    scene.connectivity   = model.mesh.elements;
+    std::vector<double> u(x.size());
+    for (size_t k = 0; k < x.size(); ++k) u[k] = x[k] - X[k];
+    std::vector<double> fx(fixed.begin(), fixed.end());
+    scene.point_fields = {{"displacement", 3, u}, {"velocity", 3, v}, {"fixed", 1, fx}};
+    char name[PETSC_MAX_PATH_LEN];
+    std::snprintf(name, sizeof name, "%s_%04d.vtu", o.vtk, step);
+    physics::write_vtu(name, scene);
+    std::string rel = name;
+    rel             = rel.substr(rel.find_last_of('/') + 1);
+    frames.emplace_back(rel, step * o.dt);
+    physics::write_pvd(std::string(o.vtk) + ".pvd", frames);
+  };
+  write_frame(0);
+
+  // ---- time loop ----------------------------------------------------------------------------
+  double      t_element = 0, t_setvalues = 0, t_solve = 0, t_comm = 0, t_total = 0;
+  long long   its_total = 0;
+  int         steps_done = 0;
+  std::string status     = "ok";
+  KSPConvergedReason last_reason = KSP_CONVERGED_ITERATING;
+  for (int step = 1; step <= o.steps; ++step) {
+    const double t0 = WallTime();
+    physics::reset_block_values(pattern, values);
+    std::fill(rhs_full.begin(), rhs_full.end(), 0.0);
+    physics::assemble_elements(model, my_elements, x.data(), v.data(), coef, &pattern, values.data(), rhs_full.data());
+    const double t1 = WallTime();
+    if (size > 1) PetscCallMPI(MPI_Reduce_scatter(rhs_full.data(), rhs_local.data(), counts.data(), MPI_DOUBLE, MPI_SUM, comm));
+    else std::copy(rhs_full.begin(), rhs_full.end(), rhs_local.begin());
+    for (int i = own_begin; i < own_end; ++i)
+      for (int d = 0; d < 3; ++d) {
+        double &r = rhs_local[3 * (i - own_begin) + d];
+        r         = fixed[i] ? 0.0 : r + rhs_gravity_scale * f_gravity[3 * i + d];
+      }
+    const double t2 = WallTime();
+    PetscCall(BlockSystemSetValues(&sys, values.data()));
+    const double t3 = WallTime();
+    if (step == 1 && o.dump[0]) PetscCall(BlockSystemDumpMatrix(&sys, o.dump));
+    SolveStats st;
+    PetscCall(BlockSystemSolve(&sys, rhs_local.data(), dv_local.data(), &st));
+    const double t4 = WallTime();
+    if (size > 1)
+      PetscCallMPI(MPI_Allgatherv(dv_local.data(), 3 * n_own, MPI_DOUBLE, dv_full.data(), counts.data(), displs.data(), MPI_DOUBLE, comm));
+    else std::copy(dv_local.begin(), dv_local.end(), dv_full.begin());
+    bool finite = true;
+    for (double d : dv_full) finite = finite && std::isfinite(d);
+    if (finite) {
+      if (o.is_static) {
+        for (size_t k = 0; k < x.size(); ++k) x[k] += dv_full[k];
+      } else {
+        for (size_t k = 0; k < x.size(); ++k) {
+          v[k] += dv_full[k];
+          x[k] += o.dt * v[k];
+        }
+      }
+    }
+    const double t5 = WallTime();
+    t_element += t1 - t0;
+    t_comm += (t2 - t1) + (t5 - t4);
+    t_setvalues += t3 - t2;
+    t_solve += t4 - t3;
+    t_total += t5 - t0;
+    its_total += st.iterations;
+    last_reason = st.reason;
+    steps_done  = step;
+    if (!o.quiet)
+      PetscCall(PetscPrintf(comm, "step %d its %" PetscInt_FMT " res %.3e reason %s assembly_ms %.2f solve_ms %.2f\n", step,
+                            st.iterations, (double)st.residual_norm, KSPConvergedReasons[st.reason], 1e3 * (t3 - t0),
+                            1e3 * (t4 - t3)));
+    if (!finite) {
+      status = "nan";
+      PetscCall(PetscPrintf(comm, "fem: step %d produced a non-finite velocity change (KSP reason %s); stopping\n", step,
+                            KSPConvergedReasons[st.reason]));
+      break;
+    }
+    if (st.reason < 0 && st.reason != KSP_DIVERGED_ITS) {
+      status = "ksp_diverged";
+      PetscCall(PetscPrintf(comm, "fem: the linear solve diverged at step %d (%s); stopping\n", step, KSPConvergedReasons[st.reason]));
+      break;
+    }
+    if (step % o.vtk_every == 0) write_frame(step);
+  }
+
+  // ---- summary ------------------------------------------------------------------------------
+  const physics::FemEnergy E = physics::fem_energy(model, x.data(), v.data());
+  const auto               P = physics::linear_momentum(model, v.data());
+  double cen[3] = {0, 0, 0}, mass_sum = 0, min_vol_ratio = 1e300;
+  {
+    const auto                w = physics::gravity_forces(model, {1, 1, 1}); // row sums of M (may be < 0 for P2 corners)
+    for (int i = 0; i < n_nodes; ++i) {
+      for (int d = 0; d < 3; ++d) cen[d] += w[3 * i] * (x[3 * i + d] - X[3 * i + d]);
+      mass_sum += w[3 * i];
+    }
+    for (int e = 0; e < model.element_count(); ++e)
+      min_vol_ratio = std::min(min_vol_ratio, physics::element_signed_volume(model.mesh, x.data(), e) / model.volume[e]);
+  }
+  const int    steps_div = std::max(steps_done, 1);
+  SummaryLine  s;
+  s.add("program", std::string("fem"));
+  s.add("mat_type", std::string(mat_type));
+  s.add("ksp_type", std::string(ksp_type));
+  s.add("ranks", (long long)size);
+  s.add("order", (long long)o.order);
+  s.add("elements", (long long)model.element_count());
+  s.add("dofs", (long long)3 * n_nodes);
+  s.add("nnz", (long long)nnz);
+  s.add("steps", (long long)steps_done);
+  s.add("ms_per_step", 1e3 * t_total / steps_div);
+  s.add("element_ms", 1e3 * t_element / steps_div);
+  s.add("setvalues_ms", 1e3 * t_setvalues / steps_div);
+  s.add("assembly_ms", 1e3 * (t_element + t_setvalues) / steps_div);
+  s.add("comm_ms", 1e3 * t_comm / steps_div);
+  s.add("solve_ms", 1e3 * t_solve / steps_div);
+  s.add("element_share", t_total > 0 ? t_element / t_total : 0.0);
+  s.add("cg_its", (double)its_total / steps_div);
+  s.add("tip_dx", x[3 * tip] - X[3 * tip]);
+  s.add("tip_dy", x[3 * tip + 1] - X[3 * tip + 1]);
+  s.add("tip_dz", x[3 * tip + 2] - X[3 * tip + 2]);
+  s.add("centroid_dx", cen[0] / mass_sum);
+  s.add("centroid_dy", cen[1] / mass_sum);
+  s.add("centroid_dz", cen[2] / mass_sum);
+  s.add("kinetic", E.kinetic);
+  s.add("elastic", E.elastic);
+  s.add("momentum_x", P[0]);
+  s.add("momentum_y", P[1]);
+  s.add("momentum_z", P[2]);
+  s.add("min_volume_ratio", min_vol_ratio);
+  s.add("ksp_reason", std::string(KSPConvergedReasons[last_reason]));
+  s.add("status", status);
+  PetscCall(PrintSummary(comm, s));
+
+  PetscCall(BlockSystemDestroy(&sys));
+  PetscCall(PetscFinalize());
+  return 0;
+}

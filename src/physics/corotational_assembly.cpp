@@ -1,0 +1,144 @@
+#include "physics/corotational_assembly.hpp"
+#include "physics/polar_decomposition.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace physics {
+
+StepCoefficients implicit_euler_coefficients(double dt, double alpha, double beta)
+{
+  StepCoefficients c;
+  c.force            = dt;
+  c.stiffness_rhs    = dt * dt + dt * beta;
+  c.mass_rhs         = dt * alpha;
+  c.mass_matrix      = 1 + dt * alpha;
+  c.stiffness_matrix = dt * dt + dt * beta;
+  return c;
+}
+
+BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &elements, const std::vector<char> &fixed,
+                                int owned_begin, int owned_end, bool merge)
+{
+  BlockPattern p;
+  p.merged      = merge;
+  const int npe = model.npe;
+  if (static_cast<int>(fixed.size()) != model.node_count()) throw std::invalid_argument("fixed flags: wrong size");
+  p.element_slots.assign(elements.size() * npe * npe, -1);
+  std::vector<std::pair<long long, size_t>> keyed; // (row * n + col, position in element_slots)
+  const long long n = model.node_count();
+  for (size_t i = 0; i < elements.size(); ++i) {
+    const int *nodes = &model.mesh.elements[static_cast<size_t>(elements[i]) * npe];
+    for (int a = 0; a < npe; ++a)
+      for (int b = 0; b < npe; ++b) {
+        if (fixed[nodes[a]] || fixed[nodes[b]]) continue;
+        keyed.emplace_back(nodes[a] * n + nodes[b], (i * npe + a) * npe + b);
+      }
+  }
+  if (merge) std::sort(keyed.begin(), keyed.end());
+  long long last = -1;
+  for (const auto &kv : keyed) {
+    if (!merge || kv.first != last) {
+      p.rows.push_back(static_cast<int>(kv.first / n));
+      p.cols.push_back(static_cast<int>(kv.first % n));
+      last = kv.first;
+    }
+    p.element_slots[kv.second] = static_cast<int>(p.rows.size()) - 1;
+  }
+  for (int v = owned_begin; v < owned_end; ++v)
+    if (fixed[v]) {
+      p.identity_slots.push_back(static_cast<int>(p.rows.size()));
+      p.rows.push_back(v);
+      p.cols.push_back(v);
+    }
+  return p;
+}
+
+void reset_block_values(const BlockPattern &pattern, std::vector<double> &values)
+{
+  values.assign(9 * pattern.rows.size(), 0.0);
+  for (int s : pattern.identity_slots) values[9 * s] = values[9 * s + 4] = values[9 * s + 8] = 1.0;
+}
+
+namespace {
+
+template <int N>
+void assemble_kernel(const FemModel &model, const std::vector<int> &elements, const double *x, const double *v,
+                     const StepCoefficients &c, const BlockPattern *pattern, double *values, double *rhs,
+                     Eigen::Matrix3d *rotations)
+{
+  using Vec3                   = Eigen::Vector3d;
+  using Mat3                   = Eigen::Matrix3d;
+  using RowMat3                = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+  const double *X              = model.mesh.nodes.data();
+  const bool    corotational   = model.settings.corotational;
+  const bool    want_matrix    = values != nullptr;
+  const bool    mass_damping   = c.mass_rhs != 0;
+  const Eigen::Matrix<double, N, N> Mref = model.reference_mass;
+  for (size_t i = 0; i < elements.size(); ++i) {
+    const int     e     = elements[i];
+    const int    *nodes = &model.mesh.elements[static_cast<size_t>(e) * N];
+    const double *K0    = &model.stiffness[static_cast<size_t>(e) * N * N * 9];
+    Mat3          R     = Mat3::Identity();
+    if (corotational) {
+      Mat3 Ds;
+      for (int k = 0; k < 3; ++k) Ds.col(k) = Vec3::Map(x + 3 * nodes[k + 1]) - Vec3::Map(x + 3 * nodes[0]);
+      R = rotation_from_deformation(Ds * model.rest_shape_inverse[e]);
+    }
+    if (rotations) rotations[i] = R;
+    // z = a_f (R^T x - X) + a_K R^T v, so that rhs_a = -R sum_b K0_ab z_b in one product with K0.
+    Vec3 z[N];
+    for (int b = 0; b < N; ++b)
+      z[b] = R.transpose() * (c.force * Vec3::Map(x + 3 * nodes[b]) + c.stiffness_rhs * Vec3::Map(v + 3 * nodes[b])) -
+             c.force * Vec3::Map(X + 3 * nodes[b]);
+    const double mass = model.settings.density * model.volume[e];
+    for (int a = 0; a < N; ++a) {
+      Vec3 s = Vec3::Zero();
+      for (int b = 0; b < N; ++b) s.noalias() += Mat3::Map(K0 + 9 * (a * N + b)) * z[b];
+      Vec3 r = -(R * s);
+      if (mass_damping)
+        for (int b = 0; b < N; ++b) r -= c.mass_rhs * mass * Mref(a, b) * Vec3::Map(v + 3 * nodes[b]);
+      Vec3::Map(rhs + 3 * nodes[a]) += r;
+    }
+    if (!want_matrix) continue;
+    const int *slot = &pattern->element_slots[i * N * N];
+    for (int a = 0; a < N; ++a)
+      for (int b = a; b < N; ++b) {
+        const int sab = slot[a * N + b];
+        if (sab < 0) continue; // a or b is fixed: eliminated
+        Mat3 B;
+        if (corotational) B.noalias() = c.stiffness_matrix * (R * Mat3::Map(K0 + 9 * (a * N + b)) * R.transpose());
+        else B = c.stiffness_matrix * Mat3::Map(K0 + 9 * (a * N + b));
+        const double mab = c.mass_matrix * mass * Mref(a, b);
+        B.diagonal().array() += mab;
+        // Stored row-major: the Map of a row-major matrix over the slot takes B as is.
+        Eigen::Map<RowMat3>(values + 9 * static_cast<size_t>(sab)) += B;
+        if (b != a) Eigen::Map<RowMat3>(values + 9 * static_cast<size_t>(slot[b * N + a])) += B.transpose();
+      }
+  }
+}
+
+} // namespace
+
+void assemble_elements(const FemModel &model, const std::vector<int> &elements, const double *x, const double *v,
+                       const StepCoefficients &c, const BlockPattern *pattern, double *block_values, double *rhs,
+                       Eigen::Matrix3d *rotations)
+{
+  if (block_values && !pattern) throw std::invalid_argument("assemble_elements: block values need a pattern");
+  if (pattern && pattern->element_slots.size() != elements.size() * model.npe * model.npe)
+    throw std::invalid_argument("assemble_elements: pattern was built for another element list");
+  if (model.npe == 4) assemble_kernel<4>(model, elements, x, v, c, pattern, block_values, rhs, rotations);
+  else assemble_kernel<10>(model, elements, x, v, c, pattern, block_values, rhs, rotations);
+}
+
+std::vector<double> elastic_forces(const FemModel &model, const double *x)
+{
+  std::vector<int> all(model.element_count());
+  for (int e = 0; e < model.element_count(); ++e) all[e] = e;
+  std::vector<double> f(3 * static_cast<size_t>(model.node_count()), 0.0), zero_v(f.size(), 0.0);
+  StepCoefficients    c; // a_f = 1, nothing else
+  assemble_elements(model, all, x, zero_v.data(), c, nullptr, nullptr, f.data());
+  return f;
+}
+
+} // namespace physics

@@ -1,0 +1,67 @@
+// The per-step element loop of the corotational FEM (the hot kernel), and the fixed sparsity pattern
+// of 3x3 blocks that it fills.
+//
+// Per element e with nodes x_e (current), X_e (rest), v_e and rotation R (polar factor of the corner
+// deformation gradient F = Ds Dm^-1; R = I for plain linear elasticity):
+//   K_e  = R K0 R^T                       (rotated stiffness, symmetric positive semi-definite)
+//   f_e  = -R K0 (R^T x_e - X_e)           (corotational elastic force; zero for any rigid motion)
+//   rhs += a_f f_e - a_K K_e v_e - a_M M_e v_e
+//   A_e  = c_M M_e + c_K K_e               (added into the element's blocks)
+// The coefficients come from the time integrator (see implicit_euler_coefficients) or from a static
+// solve (c_K = 1, a_f = 1).
+#pragma once
+#include "physics/fem_model.hpp"
+
+#include <vector>
+
+namespace physics {
+
+struct StepCoefficients {
+  double force            = 1; // a_f
+  double stiffness_rhs    = 0; // a_K
+  double mass_rhs         = 0; // a_M
+  double mass_matrix      = 0; // c_M
+  double stiffness_matrix = 0; // c_K
+};
+
+// Backward Euler, linearised once per step (Baraff & Witkin). With K = -df/dx symmetric positive
+// (semi-)definite and Rayleigh damping D = alpha M + beta K, the implicit step
+//   M (v1 - v0) = dt (f(x1) - D v1),   x1 = x0 + dt v1
+// with f(x1) ~ f(x0) - K (x1 - x0) = f(x0) - dt K (v0 + dv), dv = v1 - v0, reads
+//   M dv = dt f - dt^2 K v0 - dt^2 K dv - dt D v0 - dt D dv, i.e.
+//   ((1 + dt alpha) M + (dt^2 + dt beta) K) dv = dt f - (dt^2 + dt beta) K v0 - dt alpha M v0.
+// Without damping: (M + dt^2 K) dv = dt (f - dt K v0). The seed's "dt (f + dt K v)" is the same
+// equation only with K = +df/dx (negative definite), where the matrix would read M - dt^2 K; with
+// an SPD matrix the sign in front of dt K v must be minus (tests/unit/fem checks the residual of
+// backward Euler after one step).
+StepCoefficients implicit_euler_coefficients(double dt, double rayleigh_alpha = 0, double rayleigh_beta = 0);
+
+// COO list of 3x3 blocks for the elements one rank assembles, with fixed (Dirichlet) nodes
+// eliminated: no block in a fixed node's row or column, and one identity block on the diagonal of
+// every fixed node in [owned_begin, owned_end) (its right-hand side is 0, so its dv is 0 and the
+// matrix stays SPD with a constant pattern).
+struct BlockPattern {
+  std::vector<int> rows, cols;     // global block indices, one entry per COO block
+  std::vector<int> element_slots;  // per listed element npe*npe: COO block of (a,b), -1 if dropped
+  std::vector<int> identity_slots; // COO blocks that hold the identity (fixed nodes)
+  bool             merged = false; // element blocks summed into unique COO blocks by the caller
+};
+// merge_duplicates: rows/cols are unique (sorted by row, then column) and elements add into shared
+// blocks; otherwise every element block has its own COO entry and the Mat type sums duplicates.
+BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &elements, const std::vector<char> &fixed,
+                                int owned_begin, int owned_end, bool merge_duplicates);
+
+// Sets the identity blocks and zeroes all others: call before assemble_elements each step.
+void reset_block_values(const BlockPattern &pattern, std::vector<double> &block_values);
+
+// The element loop. x, v: 3 per node (all nodes). rhs: 3 per node, accumulated (+=). block_values:
+// 9 per COO block of `pattern`, accumulated (+=) row-major; may be null (forces only; pattern may
+// then be null too). rotations (optional): one per listed element.
+void assemble_elements(const FemModel &model, const std::vector<int> &elements, const double *x, const double *v,
+                       const StepCoefficients &c, const BlockPattern *pattern, double *block_values, double *rhs,
+                       Eigen::Matrix3d *rotations = nullptr);
+
+// Elastic forces only (a_f = 1): f = sum_e f_e over all elements, 3 per node, overwritten.
+std::vector<double> elastic_forces(const FemModel &model, const double *x);
+
+} // namespace physics

@@ -1,0 +1,116 @@
+#include "physics/fem_model.hpp"
+#include "physics/polar_decomposition.hpp"
+
+#include <cmath>
+
+namespace physics {
+
+namespace {
+
+Eigen::Matrix<double, 3, 4> corner_matrix(const TetMesh &mesh, const double *pos, int e)
+{
+  Eigen::Matrix<double, 3, 4> X;
+  const int *n = &mesh.elements[static_cast<size_t>(e) * mesh.nodes_per_element()];
+  for (int k = 0; k < 4; ++k)
+    for (int d = 0; d < 3; ++d) X(d, k) = pos[3 * n[k] + d];
+  return X;
+}
+
+} // namespace
+
+FemModel make_fem_model(const TetMesh &mesh, const FemSettings &settings)
+{
+  validate_mesh(mesh, "mesh");
+  const LameParameters lame = lame_from_young_poisson(settings.young, settings.poisson);
+  if (!(settings.density > 0)) throw std::invalid_argument("material: density must be > 0");
+  FemModel m;
+  m.mesh     = mesh;
+  m.settings = settings;
+  m.npe      = mesh.nodes_per_element();
+  const int ne = mesh.element_count(), nb = m.npe * m.npe;
+  m.rest_shape_inverse.resize(ne);
+  m.volume.resize(ne);
+  m.stiffness.resize(static_cast<size_t>(ne) * nb * 9);
+  for (int e = 0; e < ne; ++e) {
+    const TetGeometry g = tet_geometry(corner_matrix(mesh, mesh.nodes.data(), e));
+    m.rest_shape_inverse[e] = g.rest_shape_inverse;
+    m.volume[e]             = g.volume;
+    const Eigen::MatrixXd K = element_stiffness(g, mesh.order, lame);
+    double *out = &m.stiffness[static_cast<size_t>(e) * nb * 9];
+    for (int a = 0; a < m.npe; ++a)
+      for (int b = 0; b < m.npe; ++b) Eigen::Map<Eigen::Matrix3d>(out + 9 * (a * m.npe + b)) = K.block<3, 3>(3 * a, 3 * b);
+  }
+  m.reference_mass = reference_mass(mesh.order, settings.mass);
+  m.diagonal_mass  = m.reference_mass.isDiagonal();
+  return m;
+}
+
+std::vector<double> gravity_forces(const FemModel &model, const std::array<double, 3> &g)
+{
+  std::vector<double>   f(3 * static_cast<size_t>(model.node_count()), 0.0);
+  const Eigen::VectorXd row_sums = model.reference_mass.rowwise().sum();
+  for (int e = 0; e < model.element_count(); ++e) {
+    const int   *n = &model.mesh.elements[static_cast<size_t>(e) * model.npe];
+    const double m = model.settings.density * model.volume[e];
+    for (int a = 0; a < model.npe; ++a)
+      for (int d = 0; d < 3; ++d) f[3 * n[a] + d] += m * row_sums[a] * g[d];
+  }
+  return f;
+}
+
+std::array<double, 3> linear_momentum(const FemModel &model, const double *v)
+{
+  std::array<double, 3> p{0, 0, 0};
+  const Eigen::VectorXd col_sums = model.reference_mass.colwise().sum();
+  for (int e = 0; e < model.element_count(); ++e) {
+    const int   *n = &model.mesh.elements[static_cast<size_t>(e) * model.npe];
+    const double m = model.settings.density * model.volume[e];
+    for (int b = 0; b < model.npe; ++b)
+      for (int d = 0; d < 3; ++d) p[d] += m * col_sums[b] * v[3 * n[b] + d];
+  }
+  return p;
+}
+
+double total_mass(const FemModel &model)
+{
+  double s = 0;
+  for (double v : model.volume) s += v;
+  return s * model.settings.density * model.reference_mass.sum();
+}
+
+FemEnergy fem_energy(const FemModel &model, const double *x, const double *v)
+{
+  FemEnergy  E;
+  const int  npe = model.npe;
+  const auto &X  = model.mesh.nodes;
+  Eigen::VectorXd u(3 * npe), Ku(3 * npe);
+  for (int e = 0; e < model.element_count(); ++e) {
+    const int *n = &model.mesh.elements[static_cast<size_t>(e) * npe];
+    Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+    if (model.settings.corotational) {
+      Eigen::Matrix3d Ds;
+      for (int k = 0; k < 3; ++k)
+        for (int d = 0; d < 3; ++d) Ds(d, k) = x[3 * n[k + 1] + d] - x[3 * n[0] + d];
+      R = rotation_from_deformation(Ds * model.rest_shape_inverse[e]);
+    }
+    for (int a = 0; a < npe; ++a)
+      u.segment<3>(3 * a) = R.transpose() * Eigen::Vector3d(x[3 * n[a]], x[3 * n[a] + 1], x[3 * n[a] + 2]) -
+                            Eigen::Vector3d(X[3 * n[a]], X[3 * n[a] + 1], X[3 * n[a] + 2]);
+    const double *K = &model.stiffness[static_cast<size_t>(e) * npe * npe * 9];
+    Ku.setZero();
+    for (int a = 0; a < npe; ++a)
+      for (int b = 0; b < npe; ++b)
+        Ku.segment<3>(3 * a) += Eigen::Map<const Eigen::Matrix3d>(K + 9 * (a * npe + b)) * u.segment<3>(3 * b);
+    E.elastic += 0.5 * u.dot(Ku);
+    const double m = model.settings.density * model.volume[e];
+    for (int a = 0; a < npe; ++a)
+      for (int b = 0; b < npe; ++b) {
+        const double mab = m * model.reference_mass(a, b);
+        if (mab == 0) continue;
+        for (int d = 0; d < 3; ++d) E.kinetic += 0.5 * mab * v[3 * n[a] + d] * v[3 * n[b] + d];
+      }
+  }
+  return E;
+}
+
+} // namespace physics

@@ -1,0 +1,138 @@
+#include "physics/tet_mesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace physics {
+
+double element_signed_volume(const TetMesh &mesh, const double *pos, int e)
+{
+  const int *n = &mesh.elements[static_cast<size_t>(e) * mesh.nodes_per_element()];
+  double     d[3][3];
+  for (int k = 0; k < 3; ++k)
+    for (int c = 0; c < 3; ++c) d[k][c] = pos[3 * n[k + 1] + c] - pos[3 * n[0] + c];
+  const double det = d[0][0] * (d[1][1] * d[2][2] - d[1][2] * d[2][1]) - d[0][1] * (d[1][0] * d[2][2] - d[1][2] * d[2][0]) +
+                     d[0][2] * (d[1][0] * d[2][1] - d[1][1] * d[2][0]);
+  return det / 6.0;
+}
+
+TetMesh promote_to_quadratic(const TetMesh &mesh)
+{
+  if (mesh.order == 2) return mesh;
+  TetMesh out;
+  out.order = 2;
+  out.nodes = mesh.nodes;
+  const int ne = mesh.element_count();
+  out.elements.resize(static_cast<size_t>(ne) * 10);
+  std::unordered_map<unsigned long long, int> edge_node;
+  edge_node.reserve(static_cast<size_t>(ne) * 2);
+  for (int e = 0; e < ne; ++e) {
+    const int *c = &mesh.elements[4 * static_cast<size_t>(e)];
+    int       *o = &out.elements[10 * static_cast<size_t>(e)];
+    for (int k = 0; k < 4; ++k) o[k] = c[k];
+    for (int k = 0; k < 6; ++k) {
+      const int a = c[kTetEdges[k][0]], b = c[kTetEdges[k][1]];
+      const unsigned long long key =
+        (static_cast<unsigned long long>(std::min(a, b)) << 32) | static_cast<unsigned>(std::max(a, b));
+      auto it = edge_node.find(key);
+      if (it == edge_node.end()) {
+        const int id = out.node_count();
+        for (int d = 0; d < 3; ++d) out.nodes.push_back(0.5 * (mesh.nodes[3 * a + d] + mesh.nodes[3 * b + d]));
+        it = edge_node.emplace(key, id).first;
+      }
+      o[4 + k] = it->second;
+    }
+  }
+  return out;
+}
+
+void renumber_nodes(TetMesh &mesh, const std::vector<int> &new_of_old)
+{
+  const int n = mesh.node_count();
+  if (static_cast<int>(new_of_old.size()) != n) throw std::invalid_argument("renumber_nodes: permutation has wrong size");
+  std::vector<double> nodes(mesh.nodes.size());
+  for (int i = 0; i < n; ++i)
+    for (int d = 0; d < 3; ++d) nodes[3 * new_of_old[i] + d] = mesh.nodes[3 * i + d];
+  mesh.nodes.swap(nodes);
+  for (int &v : mesh.elements) v = new_of_old[v];
+}
+
+void validate_mesh(const TetMesh &mesh, const std::string &what)
+{
+  const int n = mesh.node_count(), npe = mesh.nodes_per_element();
+  if (mesh.order != 1 && mesh.order != 2) throw std::runtime_error(what + ": element order must be 1 or 2");
+  if (mesh.element_count() == 0) throw std::runtime_error(what + ": mesh has no tetrahedra");
+  if (mesh.elements.size() % npe) throw std::runtime_error(what + ": element list length is not a multiple of the element size");
+  std::vector<char> used(n, 0);
+  for (size_t k = 0; k < mesh.elements.size(); ++k) {
+    const int v = mesh.elements[k];
+    if (v < 0 || v >= n)
+      throw std::runtime_error(what + ": element " + std::to_string(k / npe) + " refers to node " + std::to_string(v) +
+                               ", outside [0, " + std::to_string(n) + ")");
+    used[v] = 1;
+  }
+  const int unused = static_cast<int>(std::count(used.begin(), used.end(), 0));
+  if (unused) throw std::runtime_error(what + ": " + std::to_string(unused) + " nodes belong to no element");
+  // Relative to the element's size, so that a tiny but well-shaped element passes.
+  int bad = 0, first_bad = -1;
+  double first_volume = 0;
+  for (int e = 0; e < mesh.element_count(); ++e) {
+    const double vol = element_signed_volume(mesh, mesh.nodes.data(), e);
+    const int   *c   = &mesh.elements[static_cast<size_t>(e) * npe];
+    double       h2  = 0;
+    for (const auto &ed : kTetEdges) {
+      double l2 = 0;
+      for (int d = 0; d < 3; ++d) {
+        const double t = mesh.nodes[3 * c[ed[0]] + d] - mesh.nodes[3 * c[ed[1]] + d];
+        l2 += t * t;
+      }
+      h2 = std::max(h2, l2);
+    }
+    if (!(vol > 1e-12 * h2 * std::sqrt(h2))) {
+      if (first_bad < 0) { first_bad = e; first_volume = vol; }
+      ++bad;
+    }
+  }
+  if (bad)
+    throw std::runtime_error(what + ": " + std::to_string(bad) + " element(s) inverted or of zero volume; first: element " +
+                             std::to_string(first_bad) + " with signed volume " + std::to_string(first_volume));
+}
+
+std::vector<int> nodes_in_box(const TetMesh &mesh, const std::array<double, 3> &lo, const std::array<double, 3> &hi,
+                              double tol)
+{
+  std::vector<int> out;
+  for (int i = 0; i < mesh.node_count(); ++i) {
+    bool in = true;
+    for (int d = 0; d < 3; ++d) in = in && mesh.nodes[3 * i + d] >= lo[d] - tol && mesh.nodes[3 * i + d] <= hi[d] + tol;
+    if (in) out.push_back(i);
+  }
+  return out;
+}
+
+std::vector<int> nodes_beyond_plane(const TetMesh &mesh, int axis, double value, int side, double tol)
+{
+  std::vector<int> out;
+  for (int i = 0; i < mesh.node_count(); ++i) {
+    const double c = mesh.nodes[3 * i + axis];
+    if ((side < 0 && c <= value + tol) || (side > 0 && c >= value - tol)) out.push_back(i);
+  }
+  return out;
+}
+
+std::array<double, 6> bounding_box(const TetMesh &mesh)
+{
+  const double inf = std::numeric_limits<double>::infinity();
+  std::array<double, 6> b{inf, inf, inf, -inf, -inf, -inf};
+  for (int i = 0; i < mesh.node_count(); ++i)
+    for (int d = 0; d < 3; ++d) {
+      b[d]     = std::min(b[d], mesh.nodes[3 * i + d]);
+      b[3 + d] = std::max(b[3 + d], mesh.nodes[3 * i + d]);
+    }
+  return b;
+}
+
+} // namespace physics
