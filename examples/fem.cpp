@@ -13,13 +13,12 @@
 // right-hand side is 0, so dv = 0 there, the matrix stays SPD and the pattern never changes.
 #include <petscbinbcsr.h>
 
-#include "common/sim_system.h"
+#include "common/fem_simulation.h"
 #include "common/summary.h"
 #include "physics/box_mesh.hpp"
 #include "physics/corotational_assembly.hpp"
 #include "physics/fem_model.hpp"
 #include "physics/msh_reader.hpp"
-#include "physics/partition.hpp"
 #include "physics/tet_mesh.hpp"
 #include "physics/vtk_writer.hpp"
 
@@ -223,81 +222,55 @@ int main(int argc, char **argv)
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(GetOptions(o));
 
-  // ---- scene: mesh, renumbering, model, fixed nodes ------------------------------------------
-  physics::TetMesh  mesh;
-  physics::FemModel model;
-  std::vector<char> fixed;
-  std::vector<int>  part_offsets;
-  std::vector<int>  new_of_old; // input node -> node in the renumbered mesh (empty: identity)
-  std::string       mesh_name;
+  // ---- scene: mesh, fixed nodes, material; FemSimulation renumbers and builds the system -------
+  FemScene    scene;
+  std::string mesh_name;
   {
     std::string msh = o.mesh;
     if (msh.size() > 4 && msh.substr(msh.size() - 4) == ".geo") PetscCall(MeshGeo(comm, msh, o.mesh_size, &msh));
     std::string error;
     try {
       if (!msh.empty()) {
-        mesh      = physics::read_msh_file(msh);
-        mesh_name = o.mesh;
+        scene.mesh = physics::read_msh_file(msh);
+        mesh_name  = o.mesh;
       } else {
-        mesh      = physics::make_box_mesh(o.box[0], o.box[1], o.box[2], (int)o.box[3], (int)o.box[4], (int)o.box[5]);
-        mesh_name = "box";
+        scene.mesh = physics::make_box_mesh(o.box[0], o.box[1], o.box[2], (int)o.box[3], (int)o.box[4], (int)o.box[5]);
+        mesh_name  = "box";
       }
-      if (o.order == 2) mesh = physics::promote_to_quadratic(mesh);
-      const physics::AdjacencyGraph g = physics::graph_from_elements(mesh.node_count(), mesh.nodes_per_element(), mesh.elements);
-      physics::Renumbering          r;
-      if (o.reorder && size > 1) {
-        physics::PartitionOptions po;
-        po.local_order = physics::LocalOrder::ReverseCuthillMcKee;
-        r              = physics::partition_graph(g, size, po);
-      } else if (o.reorder) {
-        r = physics::reorder_for_locality(g, physics::LocalOrder::ReverseCuthillMcKee);
-      }
-      if (o.reorder) {
-        physics::renumber_nodes(mesh, r.new_of_old);
-        part_offsets = r.part_offsets;
-        new_of_old   = r.new_of_old;
-      }
-      if (part_offsets.size() != (size_t)size + 1) { // no partition: even contiguous split
-        part_offsets.assign(size + 1, 0);
-        for (int p = 0; p <= size; ++p) part_offsets[p] = (int)((long long)mesh.node_count() * p / size);
-      }
-      physics::FemSettings s;
-      s.young        = o.young;
-      s.poisson      = o.poisson;
-      s.density      = o.density;
-      s.corotational = o.corotational;
-      s.mass         = o.lumped ? physics::MassLumping::Lumped : physics::MassLumping::Consistent;
-      model          = physics::make_fem_model(mesh, s);
-      fixed          = SelectFixed(mesh, o);
+      if (o.order == 2) scene.mesh = physics::promote_to_quadratic(scene.mesh);
+      scene.fixed = SelectFixed(scene.mesh, o);
     } catch (const std::exception &ex) {
       error = ex.what();
     }
     PetscCheck(error.empty(), comm, PETSC_ERR_USER_INPUT, "%s", error.c_str());
+    scene.settings.young        = o.young;
+    scene.settings.poisson      = o.poisson;
+    scene.settings.density      = o.density;
+    scene.settings.corotational = o.corotational;
+    scene.settings.mass         = o.lumped ? physics::MassLumping::Lumped : physics::MassLumping::Consistent;
+    scene.gravity               = {o.gravity[0], o.gravity[1], o.gravity[2]};
+    scene.dt                    = o.dt;
+    scene.rayleigh_alpha        = o.rayleigh[0];
+    scene.rayleigh_beta         = o.rayleigh[1];
+    scene.is_static             = o.is_static;
+    scene.merge_blocks          = o.merge;
+    scene.reorder               = o.reorder;
   }
-  const int n_nodes = model.node_count(), npe = model.npe;
-  const int own_begin = part_offsets[rank], own_end = part_offsets[rank + 1], n_own = own_end - own_begin;
-
-  std::vector<int> my_elements;
-  for (int e = 0; e < model.element_count(); ++e) {
-    const int first = model.mesh.elements[(size_t)e * npe];
-    if (first >= own_begin && first < own_end) my_elements.push_back(e);
-  }
-  const physics::BlockPattern pattern = physics::make_block_pattern(model, my_elements, fixed, own_begin, own_end, o.merge);
-
-  BlockSystem sys;
-  PetscCall(BlockSystemCreate(comm, n_nodes, n_own, pattern.rows, pattern.cols, &sys));
-  PetscCheck(sys.row_begin == 3 * own_begin && sys.row_end == 3 * own_end, PETSC_COMM_SELF, PETSC_ERR_PLIB,
-             "matrix ownership does not match the node partition");
-
-  // ---- state --------------------------------------------------------------------------------
+  const int tip_input = TipNode(scene.mesh, scene.fixed);
+  FemSimulation sim;
+  PetscCall(FemSimulationCreate(comm, scene, &sim));
+  const physics::FemModel &model = sim.model;
+  const int n_nodes = model.node_count(), npe = model.npe, tip = sim.new_of_old[tip_input];
   const std::vector<double> &X = model.mesh.nodes;
-  std::vector<double>        x(X), v(X.size(), 0.0);
+  std::vector<double>       &x = sim.x, &v = sim.v;
+
+  // ---- initial state ------------------------------------------------------------------------
   {
     double c[3] = {0, 0, 0};
     for (int i = 0; i < n_nodes; ++i)
       for (int d = 0; d < 3; ++d) c[d] += X[3 * i + d] / n_nodes;
     for (int i = 0; i < n_nodes; ++i) {
-      if (fixed[i]) continue;
+      if (sim.fixed[i]) continue;
       const double r[3] = {X[3 * i] - c[0], X[3 * i + 1] - c[1], X[3 * i + 2] - c[2]};
       for (int d = 0; d < 3; ++d) x[3 * i + d] = c[d] + o.stretch * r[d];
       v[3 * i + 0] = o.v0[0] + o.spin[1] * r[2] - o.spin[2] * r[1];
@@ -307,50 +280,36 @@ int main(int argc, char **argv)
     if (o.perturb[0] >= 0) {
       // The node is named in the numbering of the input (promoted) mesh.
       PetscCheck((PetscInt)o.perturb[0] < n_nodes, comm, PETSC_ERR_ARG_OUTOFRANGE, "-initial_perturb: node out of range");
-      int node = (int)o.perturb[0];
-      if (!new_of_old.empty()) node = new_of_old[node];
+      const int node = sim.new_of_old[(int)o.perturb[0]];
       for (int d = 0; d < 3; ++d) x[3 * node + d] += o.perturb[1 + d];
     }
   }
-  const std::vector<double> f_gravity = physics::gravity_forces(model, {o.gravity[0], o.gravity[1], o.gravity[2]});
-  const physics::StepCoefficients coef =
-    o.is_static ? physics::StepCoefficients{1, 0, 0, 0, 1} : physics::implicit_euler_coefficients(o.dt, o.rayleigh[0], o.rayleigh[1]);
-  const double        rhs_gravity_scale = o.is_static ? 1.0 : o.dt;
-  std::vector<double> values, rhs_full(3 * (size_t)n_nodes), rhs_local(3 * (size_t)n_own), dv_local(3 * (size_t)n_own, 0.0),
-    dv_full(3 * (size_t)n_nodes);
-  std::vector<int> counts(size), displs(size);
-  for (int p = 0; p < size; ++p) {
-    counts[p] = 3 * (part_offsets[p + 1] - part_offsets[p]);
-    displs[p] = 3 * part_offsets[p];
-  }
-  const int tip = TipNode(model.mesh, fixed);
 
   PetscInt    nnz;
   const char *mat_type, *ksp_type;
-  PetscCall(BlockSystemGetInfo(&sys, &nnz, &mat_type, &ksp_type));
-  long long n_fixed = std::count(fixed.begin(), fixed.end(), 1);
+  PetscCall(BlockSystemGetInfo(&sim.sys, &nnz, &mat_type, &ksp_type));
+  const long long n_fixed = std::count(sim.fixed.begin(), sim.fixed.end(), 1);
   PetscCall(PetscPrintf(comm,
                         "fem: mesh %s order %d elements %d nodes %d dofs %d fixed nodes %lld nnz %" PetscInt_FMT
                         " ranks %d mat %s ksp %s corotational %d mass %s\n",
                         mesh_name.c_str(), (int)o.order, model.element_count(), n_nodes, 3 * n_nodes, n_fixed, nnz, size,
-                        mat_type, ksp_type, (int)o.corotational,
-                        o.order == 1 ? "lumped" : (o.lumped ? "hrz" : "consistent")));
+                        mat_type, ksp_type, (int)o.corotational, o.order == 1 ? "lumped" : (o.lumped ? "hrz" : "consistent")));
 
   std::vector<std::pair<std::string, double>> frames;
   auto write_frame = [&](int step) {
     if (rank || !o.vtk[0]) return;
-    physics::VtkScene scene;
-    scene.points         = x;
-    scene.cell_type      = npe == 4 ? physics::VtkCellType::Tetra : physics::VtkCellType::QuadraticTetra;
-    scene.nodes_per_cell = npe;
-    scene.connectivity   = model.mesh.elements;
+    physics::VtkScene vs;
+    vs.points         = x;
+    vs.cell_type      = npe == 4 ? physics::VtkCellType::Tetra : physics::VtkCellType::QuadraticTetra;
+    vs.nodes_per_cell = npe;
+    vs.connectivity   = model.mesh.elements;
     std::vector<double> u(x.size());
     for (size_t k = 0; k < x.size(); ++k) u[k] = x[k] - X[k];
-    std::vector<double> fx(fixed.begin(), fixed.end());
-    scene.point_fields = {{"displacement", 3, u}, {"velocity", 3, v}, {"fixed", 1, fx}};
+    std::vector<double> fx(sim.fixed.begin(), sim.fixed.end());
+    vs.point_fields = {{"displacement", 3, u}, {"velocity", 3, v}, {"fixed", 1, fx}};
     char name[PETSC_MAX_PATH_LEN];
     std::snprintf(name, sizeof name, "%s_%04d.vtu", o.vtk, step);
-    physics::write_vtu(name, scene);
+    if (!physics::write_vtu(name, vs)) return;
     std::string rel = name;
     rel             = rel.substr(rel.find_last_of('/') + 1);
     frames.emplace_back(rel, step * o.dt);
@@ -359,72 +318,42 @@ int main(int argc, char **argv)
   write_frame(0);
 
   // ---- time loop ----------------------------------------------------------------------------
-  double      t_element = 0, t_setvalues = 0, t_solve = 0, t_comm = 0, t_total = 0;
-  long long   its_total = 0;
-  int         steps_done = 0;
-  std::string status     = "ok";
+  double             t_element = 0, t_setvalues = 0, t_solve = 0, t_comm = 0, t_total = 0;
+  long long          its_total  = 0;
+  int                steps_done = 0;
+  std::string        status     = "ok";
   KSPConvergedReason last_reason = KSP_CONVERGED_ITERATING;
   for (int step = 1; step <= o.steps; ++step) {
-    const double t0 = WallTime();
-    physics::reset_block_values(pattern, values);
-    std::fill(rhs_full.begin(), rhs_full.end(), 0.0);
-    physics::assemble_elements(model, my_elements, x.data(), v.data(), coef, &pattern, values.data(), rhs_full.data());
-    const double t1 = WallTime();
-    if (size > 1) PetscCallMPI(MPI_Reduce_scatter(rhs_full.data(), rhs_local.data(), counts.data(), MPI_DOUBLE, MPI_SUM, comm));
-    else std::copy(rhs_full.begin(), rhs_full.end(), rhs_local.begin());
-    for (int i = own_begin; i < own_end; ++i)
-      for (int d = 0; d < 3; ++d) {
-        double &r = rhs_local[3 * (i - own_begin) + d];
-        r         = fixed[i] ? 0.0 : r + rhs_gravity_scale * f_gravity[3 * i + d];
-      }
-    const double t2 = WallTime();
-    PetscCall(BlockSystemSetValues(&sys, values.data()));
-    const double t3 = WallTime();
-    if (step == 1 && o.dump[0]) PetscCall(BlockSystemDumpMatrix(&sys, o.dump));
-    SolveStats st;
-    PetscCall(BlockSystemSolve(&sys, rhs_local.data(), dv_local.data(), &st));
-    const double t4 = WallTime();
-    if (size > 1)
-      PetscCallMPI(MPI_Allgatherv(dv_local.data(), 3 * n_own, MPI_DOUBLE, dv_full.data(), counts.data(), displs.data(), MPI_DOUBLE, comm));
-    else std::copy(dv_local.begin(), dv_local.end(), dv_full.begin());
-    bool finite = true;
-    for (double d : dv_full) finite = finite && std::isfinite(d);
-    if (finite) {
-      if (o.is_static) {
-        for (size_t k = 0; k < x.size(); ++k) x[k] += dv_full[k];
-      } else {
-        for (size_t k = 0; k < x.size(); ++k) {
-          v[k] += dv_full[k];
-          x[k] += o.dt * v[k];
-        }
-      }
-    }
-    const double t5 = WallTime();
-    t_element += t1 - t0;
-    t_comm += (t2 - t1) + (t5 - t4);
-    t_setvalues += t3 - t2;
-    t_solve += t4 - t3;
-    t_total += t5 - t0;
-    its_total += st.iterations;
-    last_reason = st.reason;
+    FemStepInfo info;
+    PetscCall(FemSimulationStep(&sim, &info));
+    if (step == 1 && o.dump[0]) PetscCall(BlockSystemDumpMatrix(&sim.sys, o.dump));
+    t_element += info.element_ms;
+    t_comm += info.comm_ms;
+    t_setvalues += info.setvalues_ms;
+    t_solve += info.solve_ms;
+    t_total += info.total_ms;
+    its_total += info.stats.iterations;
+    last_reason = info.stats.reason;
     steps_done  = step;
     if (!o.quiet)
       PetscCall(PetscPrintf(comm, "step %d its %" PetscInt_FMT " res %.3e reason %s assembly_ms %.2f solve_ms %.2f\n", step,
-                            st.iterations, (double)st.residual_norm, KSPConvergedReasons[st.reason], 1e3 * (t3 - t0),
-                            1e3 * (t4 - t3)));
-    if (!finite) {
+                            info.stats.iterations, (double)info.stats.residual_norm, KSPConvergedReasons[info.stats.reason],
+                            info.element_ms + info.setvalues_ms, info.solve_ms));
+    if (!info.finite) {
       status = "nan";
       PetscCall(PetscPrintf(comm, "fem: step %d produced a non-finite velocity change (KSP reason %s); stopping\n", step,
-                            KSPConvergedReasons[st.reason]));
+                            KSPConvergedReasons[info.stats.reason]));
       break;
     }
-    if (st.reason < 0 && st.reason != KSP_DIVERGED_ITS) {
+    if (info.stats.reason < 0 && info.stats.reason != KSP_DIVERGED_ITS) {
       status = "ksp_diverged";
-      PetscCall(PetscPrintf(comm, "fem: the linear solve diverged at step %d (%s); stopping\n", step, KSPConvergedReasons[st.reason]));
+      PetscCall(PetscPrintf(comm, "fem: the linear solve diverged at step %d (%s); stopping\n", step,
+                            KSPConvergedReasons[info.stats.reason]));
       break;
     }
     if (step % o.vtk_every == 0) write_frame(step);
   }
+  t_element *= 1e-3; t_comm *= 1e-3; t_setvalues *= 1e-3; t_solve *= 1e-3; t_total *= 1e-3;
 
   // ---- summary ------------------------------------------------------------------------------
   const physics::FemEnergy E = physics::fem_energy(model, x.data(), v.data());
@@ -474,7 +403,7 @@ int main(int argc, char **argv)
   s.add("status", status);
   PetscCall(PrintSummary(comm, s));
 
-  PetscCall(BlockSystemDestroy(&sys));
+  PetscCall(FemSimulationDestroy(&sim));
   PetscCall(PetscFinalize());
   return 0;
 }
