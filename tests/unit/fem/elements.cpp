@@ -1,0 +1,168 @@
+// Element-level physics: polar decomposition, shape-function integrals, rigid-rotation invariance of
+// corotational forces, patch tests for P1 and P2.
+#include <catch2/catch.hpp>
+
+#include "fem/fem_test_util.hpp"
+#include "physics/box_mesh.hpp"
+#include "physics/polar_decomposition.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+
+using namespace physics;
+
+namespace {
+
+bool is_rotation(const Eigen::Matrix3d &R, double tol = 1e-10)
+{
+  return R.allFinite() && (R.transpose() * R - Eigen::Matrix3d::Identity()).norm() < tol && std::fabs(R.determinant() - 1) < tol;
+}
+
+Eigen::Matrix3d some_rotation()
+{
+  return Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.3, -0.8, 0.5).normalized()).toRotationMatrix();
+}
+
+// Irregular mesh: box with its interior nodes jittered.
+TetMesh jittered_box(int order)
+{
+  TetMesh      m = make_box_mesh(1.0, 0.8, 0.6, 3, 3, 3);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.06, 0.06);
+  for (int i = 0; i < m.node_count(); ++i) {
+    bool interior = true;
+    const double ext[3] = {1.0, 0.8, 0.6};
+    for (int d = 0; d < 3; ++d) interior = interior && m.nodes[3 * i + d] > 1e-9 && m.nodes[3 * i + d] < ext[d] - 1e-9;
+    if (interior)
+      for (int d = 0; d < 3; ++d) m.nodes[3 * i + d] += u(rng);
+  }
+  return order == 2 ? promote_to_quadratic(m) : m;
+}
+
+} // namespace
+
+TEST_CASE("polar decomposition: proper rotation for regular, inverted, flat and broken F", "[fem][polar]")
+{
+  const Eigen::Matrix3d Q = some_rotation();
+  Eigen::Matrix3d       S;
+  S << 1.3, 0.2, -0.1, 0.2, 0.8, 0.05, -0.1, 0.05, 1.1; // SPD stretch
+  const Eigen::Matrix3d R = rotation_from_deformation(Q * S);
+  CHECK(is_rotation(R));
+  CHECK((R - Q).norm() < 1e-10);
+
+  // Inverted: reflect one axis. Must stay a proper rotation, and R^T F symmetric.
+  const Eigen::Matrix3d F_inv = Q * Eigen::DiagonalMatrix<double, 3>(1.0, 1.0, -0.2) * S;
+  const Eigen::Matrix3d R_inv = rotation_from_deformation(F_inv);
+  CHECK(is_rotation(R_inv));
+  const Eigen::Matrix3d Sym = R_inv.transpose() * F_inv;
+  CHECK((Sym - Sym.transpose()).norm() < 1e-9);
+
+  // Flat (rank 2), collapsed (rank 1), zero, non-finite.
+  Eigen::Matrix3d flat = Q * Eigen::DiagonalMatrix<double, 3>(1.0, 2.0, 0.0);
+  CHECK(is_rotation(rotation_from_deformation(flat)));
+  CHECK((rotation_from_deformation(flat) - Q).norm() < 1e-9);
+  CHECK(is_rotation(rotation_from_deformation(Q * Eigen::DiagonalMatrix<double, 3>(1.0, 0.0, 0.0))));
+  CHECK(is_rotation(rotation_from_deformation(Eigen::Matrix3d::Zero())));
+  Eigen::Matrix3d nan = Eigen::Matrix3d::Identity();
+  nan(1, 2)           = std::nan("");
+  CHECK(is_rotation(rotation_from_deformation(nan)));
+  // Tiny but regular elements (scale-free thresholds).
+  CHECK((rotation_from_deformation(1e-9 * Q * S) - Q).norm() < 1e-9);
+}
+
+TEST_CASE("P2 shape functions integrate to -V/20 (corners) and V/5 (edges); masses positive", "[fem][mass]")
+{
+  const Eigen::VectorXd w = shape_function_integrals(2);
+  for (int a = 0; a < 4; ++a) CHECK(w[a] == Approx(-1.0 / 20));
+  for (int a = 4; a < 10; ++a) CHECK(w[a] == Approx(1.0 / 5));
+  const Eigen::MatrixXd Mc = reference_mass(2, MassLumping::Consistent);
+  CHECK(Mc.sum() == Approx(1.0));
+  CHECK(Mc(0, 0) == Approx(6.0 / 420));
+  CHECK(Mc(4, 4) == Approx(32.0 / 420));
+  CHECK((Mc - Mc.transpose()).norm() < 1e-15);
+  CHECK(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Mc).eigenvalues().minCoeff() > 0);
+  const Eigen::MatrixXd Mh = reference_mass(2, MassLumping::Lumped);
+  CHECK(Mh.isDiagonal());
+  CHECK(Mh.sum() == Approx(1.0));
+  CHECK(Mh.diagonal().minCoeff() > 0);
+  CHECK(Mh(0, 0) == Approx(1.0 / 36));
+}
+
+TEST_CASE("rigidly rotated mesh at rest: zero corotational force, spurious linear force", "[fem][corotational]")
+{
+  for (int order : {1, 2}) {
+    INFO("order " << order);
+    FemSettings s;
+    s.young          = 1e6;
+    const TetMesh mesh = jittered_box(order);
+    const Eigen::Matrix3d  Q = some_rotation();
+    const Eigen::Vector3d  t(0.4, -1.0, 2.0);
+    std::vector<double>    x(mesh.nodes.size());
+    double                 scale = 0;
+    for (int i = 0; i < mesh.node_count(); ++i) Eigen::Vector3d::Map(&x[3 * i]) = Q * Eigen::Vector3d::Map(&mesh.nodes[3 * i]) + t;
+    s.corotational        = true;
+    const FemModel corot  = make_fem_model(mesh, s);
+    s.corotational        = false;
+    const FemModel linear = make_fem_model(mesh, s);
+    // Force scale: what a unit-size displacement would produce (E * characteristic area).
+    scale = s.young * 0.1;
+    const auto fc = elastic_forces(corot, x.data());
+    const auto fl = elastic_forces(linear, x.data());
+    double     max_c = 0, max_l = 0;
+    for (size_t k = 0; k < fc.size(); ++k) {
+      max_c = std::max(max_c, std::fabs(fc[k]));
+      max_l = std::max(max_l, std::fabs(fl[k]));
+    }
+    CHECK(max_c < 1e-9 * scale);
+    CHECK(max_l > 1e-2 * scale);
+    CHECK(fem_energy(corot, x.data(), std::vector<double>(x.size(), 0.0).data()).elastic < 1e-12 * s.young);
+  }
+}
+
+TEST_CASE("patch test: a linear displacement field is reproduced exactly by P1 and P2", "[fem][patch]")
+{
+  for (int order : {1, 2}) {
+    INFO("order " << order);
+    const TetMesh mesh = jittered_box(order);
+    FemSettings   s;
+    s.corotational = false;
+    s.poisson      = 0.35;
+    const FemModel m = make_fem_model(mesh, s);
+    Eigen::Matrix3d G;
+    G << 1e-3, 2e-3, -1e-3, 0.5e-3, -2e-3, 1e-3, 3e-3, 1e-3, 0.7e-3;
+    const Eigen::Vector3d b(0.01, -0.02, 0.03);
+    auto exact = [&](int i) { return Eigen::Vector3d(G * Eigen::Vector3d::Map(&mesh.nodes[3 * i]) + b); };
+    // Boundary nodes prescribed (fixed: dx = 0 at the exact value), interior nodes solved from K u = 0.
+    std::vector<char>   boundary(mesh.node_count(), 0);
+    std::vector<double> x(mesh.nodes);
+    const double        ext[3] = {1.0, 0.8, 0.6};
+    for (int i = 0; i < mesh.node_count(); ++i) {
+      for (int d = 0; d < 3; ++d)
+        if (mesh.nodes[3 * i + d] < 1e-9 || mesh.nodes[3 * i + d] > ext[d] - 1e-9) boundary[i] = 1;
+      if (boundary[i]) Eigen::Vector3d::Map(&x[3 * i]) += exact(i);
+    }
+    // Static Newton step from x: K dx = f(x).
+    const physics::StepCoefficients c{1, 0, 0, 0, 1};
+    const auto   sys = fem_test::assemble(m, boundary, c, x, std::vector<double>(x.size(), 0.0), {}, 0);
+    const auto   dx  = fem_test::solve(sys);
+    double       err = 0;
+    int          interior = 0;
+    for (int i = 0; i < mesh.node_count(); ++i) {
+      if (boundary[i]) continue;
+      ++interior;
+      const Eigen::Vector3d u = Eigen::Vector3d::Map(&x[3 * i]) + dx.segment<3>(3 * i) - Eigen::Vector3d::Map(&mesh.nodes[3 * i]);
+      err = std::max(err, (u - exact(i)).norm());
+    }
+    CHECK(interior > 0);
+    CHECK(err < 1e-12);
+    // And the internal nodal forces of the exact field vanish at interior nodes.
+    for (int i = 0; i < mesh.node_count(); ++i) Eigen::Vector3d::Map(&x[3 * i]) = Eigen::Vector3d::Map(&mesh.nodes[3 * i]) + exact(i);
+    const auto f = elastic_forces(m, x.data());
+    double     fmax = 0;
+    for (int i = 0; i < mesh.node_count(); ++i)
+      if (!boundary[i]) fmax = std::max(fmax, Eigen::Vector3d::Map(&f[3 * i]).norm());
+    CHECK(fmax < 1e-8 * s.young * 1e-3);
+  }
+}
