@@ -130,7 +130,7 @@ bool file_exists(const std::string &p)
 }
 
 // Meshes a .geo with gmsh into a cache next to the program (build/meshes), on rank 0.
-PetscErrorCode MeshGeo(MPI_Comm comm, const std::string &geo, double size, std::string *msh)
+PetscErrorCode MeshGeo(MPI_Comm comm, const std::string geo, double size, std::string *msh)
 {
   PetscMPIInt rank;
   char        exe[PETSC_MAX_PATH_LEN] = "";
@@ -285,6 +285,12 @@ int main(int argc, char **argv)
     }
   }
 
+  auto min_volume_ratio = [&] {
+    double r = 1e300;
+    for (int e = 0; e < model.element_count(); ++e)
+      r = std::min(r, physics::element_signed_volume(model.mesh, x.data(), e) / model.volume[e]);
+    return r;
+  };
   PetscInt    nnz;
   const char *mat_type, *ksp_type;
   PetscCall(BlockSystemGetInfo(&sim.sys, &nnz, &mat_type, &ksp_type));
@@ -294,6 +300,7 @@ int main(int argc, char **argv)
                         " ranks %d mat %s ksp %s corotational %d mass %s\n",
                         mesh_name.c_str(), (int)o.order, model.element_count(), n_nodes, 3 * n_nodes, n_fixed, nnz, size,
                         mat_type, ksp_type, (int)o.corotational, o.order == 1 ? "lumped" : (o.lumped ? "hrz" : "consistent")));
+  PetscCall(PetscPrintf(comm, "fem: initial min volume ratio %g (negative: inverted elements)\n", min_volume_ratio()));
 
   std::vector<std::pair<std::string, double>> frames;
   auto write_frame = [&](int step) {
@@ -358,15 +365,14 @@ int main(int argc, char **argv)
   // ---- summary ------------------------------------------------------------------------------
   const physics::FemEnergy E = physics::fem_energy(model, x.data(), v.data());
   const auto               P = physics::linear_momentum(model, v.data());
-  double cen[3] = {0, 0, 0}, mass_sum = 0, min_vol_ratio = 1e300;
+  double cen[3] = {0, 0, 0}, mass_sum = 0;
+  const double min_vol_ratio = min_volume_ratio();
   {
     const auto                w = physics::gravity_forces(model, {1, 1, 1}); // row sums of M (may be < 0 for P2 corners)
     for (int i = 0; i < n_nodes; ++i) {
       for (int d = 0; d < 3; ++d) cen[d] += w[3 * i] * (x[3 * i + d] - X[3 * i + d]);
       mass_sum += w[3 * i];
     }
-    for (int e = 0; e < model.element_count(); ++e)
-      min_vol_ratio = std::min(min_vol_ratio, physics::element_signed_volume(model.mesh, x.data(), e) / model.volume[e]);
   }
   const int    steps_div = std::max(steps_done, 1);
   SummaryLine  s;
