@@ -59,6 +59,7 @@ static PetscErrorCode KSPView_MCG(KSP ksp, PetscViewer viewer)
     PetscCall(PetscViewerASCIIPrintf(viewer, "  matrix product fused with u.Au: %s\n", mcg->mat_fused ? "yes (matrix type provides MatMultDotLocal)" : "no (MatMult, then a local dot)"));
     if (mcg->single_storage) PetscCall(PetscViewerASCIIPrintf(viewer, "  operator values stored in single precision: residuals are relative to the rounded operator (expect ~1e-7 relative against double-precision values)\n"));
   }
+  if (mcg->drift > 0) PetscCall(PetscViewerASCIIPrintf(viewer, "  last solve: estimated rounding drift of the recursive residual %g (claims %g times above it are not re-checked)\n", (double)mcg->drift, MCG_DRIFT_MARGIN));
   if (mcg->true_checks) PetscCall(PetscViewerASCIIPrintf(viewer, "  last solve: %" PetscInt_FMT " true-residual checks, %" PetscInt_FMT " restarts, true residual norm %g\n", mcg->true_checks, mcg->restarts, (double)mcg->true_rnorm));
   PetscFunctionReturn(0);
 }

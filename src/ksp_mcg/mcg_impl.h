@@ -35,7 +35,11 @@ typedef struct {
   PetscInt  restarts;        /* residual replacements after a failed true-residual check */
   PetscReal true_rnorm;      /* norm of b - A x at the last check, -1 when none was made */
   PetscInt  true_checks;     /* number of true-residual checks of the last solve */
+  PetscReal drift;           /* estimated rounding drift of the recursive residual at the last claim */
 } KSP_MCG;
+
+/* A claim of convergence at least this far above the estimated rounding drift is not re-checked. */
+#define MCG_DRIFT_MARGIN 100.0
 
 PETSC_INTERN PetscErrorCode KSPSolve_MCG(KSP);
 

@@ -16,42 +16,48 @@
 #endif
 
 /* Order matters: it is the layout of the buffer handed to the global reduction. */
-enum { MCG_DOT_RU = 0, MCG_DOT_UW = 1, MCG_DOT_RR = 2, MCG_DOT_UU = 3, MCG_NDOTS = 4 };
+enum { MCG_DOT_RU = 0, MCG_DOT_UW = 1, MCG_DOT_RR = 2, MCG_DOT_UU = 3, MCG_DOT_XX = 4, MCG_NDOTS = 5 };
 
 /* Chronopoulos-Gear update of one index, fused with Jacobi and the local dots:
      p = u + beta p        s = w + beta s   (s tracks A p without a product)
      x = x + alpha p       r = r - alpha s
      u = dinv * r          (Jacobi == false: no preconditioner, u = r, dinv unused)
-   and adds r.u, r.r, u.u of the new r, u to ru, rr, uu (scalars, so that a host loop can declare
-   them as an OpenMP simd reduction and a device kernel can reduce them in shared memory).
+   and adds r.u, r.r, u.u of the new r, u and x.x of the new x to ru, rr, uu, xx (scalars, so that a
+   host loop can declare them as an OpenMP simd reduction and a device kernel can reduce them in
+   shared memory). x.x feeds the estimate of the rounding drift of r (see mcg_solve.cpp).
    u is read (old value) before it is written (new value), so it is updated in place. */
 template <bool Jacobi, typename Scalar>
-MCG_HOST_DEVICE inline void mcg_update_index(long i, Scalar alpha, Scalar beta, Scalar *u, const Scalar *w, Scalar *p, Scalar *s, Scalar *x, Scalar *r, const Scalar *dinv, Scalar &ru, Scalar &rr, Scalar &uu)
+MCG_HOST_DEVICE inline void mcg_update_index(long i, Scalar alpha, Scalar beta, Scalar *u, const Scalar *w, Scalar *p, Scalar *s, Scalar *x, Scalar *r, const Scalar *dinv, Scalar &ru, Scalar &rr, Scalar &uu, Scalar &xx)
 {
   const Scalar pi = u[i] + beta * p[i];
   const Scalar si = w[i] + beta * s[i];
   const Scalar ri = r[i] - alpha * si;
   const Scalar ui = Jacobi ? dinv[i] * ri : ri;
+  const Scalar xi = x[i] + alpha * pi;
   p[i] = pi;
   s[i] = si;
-  x[i] += alpha * pi;
+  x[i] = xi;
   r[i] = ri;
   u[i] = ui;
   ru += ri * ui;
   rr += ri * ri;
   uu += ui * ui;
+  xx += xi * xi;
 }
 
-/* Same update without the preconditioner (generic path: the PC is applied afterwards by PCApply). */
+/* Same update without the preconditioner (generic path: the PC is applied afterwards by PCApply);
+   adds x.x of the new x to xx. */
 template <typename Scalar>
-MCG_HOST_DEVICE inline void mcg_update_index_nopc(long i, Scalar alpha, Scalar beta, const Scalar *u, const Scalar *w, Scalar *p, Scalar *s, Scalar *x, Scalar *r)
+MCG_HOST_DEVICE inline void mcg_update_index_nopc(long i, Scalar alpha, Scalar beta, const Scalar *u, const Scalar *w, Scalar *p, Scalar *s, Scalar *x, Scalar *r, Scalar &xx)
 {
   const Scalar pi = u[i] + beta * p[i];
   const Scalar si = w[i] + beta * s[i];
+  const Scalar xi = x[i] + alpha * pi;
   p[i] = pi;
   s[i] = si;
-  x[i] += alpha * pi;
+  x[i] = xi;
   r[i] -= alpha * si;
+  xx += xi * xi;
 }
 
 /* u = dinv * r (or u = r) and the local dots of r and u: the start of a solve or a restart. */

@@ -126,6 +126,9 @@ TEST_CASE("mcg uses the fused product of binbcsr and says so", "[ksp_mcg][binbcs
   CHECK(text.find("fast path: on, Jacobi fused") != std::string::npos);
   CHECK(text.find("fused with u.Au: yes") != std::string::npos);
   CHECK(text.find("single precision") != std::string::npos);
+  // default rtol 1e-5 is far above the rounding drift: convergence accepted without an extra product
+  CHECK(text.find("estimated rounding drift") != std::string::npos);
+  CHECK(text.find("true-residual checks") == std::string::npos);
   KSPDestroy(&ksp);
   VecDestroy(&x);
   VecDestroy(&b);
@@ -147,10 +150,10 @@ TEST_CASE("single storage: converged on the rounded operator, floor against doub
   Result r = solve(B, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-6});
   CHECK(r.reason == KSP_CONVERGED_RTOL);
   CHECK(rel_residual(A, b, r.x) < 2e-6);
-  // rtol 1e-11: met on the operator MCG was given (the true-residual check confirms it on B) ...
+  // rtol 1e-11: met on the operator MCG was given (up to the recursive residual's rounding drift) ...
   r = solve(B, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-11});
   CHECK(r.reason == KSP_CONVERGED_RTOL);
-  CHECK(rel_residual(B, b, r.x) < 1e-11);
+  CHECK(rel_residual(B, b, r.x) < 1.05e-11);
   // ... but against the double-precision values the residual stays at float rounding level
   const PetscReal floor_vs_double = rel_residual(A, b, r.x);
   CHECK(floor_vs_double > 1e-10);
