@@ -14,6 +14,6 @@ add_test(NAME bench_spmv_smoke_file
 set_tests_properties(bench_spmv_smoke_file PROPERTIES LABELS "bench" TIMEOUT 60)
 
 add_test(NAME bench_spmv_smoke_mpi
-         COMMAND ${BENCH_CHECK} -allow_skipped_binbcsr ${CMAKE_CURRENT_BINARY_DIR}/bench_spmv_smoke_mpi.csv
+         COMMAND ${BENCH_CHECK} ${CMAKE_CURRENT_BINARY_DIR}/bench_spmv_smoke_mpi.csv
                  ${MPIEXEC_CMD} -n 2 $<TARGET_FILE:spmv_bench> -stencil_sizes 4 -repeats 2 -min_batch_ms 1 -stream_elements 200000)
 set_tests_properties(bench_spmv_smoke_mpi PROPERTIES LABELS "bench;mpi" TIMEOUT 60)
