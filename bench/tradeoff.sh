@@ -1,0 +1,149 @@
+#!/usr/bin/env bash
+# bench/tradeoff.sh BUILD OUT QUICK: the speed/accuracy study of issue 7 over examples/fem.
+#
+# Two scenes, one knob changed at a time from a base point; every run reports its time per step
+# (the driver's summary ms_per_step) and its error against a reference:
+#  - static: the cantilever of options/cantilever.opts (1 m x 0.1 m x 0.1 m, clamped at x = 0, own
+#    weight), plain linear elasticity, one static solve. Reference: Timoshenko beam theory,
+#      delta = q L^4 / (8 E I) + q L^2 / (2 kappa G A), q = rho g A, kappa = 10 (1 + nu) / (12 + 11 nu).
+#    Error = |tip_dz + delta| / delta (tip = the corner node at x = L).
+#  - dynamic: the same beam falling under gravity from rest, corotational, backward Euler, to
+#    t = T. Reference: converged runs on the base mesh (quadratic, double, rtol 1e-10) at dt/4 and
+#    dt/8, Richardson-extrapolated (backward Euler is first order: 2 x(dt/8) - x(dt/4)).
+#    Error = |tip displacement - reference| / |reference tip displacement| at t = T.
+#    The cost that matters for a dynamic scene is time per simulated second (steps x ms per step):
+#    the plot and the Pareto front use it; the table gives both.
+# Knobs: storage precision (binbcsr double/single), CG work per step (fixed iterations or rtol),
+# element order (P1/P2), mesh (cells along the beam), time step (dynamic only). Solver: binbcsr + mcg
+# with Jacobi, one rank.
+# Writes OUT/tradeoff.csv and OUT/tradeoff.png (error against time per step, Pareto front marked) and
+# prints the table.
+set -euo pipefail
+b=$1 out=$2 quick=$3
+fem=$b/examples/fem
+note() { echo "  note: $*"; }
+[ -x "$fem" ] || { note "examples/fem not on main yet: speed/accuracy study skipped"; exit 0; }
+
+L=1 B=0.1 E=1e7 NU=0.3 RHO=1000 G=9.81
+delta=$(awk -v L=$L -v b=$B -v E=$E -v nu=$NU -v rho=$RHO -v g=$G 'BEGIN {
+  A = b * b; I = b ^ 4 / 12; q = rho * g * A; Gs = E / (2 * (1 + nu)); k = 10 * (1 + nu) / (12 + 11 * nu)
+  printf "%.10g", q * L ^ 4 / (8 * E * I) + q * L * L / (2 * k * Gs * A) }')
+
+common=(-young $E -poisson $NU -density $RHO -gravity 0,0,-$G -fix xmin:0.001 -mat_type binbcsr
+        -ksp_type mcg -pc_type jacobi -ksp_max_it 5000 -fem_quiet)
+mesh() { echo "-mesh_box $L,$B,$B,$1,$(( ($1 + 9) / 10 )),$(( ($1 + 9) / 10 ))"; }
+
+# run LOGNAME ARGS...: prints "ms_per_step tip_dx tip_dy tip_dz reason" from the summary line
+run() {
+  local log=$out/tradeoff_$1.log
+  shift
+  if ! "$fem" "$@" >"$log" 2>&1; then echo "failed"; return; fi
+  awk '/^summary/ { for (i = 2; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] }
+       print v["ms_per_step"], v["tip_dx"], v["tip_dy"], v["tip_dz"], v["ksp_reason"] }' "$log"
+}
+
+# cg work as options: fixed:N or rtol:R
+cg_opts() {
+  case $1 in
+    fixed:*) echo "-ksp_mcg_fixed_iterations ${1#fixed:} -ksp_max_it ${1#fixed:}" ;;
+    rtol:*) echo "-ksp_rtol ${1#rtol:} -ksp_mcg_fixed_iterations 0" ;;
+  esac
+}
+
+csv=$out/tradeoff.csv
+echo "scene,knob,order,cells,precision,cg,dt,ms_per_step,cost_ms,error,ksp_reason" >"$csv"
+
+# point SCENE KNOB ORDER CELLS PRECISION CG DT [REF_TIP]
+point() {
+  local scene=$1 knob=$2 order=$3 cells=$4 prec=$5 cg=$6 dt=$7 name r ms err reason
+  name=${scene}_${knob}_p${order}_n${cells}_${prec}_${cg/:/}_dt$dt
+  local args=("${common[@]}" $(mesh "$cells") -fem_order "$order" -mat_binbcsr_precision "$prec" $(cg_opts "$cg"))
+  if [ "$scene" = static ]; then
+    args+=(-static -fem_corotational 0 -steps 1 -dt 1)
+  else
+    args+=(-fem_corotational 1 -dt "$dt" -steps "$(awk -v T="$T" -v dt="$dt" 'BEGIN { printf "%d", T / dt + 0.5 }')")
+  fi
+  r=$(run "$name" "${args[@]}")
+  if [ "$r" = failed ]; then note "$name failed (see $out/tradeoff_$name.log)"; return; fi
+  read -r ms dx dy dz reason <<<"$r"
+  if [ "$scene" = static ]; then
+    err=$(awk -v z="$dz" -v d="$delta" 'BEGIN { e = (z + d) / d; printf "%.4e", e < 0 ? -e : e }')
+  else
+    err=$(awk -v x="$dx" -v y="$dy" -v z="$dz" -v r="$ref_tip" 'BEGIN { split(r, q, " ");
+      n = sqrt((x - q[1]) ^ 2 + (y - q[2]) ^ 2 + (z - q[3]) ^ 2); d = sqrt(q[1] ^ 2 + q[2] ^ 2 + q[3] ^ 2); printf "%.4e", n / d }')
+  fi
+  # cost: ms per solve (static) or ms per simulated second (dynamic)
+  cost=$(awk -v ms="$ms" -v dt="$dt" -v s="$scene" 'BEGIN { printf "%.4g", s == "static" ? ms : ms / dt }')
+  echo "$scene,$knob,$order,$cells,$prec,$cg,$dt,$ms,$cost,$err,$reason" >>"$csv"
+}
+
+if [ "$quick" = 1 ]; then
+  cells_list=(10 20); fixed_list=(10 100); rtol_list=(1e-3 1e-8); dt_list=(0.04 0.01); T=0.1
+else
+  cells_list=(10 20 40); fixed_list=(5 10 30 100 200); rtol_list=(1e-2 1e-4 1e-6 1e-8 1e-10); dt_list=(0.04 0.02 0.01 0.005); T=0.2
+fi
+base_cells=20
+
+echo "Speed/accuracy study (examples/fem, binbcsr + mcg + Jacobi, one rank; Timoshenko tip deflection $delta m)"
+# static: base = P2, 20 cells, double, rtol 1e-8
+point static base 2 $base_cells double rtol:1e-8 1
+point static precision 2 $base_cells single rtol:1e-6 1
+for c in "${cells_list[@]}"; do [ "$c" = $base_cells ] || point static mesh 2 "$c" double rtol:1e-8 1; done
+point static order 1 $base_cells double rtol:1e-8 1
+for f in "${fixed_list[@]}"; do point static cg_fixed 2 $base_cells double fixed:$f 1; done
+for t in "${rtol_list[@]}"; do point static cg_rtol 2 $base_cells double rtol:$t 1; done
+
+# dynamic: the reference first (base mesh; Richardson extrapolation of dt/4 and dt/8 runs)
+ref_run() {
+  run "dynamic_reference_dt$1" "${common[@]}" $(mesh $base_cells) -fem_order 2 -mat_binbcsr_precision double \
+    -ksp_rtol 1e-10 -ksp_mcg_fixed_iterations 0 -fem_corotational 1 -dt "$1" \
+    -steps "$(awk -v T="$T" -v dt="$1" 'BEGIN { printf "%d", T / dt + 0.5 }')"
+}
+ref4=$(ref_run 0.0025)
+ref8=$(ref_run 0.00125)
+if [ "$ref4" = failed ] || [ "$ref8" = failed ]; then
+  note "dynamic reference failed (see $out/tradeoff_dynamic_reference_*.log): dynamic study skipped"
+else
+  read -r _ ax ay az _ <<<"$ref4"
+  read -r _ bx by bz _ <<<"$ref8"
+  ref_tip=$(awk -v ax="$ax" -v ay="$ay" -v az="$az" -v bx="$bx" -v by="$by" -v bz="$bz" \
+            'BEGIN { printf "%.10g %.10g %.10g", 2 * bx - ax, 2 * by - ay, 2 * bz - az }')
+  echo "  dynamic reference tip displacement at t = $T s: $ref_tip (dt/4: $ax $ay $az)"
+  point dynamic base 2 $base_cells double rtol:1e-6 0.01
+  point dynamic precision 2 $base_cells single rtol:1e-6 0.01
+  for c in "${cells_list[@]}"; do [ "$c" -lt $base_cells ] && point dynamic mesh 2 "$c" double rtol:1e-6 0.01; done
+  point dynamic order 1 $base_cells double rtol:1e-6 0.01
+  for f in "${fixed_list[@]}"; do point dynamic cg_fixed 2 $base_cells double fixed:$f 0.01; done
+  for t in "${rtol_list[@]}"; do [ "$t" = 1e-6 ] || point dynamic cg_rtol 2 $base_cells double rtol:$t 0.01; done
+  for d in "${dt_list[@]}"; do [ "$d" = 0.01 ] || point dynamic dt 2 $base_cells double rtol:1e-6 "$d"; done
+fi
+
+# Pareto front per scene: a point is on it when no other point is both faster and more accurate.
+awk -F, 'NR == 1 { print $0 ",pareto"; next } { line[NR] = $0; sc[NR] = $1; t[NR] = $9; e[NR] = $10 }
+  END { for (i = 2; i <= NR; i++) { p = "yes"
+          for (j = 2; j <= NR; j++) if (j != i && sc[j] == sc[i] && t[j] <= t[i] && e[j] <= e[i] && (t[j] < t[i] || e[j] < e[i])) p = "no"
+          print line[i] "," p } }' "$csv" >"$csv.tmp" && mv "$csv.tmp" "$csv"
+column -s, -t <"$csv" | sed 's/^/  /'
+
+for s in static dynamic; do
+  awk -F, -v s=$s 'NR > 1 && $1 == s { print $9, $10, $2 }' "$csv" >"$out/tradeoff_$s.dat"
+  awk -F, -v s=$s 'NR > 1 && $1 == s && $12 == "yes" { print $9, $10 }' "$csv" | sort -g >"$out/tradeoff_${s}_pareto.dat"
+done
+gnuplot <<EOF
+set terminal pngcairo size 1300,520 font ",10"
+set output "$out/tradeoff.png"
+set multiplot layout 1,2 title "Speed against accuracy: examples/fem cantilever, binbcsr + mcg (Pareto front: line)"
+set logscale xy
+set grid
+set xlabel "ms per static solve / ms per simulated second"
+set ylabel "relative error"
+set key outside right top noenhanced
+set format y "10^{%L}"
+do for [s in "static dynamic"] {
+  set title s eq "static" ? "static: error vs Timoshenko, against ms per solve" : "dynamic: error vs converged run, against ms per simulated second"
+  plot "$out/tradeoff_".s."_pareto.dat" using 1:2 with lines lw 2 lc rgb "gray" title "Pareto front", \
+       for [k in "base precision mesh order cg_fixed cg_rtol dt"] "$out/tradeoff_".s.".dat" using (strcol(3) eq k ? \$1 : NaN):2 with points pt 7 ps 1.3 title k
+}
+unset multiplot
+EOF
+echo "  wrote $csv, $out/tradeoff.png"
