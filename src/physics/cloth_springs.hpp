@@ -1,0 +1,21 @@
+// One spring's force and its Jacobians for implicit integration (Baraff & Witkin 1998).
+#pragma once
+#include "physics/cloth_model.hpp"
+
+namespace physics {
+
+struct SpringLinearisation {
+  Eigen::Vector3d force_on_a;   // f_b = -f_a
+  Eigen::Matrix3d stiffness;    // K = -df_a/dx_a (enters as +K at (a,a), (b,b), -K at (a,b), (b,a))
+  Eigen::Matrix3d damping;      // D = -df_a/dv_a, same pattern
+};
+
+// Hooke spring plus damping along the spring. The exact stiffness is
+//   k [ d d^T + (1 - L/l) (I - d d^T) ]   (d = unit direction, l = length, L = rest length),
+// whose transverse term is negative for a compressed spring (l < L) and can make M + h^2 K indefinite.
+// Following Choi & Ko (2002) the transverse term is dropped for compressed springs, so K is always
+// positive semi-definite and the system stays SPD for CG at any time step.
+SpringLinearisation linearise_spring(const Spring &s, const Eigen::Vector3d &xa, const Eigen::Vector3d &xb, const Eigen::Vector3d &va,
+                                     const Eigen::Vector3d &vb, double damping, bool choi_ko = true);
+
+} // namespace physics

@@ -1,0 +1,115 @@
+#include "physics/cloth_step.hpp"
+
+#include "physics/cloth_springs.hpp"
+
+#include <cmath>
+
+namespace physics {
+
+ClothSystem make_cloth_system(const Cloth &cloth)
+{
+  ClothSystem s;
+  s.n_particles = cloth.particle_count();
+  for (int p = 0; p < s.n_particles; ++p) s.block_row.push_back(p), s.block_col.push_back(p);
+  for (const Spring &sp : cloth.springs) {
+    s.block_row.push_back(sp.a), s.block_col.push_back(sp.b);
+    s.block_row.push_back(sp.b), s.block_col.push_back(sp.a);
+  }
+  s.block_values.assign(9 * s.block_row.size(), 0.0);
+  s.rhs.assign(3 * s.n_particles, 0.0);
+  s.dv.assign(3 * s.n_particles, 0.0);
+  return s;
+}
+
+std::string validate_params(const ClothParams &p)
+{
+  if (!(p.dt > 0) || !std::isfinite(p.dt)) return "time step must be positive and finite";
+  return "";
+}
+
+static void add_block(double *out, const Eigen::Matrix3d &m, double scale)
+{
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out[3 * r + c] += scale * m(r, c);
+}
+
+void assemble_cloth_system(const Cloth &cloth, const ClothParams &params, ClothSystem &sys)
+{
+  const double h = params.dt;
+  const int    np = sys.n_particles;
+  std::fill(sys.block_values.begin(), sys.block_values.end(), 0.0);
+  // rhs = h (f - h K v), built as h f first, then the -h^2 K v terms spring by spring.
+  for (int p = 0; p < np; ++p) {
+    double *d = &sys.block_values[9 * p];
+    d[0] = d[4] = d[8] = cloth.mass[p];
+    const Eigen::Vector3d f = h * cloth.mass[p] * cloth.gravity;
+    for (int k = 0; k < 3; ++k) sys.rhs[3 * p + k] = f[k];
+  }
+  for (size_t s = 0; s < cloth.springs.size(); ++s) {
+    const Spring             &sp = cloth.springs[s];
+    const SpringLinearisation lin = linearise_spring(sp, cloth.position[sp.a], cloth.position[sp.b], cloth.velocity[sp.a], cloth.velocity[sp.b], cloth.damping, params.choi_ko);
+    const Eigen::Matrix3d     A   = h * lin.damping + h * h * lin.stiffness;
+    const bool fa = cloth.fixed[sp.a], fb = cloth.fixed[sp.b];
+    // The spring's K acts on dv_a - dv_b; a pinned end has dv = 0, so its row, column and rhs stay out.
+    if (!fa) add_block(&sys.block_values[9 * sp.a], A, 1.0);
+    if (!fb) add_block(&sys.block_values[9 * sp.b], A, 1.0);
+    if (!fa && !fb) {
+      add_block(&sys.block_values[9 * (np + 2 * s)], A, -1.0);
+      add_block(&sys.block_values[9 * (np + 2 * s + 1)], A, -1.0);
+    }
+    const Eigen::Vector3d Kv = h * h * lin.stiffness * (cloth.velocity[sp.a] - cloth.velocity[sp.b]);
+    const Eigen::Vector3d fa_term = h * lin.force_on_a - Kv;
+    for (int k = 0; k < 3; ++k) {
+      if (!fa) sys.rhs[3 * sp.a + k] += fa_term[k];
+      if (!fb) sys.rhs[3 * sp.b + k] -= fa_term[k];
+    }
+  }
+  for (int p = 0; p < np; ++p)
+    if (cloth.fixed[p])
+      for (int k = 0; k < 3; ++k) sys.rhs[3 * p + k] = 0;
+}
+
+void cloth_forces(const Cloth &cloth, std::vector<Eigen::Vector3d> &forces)
+{
+  forces.resize(cloth.particle_count());
+  for (int p = 0; p < cloth.particle_count(); ++p) forces[p] = cloth.mass[p] * cloth.gravity;
+  for (const Spring &sp : cloth.springs) {
+    const SpringLinearisation lin = linearise_spring(sp, cloth.position[sp.a], cloth.position[sp.b], cloth.velocity[sp.a], cloth.velocity[sp.b], cloth.damping);
+    forces[sp.a] += lin.force_on_a;
+    forces[sp.b] -= lin.force_on_a;
+  }
+  for (int p = 0; p < cloth.particle_count(); ++p)
+    if (cloth.fixed[p]) forces[p].setZero();
+}
+
+ClothStepReport cloth_step(Cloth &cloth, ClothSystem &sys, const ClothParams &params, const BlockLinearSolver &solver)
+{
+  ClothStepReport report;
+  assemble_cloth_system(cloth, params, sys);
+  solver.set_matrix(sys.block_values);
+  const LinearSolveResult r = solver.solve(sys.rhs, sys.dv); // sys.dv: last step's dv, a warm start if asked for
+  report.iterations         = r.iterations;
+  report.converged          = r.converged;
+  report.breakdown          = r.breakdown;
+  const double h            = params.dt;
+  for (int p = 0; p < sys.n_particles; ++p) {
+    if (cloth.fixed[p]) continue;
+    cloth.velocity[p] += Eigen::Vector3d(sys.dv[3 * p], sys.dv[3 * p + 1], sys.dv[3 * p + 2]);
+    cloth.position[p] += h * cloth.velocity[p];
+    if (cloth.sphere.enabled) {
+      const Eigen::Vector3d d    = cloth.position[p] - cloth.sphere.centre;
+      const double          dist = d.norm();
+      if (dist < cloth.sphere.radius && dist > 0) {
+        const Eigen::Vector3d normal = d / dist;
+        cloth.position[p]            = cloth.sphere.centre + cloth.sphere.radius * normal;
+        const double vn              = cloth.velocity[p].dot(normal);
+        if (vn < 0) cloth.velocity[p] -= vn * normal;
+        report.contacts++;
+      }
+    }
+  }
+  report.max_stretch = max_stretch_ratio(cloth);
+  return report;
+}
+
+} // namespace physics
