@@ -1,0 +1,34 @@
+# Cloth driver: small scenes run to their physical checks (summary line), every matrix type and MPI give
+# the same motion, bad input is a clear error.
+set(CLOTH $<TARGET_FILE:cloth>)
+set(SUMMARY_CHECK ${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_check.sh)
+set(SUMMARY_SAME ${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_same.sh)
+set(OPTS ${CMAKE_SOURCE_DIR}/options)
+
+add_test(NAME cloth_drape_sphere
+         COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && max_stretch<1.3 && contacts>0 && unknowns==1200"
+                 -- ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 20 -steps 60 -progress_every 1000)
+add_test(NAME cloth_stiff_dt30
+         COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && max_stretch<1.1"
+                 -- ${CLOTH} -cloth_n 10 -cloth_k_stretch 1e6 -cloth_k_shear 1e5 -cloth_k_bend 1e4 -dt 0.0333333 -steps 30
+                    -ksp_rtol 1e-8 -ksp_max_it 5000 -progress_every 1000)
+set(CLOTH_SAME "${CLOTH} -cloth_n 12 -steps 30 -sphere -ksp_rtol 1e-12 -progress_every 1000")
+add_test(NAME cloth_same_result_mat_types
+         COMMAND ${SUMMARY_SAME} "energy_final max_stretch contacts" 1e-6
+                 "${CLOTH_SAME} -mat_type aij" "${CLOTH_SAME} -mat_type baij" "${CLOTH_SAME} -mat_type aij -ksp_type pipecg")
+add_test(NAME cloth_bad_dt COMMAND ${CLOTH} -cloth_n 4 -dt 0)
+set_tests_properties(cloth_bad_dt PROPERTIES PASS_REGULAR_EXPRESSION "time step must be positive")
+add_test(NAME cloth_bad_n COMMAND ${CLOTH} -cloth_n 1)
+set_tests_properties(cloth_bad_n PROPERTIES PASS_REGULAR_EXPRESSION "at least 2 x 2")
+add_test(NAME cloth_bad_pins COMMAND ${CLOTH} -cloth_n 4 -cloth_pins elbows)
+set_tests_properties(cloth_bad_pins PROPERTIES PASS_REGULAR_EXPRESSION "unknown -cloth_pins elbows")
+add_test(NAME cloth_bad_stiffness COMMAND ${CLOTH} -cloth_n 4 -cloth_k_bend -5)
+set_tests_properties(cloth_bad_stiffness PROPERTIES PASS_REGULAR_EXPRESSION "non-negative")
+set_tests_properties(cloth_drape_sphere cloth_stiff_dt30 cloth_same_result_mat_types cloth_bad_dt cloth_bad_n cloth_bad_pins
+                     cloth_bad_stiffness PROPERTIES LABELS "cloth" TIMEOUT 60)
+
+string(REPLACE ";" " " MPIEXEC_LINE "${MPIEXEC_CMD}")
+add_test(NAME cloth_mpi_np2
+         COMMAND ${SUMMARY_SAME} "energy_final max_stretch contacts" 1e-6
+                 "${CLOTH_SAME}" "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME}")
+set_tests_properties(cloth_mpi_np2 PROPERTIES LABELS "cloth;mpi" TIMEOUT 60)
