@@ -3,9 +3,12 @@
 // processes hits all variants alike); reports the minimum over the rounds. This is the measurement
 // behind the default bin width (docs/mat_binbcsr.md).
 //
-//   binbcsr_tune [-stencil_n 48] [-bin_widths 1,2,4,8,16,32] [-repeats 15] [-batch 10] [-bs 3]
+//   binbcsr_tune [-stencil_n 48] [-bin_widths 1,2,4,8,16,32] [-repeats 15] [-batch 10] [-bs 3] [-coo]
 //
 // -bs 1 measures BIN-CSR on the same stencil seen as a scalar matrix.
+// -coo also times the COO refill (MatSetValuesCOO, INSERT) of seqaij and binbcsr (default bin width,
+// both precisions) with the COO list of trilinear hexahedra on the same node grid (24x24 element
+// matrices, every entry listed once per element).
 #include <petscbinbcsr.h>
 #include "common/stencil.h"
 #include <string>
@@ -44,12 +47,58 @@ PetscErrorCode MakeBinBCSR(Mat src, PetscInt bs, PetscInt bw, MatBinBCSRPrecisio
   PetscCall(MatAssemblyEnd(*A, MAT_FINAL_ASSEMBLY));
   PetscFunctionReturn(0);
 }
+/* COO refill of the hexahedral element list on the grid: seqaij against binbcsr (both precisions). */
+PetscErrorCode TimeCOO(const StencilGrid &g, PetscInt repeats)
+{
+  const PetscInt        n = 3 * g.nodes();
+  std::vector<PetscInt> ci, cj;
+  auto                  id = [&](PetscInt x, PetscInt y, PetscInt z) { return (z * g.ny + y) * g.nx + x; };
+
+  PetscFunctionBeginUser;
+  for (PetscInt z = 0; z + 1 < g.nz; z++)
+    for (PetscInt y = 0; y + 1 < g.ny; y++)
+      for (PetscInt x = 0; x + 1 < g.nx; x++) {
+        PetscInt nodes[8], q = 0;
+        for (PetscInt c = 0; c < 8; c++) nodes[q++] = id(x + (c & 1), y + ((c >> 1) & 1), z + (c >> 2));
+        for (PetscInt a = 0; a < 24; a++)
+          for (PetscInt b = 0; b < 24; b++) {
+            ci.push_back(3 * nodes[a / 3] + a % 3);
+            cj.push_back(3 * nodes[b / 3] + b % 3);
+          }
+      }
+  std::vector<PetscScalar> v(ci.size());
+  for (size_t k = 0; k < v.size(); k++) v[k] = 1.0 + 1e-3 * (double)(k % 977);
+  const char *names[3] = {"seqaij", "binbcsr double", "binbcsr single"};
+  Mat         M[3];
+  double      best[3] = {1e300, 1e300, 1e300};
+  for (int t = 0; t < 3; t++) {
+    std::vector<PetscInt> i = ci, j = cj;
+    PetscCall(MatCreate(PETSC_COMM_SELF, &M[t]));
+    PetscCall(MatSetSizes(M[t], n, n, n, n));
+    PetscCall(MatSetBlockSize(M[t], 3));
+    PetscCall(MatSetType(M[t], t ? MATSEQBINBCSR : MATSEQAIJ));
+    if (t == 2) PetscCall(MatBinBCSRSetPrecision(M[t], MAT_BINBCSR_PRECISION_SINGLE));
+    PetscCall(MatSetPreallocationCOO(M[t], (PetscCount)i.size(), i.data(), j.data()));
+  }
+  for (PetscInt r = 0; r < repeats; r++)
+    for (int t = 0; t < 3; t++) {
+      const double t0 = MPI_Wtime();
+      PetscCall(MatSetValuesCOO(M[t], v.data(), INSERT_VALUES));
+      best[t] = PetscMin(best[t], MPI_Wtime() - t0);
+    }
+  PetscCall(PetscPrintf(PETSC_COMM_SELF, "COO refill (MatSetValuesCOO INSERT, %zu entries from %" PetscInt_FMT " hexahedra), minimum over %" PetscInt_FMT " calls\n", ci.size(), (g.nx - 1) * (g.ny - 1) * (g.nz - 1), repeats));
+  for (int t = 0; t < 3; t++) PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-16s %10.4f ms %8.2f x aij\n", names[t], 1e3 * best[t], best[0] / best[t]));
+  for (int t = 0; t < 3; t++) PetscCall(MatDestroy(&M[t]));
+  PetscFunctionReturn(0);
+}
+
 } // namespace
 
 int main(int argc, char **argv)
 {
   StencilGrid          grid;
   PetscInt             widths[16] = {1, 2, 4, 8, 16, 32}, nw = 6, repeats = 15, batch = 10, bs = 3;
+  PetscBool            coo = PETSC_FALSE;
   std::vector<Variant> vars;
   Mat                  aij, baij;
   Vec                  x, y;
@@ -67,6 +116,7 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-repeats", &repeats, nullptr));
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-batch", &batch, nullptr));
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-bs", &bs, nullptr));
+  PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-coo", &coo, nullptr));
 
   PetscCall(CreateStencilMatrix(PETSC_COMM_SELF, grid, MATSEQAIJ, nullptr, &aij));
   PetscCall(CreateStencilMatrix(PETSC_COMM_SELF, grid, MATSEQBAIJ, nullptr, &baij));
@@ -93,6 +143,7 @@ int main(int argc, char **argv)
   PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-16s %10s %8s %8s\n", "variant", "ms", "x baij", "x aij"));
   for (Variant &v : vars) PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-16s %10.4f %8.2f %8.2f\n", v.name.c_str(), 1e3 * v.best, vars[1].best / v.best, vars[0].best / v.best));
   for (Variant &v : vars) PetscCall(MatDestroy(&v.A));
+  if (coo) PetscCall(TimeCOO(grid, repeats));
   PetscCall(VecDestroy(&x));
   PetscCall(VecDestroy(&y));
   PetscCall(PetscFinalize());

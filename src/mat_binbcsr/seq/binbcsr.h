@@ -77,9 +77,11 @@ typedef struct {
 
   struct BinBCSRStaging *staging; /* non-NULL between MatSetUp/preallocation and the layout build */
 
-  /* COO assembly: value index v (v = BinBCSRValueIndex(s, e, bw, bs2)) is the sum of the COO entries
-     coo_perm[coo_jmap[v] .. coo_jmap[v+1]-1]; coo_jmap has nslots*bs2 + 1 entries. 32-bit indices
-     (checked at preallocation) halve the bytes the refill streams. */
+  /* COO assembly. The stored values of real (non-padding) slots are numbered q = 0, 1, ... in row
+     order: bin by bin, lane by lane, then point row i of the block, block k of the row, column j of
+     the block (the order of a CSR row, so consecutive values gather from the same elements).
+     Value q is the sum of the COO entries coo_perm[coo_jmap[q] .. coo_jmap[q+1]-1]; coo_jmap has
+     nz*bs2 + 1 entries. 32-bit indices (checked at preallocation) halve the bytes of the refill. */
   PetscCount coo_n;
   PetscInt  *coo_jmap;
   PetscInt  *coo_perm;

@@ -77,11 +77,12 @@ static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues
     }
     PetscCall(PetscMalloc2((size_t)a->max_row_nz * a->bs, &b->rowbuf_cols, (size_t)a->max_row_nz * a->bs, &b->rowbuf_vals));
     if (a->coo_jmap) { /* the copy can be refilled with MatSetValuesCOO too */
-      b->coo_n = a->coo_n;
-      PetscCall(PetscMalloc1(nv + 1, &b->coo_jmap));
-      PetscCall(PetscArraycpy(b->coo_jmap, a->coo_jmap, nv + 1));
-      PetscCall(PetscMalloc1(a->coo_jmap[nv], &b->coo_perm));
-      PetscCall(PetscArraycpy(b->coo_perm, a->coo_perm, a->coo_jmap[nv]));
+      const size_t nq = (size_t)a->nz * a->bs2;
+      b->coo_n        = a->coo_n;
+      PetscCall(PetscMalloc1(nq + 1, &b->coo_jmap));
+      PetscCall(PetscArraycpy(b->coo_jmap, a->coo_jmap, nq + 1));
+      PetscCall(PetscMalloc1(a->coo_jmap[nq], &b->coo_perm));
+      PetscCall(PetscArraycpy(b->coo_perm, a->coo_perm, a->coo_jmap[nq]));
     }
     b->built = PETSC_TRUE;
   } else PetscCall(MatSeqBinBCSRDuplicateStaging(A, B, copyvalues));

@@ -58,19 +58,23 @@ PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat A, PetscCount n, const Pets
   }
   PetscCall(MatSeqBinBCSRBuildLayout(A, bi, bj)); /* sets a->bs, a->bw, ... and zero values */
 
-  /* value index of every COO entry (-1: dropped) */
+  /* row-order value number q (see binbcsr.h) of every COO entry (-1: dropped) */
   PetscCall(PetscMalloc1(n, &vk));
   for (PetscCount k = 0; k < n; k++) vk[k] = -1;
-  for (PetscInt r = 0; r < mbs; r++) {
-    PetscInt kk = -1, prev = -1;
-    for (PetscInt p = rowptr[r]; p < rowptr[r + 1]; p++) {
-      const PetscInt c = (PetscInt)(key[p] >> 32), k = (PetscInt)(key[p] & 0xffffffffu);
-      if (c != prev) {
-        kk++;
-        prev = c;
+  {
+    PetscInt qbase = 0;
+    for (PetscInt r = 0; r < mbs; r++) {
+      const PetscInt nr = a->row_nz[r];
+      PetscInt       kk = -1, prev = -1;
+      for (PetscInt p = rowptr[r]; p < rowptr[r + 1]; p++) {
+        const PetscInt c = (PetscInt)(key[p] >> 32), k = (PetscInt)(key[p] & 0xffffffffu);
+        if (c != prev) {
+          kk++;
+          prev = c;
+        }
+        vk[k] = qbase + (ci[k] % bs) * nr * bs + kk * bs + cj[k] % bs;
       }
-      const PetscInt s = BinBCSRSlot(a, r, kk), e = (ci[k] % bs) * bs + cj[k] % bs;
-      vk[k]            = BinBCSRValueIndex(s, e, a->bw, a->bs2);
+      qbase += nr * a->bs2;
     }
   }
   PetscCall(PetscFree(key));
@@ -78,16 +82,16 @@ PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat A, PetscCount n, const Pets
   PetscCall(PetscFree(bi));
   PetscCall(PetscFree(bj));
 
-  /* jmap: CSR over value indices; perm filled in COO order, so each value reads ascending entries */
+  /* jmap: CSR over the value numbers; perm filled in COO order, so each value reads ascending entries */
   {
-    const PetscInt nv = a->nslots * a->bs2;
-    PetscCall(PetscCalloc1(nv + 1, &a->coo_jmap));
+    const PetscInt nq = a->nz * a->bs2;
+    PetscCall(PetscCalloc1(nq + 1, &a->coo_jmap));
     PetscCall(PetscMalloc1(nvalid, &a->coo_perm));
     for (PetscCount k = 0; k < n; k++)
       if (vk[k] >= 0) a->coo_jmap[vk[k] + 1]++;
-    for (PetscInt v = 0; v < nv; v++) a->coo_jmap[v + 1] += a->coo_jmap[v];
-    PetscCall(PetscMalloc1(nv, &fill));
-    for (PetscInt v = 0; v < nv; v++) fill[v] = a->coo_jmap[v];
+    for (PetscInt q = 0; q < nq; q++) a->coo_jmap[q + 1] += a->coo_jmap[q];
+    PetscCall(PetscMalloc1(nq, &fill));
+    for (PetscInt q = 0; q < nq; q++) fill[q] = a->coo_jmap[q];
     for (PetscCount k = 0; k < n; k++)
       if (vk[k] >= 0) a->coo_perm[fill[vk[k]]++] = (PetscInt)k;
     PetscCall(PetscFree(fill));
@@ -99,21 +103,47 @@ PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat A, PetscCount n, const Pets
 
 namespace
 {
-template <typename V>
-void coo_refill(V *val, PetscInt nv, const PetscInt *jmap, const PetscInt *perm, const PetscScalar *v, InsertMode imode)
+/* Refill in row order q (CSR order: gathers from the same elements follow each other); the writes
+   stay inside one bin's tiles at a time. */
+template <int BS, bool ADD, typename V>
+void coo_refill(const Mat_SeqBinBCSR *a, V *val, const PetscScalar *v)
 {
-  if (imode == INSERT_VALUES) {
-    for (PetscInt i = 0; i < nv; i++) val[i] = (V)binbcsr::coo_gather<PetscInt>(v, jmap, perm, i);
-  } else {
-    for (PetscInt i = 0; i < nv; i++) val[i] = (V)((double)val[i] + binbcsr::coo_gather<PetscInt>(v, jmap, perm, i));
+  const PetscInt  bs = BS ? BS : a->bs, bs2 = bs * bs, bw = a->bw;
+  const PetscInt *jmap = a->coo_jmap, *perm = a->coo_perm;
+  PetscInt        q    = 0;
+  for (PetscInt r = 0; r < a->mbs; r++) {
+    const PetscInt nr   = a->row_nz[r];
+    V             *tile = val + (size_t)a->bin_start[r / bw] * bs2 + r % bw; /* entry e of block k: tile[(k*bw*bs2) + e*bw] */
+    for (PetscInt i = 0; i < bs; i++)
+      for (PetscInt k = 0; k < nr; k++)
+        for (PetscInt j = 0; j < bs; j++, q++) {
+          V           &dst = tile[(size_t)k * bw * bs2 + (i * bs + j) * bw];
+          const double s   = binbcsr::coo_gather<PetscInt>(v, jmap, perm, q);
+          dst              = (V)(ADD ? (double)dst + s : s);
+        }
   }
+}
+
+template <int BS, typename V>
+void coo_refill_mode(const Mat_SeqBinBCSR *a, V *val, const PetscScalar *v, InsertMode imode)
+{
+  if (imode == ADD_VALUES) coo_refill<BS, true, V>(a, val, v);
+  else coo_refill<BS, false, V>(a, val, v);
+}
+
+template <typename V>
+void coo_refill_any(const Mat_SeqBinBCSR *a, V *val, const PetscScalar *v, InsertMode imode)
+{
+  if (a->bs == 3) coo_refill_mode<3, V>(a, val, v, imode);
+  else if (a->bs == 1) coo_refill_mode<1, V>(a, val, v, imode);
+  else coo_refill_mode<0, V>(a, val, v, imode);
 }
 } // namespace
 
 PetscErrorCode MatSetValuesCOO_SeqBinBCSR(Mat A, const PetscScalar v[], InsertMode imode)
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-  const PetscInt  nv = a->nslots * a->bs2;
+  const PetscInt  nv = a->nslots * a->bs2; /* padding included: it stays zero */
 
   PetscFunctionBegin;
   PetscCheck(a->built && a->coo_jmap, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatSetValuesCOO needs MatSetPreallocationCOO first");
@@ -124,8 +154,8 @@ PetscErrorCode MatSetValuesCOO_SeqBinBCSR(Mat A, const PetscScalar v[], InsertMo
       if (a->val) PetscCall(PetscArrayzero(a->val, nv));
       else PetscCall(PetscArrayzero(a->valf, nv));
     }
-  } else if (a->val) coo_refill<double>(a->val, nv, a->coo_jmap, a->coo_perm, v, imode);
-  else coo_refill<float>(a->valf, nv, a->coo_jmap, a->coo_perm, v, imode);
+  } else if (a->val) coo_refill_any<double>(a, a->val, v, imode);
+  else coo_refill_any<float>(a, a->valf, v, imode);
   PetscCall(PetscLogEventEnd(MAT_BinBCSR_SetValuesCOO, A, 0, 0, 0));
   PetscFunctionReturn(0);
 }
