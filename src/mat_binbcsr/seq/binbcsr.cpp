@@ -12,9 +12,6 @@ struct BinBCSRStaging {
   std::vector<PetscInt>               prealloc; /* block nonzeros per block row, empty if unknown */
 };
 
-/* The best default on the machine this was measured on (AVX-512, see docs/mat_binbcsr.md). */
-static const PetscInt BINBCSR_DEFAULT_BIN_WIDTH = 8;
-
 static PetscErrorCode MatSeqBinBCSRFreeLayout(Mat_SeqBinBCSR *a)
 {
   PetscFunctionBegin;
@@ -178,6 +175,7 @@ PetscErrorCode MatSeqBinBCSRBuildLayout(Mat A, const PetscInt bi[], const PetscI
   PetscCall(MatSeqBinBCSRFreeLayout(a));
   delete a->staging;
   a->staging = nullptr;
+  if (!a->bw_set) a->bw = BinBCSRDefaultBinWidth(a->bs);
   bw = a->bw;
   mbs = a->mbs;
   nbins = (mbs + bw - 1) / bw;
@@ -446,17 +444,23 @@ static PetscErrorCode MatBinBCSRSetBinWidth_SeqBinBCSR(Mat A, PetscInt bw)
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
 
   PetscFunctionBegin;
-  if (bw == PETSC_DEFAULT || bw == PETSC_DECIDE) bw = BINBCSR_DEFAULT_BIN_WIDTH;
+  if (bw == PETSC_DEFAULT || bw == PETSC_DECIDE) {
+    PetscCheck(!a->built || !a->bw_set || a->bw == BinBCSRDefaultBinWidth(a->bs), PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "The bin width must be set before the layout is built (first final assembly or COO preallocation)");
+    a->bw_set = PETSC_FALSE;
+    PetscFunctionReturn(0);
+  }
   PetscCheck(bw >= 1 && bw <= 1024, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Bin width %" PetscInt_FMT " must lie in [1, 1024]", bw);
   PetscCheck(!a->built || bw == a->bw, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "The bin width must be set before the layout is built (first final assembly or COO preallocation)");
-  a->bw = bw;
+  a->bw     = bw;
+  a->bw_set = PETSC_TRUE;
   PetscFunctionReturn(0);
 }
 
 static PetscErrorCode MatBinBCSRGetBinWidth_SeqBinBCSR(Mat A, PetscInt *bw)
 {
   PetscFunctionBegin;
-  *bw = ((Mat_SeqBinBCSR *)A->data)->bw;
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  *bw                = (a->built || a->bw_set) ? a->bw : BinBCSRDefaultBinWidth(PetscAbs(A->rmap->bs));
   PetscFunctionReturn(0);
 }
 
@@ -493,12 +497,13 @@ static PetscErrorCode MatBinBCSRGetPrecision_SeqBinBCSR(Mat A, MatBinBCSRPrecisi
 
 static PetscErrorCode MatSetFromOptions_SeqBinBCSR(Mat A, PetscOptionItems *PetscOptionsObject)
 {
-  Mat_SeqBinBCSR     *a  = (Mat_SeqBinBCSR *)A->data;
-  PetscInt            bw = a->bw;
+  Mat_SeqBinBCSR     *a = (Mat_SeqBinBCSR *)A->data;
+  PetscInt            bw;
   MatBinBCSRPrecision p  = a->precision;
   PetscBool           set;
 
   PetscFunctionBegin;
+  PetscCall(MatBinBCSRGetBinWidth_SeqBinBCSR(A, &bw));
   PetscOptionsHeadBegin(PetscOptionsObject, "MATSEQBINBCSR options");
   PetscCall(PetscOptionsInt("-mat_binbcsr_bin_width", "Rows (block rows) per bin", "MatBinBCSRSetBinWidth", bw, &bw, &set));
   if (set) PetscCall(MatBinBCSRSetBinWidth_SeqBinBCSR(A, bw));
@@ -553,7 +558,7 @@ PetscErrorCode MatCreate_SeqBinBCSR(Mat A)
   PetscCheck(size == 1, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "MATSEQBINBCSR is for one process; use MATBINBCSR or MATMPIBINBCSR");
   PetscCall(PetscNew(&a));
   A->data        = (void *)a;
-  a->bw          = BINBCSR_DEFAULT_BIN_WIDTH;
+  a->bw          = BinBCSRDefaultBinWidth(1);
   a->precision   = MAT_BINBCSR_PRECISION_DOUBLE;
   a->roworiented = PETSC_TRUE;
   a->bs          = 1;

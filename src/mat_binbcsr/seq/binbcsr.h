@@ -52,6 +52,8 @@ struct BinBCSRStaging; /* the pattern and values while the matrix is being fille
 typedef struct {
   /* configuration */
   PetscInt            bw;        /* bin width: (block) rows per bin */
+  PetscBool           bw_set;    /* set by the user; otherwise the layout build takes the default of
+                                    its block size (BinBCSRDefaultBinWidth) */
   MatBinBCSRPrecision precision; /* value storage; products accumulate in double */
   PetscInt            nonew;     /* 0: new nonzeros allowed (only before the layout exists);
                                     1: new locations silently ignored (MAT_NEW_NONZERO_LOCATIONS false);
@@ -96,6 +98,10 @@ typedef struct {
      MatSeqBinBCSRSetOps_Ops; ops->view (binbcsr.cpp) handles ASCII and forwards the rest here. */
   PetscErrorCode (*view_other)(Mat, PetscViewer);
 } Mat_SeqBinBCSR;
+
+/* Default bin width, measured on this project's AVX-512 machine (docs/mat_binbcsr.md): 8 block rows
+   for blocks (3x3: 24 scalar rows per bin), 16 rows for scalars. */
+static inline PetscInt BinBCSRDefaultBinWidth(PetscInt bs) { return bs == 1 ? 16 : 8; }
 
 /* Lane of slot s, and the index into val/valf of entry e of slot s. */
 static inline PetscInt BinBCSRLane(PetscInt s, PetscInt bw) { return s % bw; }

@@ -46,6 +46,7 @@ static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues
 
   PetscFunctionBegin;
   b->bw          = a->bw;
+  b->bw_set      = a->bw_set;
   b->precision   = a->precision;
   b->nonew       = a->nonew;
   b->roworiented = a->roworiented;

@@ -242,7 +242,17 @@ TEST_CASE("options and the public setters", "[mat_core][options]")
   PetscInt bw;
   MatBinBCSRPrecision p;
   REQUIRE(MatBinBCSRGetBinWidth(A, &bw) == 0);
-  CHECK(bw == 8); // the default (measured, docs/mat_binbcsr.md)
+  CHECK(bw == 8); // the default for blocks (measured, docs/mat_binbcsr.md)
+  {
+    Mat S = create(12, 12, 1);
+    REQUIRE(MatBinBCSRGetBinWidth(S, &bw) == 0);
+    CHECK(bw == 16); // the default for scalars
+    REQUIRE(MatSetUp(S) == 0);
+    assemble(S);
+    REQUIRE(MatBinBCSRGetBinWidth(S, &bw) == 0);
+    CHECK(bw == 16);
+    MatDestroy(&S);
+  }
   REQUIRE(MatBinBCSRGetPrecision(A, &p) == 0);
   CHECK(p == MAT_BINBCSR_PRECISION_DOUBLE);
   REQUIRE(PetscOptionsSetValue(nullptr, "-mat_binbcsr_precision", "single") == 0);
