@@ -223,6 +223,7 @@ PetscErrorCode MatSeqBinBCSRBuildLayout(Mat A, const PetscInt bi[], const PetscI
   }
   PetscCall(PetscMalloc2((size_t)a->max_row_nz * a->bs, &a->rowbuf_cols, (size_t)a->max_row_nz * a->bs, &a->rowbuf_vals));
   a->built = PETSC_TRUE;
+  A->preallocated = PETSC_TRUE; /* a layout is an allocation, however it was built (convert, load, ...) */
   A->nonzerostate++;
   PetscCall(PetscLogEventEnd(MAT_BinBCSR_BuildLayout, A, 0, 0, 0));
   PetscFunctionReturn(0);

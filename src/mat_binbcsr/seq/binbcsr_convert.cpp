@@ -169,6 +169,16 @@ PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat A, MatType type, MatReuse reuse, Ma
   std::vector<PetscInt> rowcols;
 
   PetscFunctionBegin;
+  if (!A->ops->getrow) {
+    /* a source without rows (MATTRANSPOSEVIRTUAL, ...): through its own conversion to seqaij */
+    Mat T, C = reuse == MAT_REUSE_MATRIX ? *newmat : nullptr;
+    PetscCall(MatConvert(A, MATSEQAIJ, MAT_INITIAL_MATRIX, &T));
+    PetscCall(MatConvertFrom_SeqBinBCSR(T, type, reuse == MAT_REUSE_MATRIX ? MAT_REUSE_MATRIX : MAT_INITIAL_MATRIX, &C));
+    PetscCall(MatDestroy(&T));
+    if (reuse == MAT_INPLACE_MATRIX) PetscCall(MatHeaderReplace(A, &C));
+    else *newmat = C;
+    PetscFunctionReturn(0);
+  }
   if (bs < 1 || bs != A->cmap->bs || m % bs || A->cmap->n % bs) bs = 1;
   mbs = m / bs;
   if (reuse == MAT_REUSE_MATRIX) {
