@@ -15,7 +15,7 @@ namespace matops {
 
 // Turned on once MATSEQBINBCSR's core (assembly, MatGetRow, preallocation) is on main.
 #ifndef MAT_OPS_TEST_BINBCSR
-#define MAT_OPS_TEST_BINBCSR 0
+#define MAT_OPS_TEST_BINBCSR 1
 #endif
 
 // A matrix under test: a type and, for binbcsr, its storage.
