@@ -3,8 +3,10 @@
    zeroing rows and columns, and the sums that norms need. Same conventions as binbcsr_kernels.h
    (plain inline functions, no STL, no PETSc, no allocation; callable from a CUDA kernel with one
    thread per lane): bin_val / bin_col point at the bin's first tile / slot, `nz` is the lane's count
-   of real slots (padding is never touched, so it stays zero whatever the operation), entry e of slot
-   k of the lane is bin_val[k * bw * bs2 + e * bw + lane].
+   of real slots (the lane kernels never touch padding, so it stays zero whatever the factor), entry
+   e of slot k of the lane is bin_val[k * bw * bs2 + e * bw + lane]. Operations whose result is the
+   same with padding included (finite factors, sums) run over whole arrays or bins instead: the
+   contiguous loops vectorise.
 */
 #ifndef BINBCSR_VALUE_KERNELS_H
 #define BINBCSR_VALUE_KERNELS_H
@@ -72,44 +74,61 @@ BINBCSR_HD void lane_zero_columns(V *bin_val, const I *bin_col, int nz, int bw, 
   }
 }
 
-/* Sum of v^2 over the lane's real entries. */
+/* Kernels over whole value arrays or whole bins. Padding is included: it holds zeros, which add
+   nothing to a sum and stay zero under a finite factor, and the loops run over contiguous memory. */
+
+/* y += a x over n values (a finite). */
+template <typename VY, typename VX>
+BINBCSR_HD void values_axpy(long n, VY *y, const VX *x, double a)
+{
+#pragma omp simd
+  for (long i = 0; i < n; i++) y[i] = (VY)((double)y[i] + a * (double)x[i]);
+}
+
+/* v *= a over n values (a finite). */
 template <typename V>
-BINBCSR_HD double lane_sum_squares(const V *bin_val, int nz, int bw, int bs2, int lane)
+BINBCSR_HD void values_scale(long n, V *v, double a)
+{
+#pragma omp simd
+  for (long i = 0; i < n; i++) v[i] = (V)(a * (double)v[i]);
+}
+
+/* Sum of v^2 over n values. */
+template <typename V>
+BINBCSR_HD double values_sum_squares(long n, const V *v)
 {
   double s = 0.0;
-  for (int k = 0; k < nz; k++)
-    for (int e = 0; e < bs2; e++) {
-      const double v = (double)bin_val[value_offset(k, e, bw, bs2, lane)];
-      s += v * v;
-    }
+#pragma omp simd reduction(+ : s)
+  for (long i = 0; i < n; i++) s += (double)v[i] * (double)v[i];
   return s;
 }
 
-/* row_sum[i] = sum of |a_ij| over row i (0 <= i < bs) of the lane. */
+/* row_sum[i * bw + l] += |a_ij| over row i (0 <= i < bs) of every lane l of a bin of len slot groups
+   (row_sum: bs * bw, zeroed by the caller). */
 template <typename V>
-BINBCSR_HD void lane_row_abs_sums(const V *bin_val, int nz, int bw, int bs, int lane, double *row_sum)
+BINBCSR_HD void bin_row_abs_sums(const V *bin_val, int len, int bw, int bs, double *row_sum)
 {
   const int bs2 = bs * bs;
-  for (int i = 0; i < bs; i++) row_sum[i] = 0.0;
-  for (int k = 0; k < nz; k++)
+  for (int k = 0; k < len; k++)
     for (int i = 0; i < bs; i++)
       for (int j = 0; j < bs; j++) {
-        const double v = (double)bin_val[value_offset(k, i * bs + j, bw, bs2, lane)];
-        row_sum[i] += v < 0 ? -v : v;
+        const V *v = bin_val + value_offset(k, i * bs + j, bw, bs2, 0);
+#pragma omp simd
+        for (int l = 0; l < bw; l++) row_sum[i * bw + l] += v[l] < 0 ? -(double)v[l] : (double)v[l];
       }
 }
 
-/* col_sum[c] += |a_ic| over the lane's entries (a scatter: a GPU needs atomics). */
+/* col_sum[c] += |a_ic| over the entries of a bin of len slot groups (a scatter: a GPU needs atomics). */
 template <typename V, typename I>
-BINBCSR_HD void lane_col_abs_sums(const V *bin_val, const I *bin_col, int nz, int bw, int bs, int lane, double *col_sum)
+BINBCSR_HD void bin_col_abs_sums(const V *bin_val, const I *bin_col, int len, int bw, int bs, double *col_sum)
 {
   const int bs2 = bs * bs;
-  for (int k = 0; k < nz; k++) {
-    double *cs = col_sum + (long)bin_col[(long)k * bw + lane] * bs;
+  for (int k = 0; k < len; k++) {
+    const I *cols = bin_col + (long)k * bw;
     for (int i = 0; i < bs; i++)
       for (int j = 0; j < bs; j++) {
-        const double v = (double)bin_val[value_offset(k, i * bs + j, bw, bs2, lane)];
-        cs[j] += v < 0 ? -v : v;
+        const V *v = bin_val + value_offset(k, i * bs + j, bw, bs2, 0);
+        for (int l = 0; l < bw; l++) col_sum[(long)cols[l] * bs + j] += v[l] < 0 ? -(double)v[l] : (double)v[l];
       }
   }
 }

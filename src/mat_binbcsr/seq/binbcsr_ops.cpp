@@ -218,8 +218,12 @@ static PetscErrorCode MatScale_SeqBinBCSR(Mat A, PetscScalar alpha)
   PetscFunctionBegin;
   PetscCall(CheckBuilt(A, "MatScale"));
   PetscCall(CheckFinite(A, alpha, "the scale factor"));
-  const int bw = (int)a->bw, bs2 = (int)a->bs2;
-  ForEachLane(a, [&](auto *bin_val, const PetscInt *, PetscInt, int lane, int nz) { binbcsr::lane_scale(bin_val, nz, bw, bs2, lane, alpha); });
+  if (PetscIsInfOrNanScalar(alpha)) {
+    /* real slots only: 0 * Inf would put NaN into the padding */
+    const int bw = (int)a->bw, bs2 = (int)a->bs2;
+    ForEachLane(a, [&](auto *bin_val, const PetscInt *, PetscInt, int lane, int nz) { binbcsr::lane_scale(bin_val, nz, bw, bs2, lane, alpha); });
+  } else if (a->val) binbcsr::values_scale((long)a->nslots * a->bs2, a->val, alpha);
+  else binbcsr::values_scale((long)a->nslots * a->bs2, a->valf, alpha);
   PetscCall(PetscLogFlops((PetscLogDouble)a->nz * a->bs2));
   PetscFunctionReturn(0);
 }
@@ -290,6 +294,16 @@ static PetscErrorCode MatAXPY_SeqBinBCSR(Mat Y, PetscScalar alpha, Mat X, MatStr
     /* the fast path: slot by slot, whatever each side's precision */
     const Mat_SeqBinBCSR *x  = (const Mat_SeqBinBCSR *)X->data;
     const int             bw = (int)y->bw, bs2 = (int)y->bs2;
+    const long            n  = (long)y->nslots * y->bs2;
+    if (!PetscIsInfOrNanScalar(alpha)) {
+      /* padding: 0 + alpha 0 = 0, so one contiguous pass over all values */
+      if (y->val && x->val) binbcsr::values_axpy(n, y->val, x->val, alpha);
+      else if (y->val) binbcsr::values_axpy(n, y->val, x->valf, alpha);
+      else if (x->val) binbcsr::values_axpy(n, y->valf, x->val, alpha);
+      else binbcsr::values_axpy(n, y->valf, x->valf, alpha);
+      PetscCall(PetscLogFlops(2.0 * y->nz * y->bs2));
+      PetscFunctionReturn(0);
+    }
     for (PetscInt b = 0; b < y->nbins; b++) {
       const size_t   off = (size_t)y->bin_start[b] * y->bs2;
       const PetscInt r0 = b * y->bw, r1 = PetscMin(y->mbs, r0 + y->bw);
@@ -395,24 +409,31 @@ static PetscErrorCode MatNorm_SeqBinBCSR(Mat A, NormType type, PetscReal *nrm)
   PetscFunctionBegin;
   PetscCall(CheckBuilt(A, "MatNorm"));
   if (type == NORM_FROBENIUS) {
-    double sum = 0.0;
-    ForEachLane(a, [&](auto *bin_val, const PetscInt *, PetscInt, int lane, int nz) { sum += binbcsr::lane_sum_squares(bin_val, nz, bw, bs2, lane); });
-    *nrm = PetscSqrtReal(sum);
+    const long n = (long)a->nslots * a->bs2;
+    *nrm         = PetscSqrtReal(a->val ? binbcsr::values_sum_squares(n, a->val) : binbcsr::values_sum_squares(n, a->valf));
   } else if (type == NORM_1) {
     double *col_sum;
     PetscCall(PetscCalloc1((size_t)a->nbs * bs, &col_sum));
-    ForEachLane(a, [&](auto *bin_val, const PetscInt *bin_col, PetscInt, int lane, int nz) { binbcsr::lane_col_abs_sums(bin_val, bin_col, nz, bw, bs, lane, col_sum); });
+    for (PetscInt b = 0; b < a->nbins; b++) {
+      const PetscInt s0 = a->bin_start[b], len = (a->bin_start[b + 1] - s0) / a->bw;
+      if (a->val) binbcsr::bin_col_abs_sums(a->val + (size_t)s0 * bs2, a->col + s0, (int)len, bw, bs, col_sum);
+      else binbcsr::bin_col_abs_sums(a->valf + (size_t)s0 * bs2, a->col + s0, (int)len, bw, bs, col_sum);
+    }
     *nrm = 0.0;
     for (PetscInt j = 0; j < a->nbs * bs; j++) *nrm = PetscMax(*nrm, col_sum[j]);
     PetscCall(PetscFree(col_sum));
   } else if (type == NORM_INFINITY) {
-    double row_sum[64];
-    PetscCheck(bs <= 64, PETSC_COMM_SELF, PETSC_ERR_SUP, "Block size %d too large for MatNorm", bs);
+    double *row_sum;
+    PetscCall(PetscMalloc1((size_t)bs * bw, &row_sum));
     *nrm = 0.0;
-    ForEachLane(a, [&](auto *bin_val, const PetscInt *, PetscInt, int lane, int nz) {
-      binbcsr::lane_row_abs_sums(bin_val, nz, bw, bs, lane, row_sum);
-      for (int i = 0; i < bs; i++) *nrm = PetscMax(*nrm, row_sum[i]);
-    });
+    for (PetscInt b = 0; b < a->nbins; b++) {
+      const PetscInt s0 = a->bin_start[b], len = (a->bin_start[b + 1] - s0) / a->bw;
+      PetscCall(PetscArrayzero(row_sum, (size_t)bs * bw));
+      if (a->val) binbcsr::bin_row_abs_sums(a->val + (size_t)s0 * bs2, (int)len, bw, bs, row_sum);
+      else binbcsr::bin_row_abs_sums(a->valf + (size_t)s0 * bs2, (int)len, bw, bs, row_sum);
+      for (PetscInt i = 0; i < bs * bw; i++) *nrm = PetscMax(*nrm, row_sum[i]);
+    }
+    PetscCall(PetscFree(row_sum));
   } else SETERRQ(PETSC_COMM_SELF, PETSC_ERR_SUP, "MATSEQBINBCSR has no %s norm", NormTypes[type]);
   PetscCall(PetscLogFlops(2.0 * a->nz * a->bs2));
   PetscFunctionReturn(0);

@@ -1,0 +1,104 @@
+// mat_ops_bench: times the value operations (MatAXPY with the same pattern, MatScale, MatShift,
+// MatNorm, MatZeroRowsColumns with x and b) on the 27-point 3x3-block stencil matrix, for seqaij,
+// seqbaij and binbcsr in double and single storage, in one run. Prints the minimum over -repeats
+// runs of each operation in milliseconds (the machine is shared: the minimum is the least disturbed).
+//
+//   mat_ops_bench [-stencil_n 24] [-repeats 10]
+#include "common/stencil.h"
+#include "common/summary.h"
+
+#include <petscbinbcsr.h>
+
+#include <algorithm>
+#include <functional>
+#include <limits>
+#include <vector>
+
+namespace
+{
+
+struct Flavour {
+  const char         *label;
+  MatType             type;
+  MatBinBCSRPrecision precision;
+};
+
+PetscErrorCode Time(PetscInt repeats, const std::function<PetscErrorCode()> &op, double *ms)
+{
+  PetscFunctionBeginUser;
+  *ms = std::numeric_limits<double>::infinity();
+  for (PetscInt r = 0; r < repeats; r++) {
+    const double t0 = WallTime();
+    PetscCall(op());
+    *ms = std::min(*ms, 1e3 * (WallTime() - t0));
+  }
+  PetscFunctionReturn(0);
+}
+
+} // namespace
+
+int main(int argc, char **argv)
+{
+  StencilGrid grid;
+  PetscInt    repeats = 10;
+
+  PetscCall(PetscInitialize(&argc, &argv, nullptr, "Times MATSEQBINBCSR's value operations against seqaij and seqbaij.\n"));
+  PetscCall(PetscBinBCSRRegisterAll());
+  grid.nx = grid.ny = grid.nz = 24;
+  PetscCall(StencilGridFromOptions(nullptr, &grid));
+  PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-repeats", &repeats, nullptr));
+
+  const Flavour flavours[] = {
+    {"seqaij", MATSEQAIJ, MAT_BINBCSR_PRECISION_DOUBLE},
+    {"seqbaij", MATSEQBAIJ, MAT_BINBCSR_PRECISION_DOUBLE},
+    {"binbcsr", MATSEQBINBCSR, MAT_BINBCSR_PRECISION_DOUBLE},
+    {"binbcsr-single", MATSEQBINBCSR, MAT_BINBCSR_PRECISION_SINGLE},
+  };
+  const char *ops[] = {"axpy_same", "scale", "shift", "norm_frobenius", "norm_1", "zero_rows_columns"};
+  PetscCall(PetscPrintf(PETSC_COMM_SELF, "27-point 3x3-block stencil, %" PetscInt_FMT "^3 nodes, %" PetscInt_FMT " rows; minimum of %" PetscInt_FMT " runs, ms\n", grid.nx, 3 * grid.nodes(), repeats));
+  PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-16s", "type"));
+  for (const char *op : ops) PetscCall(PetscPrintf(PETSC_COMM_SELF, " %18s", op));
+  PetscCall(PetscPrintf(PETSC_COMM_SELF, "\n"));
+
+  for (const Flavour &f : flavours) {
+    Mat                 A, X;
+    Vec                 x, b;
+    std::vector<double> ms;
+    PetscReal           nrm;
+    double              t;
+
+    PetscCall(CreateStencilMatrix(PETSC_COMM_SELF, grid, f.type, nullptr, &A));
+    PetscCall(MatBinBCSRSetPrecision(A, f.precision));
+    PetscCall(MatDuplicate(A, MAT_COPY_VALUES, &X));
+    PetscCall(MatCreateVecs(A, &x, &b));
+    PetscCall(VecSet(x, 1.0));
+    PetscCall(VecSet(b, 1.0));
+    /* boundary conditions: the unknowns of the z = 0 face */
+    std::vector<PetscInt> rows;
+    for (PetscInt node = 0; node < grid.nx * grid.ny; node++)
+      for (PetscInt c = 0; c < 3; c++) rows.push_back(3 * node + c);
+
+    PetscCall(Time(repeats, [&] { return MatAXPY(A, 1e-3, X, SAME_NONZERO_PATTERN); }, &t));
+    ms.push_back(t);
+    PetscCall(Time(repeats, [&] { return MatScale(A, 1.0001); }, &t));
+    ms.push_back(t);
+    PetscCall(Time(repeats, [&] { return MatShift(A, 1e-3); }, &t));
+    ms.push_back(t);
+    PetscCall(Time(repeats, [&] { return MatNorm(A, NORM_FROBENIUS, &nrm); }, &t));
+    ms.push_back(t);
+    PetscCall(Time(repeats, [&] { return MatNorm(A, NORM_1, &nrm); }, &t));
+    ms.push_back(t);
+    PetscCall(Time(repeats, [&] { return MatZeroRowsColumns(A, (PetscInt)rows.size(), rows.data(), 1.0, x, b); }, &t));
+    ms.push_back(t);
+
+    PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-16s", f.label));
+    for (double v : ms) PetscCall(PetscPrintf(PETSC_COMM_SELF, " %18.3f", v));
+    PetscCall(PetscPrintf(PETSC_COMM_SELF, "\n"));
+    PetscCall(VecDestroy(&x));
+    PetscCall(VecDestroy(&b));
+    PetscCall(MatDestroy(&X));
+    PetscCall(MatDestroy(&A));
+  }
+  PetscCall(PetscFinalize());
+  return 0;
+}
