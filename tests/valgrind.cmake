@@ -14,12 +14,12 @@ endforeach()
 
 if(VALGRIND_EXECUTABLE AND VALGRIND_AREAS)
   set(VALGRIND_BUILD_DIR ${CMAKE_BINARY_DIR}/valgrind)
-  set(valgrind_targets)
+  set(valgrind_targets "")
   foreach(area ${VALGRIND_AREAS})
-    list(APPEND valgrind_targets test_${area})
+    string(APPEND valgrind_targets " test_${area}")
   endforeach()
   add_test(NAME valgrind_build
-    COMMAND sh -c "\"${CMAKE_COMMAND}\" -S \"${CMAKE_SOURCE_DIR}\" -B \"${VALGRIND_BUILD_DIR}\" -DCMAKE_BUILD_TYPE=Release -DBINBCSR_NATIVE=OFF >/dev/null && \"${CMAKE_COMMAND}\" --build \"${VALGRIND_BUILD_DIR}\" -j2 --target ${valgrind_targets}")
+    COMMAND sh -c "\"${CMAKE_COMMAND}\" -S \"${CMAKE_SOURCE_DIR}\" -B \"${VALGRIND_BUILD_DIR}\" -DCMAKE_BUILD_TYPE=Release -DBINBCSR_NATIVE=OFF >/dev/null && \"${CMAKE_COMMAND}\" --build \"${VALGRIND_BUILD_DIR}\" -j2 --target${valgrind_targets}")
   set_tests_properties(valgrind_build PROPERTIES LABELS "valgrind" FIXTURES_SETUP valgrind_build TIMEOUT 1800)
   foreach(area ${VALGRIND_AREAS})
     add_test(NAME valgrind_${area}
