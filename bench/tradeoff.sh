@@ -78,7 +78,7 @@ point() {
 }
 
 if [ "$quick" = 1 ]; then
-  cells_list=(10 20); fixed_list=(10 100); rtol_list=(1e-3 1e-8); dt_list=(0.04 0.01); T=0.1
+  cells_list=(10 20); fixed_list=(10 100); rtol_list=(1e-3); dt_list=(0.04 0.01); T=0.05
 else
   cells_list=(10 20 40); fixed_list=(5 10 30 100 200); rtol_list=(1e-2 1e-4 1e-6 1e-8 1e-10); dt_list=(0.04 0.02 0.01 0.005); T=0.2
 fi
