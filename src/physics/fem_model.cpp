@@ -27,6 +27,7 @@ FemModel make_fem_model(const TetMesh &mesh, const FemSettings &settings)
   m.mesh     = mesh;
   m.settings = settings;
   m.npe      = mesh.nodes_per_element();
+  m.lame     = lame;
   const int ne = mesh.element_count(), nb = m.npe * m.npe;
   m.rest_shape_inverse.resize(ne);
   m.volume.resize(ne);
@@ -35,6 +36,9 @@ FemModel make_fem_model(const TetMesh &mesh, const FemSettings &settings)
     const TetGeometry g = tet_geometry(corner_matrix(mesh, mesh.nodes.data(), e));
     m.rest_shape_inverse[e] = g.rest_shape_inverse;
     m.volume[e]             = g.volume;
+    if (mesh.order == 1)
+      for (int a = 0; a < 4; ++a)
+        for (int d = 0; d < 3; ++d) m.gradients.push_back(g.grad_barycentric(a, d));
     const Eigen::MatrixXd K = element_stiffness(g, mesh.order, lame);
     double *out = &m.stiffness[static_cast<size_t>(e) * nb * 9];
     for (int a = 0; a < m.npe; ++a)

@@ -26,6 +26,10 @@ struct FemModel {
   std::vector<double>          volume;             // per element
   // Per element npe*npe 3x3 blocks of K0 (block (a,b) at 9*(a*npe+b), column-major like Eigen).
   std::vector<double> stiffness;
+  // Order 1 only: per element the 4 gradients of the barycentric coordinates (12 values, node-major),
+  // so the kernel forms R K0 R^T from rotated gradients instead of reading K0.
+  std::vector<double> gradients;
+  LameParameters      lame{0, 0};
   Eigen::MatrixXd     reference_mass; // npe x npe, per unit density and volume
   bool                diagonal_mass = true;
 
