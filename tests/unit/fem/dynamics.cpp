@@ -275,7 +275,7 @@ TEST_CASE("extremes: E 1e3..1e12, nu 0.499, dt 0.1 finish bounded or report dive
 TEST_CASE("parallel layout: the same trajectory on PETSC_COMM_WORLD and on one rank", "[fem][mpi]")
 {
   const FemScene s = beam_scene(2, true);
-  for (const char *type : {"aij", "baij"}) {
+  for (const char *type : {"aij", "baij", "binbcsr"}) {
     INFO(type);
     const auto opts = std::map<std::string, std::string>{{"-mat_type", type}, {"-ksp_rtol", "1e-13"}, {"-ksp_max_it", "5000"}};
     const Run  all  = run(PETSC_COMM_WORLD, s, opts, 4);
