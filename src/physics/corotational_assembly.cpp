@@ -67,18 +67,18 @@ void assemble_kernel(const FemModel &model, const std::vector<int> &elements, co
                      const StepCoefficients &c, const BlockPattern *pattern, double *values, double *rhs,
                      Eigen::Matrix3d *rotations)
 {
-  using Vec3                   = Eigen::Vector3d;
-  using Mat3                   = Eigen::Matrix3d;
-  using RowMat3                = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
-  const double *X              = model.mesh.nodes.data();
-  const bool    corotational   = model.settings.corotational;
-  const bool    want_matrix    = values != nullptr;
-  const bool    mass_damping   = c.mass_rhs != 0;
+  using Vec3                 = Eigen::Vector3d;
+  using Mat3                 = Eigen::Matrix3d;
+  using RowMat3              = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+  constexpr int NB           = packed_block_count(N);
+  const double *X            = model.mesh.nodes.data();
+  const bool    corotational = model.settings.corotational;
+  const bool    mass_damping = c.mass_rhs != 0;
   const Eigen::Matrix<double, N, N> Mref = model.reference_mass;
   for (size_t i = 0; i < elements.size(); ++i) {
     const int     e     = elements[i];
     const int    *nodes = &model.mesh.elements[static_cast<size_t>(e) * N];
-    const double *K0    = &model.stiffness[static_cast<size_t>(e) * N * N * 9];
+    const double *K0    = &model.stiffness[static_cast<size_t>(e) * NB * 9];
     Mat3          R     = Mat3::Identity();
     if (corotational) {
       Mat3 Ds;
@@ -87,34 +87,41 @@ void assemble_kernel(const FemModel &model, const std::vector<int> &elements, co
     }
     if (rotations) rotations[i] = R;
     // z = a_f (R^T x - X) + a_K R^T v, so that rhs_a = -R sum_b K0_ab z_b in one product with K0.
-    Vec3 z[N];
-    for (int b = 0; b < N; ++b)
+    Vec3 z[N], s[N];
+    for (int b = 0; b < N; ++b) {
       z[b] = R.transpose() * (c.force * Vec3::Map(x + 3 * nodes[b]) + c.stiffness_rhs * Vec3::Map(v + 3 * nodes[b])) -
              c.force * Vec3::Map(X + 3 * nodes[b]);
-    const double mass = model.settings.density * model.volume[e];
-    for (int a = 0; a < N; ++a) {
-      Vec3 s = Vec3::Zero();
-      for (int b = 0; b < N; ++b) s.noalias() += Mat3::Map(K0 + 9 * (a * N + b)) * z[b];
-      Vec3 r = -(R * s);
-      if (mass_damping)
-        for (int b = 0; b < N; ++b) r -= c.mass_rhs * mass * Mref(a, b) * Vec3::Map(v + 3 * nodes[b]);
-      Vec3::Map(rhs + 3 * nodes[a]) += r;
+      s[b].setZero();
     }
-    if (!want_matrix) continue;
-    const int *slot = &pattern->element_slots[i * N * N];
+    const double mass = model.settings.density * model.volume[e];
+    const int   *slot = values ? &pattern->element_slots[i * N * N] : nullptr;
+    // One pass over the upper blocks of K0: force products and (optionally) the rotated blocks.
     for (int a = 0; a < N; ++a)
       for (int b = a; b < N; ++b) {
+        const Eigen::Map<const Mat3> K(K0 + 9 * packed_block(a, b, N));
+        s[a].noalias() += K * z[b];
+        if (b != a) s[b].noalias() += K.transpose() * z[a];
+        if (!slot) continue;
         const int sab = slot[a * N + b];
         if (sab < 0) continue; // a or b is fixed: eliminated
         Mat3 B;
-        if (corotational) B.noalias() = c.stiffness_matrix * (R * Mat3::Map(K0 + 9 * (a * N + b)) * R.transpose());
-        else B = c.stiffness_matrix * Mat3::Map(K0 + 9 * (a * N + b));
-        const double mab = c.mass_matrix * mass * Mref(a, b);
-        B.diagonal().array() += mab;
+        if (corotational) {
+          const Mat3 RK = R * K;
+          B.noalias()   = c.stiffness_matrix * RK * R.transpose();
+        } else {
+          B = c.stiffness_matrix * K;
+        }
+        B.diagonal().array() += c.mass_matrix * mass * Mref(a, b);
         // Stored row-major: the Map of a row-major matrix over the slot takes B as is.
         Eigen::Map<RowMat3>(values + 9 * static_cast<size_t>(sab)) += B;
         if (b != a) Eigen::Map<RowMat3>(values + 9 * static_cast<size_t>(slot[b * N + a])) += B.transpose();
       }
+    for (int a = 0; a < N; ++a) {
+      Vec3 r = -(R * s[a]);
+      if (mass_damping)
+        for (int b = 0; b < N; ++b) r -= c.mass_rhs * mass * Mref(a, b) * Vec3::Map(v + 3 * nodes[b]);
+      Vec3::Map(rhs + 3 * nodes[a]) += r;
+    }
   }
 }
 

@@ -28,7 +28,7 @@ FemModel make_fem_model(const TetMesh &mesh, const FemSettings &settings)
   m.settings = settings;
   m.npe      = mesh.nodes_per_element();
   m.lame     = lame;
-  const int ne = mesh.element_count(), nb = m.npe * m.npe;
+  const int ne = mesh.element_count(), nb = packed_block_count(m.npe);
   m.rest_shape_inverse.resize(ne);
   m.volume.resize(ne);
   m.stiffness.resize(static_cast<size_t>(ne) * nb * 9);
@@ -42,7 +42,7 @@ FemModel make_fem_model(const TetMesh &mesh, const FemSettings &settings)
     const Eigen::MatrixXd K = element_stiffness(g, mesh.order, lame);
     double *out = &m.stiffness[static_cast<size_t>(e) * nb * 9];
     for (int a = 0; a < m.npe; ++a)
-      for (int b = 0; b < m.npe; ++b) Eigen::Map<Eigen::Matrix3d>(out + 9 * (a * m.npe + b)) = K.block<3, 3>(3 * a, 3 * b);
+      for (int b = a; b < m.npe; ++b) Eigen::Map<Eigen::Matrix3d>(out + 9 * packed_block(a, b, m.npe)) = K.block<3, 3>(3 * a, 3 * b);
   }
   m.reference_mass = reference_mass(mesh.order, settings.mass);
   m.diagonal_mass  = m.reference_mass.isDiagonal();
@@ -100,11 +100,14 @@ FemEnergy fem_energy(const FemModel &model, const double *x, const double *v)
     for (int a = 0; a < npe; ++a)
       u.segment<3>(3 * a) = R.transpose() * Eigen::Vector3d(x[3 * n[a]], x[3 * n[a] + 1], x[3 * n[a] + 2]) -
                             Eigen::Vector3d(X[3 * n[a]], X[3 * n[a] + 1], X[3 * n[a] + 2]);
-    const double *K = &model.stiffness[static_cast<size_t>(e) * npe * npe * 9];
+    const double *K = &model.stiffness[static_cast<size_t>(e) * packed_block_count(npe) * 9];
     Ku.setZero();
     for (int a = 0; a < npe; ++a)
-      for (int b = 0; b < npe; ++b)
-        Ku.segment<3>(3 * a) += Eigen::Map<const Eigen::Matrix3d>(K + 9 * (a * npe + b)) * u.segment<3>(3 * b);
+      for (int b = a; b < npe; ++b) {
+        const Eigen::Map<const Eigen::Matrix3d> Kab(K + 9 * packed_block(a, b, npe));
+        Ku.segment<3>(3 * a) += Kab * u.segment<3>(3 * b);
+        if (b != a) Ku.segment<3>(3 * b) += Kab.transpose() * u.segment<3>(3 * a);
+      }
     E.elastic += 0.5 * u.dot(Ku);
     const double m = model.settings.density * model.volume[e];
     for (int a = 0; a < npe; ++a)

@@ -18,13 +18,18 @@ struct FemSettings {
   MassLumping mass         = MassLumping::Consistent; // order 2 only; order 1 is always lumped
 };
 
+// Index of block (a, b), a <= b, among the upper blocks of an n x n block matrix stored row by row.
+constexpr int packed_block(int a, int b, int n) { return a * n - a * (a - 1) / 2 + (b - a); }
+constexpr int packed_block_count(int n) { return n * (n + 1) / 2; }
+
 struct FemModel {
   TetMesh                      mesh;
   FemSettings                  settings;
   int                          npe = 4;            // nodes per element
   std::vector<Eigen::Matrix3d> rest_shape_inverse; // per element: Dm^-1 of the corner tetrahedron
   std::vector<double>          volume;             // per element
-  // Per element npe*npe 3x3 blocks of K0 (block (a,b) at 9*(a*npe+b), column-major like Eigen).
+  // Per element the npe (npe+1) / 2 upper 3x3 blocks of K0 (block (a,b), a <= b, at
+  // 9 * packed_block(a, b, npe) of the element's range; column-major like Eigen). K0_ba = K0_ab^T.
   std::vector<double> stiffness;
   // Order 1 only: per element the 4 gradients of the barycentric coordinates (12 values, node-major),
   // so the kernel forms R K0 R^T from rotated gradients instead of reading K0.
