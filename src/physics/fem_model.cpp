@@ -2,6 +2,8 @@
 #include "physics/polar_decomposition.hpp"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace physics {
 
@@ -34,6 +36,23 @@ FemModel make_fem_model(const TetMesh &mesh, const FemSettings &settings)
   m.stiffness.resize(static_cast<size_t>(ne) * nb * 9);
   for (int e = 0; e < ne; ++e) {
     const TetGeometry g = tet_geometry(corner_matrix(mesh, mesh.nodes.data(), e));
+    if (mesh.order == 2) {
+      // K0 and M assume the affine (straight-sided) map of the corners: refuse curved elements.
+      const int *n = &mesh.elements[static_cast<size_t>(e) * 10];
+      for (int k = 0; k < 6; ++k) {
+        const int a = n[kTetEdges[k][0]], b = n[kTetEdges[k][1]], mid = n[4 + k];
+        double    dev = 0, len = 0;
+        for (int d = 0; d < 3; ++d) {
+          dev += std::pow(mesh.nodes[3 * mid + d] - 0.5 * (mesh.nodes[3 * a + d] + mesh.nodes[3 * b + d]), 2);
+          len += std::pow(mesh.nodes[3 * a + d] - mesh.nodes[3 * b + d], 2);
+        }
+        if (dev > 1e-12 * len)
+          throw std::runtime_error("mesh: element " + std::to_string(e) +
+                                   " is a curved 10-node tetrahedron (edge node off its edge's midpoint); only straight-sided "
+                                   "elements are supported: mesh with order 1 and use -fem_order 2, or set "
+                                   "Mesh.SecondOrderLinear = 1 in gmsh");
+      }
+    }
     m.rest_shape_inverse[e] = g.rest_shape_inverse;
     m.volume[e]             = g.volume;
     if (mesh.order == 1)

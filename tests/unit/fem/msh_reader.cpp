@@ -2,6 +2,7 @@
 // clear error for each kind of broken file.
 #include <catch2/catch.hpp>
 
+#include "physics/fem_model.hpp"
 #include "physics/msh_reader.hpp"
 
 #include <cmath>
@@ -121,4 +122,12 @@ TEST_CASE("malformed msh files give clear errors", "[fem][msh]")
   // Error messages carry the file name and line.
   CHECK_THAT(error_of(replace(good, "3 0 1 0", "3 0 x 0")), Catch::Contains("test.msh:12:"));
   CHECK_THROWS_WITH(read_msh_file("/nonexistent/file.msh"), Catch::Contains("cannot open"));
+}
+
+TEST_CASE("curved 10-node elements are refused by the model with a clear message", "[fem][msh]")
+{
+  std::istringstream in(msh41_tet10());
+  TetMesh            m = read_msh(in, "t.msh");
+  m.nodes[3 * m.elements[4] + 2] += 0.05; // bend edge (0,1) out of line
+  CHECK_THROWS_WITH(make_fem_model(m, FemSettings{}), Catch::Contains("curved 10-node"));
 }
