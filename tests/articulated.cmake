@@ -22,7 +22,8 @@ add_test(NAME articulated_bridge_small
 set(ART_SAME "${ART} -options_file ${OPTS}/chain.opts -steps 100 -ksp_rtol 1e-12 -progress_every 1000")
 add_test(NAME articulated_same_result_mat_types
          COMMAND ${SUMMARY_SAME} "energy_final joint_error_final corrections_per_step" 1e-6
-                 "${ART_SAME} -mat_type aij" "${ART_SAME} -mat_type baij" "${ART_SAME} -mat_type aij -ksp_type pipecg")
+                 "${ART_SAME} -mat_type aij" "${ART_SAME} -mat_type baij" "${ART_SAME} -mat_type aij -ksp_type pipecg"
+                 "${ART_SAME} -mat_type binbcsr" "${ART_SAME} -mat_type binbcsr -ksp_type mcg")
 add_test(NAME articulated_bad_dt
          COMMAND ${ART} -options_file ${OPTS}/chain.opts -dt -1)
 set_tests_properties(articulated_bad_dt PROPERTIES PASS_REGULAR_EXPRESSION "time step must be positive")
@@ -40,5 +41,6 @@ set(ART_MPI "${ART} -options_file ${OPTS}/loop.opts -steps 200 -ksp_rtol 1e-12 -
 string(REPLACE ";" " " MPIEXEC_LINE "${MPIEXEC_CMD}")
 add_test(NAME articulated_mpi_np2
          COMMAND ${SUMMARY_SAME} "energy_final joint_error_final corrections_per_step" 1e-6
-                 "${ART_MPI}" "${MPIEXEC_LINE} -n 2 ${ART_MPI}" "${MPIEXEC_LINE} -n 2 ${ART_MPI} -mat_type baij")
+                 "${ART_MPI}" "${MPIEXEC_LINE} -n 2 ${ART_MPI}" "${MPIEXEC_LINE} -n 2 ${ART_MPI} -mat_type baij"
+                 "${MPIEXEC_LINE} -n 2 ${ART_MPI} -mat_type binbcsr -ksp_type mcg")
 set_tests_properties(articulated_mpi_np2 PROPERTIES LABELS "articulated;mpi" TIMEOUT 60)

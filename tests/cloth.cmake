@@ -15,7 +15,8 @@ add_test(NAME cloth_stiff_dt30
 set(CLOTH_SAME "${CLOTH} -cloth_n 12 -steps 30 -sphere -ksp_rtol 1e-12 -progress_every 1000")
 add_test(NAME cloth_same_result_mat_types
          COMMAND ${SUMMARY_SAME} "energy_final max_stretch contacts" 1e-6
-                 "${CLOTH_SAME} -mat_type aij" "${CLOTH_SAME} -mat_type baij" "${CLOTH_SAME} -mat_type aij -ksp_type pipecg")
+                 "${CLOTH_SAME} -mat_type aij" "${CLOTH_SAME} -mat_type baij" "${CLOTH_SAME} -mat_type aij -ksp_type pipecg"
+                 "${CLOTH_SAME} -mat_type binbcsr" "${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg")
 add_test(NAME cloth_bad_dt COMMAND ${CLOTH} -cloth_n 4 -dt 0)
 set_tests_properties(cloth_bad_dt PROPERTIES PASS_REGULAR_EXPRESSION "time step must be positive")
 add_test(NAME cloth_bad_n COMMAND ${CLOTH} -cloth_n 1)
@@ -30,5 +31,5 @@ set_tests_properties(cloth_drape_sphere cloth_stiff_dt30 cloth_same_result_mat_t
 string(REPLACE ";" " " MPIEXEC_LINE "${MPIEXEC_CMD}")
 add_test(NAME cloth_mpi_np2
          COMMAND ${SUMMARY_SAME} "energy_final max_stretch contacts" 1e-6
-                 "${CLOTH_SAME}" "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME}")
+                 "${CLOTH_SAME}" "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME}" "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg")
 set_tests_properties(cloth_mpi_np2 PROPERTIES LABELS "cloth;mpi" TIMEOUT 60)
