@@ -44,3 +44,8 @@ add_test(NAME articulated_mpi_np2
                  "${ART_MPI}" "${MPIEXEC_LINE} -n 2 ${ART_MPI}" "${MPIEXEC_LINE} -n 2 ${ART_MPI} -mat_type baij"
                  "${MPIEXEC_LINE} -n 2 ${ART_MPI} -mat_type binbcsr -ksp_type mcg")
 set_tests_properties(articulated_mpi_np2 PROPERTIES LABELS "articulated;mpi" TIMEOUT 60)
+
+# -vtk writes one .vtu per frame and a .pvd collection; -dump_matrix writes a PETSc binary matrix.
+add_test(NAME articulated_vtk_dump
+         COMMAND sh -c "rm -rf art_out && mkdir art_out && ${ART} -options_file ${OPTS}/loop.opts -steps 4 -vtk art_out/loop -vtk_every 2 -dump_matrix art_out/A.bin -progress_every 10 && test -s art_out/loop_00004.vtu && grep -q 'NumberOfCells=\"3\"' art_out/loop_00004.vtu && grep -q loop_00002.vtu art_out/loop.pvd && test -s art_out/A.bin")
+set_tests_properties(articulated_vtk_dump PROPERTIES LABELS "articulated" TIMEOUT 60)

@@ -33,3 +33,7 @@ add_test(NAME cloth_mpi_np2
          COMMAND ${SUMMARY_SAME} "energy_final max_stretch contacts" 1e-6
                  "${CLOTH_SAME}" "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME}" "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg")
 set_tests_properties(cloth_mpi_np2 PROPERTIES LABELS "cloth;mpi" TIMEOUT 60)
+
+add_test(NAME cloth_vtk_dump
+         COMMAND sh -c "rm -rf cloth_out && mkdir cloth_out && ${CLOTH} -cloth_n 6 -steps 2 -sphere -vtk cloth_out/c -dump_matrix cloth_out/A.bin -progress_every 10 && grep -q 'NumberOfCells=\"50\"' cloth_out/c_00002.vtu && grep -q c_00001.vtu cloth_out/c.pvd && test -s cloth_out/A.bin")
+set_tests_properties(cloth_vtk_dump PROPERTIES LABELS "cloth" TIMEOUT 60)
