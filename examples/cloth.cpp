@@ -168,6 +168,7 @@ int main(int argc, char **argv)
   s.add("steps_per_s", ms > 0 ? 1e3 / ms : 0.0);
   s.add("solve_ms", done ? rs.solve_ms / done : 0.0);
   s.add("setvalues_ms", done ? rs.setvalues_ms / done : 0.0);
+  s.add("physics_ms", done ? (step_ms_total - rs.solve_ms - rs.setvalues_ms) / done : 0.0); // springs, assembly, update
   s.add("cg_its", rs.solves ? (double)rs.iterations / rs.solves : 0.0);
   s.add("unconverged_steps", unconverged);
   s.add("diverged_solves", rs.diverged_solves);
