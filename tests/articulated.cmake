@@ -37,7 +37,7 @@ set_tests_properties(articulated_chain articulated_loop articulated_mass_ratio_1
                      articulated_bridge_small articulated_same_result_mat_types articulated_bad_dt articulated_bad_mass
                      articulated_bad_scene PROPERTIES LABELS "articulated" TIMEOUT 60)
 
-set(ART_MPI "${ART} -options_file ${OPTS}/loop.opts -steps 200 -ksp_rtol 1e-12 -progress_every 1000")
+set(ART_MPI "${ART} -options_file ${OPTS}/loop.opts -steps 100 -ksp_rtol 1e-12 -progress_every 1000")
 string(REPLACE ";" " " MPIEXEC_LINE "${MPIEXEC_CMD}")
 add_test(NAME articulated_mpi_np2
          COMMAND ${SUMMARY_SAME} "energy_final joint_error_final corrections_per_step" 1e-6
