@@ -238,7 +238,9 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRResetParts(Mat mat)
   b->stash_row.clear();
   b->stash_col.clear();
   b->stash_val.clear();
-  b->compressed = PETSC_FALSE;
+  b->compressed         = PETSC_FALSE;
+  b->offdiag_rows_known = PETSC_FALSE;
+  b->offdiag_rows.clear();
   PetscFunctionReturn(0);
 }
 

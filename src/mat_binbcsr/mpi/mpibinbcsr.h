@@ -75,6 +75,11 @@ struct Mat_MPIBinBCSR {
   std::vector<PetscScalar> row_vals;
   PetscBool                getrow_active = PETSC_FALSE;
 
+  /* local rows that have off-diagonal entries (found once the pattern is fixed; MatMultDotLocal) */
+  PetscBool             offdiag_rows_known = PETSC_FALSE;
+  std::vector<PetscInt> offdiag_rows;
+  std::vector<PetscScalar> offdiag_saved;
+
   MPIBinBCSRCoo *coo = nullptr;
   PetscBool      coo_just_assembled = PETSC_FALSE; /* MatSetValuesCOO's own assembly call has nothing to do */
 };

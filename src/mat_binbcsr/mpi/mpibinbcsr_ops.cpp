@@ -59,30 +59,59 @@ PETSC_INTERN PetscErrorCode MatMultTransposeAdd_MPIBinBCSR(Mat mat, Vec x, Vec y
   PetscFunctionReturn(0);
 }
 
-/* y = A x and the local part of x.y (see MatMultDotLocal()). Without ghosts the diagonal part's
-   fused kernel does both in one pass; otherwise the dot is one extra pass over x and y. */
+/* y = A x and the local part of x.y (see MatMultDotLocal()), in one pass over the diagonal part:
+   its fused kernel gives y = A_d x and x.(A_d x) while the ghosts travel; the off-diagonal part then
+   adds B x_ghost, which changes only the few rows with off-diagonal entries, and x.(B x_ghost) is
+   summed over those rows alone (from their values before and after). */
 PETSC_INTERN PetscErrorCode MatMultDotLocal_MPIBinBCSR(Mat mat, Vec x, Vec y, PetscScalar *xdoty)
 {
   Mat_MPIBinBCSR *b                                    = MPIBinBCSR(mat);
   PetscErrorCode (*fused)(Mat, Vec, Vec, PetscScalar *) = nullptr;
+  PetscScalar     d_diag                               = 0, d_off = 0;
 
   PetscFunctionBegin;
-  if (!Ghosts(b)) PetscCall(PetscObjectQueryFunction((PetscObject)b->A, "MatMultDotLocal_C", &fused));
-  if (fused) {
-    PetscCall(fused(b->A, x, y, xdoty));
+  PetscCall(PetscObjectQueryFunction((PetscObject)b->A, "MatMultDotLocal_C", &fused));
+  if (!fused) { /* parts without a fused kernel: product, then one pass for the dot */
+    PetscCall(MatMult_MPIBinBCSR(mat, x, y));
+    const PetscScalar *xa, *ya;
+    PetscCall(VecGetArrayRead(x, &xa));
+    PetscCall(VecGetArrayRead(y, &ya));
+    for (PetscInt i = 0; i < mat->rmap->n; i++) d_diag += xa[i] * ya[i];
+    PetscCall(VecRestoreArrayRead(x, &xa));
+    PetscCall(VecRestoreArrayRead(y, &ya));
+    PetscCall(PetscLogFlops(2.0 * mat->rmap->n));
+    *xdoty = d_diag;
     PetscFunctionReturn(0);
   }
-  PetscCall(MatMult_MPIBinBCSR(mat, x, y));
-  const PetscScalar *xa, *ya;
-  const PetscInt     n   = mat->rmap->n;
-  PetscScalar        sum = 0;
-  PetscCall(VecGetArrayRead(x, &xa));
-  PetscCall(VecGetArrayRead(y, &ya));
-  for (PetscInt i = 0; i < n; i++) sum += xa[i] * ya[i];
-  PetscCall(VecRestoreArrayRead(x, &xa));
-  PetscCall(VecRestoreArrayRead(y, &ya));
-  PetscCall(PetscLogFlops(2.0 * n));
-  *xdoty = sum;
+  if (!b->offdiag_rows_known && Ghosts(b)) {
+    b->offdiag_rows.clear();
+    for (PetscInt r = 0; r < mat->rmap->n; r++) {
+      PetscInt nz;
+      PetscCall(MatGetRow(b->B, r, &nz, nullptr, nullptr));
+      if (nz) b->offdiag_rows.push_back(r);
+      PetscCall(MatRestoreRow(b->B, r, &nz, nullptr, nullptr));
+    }
+    b->offdiag_saved.resize(b->offdiag_rows.size());
+  }
+  b->offdiag_rows_known = PETSC_TRUE;
+  PetscCall(VecScatterBegin(b->Mvctx, x, b->lvec, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(fused(b->A, x, y, &d_diag));
+  PetscCall(VecScatterEnd(b->Mvctx, x, b->lvec, INSERT_VALUES, SCATTER_FORWARD));
+  if (Ghosts(b)) {
+    const PetscScalar *ya, *xa;
+    const std::size_t  nr = b->offdiag_rows.size();
+    PetscCall(VecGetArrayRead(y, &ya));
+    for (std::size_t k = 0; k < nr; k++) b->offdiag_saved[k] = ya[b->offdiag_rows[k]];
+    PetscCall(VecRestoreArrayRead(y, &ya));
+    PetscUseTypeMethod(b->B, multadd, b->lvec, y, y);
+    PetscCall(VecGetArrayRead(y, &ya));
+    PetscCall(VecGetArrayRead(x, &xa));
+    for (std::size_t k = 0; k < nr; k++) d_off += xa[b->offdiag_rows[k]] * (ya[b->offdiag_rows[k]] - b->offdiag_saved[k]);
+    PetscCall(VecRestoreArrayRead(x, &xa));
+    PetscCall(VecRestoreArrayRead(y, &ya));
+    PetscCall(PetscLogFlops(3.0 * nr));
+  }
+  *xdoty = d_diag + d_off;
   PetscFunctionReturn(0);
 }
 
