@@ -6,8 +6,6 @@
 
 #include "mpi/fem_problem.hpp"
 
-#include <petsc/private/matimpl.h>
-
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -23,19 +21,7 @@ enum class Fill { Blocked, Coo, ScalarOwnRows };
 
 const char *fill_name(Fill f) { return f == Fill::Blocked ? "blocked+stash" : f == Fill::Coo ? "coo" : "scalar own rows"; }
 
-// Parts type for the cases that need MATSEQBINBCSR's value operations (scale, shift, zero entries/rows):
-// they land separately from its core; until a seqbinbcsr provides them, these cases check the MPI
-// layer's logic with seqaij parts (the products are checked with seqbinbcsr parts everywhere else).
-const char *value_ops_parts()
-{
-  Mat  S;
-  bool have = false;
-  if (MatCreate(PETSC_COMM_SELF, &S) || MatSetType(S, MATSEQBINBCSR)) return "seqaij";
-  have = S->ops->scale && S->ops->shift && S->ops->zeroentries && S->ops->zerorows && S->ops->zerorowscolumns;
-  MatDestroy(&S);
-  return have ? nullptr : "seqaij";
-}
-
+// parts: type of the diagonal/off-diagonal parts (-mat_mpibinbcsr_inner_type), default seqbinbcsr.
 PetscErrorCode assemble(const FemProblem &fem, MatType type, Fill fill, bool empty_rank0, Mat *A, const char *parts = nullptr)
 {
   MPI_Comm    comm = PETSC_COMM_WORLD;
@@ -228,7 +214,7 @@ TEST_CASE("mpibinbcsr: refill in place (COO and MatSetValues) keeps the pattern 
 {
   const FemProblem fem(4, 4, 4, true);
   Mat              A, S;
-  PCHK(assemble(fem, MATMPIBINBCSR, Fill::Coo, false, &A, value_ops_parts()));
+  PCHK(assemble(fem, MATMPIBINBCSR, Fill::Coo, false, &A));
   PCHK(serial_reference(fem, &S));
   // second COO refill with the same values scaled by 2 (ADD on top of the first)
   PetscMPIInt rank, size;
@@ -271,7 +257,7 @@ TEST_CASE("mpibinbcsr: MatGetRow, conversion to and from mpiaij, duplicate, copy
 {
   const FemProblem fem(4, 3, 3, true);
   Mat              A, S, P, B, D;
-  PCHK(assemble(fem, MATMPIBINBCSR, Fill::Blocked, true, &A, value_ops_parts()));
+  PCHK(assemble(fem, MATMPIBINBCSR, Fill::Blocked, true, &A));
   PCHK(serial_reference(fem, &S));
   PCHK(MatConvert(A, MATMPIAIJ, MAT_INITIAL_MATRIX, &P));
   check_products(P, S);
@@ -330,7 +316,7 @@ TEST_CASE("mpibinbcsr: MatZeroRowsColumns and MatZeroRows with rows named by any
   }
   for (bool columns : {true, false}) {
     Mat A, S;
-    PCHK(assemble(fem, MATMPIBINBCSR, Fill::Coo, false, &A, value_ops_parts()));
+    PCHK(assemble(fem, MATMPIBINBCSR, Fill::Coo, false, &A));
     PCHK(serial_reference(fem, &S));
     Vec x, b, xs, bs;
     PCHK(MatCreateVecs(A, &x, &b));
