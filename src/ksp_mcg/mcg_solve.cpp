@@ -390,7 +390,10 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
 
     ksp->its = i + 1;
     PetscCall(MCGUpdate(ksp, alpha, beta, X, R, U, W, P, S, dots));
-    PetscCall(MCGMatMultDot(ksp, Amat, U, W, &dots[MCG_DOT_UW]));
+    /* w = A u only feeds the next iteration: none follows the last allowed one (fixed-iteration mode
+       saves a product per solve this way; a restart recomputes w itself) */
+    dots[MCG_DOT_UW] = 0;
+    if (i + 1 < max_its) PetscCall(MCGMatMultDot(ksp, Amat, U, W, &dots[MCG_DOT_UW]));
     PetscCall(MCGReduce(ksp, dots, MCG_NDOTS));
     MCGCheckDots(ksp, dots);
     gamma_old = gamma;
