@@ -22,13 +22,18 @@ PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat A, PetscCount n, const Pets
   bs  = rbs;
   mbs = A->rmap->n / bs;
 
-  /* block rows of the valid entries; negative indices drop the entry, out-of-range ones are errors */
-  PetscCall(PetscCalloc1(mbs + 1, &rowptr));
+  /* negative indices drop the entry, out-of-range ones are errors (checked before any allocation) */
   for (PetscCount k = 0; k < n; k++) {
     const PetscInt i = ci[k], j = cj[k];
     if (i < 0 || j < 0) continue;
     PetscCheck(i < A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "COO entry %" PetscCount_FMT ": row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", k, i, A->rmap->n);
     PetscCheck(j < A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "COO entry %" PetscCount_FMT ": column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", k, j, A->cmap->n);
+  }
+  /* block rows of the valid entries */
+  PetscCall(PetscCalloc1(mbs + 1, &rowptr));
+  for (PetscCount k = 0; k < n; k++) {
+    const PetscInt i = ci[k], j = cj[k];
+    if (i < 0 || j < 0) continue;
     rowptr[i / bs + 1]++;
     nvalid++;
   }

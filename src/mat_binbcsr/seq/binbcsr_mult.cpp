@@ -328,7 +328,10 @@ PetscErrorCode MatInvertBlockDiagonal_SeqBinBCSR(Mat A, const PetscScalar **valu
       zp = InvertBlockGeneric(bs, d, aug) ? PETSC_FALSE : PETSC_TRUE;
     }
     if (zp) {
-      PetscCheck(allowzeropivot, PETSC_COMM_SELF, PETSC_ERR_MAT_LU_ZRPVT, "Zero pivot in the diagonal block of block row %" PetscInt_FMT, r);
+      if (!allowzeropivot) {
+        PetscCall(PetscFree(aug));
+        SETERRQ(PETSC_COMM_SELF, PETSC_ERR_MAT_LU_ZRPVT, "Zero pivot in the diagonal block of block row %" PetscInt_FMT, r);
+      }
       zeropivot                      = PETSC_TRUE;
       A->factorerror_zeropivot_row   = r * bs;
       A->factorerror_zeropivot_value = 0.0;
