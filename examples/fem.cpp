@@ -58,6 +58,7 @@ struct Options {
   char        dump[PETSC_MAX_PATH_LEN] = "";
   PetscBool   merge   = PETSC_TRUE;
   PetscBool   reorder = PETSC_TRUE;
+  PetscInt    bin_order_window = FemScene().bin_order_window;
   PetscBool   quiet   = PETSC_FALSE;
   PetscBool   is_static = PETSC_FALSE;
   PetscReal   v0[3] = {0, 0, 0};
@@ -106,6 +107,7 @@ PetscErrorCode GetOptions(Options &o)
   PetscCall(PetscOptionsBool("-fem_merge_blocks", "sum element blocks into unique COO blocks here (1) or let the Mat do it (0)",
                              "", o.merge, &o.merge, nullptr));
   PetscCall(PetscOptionsBool("-fem_reorder", "METIS partition / RCM renumbering of the nodes", "", o.reorder, &o.reorder, nullptr));
+  PetscCall(PetscOptionsInt("-fem_bin_order_window", "with -fem_reorder: sort nodes by row length in windows of N (0 = off)", "", o.bin_order_window, &o.bin_order_window, nullptr));
   PetscCall(PetscOptionsBool("-fem_quiet", "no progress line per step", "", o.quiet, &o.quiet, nullptr));
   PetscCall(PetscOptionsBool("-static", "solve K(x) dx = f(x) + f_ext by Newton steps instead of time steps", "", o.is_static,
                              &o.is_static, nullptr));
@@ -256,6 +258,7 @@ int main(int argc, char **argv)
     scene.is_static             = o.is_static;
     scene.merge_blocks          = o.merge;
     scene.reorder               = o.reorder;
+    scene.bin_order_window      = (int)o.bin_order_window;
   }
   const int tip_input = TipNode(scene.mesh, scene.fixed);
   FemSimulation sim;

@@ -1,6 +1,7 @@
 #include "common/fem_simulation.h"
 #include "common/summary.h"
 #include "physics/partition.hpp"
+#include "physics/row_order.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -31,6 +32,7 @@ PetscErrorCode FemSimulationCreate(MPI_Comm comm, const FemScene &scene, FemSimu
       } else {
         r = physics::reorder_for_locality(g, physics::LocalOrder::ReverseCuthillMcKee);
       }
+      if (scene.bin_order_window > 0) r = physics::group_by_row_length(physics::row_lengths_without_fixed(g, sim->fixed), r, scene.bin_order_window);
       physics::renumber_nodes(mesh, r.new_of_old);
       std::vector<char> f(sim->fixed.size());
       for (size_t i = 0; i < f.size(); ++i) f[r.new_of_old[i]] = sim->fixed[i];
