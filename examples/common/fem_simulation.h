@@ -25,7 +25,7 @@ struct FemScene {
   bool                  is_static = false; // Newton steps on K(x) dx = f(x) + f_ext instead of time steps
   bool                  merge_blocks = true;
   bool                  reorder = true;
-  int                   bin_order_window = 64; // with reorder: sort rows by length in windows of this many nodes (physics/row_order.hpp); 0 = off
+  int                   bin_order_window = 256; // with reorder: sort rows by length in windows of this many nodes (physics/row_order.hpp); 0 = off
 };
 
 struct FemStepInfo {
