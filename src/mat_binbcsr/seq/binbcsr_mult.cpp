@@ -217,6 +217,10 @@ static PetscErrorCode MatMultTransposeKernel_SeqBinBCSR(Mat A, Vec xx, Vec zz, V
 
   PetscFunctionBegin;
   PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
+  if (A->symmetric == PETSC_BOOL3_TRUE) { /* A^T = A: the vectorised product */
+    PetscCall(MatMultKernel_SeqBinBCSR(A, xx, zz, yy, nullptr));
+    PetscFunctionReturn(0);
+  }
   if (zz && zz != yy) PetscCall(VecCopy(zz, yy));
   else if (!zz) PetscCall(VecSet(yy, 0.0));
   PetscCall(VecGetArrayRead(xx, &x));
@@ -328,10 +332,8 @@ PetscErrorCode MatInvertBlockDiagonal_SeqBinBCSR(Mat A, const PetscScalar **valu
       zp = InvertBlockGeneric(bs, d, aug) ? PETSC_FALSE : PETSC_TRUE;
     }
     if (zp) {
-      if (!allowzeropivot) {
-        PetscCall(PetscFree(aug));
-        SETERRQ(PETSC_COMM_SELF, PETSC_ERR_MAT_LU_ZRPVT, "Zero pivot in the diagonal block of block row %" PetscInt_FMT, r);
-      }
+      if (!allowzeropivot) PetscCall(PetscFree(aug));
+      PetscCheck(allowzeropivot, PETSC_COMM_SELF, PETSC_ERR_MAT_LU_ZRPVT, "Zero pivot in the diagonal block of block row %" PetscInt_FMT, r);
       zeropivot                      = PETSC_TRUE;
       A->factorerror_zeropivot_row   = r * bs;
       A->factorerror_zeropivot_value = 0.0;

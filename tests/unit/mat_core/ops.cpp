@@ -1,6 +1,7 @@
 // MatGetDiagonal, MatInvertBlockDiagonal, MatGetRow, MatDuplicate, MatCopy, MatConvert (both ways),
 // precision switching and MatView of MATSEQBINBCSR against seqaij/seqbaij.
 #include "support.h"
+#include <petsc/private/matimpl.h>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -147,6 +148,7 @@ TEST_CASE("MatConvert to and from seqaij and seqbaij", "[mat_core][convert]")
     REQUIRE(MatConvert(B, MATBINBCSR, MAT_INITIAL_MATRIX, &C) == 0);
     REQUIRE(PetscObjectTypeCompare((PetscObject)C, MATSEQBINBCSR, &is) == 0);
     CHECK(is);
+    CHECK(C->preallocated); // MatView refuses matrices that are not
     check_dense(dense(C), ref, 0);
     REQUIRE(MatGetBlockSize(C, &bbs) == 0);
     CHECK(bbs == bs);

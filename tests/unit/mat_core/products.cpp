@@ -94,6 +94,28 @@ TEST_CASE("products on a FEM-like 3x3 block stencil", "[mat_core][mult]")
   check_products(fem_pattern(5, 4, 3), bw, prec);
 }
 
+TEST_CASE("a matrix flagged symmetric multiplies its transpose through the vectorised product", "[mat_core][mult]")
+{
+  const Pattern p = fem_pattern(4, 3, 3);
+  Mat           A = build(p, MATSEQBINBCSR), R = build(p, MATSEQAIJ);
+  REQUIRE(MatSetOption(A, MAT_SYMMETRIC, PETSC_TRUE) == 0);
+  Vec x = make_vec(p.n, 5), z = make_vec(p.n, 6), y, yref;
+  REQUIRE(VecDuplicate(x, &y) == 0);
+  REQUIRE(VecDuplicate(x, &yref) == 0);
+  REQUIRE(MatMultTranspose(A, x, y) == 0);
+  REQUIRE(MatMultTranspose(R, x, yref) == 0);
+  check_close(values(y), values(yref), mult_bound(p, values(x), 0.0, true));
+  REQUIRE(MatMultTransposeAdd(A, x, z, y) == 0);
+  REQUIRE(MatMultTransposeAdd(R, x, z, yref) == 0);
+  check_close(values(y), values(yref), mult_bound(p, values(x), 0.0, true));
+  VecDestroy(&x);
+  VecDestroy(&z);
+  VecDestroy(&y);
+  VecDestroy(&yref);
+  MatDestroy(&A);
+  MatDestroy(&R);
+}
+
 TEST_CASE("products with rows of 1 and 500 blocks in one bin, a single row, an empty matrix", "[mat_core][mult]")
 {
   const PetscInt bs = GENERATE(1, 3);
