@@ -74,17 +74,25 @@ PetscErrorCode PreallocateFromBlockPattern(MPI_Comm comm, PetscInt n_local, Pets
     PetscCall(MatDestroy(&graph));
     PetscFunctionReturn(0);
   }
-  std::vector<PetscInt> d_blocks(n_local), o_blocks(n_local), d_rows(3 * n_local), o_rows(3 * n_local);
+  // sbaij stores the upper triangle only: it gets its own (upper) counts.
+  std::vector<PetscInt> d_blocks(n_local), o_blocks(n_local), du_blocks(n_local), ou_blocks(n_local);
+  std::vector<PetscInt> d_rows(3 * n_local), o_rows(3 * n_local);
   PetscInt d_max = 0, o_max = 0;
   for (PetscInt i = bstart; i < bend; ++i) {
     PetscInt        ncols;
     const PetscInt *c;
-    PetscInt        d = 0, o = 0;
+    PetscInt        d = 0, o = 0, du = 0, ou = 0;
     PetscCall(MatGetRow(graph, i, &ncols, &c, nullptr));
-    for (PetscInt k = 0; k < ncols; ++k) (c[k] >= bstart && c[k] < bend) ? ++d : ++o;
+    for (PetscInt k = 0; k < ncols; ++k) {
+      const bool local = c[k] >= bstart && c[k] < bend;
+      local ? ++d : ++o;
+      if (c[k] >= i) local ? ++du : ++ou;
+    }
     PetscCall(MatRestoreRow(graph, i, &ncols, &c, nullptr));
-    d_blocks[i - bstart] = d;
-    o_blocks[i - bstart] = o;
+    d_blocks[i - bstart]  = d;
+    o_blocks[i - bstart]  = o;
+    du_blocks[i - bstart] = du;
+    ou_blocks[i - bstart] = ou;
     for (int r = 0; r < 3; ++r) {
       d_rows[3 * (i - bstart) + r] = 3 * d;
       o_rows[3 * (i - bstart) + r] = 3 * o;
@@ -93,7 +101,13 @@ PetscErrorCode PreallocateFromBlockPattern(MPI_Comm comm, PetscInt n_local, Pets
     o_max = std::max(o_max, 3 * o);
   }
   PetscCall(MatDestroy(&graph));
-  PetscCall(MatXAIJSetPreallocation(A, 3, d_blocks.data(), o_blocks.data(), nullptr, nullptr));
+  PetscCall(MatXAIJSetPreallocation(A, 3, d_blocks.data(), o_blocks.data(), du_blocks.data(), ou_blocks.data()));
+  {
+    // The drivers hand over both triangles of their symmetric systems; sbaij keeps the upper one.
+    PetscBool is_sbaij;
+    PetscCall(PetscObjectTypeCompareAny((PetscObject)A, &is_sbaij, MATSEQSBAIJ, MATMPISBAIJ, ""));
+    if (is_sbaij) PetscCall(MatSetOption(A, MAT_IGNORE_LOWER_TRIANGULAR, PETSC_TRUE));
+  }
   PetscCall(MatSeqSELLSetPreallocation(A, d_max, d_rows.data()));
   PetscCall(MatMPISELLSetPreallocation(A, d_max, d_rows.data(), o_max, o_rows.data()));
   PetscCall(MatSetUp(A));

@@ -78,7 +78,7 @@ double residual(const Chain &c, PetscInt n, const std::vector<PetscScalar> &x)
 
 } // namespace
 
-TEST_CASE("BlockSystem: same solution for aij, baij and sell; duplicates summed; refill replaces", "[fem][sim_system]")
+TEST_CASE("BlockSystem: same solution for aij, baij, sbaij and sell; duplicates summed; refill replaces", "[fem][sim_system]")
 {
   const PetscInt n = 40;
   const Chain    c = make_chain(n, 3.0);
@@ -86,7 +86,7 @@ TEST_CASE("BlockSystem: same solution for aij, baij and sell; duplicates summed;
   const auto ref = solve_with("aij", c, n, &err);
   REQUIRE(err == 0);
   CHECK(residual(c, n, ref) < 1e-9);
-  for (const char *type : {"baij", "sell"}) {
+  for (const char *type : {"baij", "sbaij", "sell"}) {
     INFO(type);
     const auto x = solve_with(type, c, n, &err);
     REQUIRE(err == 0);
