@@ -10,6 +10,9 @@ PETSC_EXTERN PetscErrorCode MatCreate_SeqBinBCSR(Mat);
 PETSC_EXTERN PetscErrorCode MatCreate_MPIBinBCSR(Mat);
 PETSC_EXTERN PetscErrorCode KSPCreate_MCG(KSP);
 
+/* Inserts src's local rows into dst (INSERT_VALUES) and assembles dst: the generic conversion path. */
+PETSC_INTERN PetscErrorCode MatBinBCSRInsertRows_Private(Mat src, Mat dst);
+
 /* Registered once by PetscBinBCSRRegisterAll(). */
 PETSC_EXTERN PetscLogEvent MAT_BinBCSR_BuildLayout; /* first final assembly: staging -> bins */
 PETSC_EXTERN PetscLogEvent MAT_BinBCSR_SetValuesCOO; /* slot refill by gather */

@@ -28,37 +28,16 @@ static PetscErrorCode PreallocateAndFill(Mat src, Mat dst)
   }
   PetscCall(MatSeqAIJSetPreallocation(dst, 0, dnnz.data()));
   PetscCall(MatMPIAIJSetPreallocation(dst, 0, dnnz.data(), 0, onnz.data()));
-  for (PetscInt r = rstart; r < rend; r++) {
-    PetscInt           nz;
-    const PetscInt    *cols;
-    const PetscScalar *vals;
-    PetscCall(MatGetRow(src, r, &nz, &cols, &vals));
-    PetscCall(MatSetValues(dst, 1, &r, nz, cols, vals, INSERT_VALUES));
-    PetscCall(MatRestoreRow(src, r, &nz, &cols, &vals));
-  }
-  PetscCall(MatAssemblyBegin(dst, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(dst, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatBinBCSRInsertRows_Private(src, dst));
   PetscFunctionReturn(0);
 }
 
 /* Refills an existing matrix with src's values (its pattern must hold src's). */
 static PetscErrorCode RefillByRows(Mat src, Mat dst)
 {
-  PetscInt rstart, rend;
-
   PetscFunctionBegin;
   PetscCall(MatZeroEntries(dst));
-  PetscCall(MatGetOwnershipRange(src, &rstart, &rend));
-  for (PetscInt r = rstart; r < rend; r++) {
-    PetscInt           nz;
-    const PetscInt    *cols;
-    const PetscScalar *vals;
-    PetscCall(MatGetRow(src, r, &nz, &cols, &vals));
-    PetscCall(MatSetValues(dst, 1, &r, nz, cols, vals, INSERT_VALUES));
-    PetscCall(MatRestoreRow(src, r, &nz, &cols, &vals));
-  }
-  PetscCall(MatAssemblyBegin(dst, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(dst, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatBinBCSRInsertRows_Private(src, dst));
   PetscFunctionReturn(0);
 }
 

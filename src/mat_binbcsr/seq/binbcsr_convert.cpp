@@ -147,16 +147,7 @@ PetscErrorCode MatCopy_SeqBinBCSR(Mat A, Mat B, MatStructure str)
     if (b->val) PetscCall(PetscArrayzero(b->val, (size_t)b->nslots * b->bs2));
     else PetscCall(PetscArrayzero(b->valf, (size_t)b->nslots * b->bs2));
   } else if (!isbin && B->assembled) PetscCall(MatZeroEntries(B));
-  for (PetscInt r = 0; r < A->rmap->n; r++) {
-    PetscInt           n;
-    const PetscInt    *cols;
-    const PetscScalar *vals;
-    PetscCall(MatGetRow(A, r, &n, &cols, &vals));
-    PetscCall(MatSetValues(B, 1, &r, n, cols, vals, INSERT_VALUES));
-    PetscCall(MatRestoreRow(A, r, &n, &cols, &vals));
-  }
-  PetscCall(MatAssemblyBegin(B, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(B, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatBinBCSRInsertRows_Private(A, B));
   PetscFunctionReturn(0);
 }
 
