@@ -26,6 +26,7 @@
 // updated residual and the true residual against A_ref, both relative to ||b||.
 #include <petscbinbcsr.h>
 
+#include "common/bench_util.h"
 #include "common/stencil.h"
 #include "common/summary.h"
 
@@ -60,42 +61,6 @@ struct Run {
   std::vector<double> per_it;     // wall seconds per iteration, one per timed round
   std::vector<double> per_it_cpu; // process CPU seconds per iteration, one per timed round
 };
-
-std::vector<std::string> SplitList(const char *s)
-{
-  std::vector<std::string> out;
-  std::string              cur;
-  for (const char *c = s;; c++) {
-    if (*c == ',' || *c == 0) {
-      if (!cur.empty()) out.push_back(cur);
-      cur.clear();
-      if (!*c) break;
-    } else cur += *c;
-  }
-  return out;
-}
-
-std::string LastErrorText()
-{
-  const char *text = nullptr;
-  char       *specific = nullptr;
-  PetscErrorMessage(PETSC_ERR_SUP, &text, &specific);
-  std::string s = specific ? specific : (text ? text : "error");
-  while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
-  return s;
-}
-
-// A format that is not available (yet) or refuses the matrix becomes a row with a note.
-template <class F>
-PetscErrorCode Try(F f, std::string *note)
-{
-  PetscFunctionBegin;
-  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, nullptr));
-  const PetscErrorCode ierr = f();
-  PetscCall(PetscPopErrorHandler());
-  if (ierr) *note = LastErrorText();
-  PetscFunctionReturn(0);
-}
 
 PetscErrorCode BuildMatrix(MPI_Comm comm, const StencilGrid &grid, const Format &f, Mat *A)
 {

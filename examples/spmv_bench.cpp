@@ -27,6 +27,7 @@
 //   + 8 N (x) + 8 N (y)
 #include <petscbinbcsr.h>
 
+#include "common/bench_util.h"
 #include "common/stencil.h"
 #include "common/stream.h"
 
@@ -71,41 +72,6 @@ struct Candidate {
   double              bytes = 0, padding = -1, padding_info = -1, rel_err = 0;
   PetscInt            bin_width = 0;
 };
-
-std::vector<std::string> SplitList(const std::string &s)
-{
-  std::vector<std::string> out;
-  size_t                   start = 0;
-  while (start <= s.size()) {
-    size_t end = s.find(',', start);
-    if (end == std::string::npos) end = s.size();
-    if (end > start) out.push_back(s.substr(start, end - start));
-    start = end + 1;
-  }
-  return out;
-}
-
-std::string LastErrorText()
-{
-  const char *text = nullptr;
-  char       *specific = nullptr;
-  PetscErrorMessage(PETSC_ERR_SUP, &text, &specific);
-  std::string s = specific ? specific : (text ? text : "error");
-  while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
-  return s;
-}
-
-// Runs f with errors returned instead of printed and aborted; a format that is not there (yet), or
-// refuses the matrix, becomes a row with a note instead of ending the benchmark.
-template <class F>
-PetscErrorCode Try(F f, std::string *note)
-{
-  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, nullptr));
-  const PetscErrorCode ierr = f();
-  PetscCall(PetscPopErrorHandler());
-  if (ierr) *note = LastErrorText();
-  return 0;
-}
 
 PetscErrorCode LoadAIJ(MPI_Comm comm, const std::string &path, PetscInt bs, Mat *A)
 {

@@ -1,0 +1,23 @@
+// Small helpers shared by the benchmark programs.
+#pragma once
+#include <petscsys.h>
+#include <string>
+#include <vector>
+
+// "a,b,,c" -> {"a", "b", "c"}: comma lists given as options.
+std::vector<std::string> SplitList(const std::string &s);
+
+// The message of the last PETSc error, without trailing blanks.
+std::string LastErrorText();
+
+// Runs f with errors returned instead of printed and aborted; a format that is not there (yet), or
+// refuses the matrix, becomes a row with a note instead of ending the benchmark.
+template <class F>
+PetscErrorCode Try(F f, std::string *note)
+{
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, nullptr));
+  const PetscErrorCode ierr = f();
+  PetscCall(PetscPopErrorHandler());
+  if (ierr) *note = LastErrorText();
+  return 0;
+}
