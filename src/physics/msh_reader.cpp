@@ -118,18 +118,31 @@ private:
     }
   }
 
-  void read_nodes_4()
+  // Format 4.1 sections ($Nodes, $Elements) share one shape: a header "blocks total ...", then per
+  // entity block "dim tag <kind> count" and its lines. One walker checks the counts for both.
+  template <class ReadBlock> void read_entity_blocks(const char *section, const char *items, const char *kind, ReadBlock read_block)
   {
-    auto            s      = data_line("$Nodes header");
+    auto            s      = data_line((std::string(section) + " header").c_str());
     const long long blocks = get<long long>(s, "number of entity blocks");
-    const long long n      = get<long long>(s, "node count");
+    const long long n      = get<long long>(s, (std::string(items) + " count").c_str());
     long long       seen   = 0;
     for (long long b = 0; b < blocks; ++b) {
-      auto t = data_line("node block header");
+      auto t = data_line((std::string(items) + " block header").c_str());
       get<int>(t, "entity dimension");
       get<int>(t, "entity tag");
-      const int       parametric = get<int>(t, "parametric flag");
-      const long long count      = get<long long>(t, "nodes in block");
+      const int       block_kind = get<int>(t, kind);
+      const long long count      = get<long long>(t, (std::string(items) + "s in block").c_str());
+      if (count < 0) fail(std::string("negative ") + items + " count in a block");
+      read_block(block_kind, count);
+      seen += count;
+    }
+    if (seen != n) fail(std::string(section) + " announces " + std::to_string(n) + " " + items + "s but its blocks hold " + std::to_string(seen));
+  }
+
+  void read_nodes_4()
+  {
+    // The parametric flag only adds coordinates at the end of a node line, which we do not read.
+    read_entity_blocks("$Nodes", "node", "parametric flag", [&](int, long long count) {
       std::vector<long long> tags(count);
       for (auto &tag : tags) {
         auto u = data_line("node tags");
@@ -138,12 +151,9 @@ private:
       for (long long tag : tags) {
         auto         u = data_line("node coordinates");
         const double x = get<double>(u, "x"), y = get<double>(u, "y"), z = get<double>(u, "z");
-        (void)parametric; // parametric coordinates follow on the same line; not needed
         add_node(tag, x, y, z);
       }
-      seen += count;
-    }
-    if (seen != n) fail("$Nodes announces " + std::to_string(n) + " nodes but its blocks hold " + std::to_string(seen));
+    });
   }
 
   void add_tet(int type, std::istringstream &s, long long element_tag)
@@ -181,24 +191,13 @@ private:
 
   void read_elements_4()
   {
-    auto            s      = data_line("$Elements header");
-    const long long blocks = get<long long>(s, "number of entity blocks");
-    const long long n      = get<long long>(s, "element count");
-    long long       seen   = 0;
-    for (long long b = 0; b < blocks; ++b) {
-      auto t = data_line("element block header");
-      get<int>(t, "entity dimension");
-      get<int>(t, "entity tag");
-      const int       type  = get<int>(t, "element type");
-      const long long count = get<long long>(t, "elements in block");
+    read_entity_blocks("$Elements", "element", "element type", [&](int type, long long count) {
       for (long long i = 0; i < count; ++i) {
         auto            u   = data_line("elements (fewer than the block announces)");
         const long long tag = get<long long>(u, "element tag");
         if (is_tet(type)) add_tet(type, u, tag);
       }
-      seen += count;
-    }
-    if (seen != n) fail("$Elements announces " + std::to_string(n) + " elements but its blocks hold " + std::to_string(seen));
+    });
   }
 
   TetMesh build()
