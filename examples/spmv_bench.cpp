@@ -1,7 +1,8 @@
 // spmv_bench: MatMult timed for PETSc's built-in formats and MATBINBCSR (double and single storage) on
 // the same matrices in the same run, against a STREAM-triad bandwidth measured in the same run.
 //
-//   spmv_bench [-stencil_sizes 16,32,48] [-f FILE]... [-formats aij,baij,sbaij,sell,binbcsr,binbcsr_single]
+//   spmv_bench [-stencil_sizes 16,32,48] [-f FILE]... [-formats aij,baij,sbaij,sell,binbcsr,binbcsr_single,
+//              binbcsr_sym,binbcsr_sym_single]
 //              [-repeats 7] [-min_batch_ms 20] [-csv FILE] [-stats_only] [-stream_elements N]
 //              [-save_dir DIR] (also write each stencil matrix to DIR/stencilN.bin, PETSc binary)
 //              [-timer wall|cpu] (cpu: process CPU time, for a machine shared with other work)
@@ -24,6 +25,10 @@
 //   sell:    padded slots (8 + 4) + 4 (slices + 1), slices of 8 rows padded to their longest row
 //   binbcsr: slots (s bs^2 + 4) + 4 (bins + 1), s = 8 (double) or 4 (single); slots = sum over bins
 //            of bin_width x the bin's longest (block) row; padding overhead = slots / blocks - 1
+//   binbcsr_sym(_single): symmetric storage (upper blocks incl. diagonal, colour-ordered bins):
+//            slots (s bs^2 + 4) + 4 (bins + 1) with the slots the matrix reports (MatGetInfo), plus
+//            8 N more for y (zeroed first, then read and written by the scatter); padding overhead =
+//            slots / upper blocks - 1
 //   + 8 N (x) + 8 N (y)
 #include <petscbinbcsr.h>
 
@@ -44,6 +49,7 @@ struct FormatSpec {
   std::string label; // column in the table: aij, baij, ..., binbcsr_single
   std::string type;  // the MatType root name
   bool        single = false;
+  bool        sym    = false; // binbcsr symmetric storage (upper triangle)
 };
 
 // Where a matrix comes from: a stencil grid or a binary file.
@@ -167,6 +173,13 @@ double ModelBytes(const Candidate &c, const MatrixStats &st, MPI_Comm comm, doub
   if (c.spec.type == "baij") return st.blocks * (8 * bs * bs + 4) + 4 * (nbrows + 1) + vec;
   if (c.spec.type == "sbaij") return st.upper_blocks * (8 * bs * bs + 4) + 4 * (nbrows + 1) + vec;
   if (c.spec.type == "sell") return st.sell_slots * 12 + 4 * (std::ceil(st.rows / 8.0) + 1) + vec;
+  if (c.spec.type == "binbcsr" && c.spec.sym) {
+    MatInfo info;
+    if (MatGetInfo(c.A, MAT_GLOBAL_SUM, &info)) return 0;
+    const double slots = info.nz_allocated / (bs * bs), bins = std::ceil(nbrows / std::max<PetscInt>(1, c.bin_width));
+    *padding           = 100.0 * (slots - st.upper_blocks) / st.upper_blocks;
+    return slots * ((c.spec.single ? 4 : 8) * bs * bs + 4) + 4 * (bins + 1) + vec + 8.0 * st.rows;
+  }
   if (c.spec.type == "binbcsr") {
     double       bins;
     const double slots = BinnedBlocks(st, std::max<PetscInt>(1, c.bin_width), comm, &bins);
@@ -184,6 +197,34 @@ PetscErrorCode BuildCandidate(MPI_Comm comm, const MatrixSource &src, Mat aij_fi
     else PetscCall(MatConvert(aij_file, c->spec.type.c_str(), MAT_INITIAL_MATRIX, &c->A));
   } else {
     PetscCall(CreateStencilMatrix(comm, src.grid, c->spec.type.c_str(), nullptr, &c->A));
+  }
+  if (c->spec.sym) { /* the same entries (both triangles handed over) into symmetric storage */
+    Mat      S;
+    PetscInt bs, rlo, rhi, mloc, nloc;
+    PetscCall(MatGetLocalSize(c->A, &mloc, &nloc));
+    PetscCall(MatCreate(comm, &S));
+    PetscCall(MatSetSizes(S, mloc, nloc, PETSC_DETERMINE, PETSC_DETERMINE));
+    PetscCall(MatGetBlockSize(c->A, &bs));
+    PetscCall(MatSetBlockSize(S, bs));
+    PetscCall(MatSetType(S, MATBINBCSR));
+    PetscCall(MatBinBCSRSetSymmetricStorage(S, PETSC_TRUE));
+    PetscCall(MatSetUp(S));
+    PetscCall(MatGetOwnershipRange(c->A, &rlo, &rhi));
+    for (PetscInt r = rlo; r < rhi; r++) {
+      PetscInt           n;
+      const PetscInt    *cols;
+      const PetscScalar *vals;
+      PetscCall(MatGetRow(c->A, r, &n, &cols, &vals));
+      PetscCall(MatSetValues(S, 1, &r, n, cols, vals, INSERT_VALUES));
+      PetscCall(MatRestoreRow(c->A, r, &n, &cols, &vals));
+    }
+    PetscCall(MatAssemblyBegin(S, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(S, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatDestroy(&c->A));
+    c->A = S;
+    PetscBool sym;
+    PetscCall(MatBinBCSRGetSymmetricStorage(c->A, &sym));
+    PetscCheck(sym, comm, PETSC_ERR_SUP, "symmetric storage not available");
   }
   if (c->spec.single) {
     MatBinBCSRPrecision p;
@@ -400,16 +441,17 @@ int main(int argc, char **argv)
   char     buf[PETSC_MAX_PATH_LEN] = "";
   PetscBool flg;
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-formats", buf, sizeof buf, &flg));
-  const std::string formats = flg ? buf : "aij,baij,sbaij,sell,binbcsr,binbcsr_single";
+  const std::string formats = flg ? buf : "aij,baij,sbaij,sell,binbcsr,binbcsr_single,binbcsr_sym,binbcsr_sym_single";
   for (const std::string &f : SplitList(formats)) {
     FormatSpec spec;
     spec.label = f;
     spec.type  = f;
-    if (f == "binbcsr_single") {
+    if (f == "binbcsr_single" || f == "binbcsr_sym" || f == "binbcsr_sym_single") {
       spec.type   = "binbcsr";
-      spec.single = true;
+      spec.single = f != "binbcsr_sym";
+      spec.sym    = f != "binbcsr_single";
     }
-    PetscCheck(spec.type == "aij" || spec.type == "baij" || spec.type == "sbaij" || spec.type == "sell" || spec.type == "binbcsr", comm, PETSC_ERR_ARG_WRONG, "Unknown format %s: use aij, baij, sbaij, sell, binbcsr, binbcsr_single", f.c_str());
+    PetscCheck(spec.type == "aij" || spec.type == "baij" || spec.type == "sbaij" || spec.type == "sell" || spec.type == "binbcsr", comm, PETSC_ERR_ARG_WRONG, "Unknown format %s: use aij, baij, sbaij, sell, binbcsr, binbcsr_single, binbcsr_sym, binbcsr_sym_single", f.c_str());
     set.formats.push_back(spec);
   }
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-repeats", &set.repeats, nullptr));

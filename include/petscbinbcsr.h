@@ -40,6 +40,13 @@ PETSC_EXTERN PetscErrorCode MatBinBCSRGetBinWidth(Mat, PetscInt *);
    (values are converted). No-op on matrices of other types. */
 PETSC_EXTERN PetscErrorCode MatBinBCSRSetPrecision(Mat, MatBinBCSRPrecision);
 PETSC_EXTERN PetscErrorCode MatBinBCSRGetPrecision(Mat, MatBinBCSRPrecision *);
+/* Symmetric storage: only blocks on or above the block diagonal are stored (about half the bytes);
+   values given below it (MatSetValues, COO) are ignored, as sbaij does with
+   MAT_IGNORE_LOWER_TRIANGULAR; implies MAT_SYMMETRIC and MAT_SYMMETRY_ETERNAL. Square matrices
+   only; set before the layout is built. Option -mat_binbcsr_symmetric_storage. The setter is a no-op
+   and the getter answers PETSC_FALSE on matrices of other types. */
+PETSC_EXTERN PetscErrorCode MatBinBCSRSetSymmetricStorage(Mat, PetscBool);
+PETSC_EXTERN PetscErrorCode MatBinBCSRGetSymmetricStorage(Mat, PetscBool *);
 
 /* y = A x and *xdoty = the local (this rank's rows, unreduced) part of x^T y, in one pass over A when
    the matrix type provides it (composed "MatMultDotLocal_C"), otherwise MatMult and a local dot.

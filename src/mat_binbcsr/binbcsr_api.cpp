@@ -40,6 +40,25 @@ PetscErrorCode MatBinBCSRGetPrecision(Mat A, MatBinBCSRPrecision *p)
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode MatBinBCSRSetSymmetricStorage(Mat A, PetscBool flg)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidLogicalCollectiveBool(A, flg, 2);
+  PetscTryMethod(A, "MatBinBCSRSetSymmetricStorage_C", (Mat, PetscBool), (A, flg));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatBinBCSRGetSymmetricStorage(Mat A, PetscBool *flg)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidBoolPointer(flg, 2);
+  *flg = PETSC_FALSE;
+  PetscTryMethod(A, "MatBinBCSRGetSymmetricStorage_C", (Mat, PetscBool *), (A, flg));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode MatMultDotLocal(Mat A, Vec x, Vec y, PetscScalar *xdoty)
 {
   PetscErrorCode (*fused)(Mat, Vec, Vec, PetscScalar *) = nullptr;

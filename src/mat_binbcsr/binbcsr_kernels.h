@@ -78,6 +78,75 @@ BINBCSR_HD void lane_mult_transpose(const V *bin_val, const I *bin_col, int nz, 
   }
 }
 
+/* Symmetric storage (upper triangle; see binbcsr.h): one lane of a bin, len slots, all of them (real
+   and padding). For every slot of block column c: acc += block x_c, and when c != own (an
+   off-diagonal block (r, c), c > r): y_c += block^T xr, the product with the lower block that is not
+   stored. Padding slots hold zeros and own as their column, the diagonal block has c == own: neither
+   scatters. The caller zeroes y first and adds acc to y_r after the lane. Lanes of one bin may run
+   in any order or in lock step per slot (SIMD lanes, a warp): the layout build colours the slots so
+   that no two lanes of one slot group scatter to the same column, so no atomics are needed (a GPU
+   must keep the lanes of a bin in step per slot, e.g. one warp per bin with __syncwarp per k). */
+template <int BS, typename V, typename I>
+BINBCSR_HD void sym_lane_mult(const V *bin_val, const I *bin_col, int len, int bw, int bs_rt, int lane, I own, const double *x, const double *xr, double *y, double *acc)
+{
+  const int bs  = BS ? BS : bs_rt;
+  const int bs2 = bs * bs;
+  for (int k = 0; k < len; k++) {
+    const long s = (long)k * bw + lane;
+    const I    c = bin_col[s];
+    const V   *t = bin_val + (long)k * bw * bs2 + lane;
+    slot_mult<BS, V>(t, bw, bs, x + (long)c * bs, acc);
+    if (c != own) slot_mult_transpose<BS, V>(t, bw, bs, xr, y + (long)c * bs);
+  }
+}
+
+/* The same for a whole bin of BW lanes (BW, BS compile-time), lanes in lock step per slot: the lane
+   loop is the SIMD loop. Gathers x_c, fused multiply-adds into BS accumulators per lane, and a masked
+   scatter-add of block^T x_r into y_c (conflict-free by the colouring). Lanes whose row is >= mbs are
+   phantom: their slots are padding (zeros, column own = mbs - 1, masked out) and their acc is
+   dropped. On exit y_r += acc for the real lanes. */
+template <int BS, int BW, typename V, typename I>
+BINBCSR_HD void sym_bin_mult(const V *bin_val, const I *bin_col, int len, I r0, I mbs, const double *x, double *y)
+{
+  constexpr int BS2 = BS * BS;
+  double        acc[BS][BW], xr[BS][BW];
+  I             own[BW];
+  for (int l = 0; l < BW; l++) {
+    const bool real = r0 + l < mbs;
+    own[l]          = real ? r0 + l : mbs - 1;
+    for (int i = 0; i < BS; i++) {
+      acc[i][l] = 0.0;
+      xr[i][l]  = real ? x[(long)(r0 + l) * BS + i] : 0.0;
+    }
+  }
+  for (int k = 0; k < len; k++) {
+    const I *c = bin_col + (long)k * BW;
+    const V *t = bin_val + (long)k * BW * BS2;
+#pragma omp simd
+    for (int l = 0; l < BW; l++) {
+      const I cl = c[l];
+      double  xc[BS], v[BS2];
+      for (int j = 0; j < BS; j++) xc[j] = x[(long)cl * BS + j];
+      for (int e = 0; e < BS2; e++) v[e] = (double)t[e * BW + l];
+      for (int i = 0; i < BS; i++) {
+        double s = acc[i][l];
+        for (int j = 0; j < BS; j++) s += v[i * BS + j] * xc[j];
+        acc[i][l] = s;
+      }
+      if (cl != own[l]) {
+        for (int j = 0; j < BS; j++) {
+          double s = 0.0;
+          for (int i = 0; i < BS; i++) s += v[i * BS + j] * xr[i][l];
+          y[(long)cl * BS + j] += s;
+        }
+      }
+    }
+  }
+  for (int l = 0; l < BW; l++)
+    if (r0 + l < mbs)
+      for (int i = 0; i < BS; i++) y[(long)(r0 + l) * BS + i] += acc[i][l];
+}
+
 /* COO refill of one value: the sum of the coo entries perm[jmap[v] .. jmap[v+1]-1] of coo_v. */
 template <typename I>
 BINBCSR_HD double coo_gather(const double *coo_v, const I *jmap, const I *perm, long v)

@@ -19,6 +19,10 @@ static PetscErrorCode MatSeqBinBCSRFreeLayout(Mat_SeqBinBCSR *a)
   PetscCall(PetscFree(a->row_nz));
   PetscCall(PetscFree(a->diag_slot));
   PetscCall(PetscFree(a->col));
+  PetscCall(PetscFree(a->row_off));
+  PetscCall(PetscFree(a->real_slot));
+  PetscCall(PetscFree(a->lower_off));
+  PetscCall(PetscFree(a->lower_slot));
   PetscCall(PetscFree(a->val));
   PetscCall(PetscFree(a->valf));
   PetscCall(PetscFree2(a->rowbuf_cols, a->rowbuf_vals));
@@ -140,6 +144,21 @@ PetscErrorCode MatSeqBinBCSRStagingZeroValues(Mat A)
   PetscFunctionReturn(0);
 }
 
+/* Symmetric storage chosen after some values were staged: the staged lower triangle goes. */
+PetscErrorCode MatSeqBinBCSRStagingDropLower(Mat A)
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+
+  PetscFunctionBegin;
+  for (PetscInt r = 0; r < (PetscInt)a->staging->cols.size(); r++) {
+    std::vector<PetscInt> &cols = a->staging->cols[r];
+    const size_t           nlow = (size_t)(std::lower_bound(cols.begin(), cols.end(), r) - cols.begin());
+    cols.erase(cols.begin(), cols.begin() + nlow);
+    a->staging->vals[r].erase(a->staging->vals[r].begin(), a->staging->vals[r].begin() + nlow * a->bs2);
+  }
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode MatSeqBinBCSRDuplicateStaging(Mat A, Mat B, PetscBool copyvalues)
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data, *b = (Mat_SeqBinBCSR *)B->data;
@@ -153,15 +172,102 @@ PetscErrorCode MatSeqBinBCSRDuplicateStaging(Mat A, Mat B, PetscBool copyvalues)
 
 PetscInt MatSeqBinBCSRFindSlot(const Mat_SeqBinBCSR *a, PetscInt brow, PetscInt bcol)
 {
-  const PetscInt bw = a->bw, base = a->bin_start[brow / bw] + brow % bw;
-  PetscInt       lo = 0, hi = a->row_nz[brow];
+  PetscInt lo = 0, hi = a->row_nz[brow];
+  if (a->sym && bcol < brow) return -1; /* not stored: the transposed block (bcol, brow) is */
   while (lo < hi) {
-    const PetscInt mid = (lo + hi) / 2, c = a->col[base + mid * bw];
-    if (c == bcol) return base + mid * bw;
+    const PetscInt mid = (lo + hi) / 2, s = BinBCSRSlot(a, brow, mid), c = a->col[s];
+    if (c == bcol) return s;
     if (c < bcol) lo = mid + 1;
     else hi = mid;
   }
   return -1;
+}
+
+/* The symmetric-storage part of MatSeqBinBCSRBuildLayout: bins ordered by the colouring. */
+static PetscErrorCode MatSeqBinBCSRBuildLayoutSym(Mat A, const PetscInt bi[], const PetscInt bj[])
+{
+  Mat_SeqBinBCSR       *a = (Mat_SeqBinBCSR *)A->data;
+  const PetscInt        bw = a->bw, mbs = a->mbs, nbins = a->nbins;
+  std::vector<PetscInt> slot_col, entry_k, colid(a->nbs, -1), allcol;
+
+  PetscFunctionBegin;
+  PetscCheck(A->rmap->n == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Symmetric storage needs a square matrix, this one is %" PetscInt_FMT " x %" PetscInt_FMT, A->rmap->n, A->cmap->n);
+  for (PetscInt r = 0; r < mbs; r++) {
+    PetscCheck(bi[r + 1] - bi[r] >= 0 && bi[r + 1] - bi[r] <= a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_CORRUPT, "Block row %" PetscInt_FMT " has %" PetscInt_FMT " blocks", r, bi[r + 1] - bi[r]);
+    for (PetscInt p = bi[r]; p < bi[r + 1]; p++) {
+      PetscCheck(bj[p] >= 0 && bj[p] < a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Block column %" PetscInt_FMT " of block row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", bj[p], r, a->nbs);
+      PetscCheck(p == bi[r] || bj[p] > bj[p - 1], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Block columns of block row %" PetscInt_FMT " are not sorted and unique", r);
+    }
+  }
+  PetscCall(PetscMalloc1(mbs + 1, &a->row_off));
+  a->row_off[0] = 0;
+  for (PetscInt r = 0; r < mbs; r++) {
+    PetscInt n = 0;
+    for (PetscInt p = bi[r]; p < bi[r + 1]; p++) n += bj[p] >= r;
+    a->row_nz[r]      = n;
+    a->row_off[r + 1] = a->row_off[r] + n;
+    a->max_row_nz     = PetscMax(a->max_row_nz, n);
+  }
+  a->nz = a->row_off[mbs];
+  PetscCall(PetscMalloc1(a->nz, &a->real_slot));
+  for (PetscInt b = 0; b < nbins; b++) {
+    const PetscInt r0 = b * bw;
+    entry_k.clear();
+    const PetscInt len = MatSeqBinBCSRColourBin(bw, r0, mbs, bi, bj, slot_col, entry_k, colid);
+    PetscCheck((PetscInt64)a->bin_start[b] + (PetscInt64)len * bw <= PETSC_MAX_INT / PetscMax(a->bs2, 1), PETSC_COMM_SELF, PETSC_ERR_SUP, "Matrix too large for 32-bit slot indices");
+    a->bin_start[b + 1] = a->bin_start[b] + len * bw;
+    allcol.insert(allcol.end(), slot_col.begin(), slot_col.end());
+    size_t e = 0;
+    for (PetscInt r = r0; r < PetscMin(mbs, r0 + bw); r++) {
+      a->diag_slot[r] = -1;
+      for (PetscInt k = 0; k < a->row_nz[r]; k++, e++) {
+        const PetscInt s                 = a->bin_start[b] + entry_k[e] * bw + (r - r0);
+        a->real_slot[a->row_off[r] + k] = s;
+        if (allcol[s] == r) a->diag_slot[r] = s;
+      }
+    }
+  }
+  a->nslots = a->bin_start[nbins];
+  PetscCall(PetscMalloc1(a->nslots, &a->col));
+  std::copy(allcol.begin(), allcol.end(), a->col);
+  if (a->precision == MAT_BINBCSR_PRECISION_DOUBLE) PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->val));
+  else PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->valf));
+  PetscCall(PetscMalloc2((size_t)PetscMax(a->nbs, 1) * a->bs, &a->rowbuf_cols, (size_t)PetscMax(a->nbs, 1) * a->bs, &a->rowbuf_vals)); /* a full row, both triangles */
+  a->built        = PETSC_TRUE;
+  A->preallocated = PETSC_TRUE;
+  A->nonzerostate++;
+  PetscCall(MatSetOption(A, MAT_SYMMETRIC, PETSC_TRUE));
+  PetscCall(MatSetOption(A, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatSeqBinBCSRBuildLowerIndex(Mat_SeqBinBCSR *a)
+{
+  PetscInt *fill;
+
+  PetscFunctionBegin;
+  if (a->lower_off) PetscFunctionReturn(0);
+  PetscCall(PetscCalloc1(a->mbs + 1, &a->lower_off));
+  for (PetscInt r = 0; r < a->mbs; r++)
+    for (PetscInt k = 0; k < a->row_nz[r]; k++) {
+      const PetscInt c = a->col[BinBCSRSlot(a, r, k)];
+      if (c != r) a->lower_off[c + 1]++;
+    }
+  for (PetscInt r = 0; r < a->mbs; r++) a->lower_off[r + 1] += a->lower_off[r];
+  PetscCall(PetscMalloc1(2 * PetscMax(a->lower_off[a->mbs], 1), &a->lower_slot));
+  PetscCall(PetscMalloc1(a->mbs, &fill));
+  for (PetscInt r = 0; r < a->mbs; r++) fill[r] = a->lower_off[r];
+  for (PetscInt r = 0; r < a->mbs; r++) /* rows ascending: each lower list comes out in ascending c */
+    for (PetscInt k = 0; k < a->row_nz[r]; k++) {
+      const PetscInt s = BinBCSRSlot(a, r, k), c = a->col[s];
+      if (c != r) {
+        a->lower_slot[2 * fill[c]]     = s;
+        a->lower_slot[2 * fill[c] + 1] = r;
+        fill[c]++;
+      }
+    }
+  PetscCall(PetscFree(fill));
+  PetscFunctionReturn(0);
 }
 
 PetscErrorCode MatSeqBinBCSRBuildLayout(Mat A, const PetscInt bi[], const PetscInt bj[])
@@ -186,6 +292,11 @@ PetscErrorCode MatSeqBinBCSRBuildLayout(Mat A, const PetscInt bi[], const PetscI
   a->bin_start[0] = 0;
   a->nz = 0;
   a->max_row_nz = 0;
+  if (a->sym) {
+    PetscCall(MatSeqBinBCSRBuildLayoutSym(A, bi, bj));
+    PetscCall(PetscLogEventEnd(MAT_BinBCSR_BuildLayout, A, 0, 0, 0));
+    PetscFunctionReturn(0);
+  }
   for (PetscInt b = 0; b < nbins; b++) {
     PetscInt len = 0;
     for (PetscInt r = b * bw; r < PetscMin(mbs, (b + 1) * bw); r++) {
@@ -336,6 +447,7 @@ static PetscErrorCode MatSetValues_SeqBinBCSR(Mat A, PetscInt m, const PetscInt 
       PetscCheck(c < A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", c, A->cmap->n);
       const PetscScalar x = v ? (a->roworiented ? v[i * n + j] : v[j * m + i]) : 0.0;
       const PetscInt    bc = c / a->bs, e = ri * a->bs + c % a->bs;
+      if (a->sym && bc < br) continue; /* symmetric storage: the lower triangle is implied */
       if (a->built) PetscCall(LayoutAdd(a, br, bc, e, x, mode, r, c, cache));
       else PetscCall(StagingAdd(A, a, br, bc, e, x, mode, r, c));
     }
@@ -360,6 +472,7 @@ static PetscErrorCode MatSetValuesBlocked_SeqBinBCSR(Mat A, PetscInt m, const Pe
       const PetscInt bc = in[j];
       if (bc < 0) continue;
       PetscCheck(bc < a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Block column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", bc, a->nbs);
+      if (a->sym && bc < br) continue; /* symmetric storage: the lower triangle is implied */
       for (PetscInt ii = 0; ii < bs; ii++) {
         for (PetscInt jj = 0; jj < bs; jj++) {
           const PetscInt    prow = i * bs + ii, pcol = j * bs + jj;
@@ -387,6 +500,11 @@ static PetscErrorCode MatGetValues_SeqBinBCSR(Mat A, PetscInt m, const PetscInt 
       const PetscInt c = in[j];
       if (c < 0) continue;
       PetscCheck(c < A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", c, A->cmap->n);
+      if (a->sym && c / a->bs < r / a->bs) { /* the transposed entry of the stored upper block */
+        const PetscInt s = MatSeqBinBCSRFindSlot(a, c / a->bs, r / a->bs);
+        v[i * n + j]     = s < 0 ? 0.0 : BinBCSRGetValue(a, BinBCSRValueIndex(s, (c % a->bs) * a->bs + r % a->bs, a->bw, a->bs2));
+        continue;
+      }
       const PetscInt s = MatSeqBinBCSRFindSlot(a, r / a->bs, c / a->bs);
       v[i * n + j]     = s < 0 ? 0.0 : BinBCSRGetValue(a, BinBCSRValueIndex(s, (r % a->bs) * a->bs + c % a->bs, a->bw, a->bs2));
     }
@@ -496,12 +614,36 @@ static PetscErrorCode MatBinBCSRGetPrecision_SeqBinBCSR(Mat A, MatBinBCSRPrecisi
   PetscFunctionReturn(0);
 }
 
+static PetscErrorCode MatBinBCSRSetSymmetricStorage_SeqBinBCSR(Mat A, PetscBool flg)
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+
+  PetscFunctionBegin;
+  if (flg == a->sym) PetscFunctionReturn(0);
+  PetscCheck(!a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Symmetric storage must be chosen before the layout is built (first final assembly, COO preallocation, conversion or load)");
+  PetscCheck(!flg || A->rmap->N < 0 || A->cmap->N < 0 || A->rmap->N == A->cmap->N, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Symmetric storage needs a square matrix, this one is %" PetscInt_FMT " x %" PetscInt_FMT, A->rmap->N, A->cmap->N);
+  a->sym = flg;
+  if (a->staging && flg) PetscCall(MatSeqBinBCSRStagingDropLower(A));
+  if (flg) {
+    PetscCall(MatSetOption(A, MAT_SYMMETRIC, PETSC_TRUE));
+    PetscCall(MatSetOption(A, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRGetSymmetricStorage_SeqBinBCSR(Mat A, PetscBool *flg)
+{
+  PetscFunctionBegin;
+  *flg = ((Mat_SeqBinBCSR *)A->data)->sym;
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MatSetFromOptions_SeqBinBCSR(Mat A, PetscOptionItems *PetscOptionsObject)
 {
   Mat_SeqBinBCSR     *a = (Mat_SeqBinBCSR *)A->data;
   PetscInt            bw;
   MatBinBCSRPrecision p  = a->precision;
-  PetscBool           set;
+  PetscBool           set, sym;
 
   PetscFunctionBegin;
   PetscCall(MatBinBCSRGetBinWidth_SeqBinBCSR(A, &bw));
@@ -510,6 +652,9 @@ static PetscErrorCode MatSetFromOptions_SeqBinBCSR(Mat A, PetscOptionItems *Pets
   if (set) PetscCall(MatBinBCSRSetBinWidth_SeqBinBCSR(A, bw));
   PetscCall(PetscOptionsEnum("-mat_binbcsr_precision", "Storage precision of the values", "MatBinBCSRSetPrecision", MatBinBCSRPrecisions, (PetscEnum)p, (PetscEnum *)&p, &set));
   if (set) PetscCall(MatBinBCSRSetPrecision_SeqBinBCSR(A, p));
+  sym = a->sym;
+  PetscCall(PetscOptionsBool("-mat_binbcsr_symmetric_storage", "Store the upper triangle only (symmetric matrices; the lower triangle given is ignored)", "MatBinBCSRSetSymmetricStorage", sym, &sym, &set));
+  if (set) PetscCall(MatBinBCSRSetSymmetricStorage_SeqBinBCSR(A, sym));
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }
@@ -532,7 +677,7 @@ static PetscErrorCode MatGetInfo_SeqBinBCSR_Basic(Mat A, MatInfoType flag, MatIn
   PetscFunctionReturn(0);
 }
 
-static const char *const composed_names[] = {"MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatSeqAIJSetPreallocation_C", "MatSeqBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatConvert_seqbinbcsr_seqaij_C", "MatConvert_seqbinbcsr_seqbaij_C"};
+static const char *const composed_names[] = {"MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatSeqAIJSetPreallocation_C", "MatSeqBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatConvert_seqbinbcsr_seqaij_C", "MatConvert_seqbinbcsr_seqbaij_C"};
 
 static PetscErrorCode MatDestroy_SeqBinBCSR(Mat A)
 {
@@ -593,6 +738,8 @@ PetscErrorCode MatCreate_SeqBinBCSR(Mat A)
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRGetBinWidth_C", MatBinBCSRGetBinWidth_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRSetPrecision_C", MatBinBCSRSetPrecision_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRGetPrecision_C", MatBinBCSRGetPrecision_SeqBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRSetSymmetricStorage_C", MatBinBCSRSetSymmetricStorage_SeqBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRGetSymmetricStorage_C", MatBinBCSRGetSymmetricStorage_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatSeqAIJSetPreallocation_C", MatSeqAIJSetPreallocation_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatSeqBAIJSetPreallocation_C", MatSeqBAIJSetPreallocation_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatSetPreallocationCOO_C", MatSetPreallocationCOO_SeqBinBCSR));

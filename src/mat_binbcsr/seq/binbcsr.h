@@ -45,6 +45,7 @@
 
 #include "binbcsr_impl.h"
 #include <petsc/private/matimpl.h>
+#include <vector>
 
 struct BinBCSRStaging; /* the pattern and values while the matrix is being filled for the first time
                           (private to binbcsr.cpp: per block row, sorted block columns and values) */
@@ -61,6 +62,9 @@ typedef struct {
                                     preallocation (MAT_NEW_NONZERO_ALLOCATION_ERR). Once the layout
                                     exists a new location is an error unless nonew == 1. */
   PetscBool           roworiented; /* MAT_ROW_ORIENTED for MatSetValues(Blocked) */
+  PetscBool           sym;         /* symmetric storage: only blocks with block column >= block row
+                                      are stored; entries below the block diagonal are ignored. The
+                                      slots of a bin are ordered by an edge colouring (below). */
 
   /* the bin layout: valid once built (first final assembly, MatSetPreallocationCOO, MatConvert) */
   PetscBool  built;
@@ -74,6 +78,12 @@ typedef struct {
   PetscInt   nslots;       /* bin_start[nbins] */
   PetscInt   nz;           /* stored blocks (sum of row_nz) */
   PetscInt   max_row_nz;   /* longest row, in blocks */
+  PetscInt  *row_off;      /* symmetric storage only: [mbs + 1] offsets into real_slot, else NULL */
+  PetscInt  *real_slot;    /* symmetric storage only: [nz] the slots of each row's real blocks in
+                              ascending column order (the colouring scatters them over the bin) */
+  PetscInt  *lower_off;    /* symmetric storage, built on demand (MatGetRow): [mbs + 1] offsets */
+  PetscInt  *lower_slot;   /* [2 * (off-diagonal blocks)]: for block row r, (slot, c) of each stored
+                              block (c, r), c < r, in ascending c: row r's lower part, transposed */
   MatScalar *val;          /* [nslots * bs2] when precision is double, else NULL */
   float     *valf;         /* [nslots * bs2] when precision is single, else NULL */
 
@@ -110,9 +120,11 @@ static inline PetscInt BinBCSRValueIndex(PetscInt s, PetscInt e, PetscInt bw, Pe
   const PetscInt l = s % bw;
   return (s - l) * bs2 + e * bw + l;
 }
-/* Slot of entry k of block row r (k < row_nz[r] for a real entry). */
+/* Slot of the k-th real block (ascending column) of block row r, k < row_nz[r]. With full storage
+   it is entry k of the lane; with symmetric storage the colouring decides. */
 static inline PetscInt BinBCSRSlot(const Mat_SeqBinBCSR *a, PetscInt r, PetscInt k)
 {
+  if (a->real_slot) return a->real_slot[a->row_off[r] + k];
   return a->bin_start[r / a->bw] + k * a->bw + r % a->bw;
 }
 /* Value at value index v, whatever the storage precision. */
@@ -122,6 +134,18 @@ static inline void        BinBCSRSetValue(Mat_SeqBinBCSR *a, PetscInt v, PetscSc
   if (a->val) a->val[v] = x;
   else a->valf[v] = (float)x;
 }
+
+/* Symmetric storage: the slot order of bin [r0, r0 + bw) by edge colouring (binbcsr_colour.cpp).
+   bi/bj: the block pattern (sorted rows; entries below the diagonal are skipped). Returns the bin's
+   slot groups L; slot_col gets L * bw columns (slot k of lane l at k * bw + l, padding: the lane's own
+   row, mbs - 1 for phantom lanes); entry_k gets, lane by lane, the slot group of each upper block in
+   column order. colid: [nbs] scratch, all -1 on entry and on exit. */
+PetscInt MatSeqBinBCSRColourBin(PetscInt bw, PetscInt r0, PetscInt mbs, const PetscInt bi[], const PetscInt bj[], std::vector<PetscInt> &slot_col, std::vector<PetscInt> &entry_k, std::vector<PetscInt> &colid);
+
+/* Symmetric storage: builds lower_off/lower_slot if missing (pattern is frozen, so once). */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRBuildLowerIndex(Mat_SeqBinBCSR *);
+/* Refuses an operation that symmetric storage does not provide. */
+#define BinBCSRCheckNotSym(a, opname) PetscCheck(!(a)->sym, PETSC_COMM_SELF, PETSC_ERR_SUP, "%s is not available for MATSEQBINBCSR with symmetric storage (upper triangle only; -mat_binbcsr_symmetric_storage)", opname)
 
 /* Slot of block (brow, bcol), -1 if the pattern has no such block (binary search in the lane). */
 PETSC_INTERN PetscInt MatSeqBinBCSRFindSlot(const Mat_SeqBinBCSR *, PetscInt brow, PetscInt bcol);
@@ -133,6 +157,7 @@ PETSC_INTERN PetscErrorCode MatSeqBinBCSRBuildLayout(Mat, const PetscInt bi[], c
 
 /* Before the layout exists: zero the staged values, keeping the staged pattern (MatZeroEntries). */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRStagingZeroValues(Mat);
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRStagingDropLower(Mat);
 
 /* ASCII MatView (info formats and the default entry listing). */
 PETSC_INTERN PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat, PetscViewer);

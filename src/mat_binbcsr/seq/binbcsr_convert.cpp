@@ -12,12 +12,23 @@ PetscErrorCode MatGetRow_SeqBinBCSR(Mat A, PetscInt row, PetscInt *nz, PetscInt 
   PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatGetRow needs an assembled MATSEQBINBCSR matrix");
   PetscCheck(row >= 0 && row < A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", row, A->rmap->n);
   PetscCheck(!a->getrowactive, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatRestoreRow the previous row first");
-  const PetscInt bs = a->bs, br = row / bs, ri = row % bs, n = a->row_nz[br];
-  for (PetscInt k = 0; k < n; k++) {
+  const PetscInt bs = a->bs, br = row / bs, ri = row % bs;
+  PetscInt       n = 0;
+  if (a->sym) { /* the full row: the transposed blocks (c, br), c < br, then the stored ones */
+    PetscCall(MatSeqBinBCSRBuildLowerIndex(a));
+    for (PetscInt p = a->lower_off[br]; p < a->lower_off[br + 1]; p++, n++) {
+      const PetscInt s = a->lower_slot[2 * p], c = a->lower_slot[2 * p + 1];
+      for (PetscInt j = 0; j < bs; j++) {
+        a->rowbuf_cols[n * bs + j] = c * bs + j;
+        a->rowbuf_vals[n * bs + j] = BinBCSRGetValue(a, BinBCSRValueIndex(s, j * bs + ri, a->bw, a->bs2));
+      }
+    }
+  }
+  for (PetscInt k = 0; k < a->row_nz[br]; k++, n++) {
     const PetscInt s = BinBCSRSlot(a, br, k);
     for (PetscInt j = 0; j < bs; j++) {
-      a->rowbuf_cols[k * bs + j] = a->col[s] * bs + j;
-      a->rowbuf_vals[k * bs + j] = BinBCSRGetValue(a, BinBCSRValueIndex(s, ri * bs + j, a->bw, a->bs2));
+      a->rowbuf_cols[n * bs + j] = a->col[s] * bs + j;
+      a->rowbuf_vals[n * bs + j] = BinBCSRGetValue(a, BinBCSRValueIndex(s, ri * bs + j, a->bw, a->bs2));
     }
   }
   if (nz) *nz = n * bs;
@@ -50,6 +61,7 @@ static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues
   b->precision   = a->precision;
   b->nonew       = a->nonew;
   b->roworiented = a->roworiented;
+  b->sym         = a->sym;
   b->bs          = a->bs;
   b->bs2         = a->bs2;
   b->mbs         = a->mbs;
@@ -76,7 +88,16 @@ static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues
       if (copyvalues) PetscCall(PetscArraycpy(b->valf, a->valf, nv));
       else PetscCall(PetscArrayzero(b->valf, nv));
     }
-    PetscCall(PetscMalloc2((size_t)a->max_row_nz * a->bs, &b->rowbuf_cols, (size_t)a->max_row_nz * a->bs, &b->rowbuf_vals));
+    if (a->sym) {
+      PetscCall(PetscMalloc1(a->mbs + 1, &b->row_off));
+      PetscCall(PetscArraycpy(b->row_off, a->row_off, a->mbs + 1));
+      PetscCall(PetscMalloc1(a->nz, &b->real_slot));
+      PetscCall(PetscArraycpy(b->real_slot, a->real_slot, a->nz));
+    }
+    {
+      const size_t nrow = (size_t)(a->sym ? PetscMax(a->nbs, 1) : a->max_row_nz) * a->bs;
+      PetscCall(PetscMalloc2(nrow, &b->rowbuf_cols, nrow, &b->rowbuf_vals));
+    }
     if (a->coo_jmap) { /* the copy can be refilled with MatSetValuesCOO too */
       const size_t nq = (size_t)a->nz * a->bs2;
       b->coo_n        = a->coo_n;
@@ -121,12 +142,13 @@ PetscErrorCode MatCopy_SeqBinBCSR(Mat A, Mat B, MatStructure str)
   if (isbin) {
     Mat_SeqBinBCSR *b = (Mat_SeqBinBCSR *)B->data;
     PetscCheck(b->bs == a->bs || !b->built, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP, "Block sizes differ: %" PetscInt_FMT " and %" PetscInt_FMT, a->bs, b->bs);
-    if (b->built && b->bw == a->bw && b->mbs == a->mbs && b->nbs == a->nbs && b->nslots == a->nslots) {
+    if (b->built && b->bw == a->bw && b->mbs == a->mbs && b->nbs == a->nbs && b->nslots == a->nslots && b->sym == a->sym) {
       same = (PetscBool)(str == SAME_NONZERO_PATTERN);
       if (!same) {
         PetscCall(PetscArraycmp(a->bin_start, b->bin_start, a->nbins + 1, &same));
         if (same) PetscCall(PetscArraycmp(a->row_nz, b->row_nz, a->mbs, &same));
         if (same) PetscCall(PetscArraycmp(a->col, b->col, a->nslots, &same));
+        if (same && a->sym) PetscCall(PetscArraycmp(a->real_slot, b->real_slot, a->nz, &same));
       }
     }
     if (same) {
@@ -158,10 +180,13 @@ PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat A, MatType type, MatReuse reuse, Ma
   Mat                   B;
   PetscInt              bs = A->rmap->bs, m = A->rmap->n, mbs, *bi, *bj;
   std::vector<PetscInt> rowcols;
+  PetscBool             is_sbaij;
 
   PetscFunctionBegin;
-  if (!A->ops->getrow) {
-    /* a source without rows (MATTRANSPOSEVIRTUAL, ...): through its own conversion to seqaij */
+  PetscCall(PetscObjectTypeCompare((PetscObject)A, MATSEQSBAIJ, &is_sbaij));
+  if (!A->ops->getrow || is_sbaij) {
+    /* a source without rows (MATTRANSPOSEVIRTUAL, ...) or with upper rows only (seqsbaij): through
+       its own conversion to seqaij */
     Mat T, C = reuse == MAT_REUSE_MATRIX ? *newmat : nullptr;
     PetscCall(MatConvert(A, MATSEQAIJ, MAT_INITIAL_MATRIX, &T));
     PetscCall(MatConvertFrom_SeqBinBCSR(T, type, reuse == MAT_REUSE_MATRIX ? MAT_REUSE_MATRIX : MAT_INITIAL_MATRIX, &C));
@@ -218,6 +243,10 @@ PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat A, MatType type, MatReuse reuse, Ma
       PetscCall(MatGetRow(A, r, &n, &cols, &vals));
       for (PetscInt p = 0; p < n; p++) { /* both sorted: walk the block row */
         const PetscInt bc = cols[p] / bs;
+        if (b->sym) { /* upper triangle only, slots where the colouring put them */
+          if (bc >= br) BinBCSRSetValue(b, BinBCSRValueIndex(MatSeqBinBCSRFindSlot(b, br, bc), (r % bs) * bs + cols[p] % bs, b->bw, b->bs2), vals[p]);
+          continue;
+        }
         while (bj[bi[br] + k] != bc) k++;
         BinBCSRSetValue(b, BinBCSRValueIndex(BinBCSRSlot(b, br, k), (r % bs) * bs + cols[p] % bs, b->bw, b->bs2), vals[p]);
       }
@@ -244,6 +273,33 @@ static PetscErrorCode MatConvert_SeqBinBCSR_XAIJ(Mat A, MatType newtype, MatReus
 
   PetscFunctionBegin;
   PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatConvert needs an assembled MATSEQBINBCSR matrix");
+  if (a->sym) { /* both triangles, through the full rows */
+    if (reuse == MAT_REUSE_MATRIX) {
+      B = *newmat;
+      PetscCall(MatZeroEntries(B));
+    } else {
+      PetscCall(MatCreate(PetscObjectComm((PetscObject)A), &B));
+      PetscCall(MatSetSizes(B, A->rmap->n, A->cmap->n, A->rmap->N, A->cmap->N));
+      PetscCall(MatSetBlockSizesFromMats(B, A, A));
+      PetscCall(MatSetType(B, newtype));
+      PetscCall(MatSeqBinBCSRBuildLowerIndex(a));
+      PetscCall(PetscMalloc1(A->rmap->n, &nnz));
+      for (PetscInt r = 0; r < A->rmap->n; r++) nnz[r] = (a->row_nz[r / bs] + a->lower_off[r / bs + 1] - a->lower_off[r / bs]) * (blocked ? 1 : bs);
+      if (blocked) {
+        PetscInt *bnnz;
+        PetscCall(PetscMalloc1(a->mbs, &bnnz));
+        for (PetscInt r = 0; r < a->mbs; r++) bnnz[r] = nnz[r * bs];
+        PetscCall(MatSeqBAIJSetPreallocation(B, bs, 0, bnnz));
+        PetscCall(PetscFree(bnnz));
+      } else PetscCall(MatSeqAIJSetPreallocation(B, 0, nnz));
+      PetscCall(PetscFree(nnz));
+    }
+    PetscCall(MatBinBCSRInsertRows_Private(A, B));
+    PetscCall(MatPropagateSymmetryOptions(A, B));
+    if (reuse == MAT_INPLACE_MATRIX) PetscCall(MatHeaderReplace(A, &B));
+    else *newmat = B;
+    PetscFunctionReturn(0);
+  }
   if (reuse == MAT_REUSE_MATRIX) {
     B = *newmat;
     PetscCall(MatZeroEntries(B));
@@ -302,6 +358,13 @@ PetscErrorCode MatConvert_SeqBinBCSR_SeqBAIJ(Mat A, MatType newtype, MatReuse re
   PetscFunctionReturn(0);
 }
 
+static PetscInt CountDiagonalBlocks(const Mat_SeqBinBCSR *a)
+{
+  PetscInt n = 0;
+  for (PetscInt r = 0; r < a->mbs; r++) n += a->diag_slot[r] >= 0;
+  return n;
+}
+
 PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
 {
   Mat_SeqBinBCSR   *a = (Mat_SeqBinBCSR *)A->data;
@@ -320,6 +383,7 @@ PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
     }
     PetscCall(PetscViewerASCIIPrintf(viewer, "bins %" PetscInt_FMT ", stored blocks %" PetscInt_FMT ", slots %" PetscInt_FMT " (padding overhead %.2f%%), longest row %" PetscInt_FMT " blocks\n", a->nbins, a->nz, a->nslots, a->nz ? 100.0 * (double)(a->nslots - a->nz) / (double)a->nz : 0.0, a->max_row_nz));
     PetscCall(PetscViewerASCIIPrintf(viewer, "bytes: values %zu, indices %zu (column per slot and bin offsets)%s\n", vbytes, ibytes, a->coo_jmap ? ", COO map present" : ""));
+    if (a->sym) PetscCall(PetscViewerASCIIPrintf(viewer, "symmetric storage: upper triangle, %" PetscInt_FMT " stored blocks (the lower %" PetscInt_FMT " implied), %" PetscInt_FMT " padding slots; slots ordered by edge colouring\n", a->nz, a->nz - CountDiagonalBlocks(a), a->nslots - a->nz));
     PetscFunctionReturn(0);
   }
   PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatView of the entries needs an assembled matrix");
@@ -327,6 +391,16 @@ PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
   for (PetscInt r = 0; r < A->rmap->n; r++) {
     const PetscInt bs = a->bs, br = r / bs, ri = r % bs;
     PetscCall(PetscViewerASCIIPrintf(viewer, "row %" PetscInt_FMT ":", r));
+    if (a->sym) { /* both triangles, as AIJ lists them */
+      PetscInt           n;
+      const PetscInt    *cols;
+      const PetscScalar *vals;
+      PetscCall(MatGetRow_SeqBinBCSR(A, r, &n, (PetscInt **)&cols, (PetscScalar **)&vals));
+      for (PetscInt k = 0; k < n; k++) PetscCall(PetscViewerASCIIPrintf(viewer, " (%" PetscInt_FMT ", %g) ", cols[k], (double)vals[k]));
+      PetscCall(MatRestoreRow_SeqBinBCSR(A, r, &n, (PetscInt **)&cols, (PetscScalar **)&vals));
+      PetscCall(PetscViewerASCIIPrintf(viewer, "\n"));
+      continue;
+    }
     for (PetscInt k = 0; k < a->row_nz[br]; k++) {
       const PetscInt s = BinBCSRSlot(a, br, k);
       for (PetscInt j = 0; j < bs; j++) PetscCall(PetscViewerASCIIPrintf(viewer, " (%" PetscInt_FMT ", %g) ", a->col[s] * bs + j, (double)BinBCSRGetValue(a, BinBCSRValueIndex(s, ri * bs + j, a->bw, a->bs2))));

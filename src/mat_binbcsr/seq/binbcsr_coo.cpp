@@ -73,6 +73,7 @@ PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat A, PetscCount n, const Pets
       PetscInt       kk = -1, prev = -1;
       for (PetscInt p = rowptr[r]; p < rowptr[r + 1]; p++) {
         const PetscInt c = (PetscInt)(key[p] >> 32), k = (PetscInt)(key[p] & 0xffffffffu);
+        if (a->sym && c < r) continue; /* symmetric storage: the lower triangle maps to no slot */
         if (c != prev) {
           kk++;
           prev = c;
@@ -117,15 +118,16 @@ void coo_refill(const Mat_SeqBinBCSR *a, V *val, const PetscScalar *v)
   const PetscInt *jmap = a->coo_jmap, *perm = a->coo_perm;
   PetscInt        q    = 0;
   for (PetscInt r = 0; r < a->mbs; r++) {
-    const PetscInt nr   = a->row_nz[r];
-    V             *tile = val + (size_t)a->bin_start[r / bw] * bs2 + r % bw; /* entry e of block k: tile[(k*bw*bs2) + e*bw] */
+    const PetscInt nr = a->row_nz[r];
     for (PetscInt i = 0; i < bs; i++)
-      for (PetscInt k = 0; k < nr; k++)
+      for (PetscInt k = 0; k < nr; k++) {
+        V *blk = val + BinBCSRValueIndex(BinBCSRSlot(a, r, k), i * bs, bw, bs2); /* entry (i, j): blk[j * bw] */
         for (PetscInt j = 0; j < bs; j++, q++) {
-          V           &dst = tile[(size_t)k * bw * bs2 + (i * bs + j) * bw];
+          V           &dst = blk[(size_t)j * bw];
           const double s   = binbcsr::coo_gather<PetscInt>(v, jmap, perm, q);
           dst              = (V)(ADD ? (double)dst + s : s);
         }
+      }
   }
 }
 

@@ -39,6 +39,13 @@ PetscErrorCode ViewBinary(Mat A, PetscViewer viewer)
 
   PetscFunctionBegin;
   PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatView to a binary file needs an assembled matrix");
+  if (a->sym) { /* both triangles, as seqaij writes them */
+    Mat B;
+    PetscCall(MatConvert(A, MATSEQAIJ, MAT_INITIAL_MATRIX, &B));
+    PetscCall(MatView(B, viewer));
+    PetscCall(MatDestroy(&B)); /* seqaij writes -matload_block_size into the .info itself */
+    PetscFunctionReturn(0);
+  }
   PetscCall(PetscViewerSetUp(viewer));
   nz        = a->nz * a->bs2;
   header[0] = MAT_FILE_CLASSID;
@@ -157,6 +164,7 @@ PetscErrorCode MatLoad_SeqBinBCSR(Mat A, PetscViewer viewer)
     Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
     for (PetscInt i = 0; i < m; i++)
       for (PetscInt k = rowptr[i]; k < rowptr[i + 1]; k++) {
+        if (a->sym && cols[k] / bs < i / bs) continue; /* symmetric storage: the lower triangle is implied */
         const PetscInt s = MatSeqBinBCSRFindSlot(a, i / bs, cols[k] / bs);
         BinBCSRSetValue(a, BinBCSRValueIndex(s, (i % bs) * bs + cols[k] % bs, a->bw, a->bs2), vals[k]); /* a repeated entry: the last one wins, as with INSERT_VALUES */
       }

@@ -118,6 +118,71 @@ void mult_dispatch(const Mat_SeqBinBCSR *a, const V *val, const double *x, const
   else mult_bins_any<0, V>(m, a->bw, x, z, y, dot, acc);
 }
 
+/* Symmetric storage: y += A x with the upper triangle (y holds z or zero on entry); *dot += x.y over
+   the rows of each bin once they are final (no later bin scatters into rows of earlier bins). */
+template <int BS, int BW, typename V>
+void sym_mult_bins_fixed(const Mat_SeqBinBCSR *a, const V *val, const double *x, double *y, double *dot)
+{
+  constexpr int BS2 = BS * BS;
+  double        d   = 0.0;
+  for (PetscInt b = 0; b < a->nbins; b++) {
+    const PetscInt s0 = a->bin_start[b], len = (a->bin_start[b + 1] - s0) / BW, r0 = b * BW;
+    binbcsr::sym_bin_mult<BS, BW, V, PetscInt>(val + (size_t)s0 * BS2, a->col + s0, (int)len, r0, a->mbs, x, y);
+    if (dot)
+      for (PetscInt p = r0 * BS; p < PetscMin(a->mbs, r0 + BW) * BS; p++) d += x[p] * y[p];
+  }
+  if (dot) *dot += d;
+}
+
+/* Any bin width or block size: the lanes of a bin one after the other (no conflicts at all). */
+template <int BS, typename V>
+void sym_mult_bins_any(const Mat_SeqBinBCSR *a, const V *val, const double *x, double *y, double *dot, double *acc)
+{
+  const PetscInt bs = BS ? BS : a->bs, bs2 = bs * bs, bw = a->bw;
+  double         d  = 0.0;
+  for (PetscInt b = 0; b < a->nbins; b++) {
+    const PetscInt s0 = a->bin_start[b], len = (a->bin_start[b + 1] - s0) / bw, r0 = b * bw, r1 = PetscMin(a->mbs, r0 + bw);
+    for (PetscInt r = r0; r < r1; r++) {
+      for (PetscInt i = 0; i < bs; i++) acc[i] = 0.0;
+      binbcsr::sym_lane_mult<BS, V, PetscInt>(val + (size_t)s0 * bs2, a->col + s0, (int)len, (int)bw, (int)bs, (int)(r - r0), r, x, x + (size_t)r * bs, y, acc);
+      for (PetscInt i = 0; i < bs; i++) y[r * bs + i] += acc[i];
+    }
+    if (dot)
+      for (PetscInt p = r0 * bs; p < r1 * bs; p++) d += x[p] * y[p];
+  }
+  if (dot) *dot += d;
+}
+
+template <int BS, typename V>
+void sym_mult_dispatch_bw(const Mat_SeqBinBCSR *a, const V *val, const double *x, double *y, double *dot, double *acc)
+{
+  switch (a->bw) {
+  case 4:
+    sym_mult_bins_fixed<BS, 4, V>(a, val, x, y, dot);
+    break;
+  case 8:
+    sym_mult_bins_fixed<BS, 8, V>(a, val, x, y, dot);
+    break;
+  case 16:
+    sym_mult_bins_fixed<BS, 16, V>(a, val, x, y, dot);
+    break;
+  case 32:
+    sym_mult_bins_fixed<BS, 32, V>(a, val, x, y, dot);
+    break;
+  default:
+    sym_mult_bins_any<BS, V>(a, val, x, y, dot, acc);
+  }
+}
+
+template <typename V>
+void sym_mult_dispatch(const Mat_SeqBinBCSR *a, const V *val, const double *x, double *y, double *dot, double *acc)
+{
+  if (dot) *dot = 0.0;
+  if (a->bs == 3) sym_mult_dispatch_bw<3, V>(a, val, x, y, dot, acc);
+  else if (a->bs == 1) sym_mult_dispatch_bw<1, V>(a, val, x, y, dot, acc);
+  else sym_mult_bins_any<0, V>(a, val, x, y, dot, acc);
+}
+
 /* y += A^T x (y holds z or zero on entry). Scatter: rows are visited lane by lane. */
 template <int BS, typename V>
 void mult_transpose_bins(const Mat_SeqBinBCSR *a, const V *val, const double *x, double *y)
@@ -142,6 +207,13 @@ void mult_transpose_dispatch(const Mat_SeqBinBCSR *a, const V *val, const double
 
 } // namespace
 
+static PetscInt CountDiagonal(const Mat_SeqBinBCSR *a)
+{
+  PetscInt n = 0;
+  for (PetscInt r = 0; r < a->mbs; r++) n += a->diag_slot[r] >= 0;
+  return n;
+}
+
 /* y = z + A x (z may be null, may alias y); dot: optional local x.y. */
 static PetscErrorCode MatMultKernel_SeqBinBCSR(Mat A, Vec xx, Vec zz, Vec yy, PetscScalar *dot)
 {
@@ -156,6 +228,18 @@ static PetscErrorCode MatMultKernel_SeqBinBCSR(Mat A, Vec xx, Vec zz, Vec yy, Pe
     if (!fixed) PetscCall(PetscMalloc1(a->bs, &acc));
   }
   PetscCall(VecGetArrayRead(xx, &x));
+  if (a->sym) { /* y = z (or 0), then y += A x with scatters */
+    if (zz && zz != yy) PetscCall(VecCopy(zz, yy));
+    PetscCall(VecGetArray(yy, &y));
+    if (!zz) PetscCall(PetscArrayzero(y, A->rmap->n));
+    if (a->val) sym_mult_dispatch<double>(a, a->val, x, y, dot, acc);
+    else sym_mult_dispatch<float>(a, a->valf, x, y, dot, acc);
+    PetscCall(VecRestoreArray(yy, &y));
+    PetscCall(VecRestoreArrayRead(xx, &x));
+    PetscCall(PetscFree(acc));
+    PetscCall(PetscLogFlops(2.0 * (2 * a->nz - CountDiagonal(a)) * a->bs2 - (zz ? 0.0 : (double)A->rmap->n) + (dot ? 2.0 * A->rmap->n : 0.0)));
+    PetscFunctionReturn(0);
+  }
   if (zz == yy) {
     PetscCall(VecGetArray(yy, &y));
     z = y;
@@ -217,7 +301,7 @@ static PetscErrorCode MatMultTransposeKernel_SeqBinBCSR(Mat A, Vec xx, Vec zz, V
 
   PetscFunctionBegin;
   PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
-  if (A->symmetric == PETSC_BOOL3_TRUE) { /* A^T = A: the vectorised product */
+  if (A->symmetric == PETSC_BOOL3_TRUE || a->sym) { /* A^T = A: the vectorised product */
     PetscCall(MatMultKernel_SeqBinBCSR(A, xx, zz, yy, nullptr));
     PetscFunctionReturn(0);
   }

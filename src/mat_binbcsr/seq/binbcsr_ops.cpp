@@ -35,6 +35,20 @@ void ForEachLane(const Mat_SeqBinBCSR *a, F &&f)
   else ForEachLane(a, a->valf, f);
 }
 
+/* f(value index, row block r, column block c, i, j) for every stored value of a real slot (padding
+   excluded), whatever the storage; used where symmetric storage scatters real slots over the bin. */
+template <typename F>
+void ForEachRealValue(const Mat_SeqBinBCSR *a, F &&f)
+{
+  const PetscInt bs = a->bs;
+  for (PetscInt r = 0; r < a->mbs; r++)
+    for (PetscInt k = 0; k < a->row_nz[r]; k++) {
+      const PetscInt s = BinBCSRSlot(a, r, k), c = a->col[s];
+      for (PetscInt i = 0; i < bs; i++)
+        for (PetscInt j = 0; j < bs; j++) f(BinBCSRValueIndex(s, i * bs + j, a->bw, a->bs2), r, c, i, j);
+    }
+}
+
 PetscErrorCode CheckBuilt(Mat A, const char *op)
 {
   const Mat_SeqBinBCSR *a = (const Mat_SeqBinBCSR *)A->data;
@@ -104,7 +118,7 @@ PetscErrorCode PatternContains(Mat Y, Mat X, PetscBool *contains)
     const PetscInt *cols;
     PetscCall(MatGetRow(X, i, &n, &cols, nullptr));
     for (PetscInt k = 0; k < n; k++)
-      if (MatSeqBinBCSRFindSlot(y, i / y->bs, cols[k] / y->bs) < 0) {
+      if (!(y->sym && cols[k] / y->bs < i / y->bs) && MatSeqBinBCSRFindSlot(y, i / y->bs, cols[k] / y->bs) < 0) {
         *contains = PETSC_FALSE;
         break;
       }
@@ -125,6 +139,7 @@ PetscErrorCode AddRows(Mat Y, PetscScalar a, Mat X)
     const PetscScalar *vals;
     PetscCall(MatGetRow(X, i, &n, &cols, &vals));
     for (PetscInt k = 0; k < n; k++) {
+      if (y->sym && cols[k] / bs < i / bs) continue; /* symmetric storage: the lower triangle is implied */
       const PetscInt s = MatSeqBinBCSRFindSlot(y, i / bs, cols[k] / bs);
       const PetscInt v = BinBCSRValueIndex(s, (i % bs) * bs + cols[k] % bs, y->bw, y->bs2);
       BinBCSRSetValue(y, v, BinBCSRGetValue(y, v) + a * vals[k]);
@@ -166,6 +181,7 @@ PetscErrorCode AXPYUnion(Mat Y, PetscScalar a, Mat X)
   PetscCall(MatSetType(B, MATSEQBINBCSR));
   PetscCall(MatBinBCSRSetBinWidth(B, y->bw));
   PetscCall(MatBinBCSRSetPrecision(B, y->precision));
+  PetscCall(MatBinBCSRSetSymmetricStorage(B, y->sym));
   PetscCall(PetscLayoutSetUp(B->rmap));
   PetscCall(PetscLayoutSetUp(B->cmap));
   PetscCall(MatSeqBinBCSRBuildLayout(B, bi.data(), bj.data()));
@@ -189,8 +205,9 @@ PetscErrorCode AXPYUnion(Mat Y, PetscScalar a, Mat X)
 PetscBool SameLayout(const Mat_SeqBinBCSR *y, const Mat_SeqBinBCSR *x)
 {
   if (!y->built || !x->built) return PETSC_FALSE;
-  if (y->bs != x->bs || y->bw != x->bw || y->mbs != x->mbs || y->nbs != x->nbs || y->nslots != x->nslots) return PETSC_FALSE;
+  if (y->bs != x->bs || y->bw != x->bw || y->mbs != x->mbs || y->nbs != x->nbs || y->nslots != x->nslots || y->sym != x->sym) return PETSC_FALSE;
   if (y->bin_start == x->bin_start && y->col == x->col) return PETSC_TRUE;
+  if (y->sym && !std::equal(y->real_slot, y->real_slot + y->nz, x->real_slot)) return PETSC_FALSE;
   return std::equal(y->bin_start, y->bin_start + y->nbins + 1, x->bin_start) && std::equal(y->row_nz, y->row_nz + y->mbs, x->row_nz) && std::equal(y->col, y->col + y->nslots, x->col) ? PETSC_TRUE : PETSC_FALSE;
 }
 
@@ -221,7 +238,8 @@ static PetscErrorCode MatScale_SeqBinBCSR(Mat A, PetscScalar alpha)
   if (PetscIsInfOrNanScalar(alpha)) {
     /* real slots only: 0 * Inf would put NaN into the padding */
     const int bw = (int)a->bw, bs2 = (int)a->bs2;
-    ForEachLane(a, [&](auto *bin_val, const PetscInt *, PetscInt, int lane, int nz) { binbcsr::lane_scale(bin_val, nz, bw, bs2, lane, alpha); });
+    if (a->sym) ForEachRealValue(a, [&](PetscInt v, PetscInt, PetscInt, PetscInt, PetscInt) { BinBCSRSetValue(a, v, alpha * BinBCSRGetValue(a, v)); });
+    else ForEachLane(a, [&](auto *bin_val, const PetscInt *, PetscInt, int lane, int nz) { binbcsr::lane_scale(bin_val, nz, bw, bs2, lane, alpha); });
   } else if (a->val) binbcsr::values_scale((long)a->nslots * a->bs2, a->val, alpha);
   else binbcsr::values_scale((long)a->nslots * a->bs2, a->valf, alpha);
   PetscCall(PetscLogFlops((PetscLogDouble)a->nz * a->bs2));
@@ -304,6 +322,11 @@ static PetscErrorCode MatAXPY_SeqBinBCSR(Mat Y, PetscScalar alpha, Mat X, MatStr
       PetscCall(PetscLogFlops(2.0 * y->nz * y->bs2));
       PetscFunctionReturn(0);
     }
+    if (y->sym) { /* real slots only (the colouring scatters them over the bin) */
+      ForEachRealValue(y, [&](PetscInt v, PetscInt, PetscInt, PetscInt, PetscInt) { BinBCSRSetValue(y, v, BinBCSRGetValue(y, v) + alpha * BinBCSRGetValue(x, v)); });
+      PetscCall(PetscLogFlops(2.0 * y->nz * y->bs2));
+      PetscFunctionReturn(0);
+    }
     for (PetscInt b = 0; b < y->nbins; b++) {
       const size_t   off = (size_t)y->bin_start[b] * y->bs2;
       const PetscInt r0 = b * y->bw, r1 = PetscMin(y->mbs, r0 + y->bw);
@@ -334,6 +357,7 @@ static PetscErrorCode MatZeroRows_SeqBinBCSR(Mat A, PetscInt N, const PetscInt r
   PetscInt        v;
 
   PetscFunctionBegin;
+  BinBCSRCheckNotSym(a, "MatZeroRows (zeroing rows but not columns would make the matrix non-symmetric; use MatZeroRowsColumns)");
   PetscCall(CheckRows(A, N, rows, diag, x, b, PETSC_FALSE, "MatZeroRows"));
   if (x && b) {
     const PetscScalar *xx;
@@ -378,6 +402,28 @@ static PetscErrorCode MatZeroRowsColumns_SeqBinBCSR(Mat A, PetscInt N, const Pet
     PetscCall(VecGetArrayRead(x, &xx));
     PetscCall(VecGetArray(b, &bb));
   }
+  if (a->sym) {
+    /* each stored entry (R, C) of an upper block stands for itself and, off the diagonal block, for
+       (C, R): move the known values of both to b, then zero it if its row or column goes */
+    ForEachRealValue(a, [&](PetscInt v, PetscInt r, PetscInt c, PetscInt i, PetscInt j) {
+      const PetscInt R = r * bs + i, C = c * bs + j;
+      if (!zeroed[R] && !zeroed[C]) return;
+      const PetscScalar val = BinBCSRGetValue(a, v);
+      if (bb) {
+        if (!zeroed[R]) bb[R] -= val * xx[C];
+        if (c != r && !zeroed[C]) bb[C] -= val * xx[R];
+      }
+      BinBCSRSetValue(a, v, 0.0);
+    });
+    for (PetscInt i = 0; i < A->rmap->n; i++) {
+      if (!zeroed[i]) continue;
+      if (bb) bb[i] = diag * xx[i];
+      if (diag != 0.0) {
+        PetscCall(DiagonalIndex(A, i, "MatZeroRowsColumns", &v));
+        BinBCSRSetValue(a, v, diag);
+      }
+    }
+  } else {
   /* the columns, in the rows that stay (moving the known values to b) */
   ForEachLane(a, [&](auto *bin_val, const PetscInt *bin_col, PetscInt r, int lane, int nz) { binbcsr::lane_zero_columns(bin_val, bin_col, nz, bw, bs, lane, zeroed, zeroed + r * bs, xx, bb ? bb + r * bs : nullptr); });
   /* then the rows */
@@ -392,6 +438,7 @@ static PetscErrorCode MatZeroRowsColumns_SeqBinBCSR(Mat A, PetscInt N, const Pet
       PetscCall(DiagonalIndex(A, i, "MatZeroRowsColumns", &v));
       BinBCSRSetValue(a, v, diag);
     }
+  }
   }
   if (x && b) {
     PetscCall(VecRestoreArrayRead(x, &xx));
@@ -408,6 +455,31 @@ static PetscErrorCode MatNorm_SeqBinBCSR(Mat A, NormType type, PetscReal *nrm)
 
   PetscFunctionBegin;
   PetscCall(CheckBuilt(A, "MatNorm"));
+  if (a->sym) {
+    /* Frobenius: off-diagonal blocks count twice; 1 = infinity (symmetric): row sums of the full
+       matrix, i.e. the stored rows plus the stored off-diagonal blocks' columns */
+    if (type == NORM_FROBENIUS) {
+      double sum = 0.0;
+      ForEachRealValue(a, [&](PetscInt v, PetscInt r, PetscInt c, PetscInt, PetscInt) {
+        const double x = PetscAbsScalar(BinBCSRGetValue(a, v));
+        sum += (c == r ? 1.0 : 2.0) * x * x;
+      });
+      *nrm = PetscSqrtReal(sum);
+    } else if (type == NORM_1 || type == NORM_INFINITY) {
+      double *row_sum;
+      PetscCall(PetscCalloc1((size_t)a->mbs * bs, &row_sum));
+      ForEachRealValue(a, [&](PetscInt v, PetscInt r, PetscInt c, PetscInt i, PetscInt j) {
+        const double x = PetscAbsScalar(BinBCSRGetValue(a, v));
+        row_sum[r * bs + i] += x;
+        if (c != r) row_sum[c * bs + j] += x;
+      });
+      *nrm = 0.0;
+      for (PetscInt i = 0; i < a->mbs * bs; i++) *nrm = PetscMax(*nrm, row_sum[i]);
+      PetscCall(PetscFree(row_sum));
+    } else SETERRQ(PETSC_COMM_SELF, PETSC_ERR_SUP, "MATSEQBINBCSR has no %s norm", NormTypes[type]);
+    PetscCall(PetscLogFlops(2.0 * a->nz * a->bs2));
+    PetscFunctionReturn(0);
+  }
   if (type == NORM_FROBENIUS) {
     const long n = (long)a->nslots * a->bs2;
     *nrm         = PetscSqrtReal(a->val ? binbcsr::values_sum_squares(n, a->val) : binbcsr::values_sum_squares(n, a->valf));
@@ -456,7 +528,7 @@ static PetscErrorCode MatGetInfo_SeqBinBCSR(Mat A, MatInfoType flag, MatInfo *in
     info->nz_used            = (double)a->nz * bs2;
     info->nz_allocated       = (double)a->nslots * bs2;
     info->nz_unneeded        = info->nz_allocated - info->nz_used;
-    info->memory             = info->nz_allocated * value_bytes + (double)(a->nslots + a->nbins + 1 + 2 * a->mbs) * sizeof(PetscInt) + (a->coo_jmap ? (double)(a->nslots * bs2 + 1 + a->coo_n) * sizeof(PetscInt) : 0.0);
+    info->memory             = info->nz_allocated * value_bytes + (double)(a->nslots + a->nbins + 1 + 2 * a->mbs + (a->sym ? a->nz + a->mbs + 1 : 0)) * sizeof(PetscInt) + (a->coo_jmap ? (double)(a->nslots * bs2 + 1 + a->coo_n) * sizeof(PetscInt) : 0.0);
   }
   PetscFunctionReturn(0);
 }

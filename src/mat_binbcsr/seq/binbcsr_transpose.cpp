@@ -17,6 +17,11 @@ PetscErrorCode MatTranspose_SeqBinBCSR(Mat A, MatReuse reuse, Mat *B)
 
   PetscFunctionBegin;
   PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatTranspose needs an assembled MATSEQBINBCSR matrix");
+  if (a->sym) { /* symmetric storage: A^T = A */
+    if (reuse == MAT_INITIAL_MATRIX) PetscCall(MatDuplicate(A, MAT_COPY_VALUES, B));
+    else if (reuse == MAT_REUSE_MATRIX && *B != A) PetscCall(MatCopy(A, *B, SAME_NONZERO_PATTERN));
+    PetscFunctionReturn(0);
+  }
   /* transposed pattern: block row c of A^T lists the block rows r of A holding column c, in order */
   for (PetscInt r = 0; r < a->mbs; r++)
     for (PetscInt k = 0; k < a->row_nz[r]; k++) bi[a->col[BinBCSRSlot(a, r, k)] + 1]++;
