@@ -12,7 +12,7 @@ static PetscErrorCode MatDestroy_MPIBinBCSR(Mat mat)
   delete MPIBinBCSR(mat);
   mat->data = nullptr;
   PetscCall(PetscObjectChangeTypeName((PetscObject)mat, nullptr));
-  const char *names[] = {"MatMPIAIJSetPreallocation_C", "MatMPIBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatGetDiagonalBlock_C", "MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatConvert_mpibinbcsr_mpiaij_C"};
+  const char *names[] = {"MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatMPIAIJSetPreallocation_C", "MatMPIBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatGetDiagonalBlock_C", "MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatConvert_mpibinbcsr_mpiaij_C"};
   for (const char *name : names) PetscCall(PetscObjectComposeFunction((PetscObject)mat, name, (void (*)(void)) nullptr));
   PetscFunctionReturn(0);
 }
@@ -130,6 +130,32 @@ static PetscErrorCode MatBinBCSRGetPrecision_MPIBinBCSR(Mat mat, MatBinBCSRPreci
   PetscFunctionReturn(0);
 }
 
+/* Symmetric storage applies to the diagonal part: the off-diagonal part stays full, so every rank
+   multiplies its own rows without sending transposed contributions to other ranks. */
+static PetscErrorCode MatBinBCSRSetSymmetricStorage_MPIBinBCSR(Mat mat, PetscBool flg)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  if (flg == b->sym) PetscFunctionReturn(0);
+  PetscCheck(!flg || mat->rmap->N < 0 || mat->cmap->N < 0 || mat->rmap->N == mat->cmap->N, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_SIZ, "Symmetric storage needs a square matrix, this one is %" PetscInt_FMT " x %" PetscInt_FMT, mat->rmap->N, mat->cmap->N);
+  PetscCheck(!mat->assembled && !b->compressed, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONGSTATE, "Symmetric storage must be chosen before the layout is built (first final assembly or COO preallocation)");
+  if (b->A) PetscCall(MatBinBCSRSetSymmetricStorage(b->A, flg));
+  b->sym = flg;
+  if (flg) {
+    PetscCall(MatSetOption(mat, MAT_SYMMETRIC, PETSC_TRUE));
+    PetscCall(MatSetOption(mat, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRGetSymmetricStorage_MPIBinBCSR(Mat mat, PetscBool *flg)
+{
+  PetscFunctionBegin;
+  *flg = MPIBinBCSR(mat)->sym;
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MatGetDiagonalBlock_MPIBinBCSR(Mat mat, Mat *a)
 {
   PetscFunctionBegin;
@@ -143,7 +169,7 @@ static PetscErrorCode MatSetFromOptions_MPIBinBCSR(Mat mat, PetscOptionItems *Pe
   PetscInt            bw = b->bin_width;
   MatBinBCSRPrecision p  = b->precision;
   char                inner[64];
-  PetscBool           flg;
+  PetscBool           flg, sym;
 
   PetscFunctionBegin;
   PetscOptionsHeadBegin(PetscOptionsObject, "MATMPIBINBCSR options");
@@ -156,6 +182,9 @@ static PetscErrorCode MatSetFromOptions_MPIBinBCSR(Mat mat, PetscOptionItems *Pe
   if (flg) PetscCall(MatBinBCSRSetBinWidth_MPIBinBCSR(mat, bw));
   PetscCall(PetscOptionsEnum("-mat_binbcsr_precision", "Value storage", "MatBinBCSRSetPrecision", MatBinBCSRPrecisions, (PetscEnum)p, (PetscEnum *)&p, &flg));
   if (flg) PetscCall(MatBinBCSRSetPrecision_MPIBinBCSR(mat, p));
+  sym = b->sym;
+  PetscCall(PetscOptionsBool("-mat_binbcsr_symmetric_storage", "Store the upper triangle of the diagonal part only (symmetric matrices; the lower triangle given is ignored)", "MatBinBCSRSetSymmetricStorage", sym, &sym, &flg));
+  if (flg) PetscCall(MatBinBCSRSetSymmetricStorage_MPIBinBCSR(mat, sym));
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }
@@ -214,10 +243,10 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRCreatePart(Mat mat, PetscInt m, PetscIn
   PetscCall(MatSetType(*part, b->inner_type));
   if (b->bin_width) PetscCall(MatBinBCSRSetBinWidth(*part, b->bin_width));
   if (b->precision_set) PetscCall(MatBinBCSRSetPrecision(*part, b->precision));
+  if (b->sym && part == &b->A) PetscCall(MatBinBCSRSetSymmetricStorage(*part, PETSC_TRUE)); /* B stays full */
   for (const auto &[op, flg] : b->part_options) {
     const bool wholematrix = op == MAT_SYMMETRIC || op == MAT_SPD || op == MAT_HERMITIAN || op == MAT_STRUCTURALLY_SYMMETRIC || op == MAT_SYMMETRY_ETERNAL || op == MAT_STRUCTURAL_SYMMETRY_ETERNAL || op == MAT_SPD_ETERNAL;
-    if (wholematrix && m != n) continue; /* not a property of the off-diagonal part */
-    if (wholematrix && !b->A) continue;  /* only A when created first */
+    if (wholematrix && part != &b->A) continue; /* not a property of the off-diagonal part (even when it happens to be square) */
     PetscCall(MatSetOption(*part, op, flg));
   }
   PetscFunctionReturn(0);
@@ -314,6 +343,7 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRBuildSendSF(MPI_Comm comm, PetscInt nse
    more than one rank.
 
    Options: -mat_binbcsr_bin_width, -mat_binbcsr_precision (forwarded to both parts),
+            -mat_binbcsr_symmetric_storage (the diagonal part only; the off-diagonal part stays full),
             -mat_mpibinbcsr_inner_type (type of the parts, default seqbinbcsr).
 M*/
 PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
@@ -362,6 +392,8 @@ PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatMultDotLocal_C", MatMultDotLocal_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatGetDiagonalBlock_C", MatGetDiagonalBlock_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetBinWidth_C", MatBinBCSRSetBinWidth_MPIBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetSymmetricStorage_C", MatBinBCSRSetSymmetricStorage_MPIBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetSymmetricStorage_C", MatBinBCSRGetSymmetricStorage_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetBinWidth_C", MatBinBCSRGetBinWidth_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetPrecision_C", MatBinBCSRSetPrecision_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetPrecision_C", MatBinBCSRGetPrecision_MPIBinBCSR));

@@ -69,6 +69,7 @@ struct Mat_MPIBinBCSR {
   PetscInt                                     bin_width = 0;                     /* 0: the inner type's default */
   PetscBool                                    precision_set = PETSC_FALSE;
   MatBinBCSRPrecision                          precision = MAT_BINBCSR_PRECISION_DOUBLE;
+  PetscBool                                    sym = PETSC_FALSE; /* symmetric storage of the diagonal part (B stays full) */
 
   /* MatGetRow buffers */
   std::vector<PetscInt>    row_cols;

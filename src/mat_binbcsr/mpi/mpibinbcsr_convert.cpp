@@ -167,6 +167,7 @@ PETSC_INTERN PetscErrorCode MatDuplicate_MPIBinBCSR(Mat mat, MatDuplicateOption 
   c->bin_width          = b->bin_width;
   c->precision_set      = b->precision_set;
   c->precision          = b->precision;
+  c->sym                = b->sym;
   c->garray             = b->garray;
   c->compressed         = b->compressed;
   c->b_staging          = b->b_staging;

@@ -467,3 +467,57 @@ TEST_CASE("mpibinbcsr: settings forwarded, bad input refused", "[mpi]")
   }
   PCHK(MatDestroy(&A));
 }
+
+TEST_CASE("mpibinbcsr with symmetric storage (upper diagonal part, full off-diagonal part) equals the serial matrix", "[mpi][sym]")
+{
+  PCHK(PetscOptionsSetValue(nullptr, "-mat_binbcsr_symmetric_storage", "1"));
+  for (bool empty_rank0 : {false, true})
+    for (Fill fill : {Fill::Blocked, Fill::Coo, Fill::ScalarOwnRows}) {
+      INFO("fill " << fill_name(fill) << ", rank 0 empty " << empty_rank0);
+      const FemProblem fem(5, 4, 3, true);
+      Mat              A, S, C;
+      PCHK(assemble(fem, MATMPIBINBCSR, fill, empty_rank0, &A));
+      PetscBool sym = PETSC_FALSE;
+      PCHK(MatBinBCSRGetSymmetricStorage(A, &sym));
+      CHECK(sym);
+      PCHK(serial_reference(fem, &S));
+      check_products(A, S);
+      // both triangles back out of it
+      PCHK(MatConvert(A, MATMPIAIJ, MAT_INITIAL_MATRIX, &C));
+      check_products(C, S);
+      PCHK(MatDestroy(&C));
+      PCHK(MatDestroy(&A));
+      PCHK(MatDestroy(&S));
+    }
+  // CG and MCG: the iterations of aij
+  const FemProblem fem(6, 5, 4, true);
+  for (KSPType kt : {KSPCG, KSPMCG}) {
+    PetscInt its[2];
+    for (int t = 0; t < 2; ++t) {
+      Mat A;
+      KSP ksp;
+      PC  pc;
+      Vec b, x;
+      if (t == 0) PCHK(PetscOptionsClearValue(nullptr, "-mat_binbcsr_symmetric_storage"));
+      else PCHK(PetscOptionsSetValue(nullptr, "-mat_binbcsr_symmetric_storage", "1"));
+      PCHK(assemble(fem, t == 0 ? MATMPIAIJ : MATMPIBINBCSR, Fill::Coo, false, &A));
+      PCHK(MatCreateVecs(A, &x, &b));
+      PCHK(fill_test_vector(b));
+      PCHK(KSPCreate(PETSC_COMM_WORLD, &ksp));
+      PCHK(KSPSetOperators(ksp, A, A));
+      PCHK(KSPSetType(ksp, kt));
+      PCHK(KSPGetPC(ksp, &pc));
+      PCHK(PCSetType(pc, PCJACOBI));
+      PCHK(KSPSetTolerances(ksp, 1e-10, 1e-50, PETSC_DEFAULT, 1000));
+      PCHK(KSPSolve(ksp, b, x));
+      PCHK(KSPGetIterationNumber(ksp, &its[t]));
+      PCHK(KSPDestroy(&ksp));
+      PCHK(VecDestroy(&b));
+      PCHK(VecDestroy(&x));
+      PCHK(MatDestroy(&A));
+    }
+    INFO("ksp " << kt);
+    CHECK(its[0] == its[1]);
+  }
+  PCHK(PetscOptionsClearValue(nullptr, "-mat_binbcsr_symmetric_storage"));
+}
