@@ -62,6 +62,10 @@ point() {
     args+=(-static -fem_corotational 0 -steps 1 -dt 1)
   else
     args+=(-fem_corotational 1 -dt "$dt" -steps "$(awk -v T="$T" -v dt="$dt" 'BEGIN { printf "%d", T / dt + 0.5 }')")
+    # rtol 1e-6 is below single storage's precision floor on this stiff beam: MCG stops with
+    # DIVERGED_BREAKDOWN and the driver stops the run. Claim relative to the rounded matrix instead
+    # (the static point keeps the default and shows the honest reason).
+    [ "$prec" = single ] && args+=(-ksp_mcg_precision_floor 0)
   fi
   r=$(run "$name" "${args[@]}")
   if [ "$r" = failed ]; then note "$name failed (see $out/tradeoff_$name.log)"; return; fi

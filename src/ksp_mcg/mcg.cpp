@@ -57,8 +57,14 @@ static PetscErrorCode KSPView_MCG(KSP ksp, PetscViewer viewer)
       PetscCall(PetscViewerASCIIPrintf(viewer, "  fast path: off (%s): PCApply between two fused vector passes\n", mcg->why_generic));
     }
     PetscCall(PetscViewerASCIIPrintf(viewer, "  matrix product fused with u.Au: %s\n", mcg->mat_fused ? "yes (matrix type provides MatMultDotLocal)" : "no (MatMult, then a local dot)"));
-    if (mcg->single_storage) PetscCall(PetscViewerASCIIPrintf(viewer, "  operator values stored in single precision: residuals are relative to the rounded operator (expect ~1e-7 relative against double-precision values)\n"));
   }
+  if (mcg->fixed_its <= 0) {
+    if (mcg->floor_set == 0) PetscCall(PetscViewerASCIIPrintf(viewer, "  precision floor: off (-ksp_mcg_precision_floor 0)\n"));
+    else if (mcg->floor_set > 0 || mcg->roundoff > 0) PetscCall(PetscViewerASCIIPrintf(viewer, "  precision floor: operator products rounded at u = %g (%s); no tolerance is claimed below u ||A|| ||x||, the solve stops there with DIVERGED_BREAKDOWN\n", (double)(mcg->floor_set > 0 ? mcg->floor_set : mcg->roundoff), mcg->floor_set > 0 ? "-ksp_mcg_precision_floor" : "values stored in single precision"));
+    else if (ksp->setupstage == KSP_SETUP_NEW) PetscCall(PetscViewerASCIIPrintf(viewer, "  precision floor: decided from the matrix at the first solve (single-precision storage: u = %g)\n", MCG_SINGLE_ROUNDOFF));
+    else PetscCall(PetscViewerASCIIPrintf(viewer, "  precision floor: none (operator products in double precision)\n"));
+  }
+  if (mcg->floor > 0) PetscCall(PetscViewerASCIIPrintf(viewer, "  last solve: precision floor u ||A|| ||x|| = %g (||A|| >= %g, ||x|| = %g)%s\n", (double)mcg->floor, (double)mcg->floor_anorm, (double)mcg->floor_xnorm, mcg->floor_hit && ksp->reason == KSP_DIVERGED_BREAKDOWN ? ": REACHED before the tolerance, stopped there (DIVERGED_BREAKDOWN; the residual against the assembled values is about the floor)" : mcg->floor_hit ? ": reached" : ", not reached"));
   if (mcg->drift > 0) PetscCall(PetscViewerASCIIPrintf(viewer, "  last solve: estimated rounding drift of the recursive residual %g (claims %g times above it are not re-checked)\n", (double)mcg->drift, MCG_DRIFT_MARGIN));
   if (mcg->true_checks) PetscCall(PetscViewerASCIIPrintf(viewer, "  last solve: %" PetscInt_FMT " true-residual checks, %" PetscInt_FMT " restarts, true residual norm %g\n", mcg->true_checks, mcg->restarts, (double)mcg->true_rnorm));
   PetscFunctionReturn(0);
@@ -94,7 +100,36 @@ static PetscErrorCode KSPSetFromOptions_MCG(KSP ksp, PetscOptionItems *PetscOpti
   PetscCall(PetscOptionsBool("-ksp_mcg_fused_pc", "Apply PCJACOBI/PCNONE inside the fused vector pass", "", mcg->allow_fused, &mcg->allow_fused, nullptr));
   PetscCall(PetscOptionsBool("-ksp_mcg_verify_residual", "Confirm convergence on the true residual b - A x, restarting if it fails", "", mcg->verify, &mcg->verify, nullptr));
   PetscCall(PetscOptionsReal("-ksp_mcg_stagnation", "Each restart must shrink the true residual by this factor", "", mcg->stagnation, &mcg->stagnation, nullptr));
+  PetscCall(PetscOptionsReal("-ksp_mcg_precision_floor", "Relative rounding u of the operator's products: stop at u ||A|| ||x|| instead of claiming a tolerance below it (-1: from the matrix, 0: off)", "", mcg->floor_set, &mcg->floor_set, nullptr));
+  PetscCheck(mcg->floor_set == MCG_FLOOR_AUTO || (mcg->floor_set >= 0 && mcg->floor_set < 1), PetscObjectComm((PetscObject)ksp), PETSC_ERR_ARG_OUTOFRANGE, "-ksp_mcg_precision_floor must be -1 (from the matrix), 0 (off) or a relative rounding in (0, 1), not %g", (double)mcg->floor_set);
   PetscOptionsHeadEnd();
+  PetscFunctionReturn(0);
+}
+
+/* -ksp_converged_reason: before PETSc's line (PETSc calls registered views first), say that a DIVERGED_BREAKDOWN was the precision floor.
+   Registered once per KSP with KSPConvergedReasonViewSet (PETSc calls those views after every solve),
+   it prints only when -ksp_converged_reason is given and the KSP is still KSPMCG. */
+static PetscErrorCode KSPConvergedReasonView_MCGFloor(KSP ksp, void *)
+{
+  PetscBool         ismcg, flg, iascii;
+  PetscViewer       viewer;
+  PetscViewerFormat format;
+  KSP_MCG          *mcg;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPMCG, &ismcg));
+  if (!ismcg) PetscFunctionReturn(0);
+  mcg = (KSP_MCG *)ksp->data;
+  if (!mcg->floor_hit || ksp->reason != KSP_DIVERGED_BREAKDOWN) PetscFunctionReturn(0);
+  PetscCall(PetscOptionsGetViewer(PetscObjectComm((PetscObject)ksp), ((PetscObject)ksp)->options, ((PetscObject)ksp)->prefix, "-ksp_converged_reason", &viewer, &format, &flg));
+  if (!flg) PetscFunctionReturn(0);
+  PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &iascii));
+  if (iascii) {
+    PetscCall(PetscViewerASCIIAddTab(viewer, ((PetscObject)ksp)->tablevel));
+    PetscCall(PetscViewerASCIIPrintf(viewer, "KSPMCG reached the precision floor of its operator: ||b - A x|| ~ u ||A|| ||x|| = %g (u = %g%s) before the tolerance; the solve stopped there\n", (double)mcg->floor, (double)mcg->roundoff, mcg->single_storage ? ", values stored in single precision" : ""));
+    PetscCall(PetscViewerASCIISubtractTab(viewer, ((PetscObject)ksp)->tablevel));
+  }
+  PetscCall(PetscViewerDestroy(&viewer));
   PetscFunctionReturn(0);
 }
 
@@ -109,7 +144,10 @@ static PetscErrorCode KSPSetFromOptions_MCG(KSP ksp, PetscOptionItems *PetscOpti
 +  -ksp_mcg_fixed_iterations <n> - exactly n iterations per solve, no convergence test (0: off)
 .  -ksp_mcg_fused_pc <bool> - fuse jacobi/none into the vector pass (default true)
 .  -ksp_mcg_verify_residual <bool> - confirm convergence on b - A x (default true)
--  -ksp_mcg_stagnation <f> - a restart from the true residual must shrink it by f (default 0.5)
+.  -ksp_mcg_stagnation <f> - a restart from the true residual must shrink it by f (default 0.5)
+-  -ksp_mcg_precision_floor <u> - relative rounding of the operator's products; the solve stops with
+   KSP_DIVERGED_BREAKDOWN at u ||A|| ||x|| instead of claiming a tolerance below it (default -1: from
+   the matrix, 2^-24 for binbcsr single storage and none otherwise; 0: off)
 M*/
 PetscErrorCode KSPCreate_MCG(KSP ksp)
 {
@@ -121,6 +159,7 @@ PetscErrorCode KSPCreate_MCG(KSP ksp)
   mcg->verify      = PETSC_TRUE;
   mcg->stagnation  = 0.5;
   mcg->true_rnorm  = -1.0;
+  mcg->floor_set   = MCG_FLOOR_AUTO;
   ksp->data        = (void *)mcg;
   PetscCall(KSPSetSupportedNorm(ksp, KSP_NORM_PRECONDITIONED, PC_LEFT, 3));
   PetscCall(KSPSetSupportedNorm(ksp, KSP_NORM_UNPRECONDITIONED, PC_LEFT, 2));
@@ -136,6 +175,12 @@ PetscErrorCode KSPCreate_MCG(KSP ksp)
   ksp->ops->buildresidual  = KSPBuildResidualDefault;
   PetscCall(PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGSetFixedIterations_C", KSPMCGSetFixedIterations_MCG));
   PetscCall(PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGGetFixedIterations_C", KSPMCGGetFixedIterations_MCG));
+  {
+    PetscBool registered = PETSC_FALSE;
+    for (PetscInt k = 0; k < ksp->numberreasonviews; k++)
+      if (ksp->reasonview[k] == KSPConvergedReasonView_MCGFloor) registered = PETSC_TRUE;
+    if (!registered) PetscCall(KSPConvergedReasonViewSet(ksp, KSPConvergedReasonView_MCGFloor, nullptr, nullptr));
+  }
   PetscFunctionReturn(0);
 }
 

@@ -18,12 +18,15 @@ typedef struct {
   PetscBool allow_fused;   /* -ksp_mcg_fused_pc: apply jacobi/none inside the vector pass */
   PetscBool verify;        /* -ksp_mcg_verify_residual: confirm convergence on b - A x */
   PetscReal stagnation;    /* a restart must shrink the true residual by this factor, else give up */
+  PetscReal floor_set;     /* -ksp_mcg_precision_floor: relative rounding u of the operator's products;
+                              MCG_FLOOR_AUTO: from the matrix (single storage: 2^-24, else none), 0: off */
 
   /* chosen at each solve */
   MCGPreconditioning how;
   char               why_generic[160]; /* why the fused path was not taken (for KSPView) */
   PetscBool          mat_fused;        /* Amat composes "MatMultDotLocal_C" */
   PetscBool          single_storage;   /* Amat stores its values in single precision */
+  PetscReal          roundoff;         /* u used in this solve (0: no precision floor) */
 
   /* Jacobi diagonal owned by KSPMCG, rebuilt when the preconditioning matrix changes */
   Vec              dinv;
@@ -36,10 +39,20 @@ typedef struct {
   PetscReal true_rnorm;      /* norm of b - A x at the last check, -1 when none was made */
   PetscInt  true_checks;     /* number of true-residual checks of the last solve */
   PetscReal drift;           /* estimated rounding drift of the recursive residual at the last claim */
+  PetscReal floor;           /* precision floor u ||A|| ||x|| (2-norm of b - A x) at the end, 0 when none */
+  PetscBool floor_hit;       /* the last solve's residual fell below the precision floor */
+  PetscReal floor_anorm, floor_xnorm; /* the estimates of ||A|| and ||x|| the floor was made of */
 } KSP_MCG;
 
 /* A claim of convergence at least this far above the estimated rounding drift is not re-checked. */
 #define MCG_DRIFT_MARGIN 100.0
+
+/* -ksp_mcg_precision_floor default: take the operator's rounding from the matrix. */
+#define MCG_FLOOR_AUTO -1.0
+/* Relative rounding of values stored in single precision (round to nearest: 2^-24). */
+#define MCG_SINGLE_ROUNDOFF 5.9604644775390625e-08
+/* Below the precision floor, iterate until the residual of the rounded system is this fraction of it. */
+#define MCG_FLOOR_DEPTH 0.1
 
 PETSC_INTERN PetscErrorCode KSPSolve_MCG(KSP);
 

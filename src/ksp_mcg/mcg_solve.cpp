@@ -309,11 +309,13 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
   PetscCall(PCGetOperators(ksp->pc, &Amat, &Pmat));
   PetscCall(MCGChoosePath(ksp, Amat));
   {
+    /* MatBinBCSRGetPrecision answers double for every other matrix type (aij, shell, ...) */
     MatBinBCSRPrecision precision;
     PetscCall(MatBinBCSRGetPrecision(Amat, &precision));
     mcg->single_storage = precision == MAT_BINBCSR_PRECISION_SINGLE ? PETSC_TRUE : PETSC_FALSE;
-    if (mcg->single_storage && ksp->rtol < 1e-6)
-      PetscCall(PetscInfo(ksp, "rtol %g with single-precision matrix storage: residuals are relative to the rounded operator; against double-precision values expect a floor near 1e-7\n", (double)ksp->rtol));
+    mcg->roundoff       = mcg->floor_set != MCG_FLOOR_AUTO ? mcg->floor_set : (mcg->single_storage ? MCG_SINGLE_ROUNDOFF : 0.0);
+    if (mcg->fixed_its > 0 || ksp->normtype == KSP_NORM_NONE) mcg->roundoff = 0.0; /* no tolerance is claimed */
+    if (mcg->roundoff > 0) PetscCall(PetscInfo(ksp, "operator products rounded at u = %g%s: no tolerance is claimed below u ||A|| ||x||\n", (double)mcg->roundoff, mcg->single_storage ? " (single-precision storage)" : ""));
   }
   if (mcg->how == MCG_PC_JACOBI) PetscCall(MCGUpdateDiagonal(ksp));
   max_its           = mcg->fixed_its > 0 ? mcg->fixed_its : ksp->max_it;
@@ -321,6 +323,8 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
   mcg->true_checks  = 0;
   mcg->true_rnorm   = -1.0;
   mcg->drift        = 0.0;
+  mcg->floor        = 0.0;
+  mcg->floor_hit    = PETSC_FALSE;
   ksp->its          = 0;
 
   /* r = b - A x, u = M^-1 r, w = A u, and the first reduction */
@@ -409,6 +413,36 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
     PetscCall(KSPMonitor(ksp, i, dp));
     if (mcg->fixed_its > 0) continue;
     PetscCall((*ksp->converged)(ksp, i, dp, &ksp->reason, ksp->cnvP));
+
+    /* Precision floor. When the operator's products are rounded at relative u (single-precision
+       storage), b - A x against the values the user assembled differs from the residual MCG
+       iterates on by up to about u ||A|| ||x|| (||A|| from the largest Rayleigh quotient seen,
+       ||x|| from the reduced x.x: both free). A tolerance met at or below that floor cannot be
+       claimed honestly, so the claim is withheld; the iteration goes on until the residual of the
+       rounded system is MCG_FLOOR_DEPTH below the floor (the solution is then as good as the
+       rounded operator allows: the estimate is a bound, the actual plateau is usually a few times
+       lower) and stops with KSP_DIVERGED_BREAKDOWN, reporting the floor as the residual norm. */
+    if (mcg->roundoff > 0 && (ksp->reason == KSP_CONVERGED_ITERATING || MCGIsToleranceClaim(ksp->reason))) {
+      const PetscReal r_un = PetscSqrtReal(PetscAbsScalar(dots[MCG_DOT_RR]));
+      mcg->floor       = mcg->roundoff * anorm * xnorm;
+      mcg->floor_anorm = anorm;
+      mcg->floor_xnorm = xnorm;
+      if (r_un <= mcg->floor) {
+        if (ksp->reason) {
+          if (!mcg->floor_hit) PetscCall(PetscInfo(ksp, "Tolerance met at residual norm %g, at or below the precision floor u ||A|| ||x|| = %g (u %g, ||A|| >= %g, ||x|| %g): claim withheld\n", (double)r_un, (double)mcg->floor, (double)mcg->roundoff, (double)anorm, (double)xnorm));
+          ksp->reason = KSP_CONVERGED_ITERATING;
+        }
+        mcg->floor_hit = PETSC_TRUE;
+      }
+      if (mcg->floor_hit && r_un <= MCG_FLOOR_DEPTH * mcg->floor) {
+        PetscCheck(!ksp->errorifnotconverged, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "KSPMCG: the tolerance is below the precision floor u ||A|| ||x|| = %g of the operator (u = %g)", (double)mcg->floor, (double)mcg->roundoff);
+        PetscCall(PetscInfo(ksp, "Precision floor u ||A|| ||x|| = %g (u %g, ||A|| >= %g, ||x|| %g) reached at iteration %" PetscInt_FMT " before the tolerance: stopping\n", (double)mcg->floor, (double)mcg->roundoff, (double)anorm, (double)xnorm, i));
+        ksp->reason = KSP_DIVERGED_BREAKDOWN;
+        /* the floor in the KSP's norm: scaled by the ratio of the KSP's norm to the 2-norm of r */
+        ksp->rnorm = r_un > 0 ? dp * (mcg->floor / r_un) : mcg->floor;
+        break;
+      }
+    }
 
     /* The recursively updated r drifts from b - A x by rounding, by at most about
        eps * sum_k (|A| |x_k| + |r_k|) (Greenbaum 1997; |A| estimated from below by the largest

@@ -55,10 +55,14 @@ TEST_CASE("mcg matches cg on binbcsr, double and single storage", "[ksp_mcg][bin
         continue;
       }
       INFO("grid " << n << ", precision " << MatBinBCSRPrecisions[precision]);
+      // the same iteration as KSPCG on the operator both are given: for single storage that needs the
+      // precision floor off (with it, mcg stops at the floor instead of claiming rtol 1e-10; see
+      // precision_floor.cpp)
+      const char *floor_off = "-ksp_mcg_precision_floor 0";
       for (const char *pc : {PCJACOBI, PCNONE}) {
         INFO("pc " << pc);
         const Result cg = solve(B, b, Solve{KSPCG, pc, KSP_NORM_UNPRECONDITIONED, 1e-10});
-        const Result mcg = solve(B, b, Solve{KSPMCG, pc, KSP_NORM_UNPRECONDITIONED, 1e-10});
+        const Result mcg = solve(B, b, Solve{KSPMCG, pc, KSP_NORM_UNPRECONDITIONED, 1e-10, 1000, 0, floor_off});
         REQUIRE(mcg.err == 0);
         CHECK(cg.reason > 0);
         CHECK(mcg.reason == cg.reason);
@@ -67,7 +71,7 @@ TEST_CASE("mcg matches cg on binbcsr, double and single storage", "[ksp_mcg][bin
         for (size_t k = 0; k < 15 && k < cg.history.size() && k < mcg.history.size() && cg.history[k] > 1e-9 * cg.history[0]; k++) CHECK(mcg.history[k] == Approx(cg.history[k]).epsilon(1e-8));
         // k iterates equal to round-off
         const Result cg5 = solve(B, b, Solve{KSPCG, pc, KSP_NORM_UNPRECONDITIONED, 1e-30, 5});
-        const Result mcg5 = solve(B, b, Solve{KSPMCG, pc, KSP_NORM_UNPRECONDITIONED, 1e-30, 5});
+        const Result mcg5 = solve(B, b, Solve{KSPMCG, pc, KSP_NORM_UNPRECONDITIONED, 1e-30, 5, 0, floor_off});
         CHECK(rel_diff(mcg5.x, cg5.x) < 1e-12);
       }
       // binbcsr double storage is the same operator as aij: same iterates as mcg on aij
@@ -136,7 +140,7 @@ TEST_CASE("mcg uses the fused product of binbcsr and says so", "[ksp_mcg][binbcs
   MatDestroy(&A);
 }
 
-TEST_CASE("single storage: converged on the rounded operator, floor against double values", "[ksp_mcg][binbcsr]")
+TEST_CASE("single storage: rtol 1e-6 converges, rtol 1e-11 stops at the precision floor", "[ksp_mcg][binbcsr]")
 {
   Mat A = block_laplacian(12, 12);
   Mat B = to_binbcsr(A, MAT_BINBCSR_PRECISION_SINGLE);
@@ -145,19 +149,30 @@ TEST_CASE("single storage: converged on the rounded operator, floor against doub
     MatDestroy(&A);
     return;
   }
-  Vec b = rhs(A);
+  Vec       b = rhs(A);
+  PetscReal bnorm;
+  VecNorm(b, NORM_2, &bnorm);
   // rtol 1e-6: reachable also against the double-precision matrix
   Result r = solve(B, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-6});
   CHECK(r.reason == KSP_CONVERGED_RTOL);
   CHECK(rel_residual(A, b, r.x) < 2e-6);
-  // rtol 1e-11: met on the operator MCG was given (up to the recursive residual's rounding drift) ...
-  r = solve(B, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-11});
+  // rtol 1e-11 with the precision floor off: met on the operator MCG was given (up to the recursive
+  // residual's rounding drift) ...
+  r = solve(B, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-11, 1000, 0, "-ksp_mcg_precision_floor 0"});
   CHECK(r.reason == KSP_CONVERGED_RTOL);
   CHECK(rel_residual(B, b, r.x) < 1.05e-11);
   // ... but against the double-precision values the residual stays at float rounding level
   const PetscReal floor_vs_double = rel_residual(A, b, r.x);
   CHECK(floor_vs_double > 1e-10);
   CHECK(floor_vs_double < 1e-5);
+  // by default no such claim: stopped at the floor, which is reported as the residual norm and is
+  // not below the residual against the double-precision values
+  r = solve(B, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-11});
+  CHECK(r.reason == KSP_DIVERGED_BREAKDOWN);
+  const PetscReal true_vs_double = rel_residual(A, b, r.x);
+  CHECK(r.rnorm / bnorm >= true_vs_double);
+  CHECK(r.rnorm / bnorm < 20 * true_vs_double);
+  CHECK(true_vs_double < 2 * floor_vs_double); // as accurate as iterating on
   MatDestroy(&B);
   MatDestroy(&A);
   VecDestroy(&b);

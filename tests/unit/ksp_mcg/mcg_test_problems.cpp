@@ -3,7 +3,7 @@
 
 namespace mcg_test {
 
-Mat block_laplacian(PetscInt nx, PetscInt ny, const char *mattype)
+Mat block_laplacian(PetscInt nx, PetscInt ny, const char *mattype, PetscReal neumann_shift)
 {
   const PetscInt    bs = 3, nodes = nx * ny;
   const PetscScalar K[3][3] = {{4, 1, 0}, {1, 3, 1}, {0, 1, 2}};
@@ -24,11 +24,14 @@ Mat block_laplacian(PetscInt nx, PetscInt ny, const char *mattype)
   for (PetscInt node = start; node < start + local_nodes; node++) {
     const PetscInt i = node % nx, j = node / nx;
     const PetscInt nb[5][2] = {{i, j}, {i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
+    PetscInt       neighbours = 0;
+    for (int k = 1; k < 5; k++) neighbours += nb[k][0] >= 0 && nb[k][1] >= 0 && nb[k][0] < nx && nb[k][1] < ny;
+    const PetscScalar centre = neumann_shift >= 0 ? neighbours + neumann_shift : 4.0 + 1.0;
     for (int k = 0; k < 5; k++) {
       const PetscInt ni = nb[k][0], nj = nb[k][1];
       if (ni < 0 || nj < 0 || ni >= nx || nj >= ny) continue;
       const PetscInt other = nj * nx + ni;
-      const PetscScalar lap = k == 0 ? 4.0 + 1.0 : -1.0; // shifted Laplacian: SPD, moderately conditioned
+      const PetscScalar lap = k == 0 ? centre : -1.0; // shifted Laplacian: SPD
       for (PetscInt a = 0; a < bs; a++)
         for (PetscInt b = 0; b < bs; b++) {
           const PetscScalar v = lap * K[a][b] * scale(node) * scale(other);

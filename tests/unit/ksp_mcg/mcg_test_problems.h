@@ -9,7 +9,9 @@ namespace mcg_test {
 
 // 3x3-block operator on an nx x ny grid: (5-point Laplacian) (x) K + shift, with K a fixed SPD 3x3
 // block, then scaled symmetrically by a smoothly varying diagonal so that Jacobi matters. SPD.
-Mat block_laplacian(PetscInt nx, PetscInt ny, const char *mattype = MATAIJ);
+// neumann_shift >= 0: the Laplacian's diagonal is the node's neighbour count + neumann_shift instead
+// of 5 (singular Neumann Laplacian shifted by neumann_shift: condition number ~ 1 / neumann_shift).
+Mat block_laplacian(PetscInt nx, PetscInt ny, const char *mattype = MATAIJ, PetscReal neumann_shift = -1);
 // Diagonal matrix with the given diagonal (rank 0 owns everything, other ranks nothing).
 Mat diagonal(const std::vector<PetscScalar> &d);
 // Vector compatible with A, every entry equal to `value` (or 1, 2, 3, ... when value is NaN-free
