@@ -29,6 +29,7 @@
 #include <stdexcept>
 #include <string>
 #include <sys/stat.h>
+#include <ctime>
 #include <unistd.h>
 #include <vector>
 
@@ -60,6 +61,7 @@ struct Options {
   PetscBool   reorder = PETSC_TRUE;
   PetscInt    bin_order_window = FemScene().bin_order_window;
   PetscBool   quiet   = PETSC_FALSE;
+  PetscInt    element_bench = 0;
   PetscBool   is_static = PETSC_FALSE;
   PetscReal   v0[3] = {0, 0, 0};
   PetscReal   spin[3] = {0, 0, 0};
@@ -108,6 +110,8 @@ PetscErrorCode GetOptions(Options &o)
                              "", o.merge, &o.merge, nullptr));
   PetscCall(PetscOptionsBool("-fem_reorder", "METIS partition / RCM renumbering of the nodes", "", o.reorder, &o.reorder, nullptr));
   PetscCall(PetscOptionsInt("-fem_bin_order_window", "with -fem_reorder: sort nodes by row length in windows of N (0 = off)", "", o.bin_order_window, &o.bin_order_window, nullptr));
+  PetscCall(PetscOptionsInt("-fem_element_bench", "after the steps, time the element loop N more times (CPU time)", "",
+                            o.element_bench, &o.element_bench, nullptr));
   PetscCall(PetscOptionsBool("-fem_quiet", "no progress line per step", "", o.quiet, &o.quiet, nullptr));
   PetscCall(PetscOptionsBool("-static", "solve K(x) dx = f(x) + f_ext by Newton steps instead of time steps", "", o.is_static,
                              &o.is_static, nullptr));
@@ -369,6 +373,32 @@ int main(int argc, char **argv)
       break;
     }
     if (step % o.vtk_every == 0) write_frame(step);
+  }
+  if (o.element_bench > 0) {
+    // CPU time of this process (less sensitive to other jobs than wall time); min and median.
+    auto cpu_ms = [] {
+      timespec ts;
+      clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+      return 1e3 * ts.tv_sec + 1e-6 * ts.tv_nsec;
+    };
+    std::vector<double> reset_ms, loop_ms;
+    for (PetscInt r = 0; r < o.element_bench; ++r) {
+      const double c0 = cpu_ms();
+      physics::reset_block_values(sim.pattern, sim.values);
+      std::fill(sim.rhs_full.begin(), sim.rhs_full.end(), 0.0);
+      const double c1 = cpu_ms();
+      physics::assemble_elements(model, sim.elements, x.data(), v.data(), sim.coefficients, &sim.pattern, sim.values.data(),
+                                 sim.rhs_full.data());
+      const double c2 = cpu_ms();
+      reset_ms.push_back(c1 - c0);
+      loop_ms.push_back(c2 - c1);
+    }
+    std::sort(reset_ms.begin(), reset_ms.end());
+    std::sort(loop_ms.begin(), loop_ms.end());
+    PetscCall(PetscSynchronizedPrintf(comm, "element_bench rank %d elements %zu reset_ms min %.3f median %.3f loop_ms min %.3f median %.3f ns_per_element %.1f\n",
+                                      rank, sim.elements.size(), reset_ms.front(), reset_ms[reset_ms.size() / 2], loop_ms.front(),
+                                      loop_ms[loop_ms.size() / 2], 1e6 * loop_ms.front() / std::max<size_t>(sim.elements.size(), 1)));
+    PetscCall(PetscSynchronizedFlush(comm, PETSC_STDOUT));
   }
   t_element *= 1e-3; t_comm *= 1e-3; t_setvalues *= 1e-3; t_solve *= 1e-3; t_total *= 1e-3;
 

@@ -34,6 +34,7 @@ PetscErrorCode FemSimulationCreate(MPI_Comm comm, const FemScene &scene, FemSimu
       }
       if (scene.bin_order_window > 0) r = physics::group_by_row_length(physics::row_lengths_without_fixed(g, sim->fixed), r, scene.bin_order_window);
       physics::renumber_nodes(mesh, r.new_of_old);
+      physics::sort_elements_by_lowest_node(mesh);
       std::vector<char> f(sim->fixed.size());
       for (size_t i = 0; i < f.size(); ++i) f[r.new_of_old[i]] = sim->fixed[i];
       sim->fixed        = f;

@@ -60,6 +60,21 @@ void renumber_nodes(TetMesh &mesh, const std::vector<int> &new_of_old)
   for (int &v : mesh.elements) v = new_of_old[v];
 }
 
+void sort_elements_by_lowest_node(TetMesh &mesh)
+{
+  const int        npe = mesh.nodes_per_element(), ne = mesh.element_count();
+  std::vector<int> lowest(ne), order(ne);
+  for (int e = 0; e < ne; ++e) {
+    lowest[e] = *std::min_element(mesh.elements.begin() + static_cast<size_t>(e) * npe, mesh.elements.begin() + static_cast<size_t>(e + 1) * npe);
+    order[e]  = e;
+  }
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return lowest[a] < lowest[b]; });
+  std::vector<int> sorted(mesh.elements.size());
+  for (int k = 0; k < ne; ++k)
+    std::copy_n(mesh.elements.begin() + static_cast<size_t>(order[k]) * npe, npe, sorted.begin() + static_cast<size_t>(k) * npe);
+  mesh.elements.swap(sorted);
+}
+
 void validate_mesh(const TetMesh &mesh, const std::string &what)
 {
   const int n = mesh.node_count(), npe = mesh.nodes_per_element();

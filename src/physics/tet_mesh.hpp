@@ -34,6 +34,12 @@ TetMesh promote_to_quadratic(const TetMesh &mesh);
 // Node n becomes new_of_old[n] (a permutation of 0..node_count-1).
 void renumber_nodes(TetMesh &mesh, const std::vector<int> &new_of_old);
 
+// Reorders the elements by their lowest node number (stable; each element keeps its node order, so
+// its orientation). After a locality numbering of the nodes, consecutive elements then touch nearby
+// rows of the matrix, and the element loop's writes into the row-sorted block values hit cache
+// instead of memory (in mesh-file order they missed on most of the 16 blocks of every P1 element).
+void sort_elements_by_lowest_node(TetMesh &mesh);
+
 // Throws std::runtime_error naming the first offending element when an element's rest volume is not
 // positive (inverted or flat) or a node index is out of range, and when nodes are unused.
 void validate_mesh(const TetMesh &mesh, const std::string &what);

@@ -72,6 +72,42 @@ TEST_CASE("polar decomposition: proper rotation for regular, inverted, flat and 
   CHECK((rotation_from_deformation(1e-9 * Q * S) - Q).norm() < 1e-9);
 }
 
+TEST_CASE("polar decomposition agrees with the SVD polar factor on random F, near inversion too", "[fem][polar]")
+{
+  std::mt19937                           rng(11);
+  std::normal_distribution<double>       normal(0, 1);
+  std::uniform_real_distribution<double> uniform(0, 1);
+  auto random_rotation = [&] {
+    Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
+    return q.normalized().toRotationMatrix();
+  };
+  double worst = 0;
+  for (int k = 0; k < 2000; ++k) {
+    // F = U diag(s) V^T with singular values between 0.05 and 3 (strains of 1e-6 to 200%).
+    const double    spread = std::pow(10.0, -6 + 6 * uniform(rng));
+    Eigen::Vector3d s;
+    for (int d = 0; d < 3; ++d) s[d] = std::max(0.05, 1 + spread * normal(rng));
+    const Eigen::Matrix3d U = random_rotation(), V = random_rotation();
+    const Eigen::Matrix3d F = U * s.asDiagonal() * V.transpose();
+    const Eigen::Matrix3d R = rotation_from_deformation(F);
+    REQUIRE(is_rotation(R));
+    worst = std::max(worst, (R - U * V.transpose()).norm());
+  }
+  CHECK(worst < 1e-12);
+  // Across inversion: smallest singular value from +1e-3 through 0 to -1e-3 (one axis reflected).
+  // The rotation is the one of the sign-corrected SVD, a proper rotation, and continuous.
+  const Eigen::Matrix3d U = random_rotation(), V = random_rotation();
+  Eigen::Matrix3d       previous = Eigen::Matrix3d::Zero();
+  for (int k = -10; k <= 10; ++k) {
+    const Eigen::Matrix3d F = U * Eigen::Vector3d(1.2, 0.9, 1e-4 * k).asDiagonal() * V.transpose();
+    const Eigen::Matrix3d R = rotation_from_deformation(F);
+    CHECK(is_rotation(R));
+    CHECK((R - U * V.transpose()).norm() < 1e-9);
+    if (k > -10) CHECK((R - previous).norm() < 1e-9);
+    previous = R;
+  }
+}
+
 TEST_CASE("P2 shape functions integrate to -V/20 (corners) and V/5 (edges); masses positive", "[fem][mass]")
 {
   const Eigen::VectorXd w = shape_function_integrals(2);
