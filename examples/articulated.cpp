@@ -6,9 +6,9 @@
 // Scenes (-scene): chain (-chain_links, -chain_length, -chain_angle, -chain_mass_first, -chain_mass_last),
 // bridge (-bridge_chains, -bridge_links, -bridge_tie_every, -bridge_sag), loop (four-bar linkage).
 // Solver options: -joint_tol (m), -max_corrections, -joint_regularisation, -joint_refresh,
-// -velocity_stabilisation. Output: a progress line every -progress_every steps, -vtk PREFIX (.vtu per
-// -vtk_every steps plus PREFIX.pvd), -dump_matrix FILE (J M^-1 J^T of the first step, PETSc binary), and a
-// final `summary key=value ...` line.
+// -velocity_stabilisation, -joint_warm_start (previous step's impulses as initial guesses). Output: a progress
+// line every -progress_every steps, -vtk PREFIX (.vtu per -vtk_every steps plus PREFIX.pvd), -dump_matrix FILE
+// (J M^-1 J^T of the first step, PETSc binary), and a final `summary key=value ...` line.
 #include "common/replicated_solver.h"
 #include "common/summary.h"
 #include "physics/articulated_scenes.hpp"
@@ -112,7 +112,7 @@ int main(int argc, char **argv)
 
   physics::ArticulatedParams params;
   PetscInt                   steps = 100, progress_every = 1, vtk_every = 1, max_corr = params.max_corrections;
-  PetscBool                  vel_stab = PETSC_TRUE, refresh = PETSC_FALSE, vtk_points = PETSC_FALSE, set_vtk, set_dump;
+  PetscBool                  vel_stab = PETSC_TRUE, refresh = PETSC_FALSE, warm = PETSC_FALSE, vtk_points = PETSC_FALSE, set_vtk, set_dump;
   char                       vtk_prefix[PETSC_MAX_PATH_LEN] = "", dump_path[PETSC_MAX_PATH_LEN] = "";
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-steps", &steps, nullptr));
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-dt", &params.dt, nullptr));
@@ -122,6 +122,8 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-joint_regularisation", &params.regularisation, nullptr));
   PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-joint_refresh", &refresh, nullptr));
   PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-velocity_stabilisation", &vel_stab, nullptr));
+  PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-joint_warm_start", &warm, nullptr));
+  params.warm_start             = warm;
   params.refresh_matrix         = refresh;
   params.velocity_stabilisation = vel_stab;
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-progress_every", &progress_every, nullptr));
@@ -140,6 +142,7 @@ int main(int argc, char **argv)
   ReplicatedSolver           rs;
   PetscCall(ReplicatedSolverCreate(comm, solver.pattern.n_joints, solver.pattern.block_row, solver.pattern.block_col, &rs));
   const physics::BlockLinearSolver linear = ReplicatedSolverAdapter(&rs);
+  if (params.warm_start) PetscCall(KSPSetInitialGuessNonzero(rs.sys.ksp, PETSC_TRUE)); // the physics supplies the guesses
   PetscInt    nnz;
   const char *mat_type, *ksp_type;
   PetscCall(BlockSystemGetInfo(&rs.sys, &nnz, &mat_type, &ksp_type));

@@ -3,6 +3,12 @@
 // distributed. With P > 1 ranks the block rows are partitioned with METIS (physics/partition.hpp) over the
 // pattern's graph and renumbered so each rank owns a contiguous range; each rank hands its own rows' blocks
 // to the BlockSystem and the solution is gathered back to every rank (MPI_Allgatherv), in physics order.
+// On any number of ranks the rows are then sorted by length inside windows of -rows_group_window rows
+// (physics/row_order.hpp; default 256 for -mat_type binbcsr or sell, else 0 = off), so that the bins hold
+// rows of similar length and carry little padding; the physics never sees the new numbering (right-hand sides and solutions are
+// permuted here, the COO values keep their order).
+// The solution vector passed to the solve is the initial guess when the KSP uses one
+// (KSPSetInitialGuessNonzero / -ksp_initial_guess_nonzero).
 #pragma once
 #include "common/sim_system.h"
 #include "physics/block_solver.hpp"
@@ -14,7 +20,8 @@ struct ReplicatedSolver {
   MPI_Comm                 comm = MPI_COMM_NULL;
   int                      size = 1, rank = 0;
   PetscInt                 n_blocks = 0;                  // block rows
-  std::vector<int>         new_of_old, old_of_new;        // identity on one rank
+  std::vector<int>         new_of_old, old_of_new;        // physics block row -> solver block row and back
+  bool                     renumbered = false;            // new_of_old is not the identity
   std::vector<int>         row_offsets;                   // block rows per rank, size + 1 entries
   std::vector<size_t>      local_blocks;                  // indices into the physics COO list, this rank's rows
   std::vector<PetscScalar> local_values, rhs_local, sol_local, sol_all;

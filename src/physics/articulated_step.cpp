@@ -23,42 +23,77 @@ std::string validate_params(const ArticulatedParams &p)
 
 namespace {
 
-struct Arms {
-  std::vector<Eigen::Vector3d> a, b; // world arms of each joint's two ends at the start of the step
-};
-
-void apply_joint_impulses(ArticulatedScene &scene, const Arms &arms, const std::vector<Eigen::Matrix3d> &inv_inertia, const std::vector<double> &impulses)
+void apply_joint_impulses(ArticulatedScene &scene, const ArticulatedSolver &s, const std::vector<double> &impulses)
 {
   for (size_t j = 0; j < scene.joints.size(); ++j) {
     const BallJoint      &jt = scene.joints[j];
     const Eigen::Vector3d p(impulses[3 * j], impulses[3 * j + 1], impulses[3 * j + 2]);
-    if (jt.body_a != kWorld) apply_impulse(scene.bodies[jt.body_a], inv_inertia[jt.body_a], arms.a[j], p);
-    if (jt.body_b != kWorld) apply_impulse(scene.bodies[jt.body_b], inv_inertia[jt.body_b], arms.b[j], -p);
+    if (jt.body_a != kWorld) apply_impulse(scene.bodies[jt.body_a], s.inverse_inertia[jt.body_a], s.arm_a[j], p);
+    if (jt.body_b != kWorld) apply_impulse(scene.bodies[jt.body_b], s.inverse_inertia[jt.body_b], s.arm_b[j], -p);
   }
 }
 
 // C(x~): joint errors at the positions the bodies would reach after dt with their current velocities.
-double predicted_errors(const ArticulatedScene &scene, double dt, std::vector<Eigen::Vector3d> &pos, std::vector<Eigen::Quaterniond> &rot,
-                        std::vector<double> &errors)
+// Returns max |C|.
+double predicted_errors(const ArticulatedScene &scene, double dt, ArticulatedSolver &s)
 {
-  const size_t nb = scene.bodies.size();
-  pos.resize(nb);
-  rot.resize(nb);
+  const size_t nb = scene.bodies.size(), nj = scene.joints.size();
   for (size_t i = 0; i < nb; ++i) {
-    const RigidBody &b = scene.bodies[i];
-    pos[i]             = b.position + dt * b.velocity;
-    rot[i]             = rotated(b.orientation, b.angular_velocity, dt);
+    const RigidBody &b         = scene.bodies[i];
+    s.predicted_position[i]    = b.position + dt * b.velocity;
+    s.predicted_orientation[i] = rotated(b.orientation, b.angular_velocity, dt);
   }
-  auto at = [&](int body, const Eigen::Vector3d &anchor) -> Eigen::Vector3d { return body == kWorld ? anchor : Eigen::Vector3d(pos[body] + rot[body] * anchor); };
-  errors.resize(3 * scene.joints.size());
-  double worst = 0;
-  for (size_t j = 0; j < scene.joints.size(); ++j) {
+  auto at = [&](int body, const Eigen::Vector3d &anchor) -> Eigen::Vector3d {
+    return body == kWorld ? anchor : Eigen::Vector3d(s.predicted_position[body] + s.predicted_orientation[body] * anchor);
+  };
+  double worst2 = 0;
+  for (size_t j = 0; j < nj; ++j) {
     const BallJoint      &jt = scene.joints[j];
     const Eigen::Vector3d e  = at(jt.body_a, jt.anchor_a) - at(jt.body_b, jt.anchor_b);
-    for (int k = 0; k < 3; ++k) errors[3 * j + k] = e[k];
-    worst = std::max(worst, e.norm());
+    for (int k = 0; k < 3; ++k) s.errors[3 * j + k] = e[k];
+    worst2 = std::max(worst2, e.squaredNorm());
   }
-  return worst;
+  return std::sqrt(worst2);
+}
+
+// Rotation, world inverse inertia and joint arms for the given orientations (the bodies' own when null).
+void update_frames(const ArticulatedScene &scene, ArticulatedSolver &s, const std::vector<Eigen::Quaterniond> *orientations)
+{
+  for (size_t i = 0; i < scene.bodies.size(); ++i) {
+    const RigidBody &b = scene.bodies[i];
+    s.rotation[i]      = (orientations ? (*orientations)[i] : b.orientation).toRotationMatrix();
+    s.inverse_inertia[i] = s.rotation[i] * b.inertia_body.inverse() * s.rotation[i].transpose();
+  }
+  for (size_t j = 0; j < scene.joints.size(); ++j) {
+    const BallJoint &jt = scene.joints[j];
+    s.arm_a[j]          = jt.body_a == kWorld ? Eigen::Vector3d::Zero() : Eigen::Vector3d(s.rotation[jt.body_a] * jt.anchor_a);
+    s.arm_b[j]          = jt.body_b == kWorld ? Eigen::Vector3d::Zero() : Eigen::Vector3d(s.rotation[jt.body_b] * jt.anchor_b);
+  }
+}
+
+// Relative connector velocities u_a - u_b (J v) with the current arms; returns max |J v|.
+double velocity_errors(const ArticulatedScene &scene, ArticulatedSolver &s)
+{
+  auto velocity = [&](int body, const Eigen::Vector3d &arm) -> Eigen::Vector3d {
+    if (body == kWorld) return Eigen::Vector3d::Zero();
+    const RigidBody &b = scene.bodies[body];
+    return b.velocity + b.angular_velocity.cross(arm);
+  };
+  double worst2 = 0;
+  for (size_t j = 0; j < scene.joints.size(); ++j) {
+    const BallJoint      &jt = scene.joints[j];
+    const Eigen::Vector3d u  = velocity(jt.body_a, s.arm_a[j]) - velocity(jt.body_b, s.arm_b[j]);
+    for (int k = 0; k < 3; ++k) s.errors[3 * j + k] = u[k];
+    worst2 = std::max(worst2, u.squaredNorm());
+  }
+  return std::sqrt(worst2);
+}
+
+// The initial guess for a solve: `guess` if warm starting with one of the right size, otherwise zero.
+void set_initial_guess(const ArticulatedParams &params, const std::vector<double> &guess, std::vector<double> &x)
+{
+  if (params.warm_start && guess.size() == x.size()) std::copy(guess.begin(), guess.end(), x.begin());
+  else std::fill(x.begin(), x.end(), 0.0);
 }
 
 } // namespace
@@ -76,17 +111,14 @@ ArticulatedStepReport articulated_step(ArticulatedScene &scene, ArticulatedSolve
     return report;
   }
 
-  std::vector<Eigen::Matrix3d> inv_inertia(nb);
-  for (size_t i = 0; i < nb; ++i) inv_inertia[i] = world_inverse_inertia(scene.bodies[i]);
-  Arms arms;
-  arms.a.resize(nj), arms.b.resize(nj);
-  for (size_t j = 0; j < nj; ++j) {
-    arms.a[j] = joint_arm(scene, scene.joints[j].body_a, scene.joints[j].anchor_a);
-    arms.b[j] = joint_arm(scene, scene.joints[j].body_b, scene.joints[j].anchor_b);
-  }
+  s.rotation.resize(nb), s.inverse_inertia.resize(nb), s.predicted_position.resize(nb), s.predicted_orientation.resize(nb);
+  s.arm_a.resize(nj), s.arm_b.resize(nj);
+  s.rhs.resize(3 * nj), s.impulses.resize(3 * nj), s.errors.resize(3 * nj);
+  s.correction_sum.assign(3 * nj, 0.0);
+  update_frames(scene, s, nullptr);
 
   auto refill = [&]() {
-    fill_joint_matrix(scene, s.pattern, s.regularised ? params.regularisation : 0.0, s.block_values);
+    fill_joint_matrix(scene, s.pattern, s.regularised ? params.regularisation : 0.0, s.inverse_inertia, s.arm_a, s.arm_b, s.block_values);
     linear_solver.set_matrix(s.block_values);
   };
   auto switch_to_regularised = [&]() {
@@ -95,11 +127,13 @@ ArticulatedStepReport articulated_step(ArticulatedScene &scene, ArticulatedSolve
     refill();
   };
   // A breakdown on the unregularised matrix means A is (numerically) singular: regularise and retry.
-  auto solve = [&]() {
+  auto solve = [&](const std::vector<double> &guess) {
+    set_initial_guess(params, guess, s.impulses);
     LinearSolveResult r = linear_solver.solve(s.rhs, s.impulses);
     report.linear_solves++, report.linear_iterations += r.iterations;
     if (r.breakdown && !s.regularised) {
       switch_to_regularised();
+      set_initial_guess(params, guess, s.impulses);
       r = linear_solver.solve(s.rhs, s.impulses);
       report.linear_solves++, report.linear_iterations += r.iterations;
     }
@@ -109,66 +143,58 @@ ArticulatedStepReport articulated_step(ArticulatedScene &scene, ArticulatedSolve
         break;
       }
   };
+  static const std::vector<double> no_guess;
 
   refill();
 
-  joint_velocity_errors(scene, s.errors);
-  for (size_t j = 0; j < nj; ++j) report.velocity_error = std::max(report.velocity_error, Eigen::Vector3d(s.errors[3 * j], s.errors[3 * j + 1], s.errors[3 * j + 2]).norm());
+  report.velocity_error = velocity_errors(scene, s);
   if (params.velocity_stabilisation && report.velocity_error > 0) {
-    s.rhs.resize(3 * nj);
     for (size_t k = 0; k < 3 * nj; ++k) s.rhs[k] = -s.errors[k];
-    solve();
-    apply_joint_impulses(scene, arms, inv_inertia, s.impulses);
+    solve(s.last_stabilisation);
+    apply_joint_impulses(scene, s, s.impulses);
+    s.last_stabilisation = s.impulses;
   }
 
-  for (RigidBody &b : scene.bodies) apply_unconstrained_velocity_update(b, scene.gravity, dt);
+  for (size_t i = 0; i < nb; ++i) apply_unconstrained_velocity_update(scene.bodies[i], s.rotation[i], scene.gravity, dt);
 
-  std::vector<Eigen::Vector3d>    pos;
-  std::vector<Eigen::Quaterniond> rot;
-  double                          error = predicted_errors(scene, dt, pos, rot, s.errors);
+  double error = predicted_errors(scene, dt, s);
   while (error >= params.joint_tol && report.corrections < params.max_corrections) {
     if (params.refresh_matrix && report.corrections > 0) {
       // Newton-like variant: matrix and impulse arms at the predicted orientations.
-      for (size_t i = 0; i < nb; ++i) {
-        const Eigen::Matrix3d R = rot[i].toRotationMatrix();
-        inv_inertia[i]          = R * scene.bodies[i].inertia_body.inverse() * R.transpose();
-      }
-      for (size_t j = 0; j < nj; ++j) {
-        const BallJoint &jt = scene.joints[j];
-        arms.a[j]           = jt.body_a == kWorld ? Eigen::Vector3d::Zero() : Eigen::Vector3d(rot[jt.body_a] * jt.anchor_a);
-        arms.b[j]           = jt.body_b == kWorld ? Eigen::Vector3d::Zero() : Eigen::Vector3d(rot[jt.body_b] * jt.anchor_b);
-      }
-      fill_joint_matrix(scene, s.pattern, s.regularised ? params.regularisation : 0.0, s.block_values, &rot);
-      linear_solver.set_matrix(s.block_values);
+      update_frames(scene, s, &s.predicted_orientation);
+      refill();
     }
-    s.rhs.resize(3 * nj);
     for (size_t k = 0; k < 3 * nj; ++k) s.rhs[k] = -s.errors[k] / dt;
-    solve();
-    apply_joint_impulses(scene, arms, inv_inertia, s.impulses);
+    solve(report.corrections == 0 ? s.last_correction : no_guess);
+    apply_joint_impulses(scene, s, s.impulses);
     report.corrections++;
-    double next = predicted_errors(scene, dt, pos, rot, s.errors);
+    double next = predicted_errors(scene, dt, s);
     // The linearised impulse overshoots when bodies turn far in one step (light links between heavy
     // ones): take back half of it until the error falls (a backtracking line search on max |C|).
     for (int halving = 0; next > error && halving < params.max_halvings; ++halving) {
       for (double &p : s.impulses) p *= -0.5;
-      apply_joint_impulses(scene, arms, inv_inertia, s.impulses);
+      apply_joint_impulses(scene, s, s.impulses);
       for (double &p : s.impulses) p = -p;
-      next = predicted_errors(scene, dt, pos, rot, s.errors);
+      next = predicted_errors(scene, dt, s);
     }
+    for (size_t k = 0; k < 3 * nj; ++k) s.correction_sum[k] += s.impulses[k]; // what was applied
     // No fraction of the impulse helps: the linearisation has run out (round-off in very unequal masses,
     // or a step too long for the rotations); stop and report the step unconverged.
     if (next > error) {
       report.stalled = true;
+      error          = next;
       break;
     }
     error = next;
   }
+  if (report.corrections > 0) s.last_correction.swap(s.correction_sum);
 
   for (size_t i = 0; i < nb; ++i) {
-    scene.bodies[i].position    = pos[i];
-    scene.bodies[i].orientation = rot[i];
+    scene.bodies[i].position    = s.predicted_position[i];
+    scene.bodies[i].orientation = s.predicted_orientation[i];
   }
-  report.joint_error = max_joint_error(scene);
+  // The positions are the last predicted ones, so the last predicted error is the joint error.
+  report.joint_error = error;
   report.converged   = report.joint_error < params.joint_tol;
   return report;
 }

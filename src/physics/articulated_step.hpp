@@ -26,6 +26,12 @@ struct ArticulatedParams {
   bool   velocity_stabilisation = true;
   bool   regularise_from_start  = false;
   bool   refresh_matrix         = false; // refill A at the predicted orientations for every correction after the first
+  // Initial guesses from the previous step: its stabilisation impulses for the stabilisation solve, the sum
+  // of its correction impulses for the first correction, zero for later corrections. Only used if the
+  // linear solver takes the incoming solution as its initial guess (the PETSc drivers then set
+  // KSPSetInitialGuessNonzero). Off by default: it pays when the structure hangs nearly at rest (the same
+  // impulses hold it up every step) and costs iterations when it swings (see docs/articulated.md).
+  bool   warm_start             = false;
 };
 
 struct ArticulatedStepReport {
@@ -43,7 +49,14 @@ struct ArticulatedSolver {
   JointMatrixPattern  pattern;
   std::vector<double> block_values;
   bool                regularised = false;
-  std::vector<double> rhs, impulses, errors; // scratch
+  // Warm start: the previous step's stabilisation impulses and summed correction impulses (3 per joint).
+  std::vector<double> last_stabilisation, last_correction;
+  // Scratch, sized at the first step and reused: no allocation per step after it.
+  std::vector<double>             rhs, impulses, errors, correction_sum;
+  std::vector<Eigen::Matrix3d>    rotation, inverse_inertia;       // per body, start-of-step (or predicted) frame
+  std::vector<Eigen::Vector3d>    arm_a, arm_b;                    // per joint, world arms of its two ends
+  std::vector<Eigen::Vector3d>    predicted_position;              // per body, after dt with the current velocities
+  std::vector<Eigen::Quaterniond> predicted_orientation;
 };
 
 ArticulatedSolver make_articulated_solver(const ArticulatedScene &scene, const ArticulatedParams &params);

@@ -48,42 +48,63 @@ JointMatrixPattern build_joint_matrix_pattern(const ArticulatedScene &scene)
   return p;
 }
 
-Eigen::Matrix3d body_coupling_block(double mass, const Eigen::Matrix3d &inverse_inertia_world, const Eigen::Vector3d &r1, const Eigen::Vector3d &r2)
-{
-  Eigen::Matrix3d c1, c2;
-  c1 << 0, -r1.z(), r1.y(), r1.z(), 0, -r1.x(), -r1.y(), r1.x(), 0;
-  c2 << 0, -r2.z(), r2.y(), r2.z(), 0, -r2.x(), -r2.y(), r2.x(), 0;
-  return Eigen::Matrix3d::Identity() / mass - c1 * inverse_inertia_world * c2;
-}
-
 void fill_joint_matrix(const ArticulatedScene &scene, const JointMatrixPattern &pattern, double regularisation, std::vector<double> &block_values,
                        const std::vector<Eigen::Quaterniond> *orientations)
 {
+  const size_t                 nb = scene.bodies.size(), nj = scene.joints.size();
+  std::vector<Eigen::Matrix3d> inverse_inertia(nb);
+  std::vector<Eigen::Vector3d> arm_a(nj), arm_b(nj);
+  auto orientation = [&](int body) { return orientations ? (*orientations)[body] : scene.bodies[body].orientation; };
+  for (size_t i = 0; i < nb; ++i) {
+    const Eigen::Matrix3d R = orientation((int)i).toRotationMatrix();
+    inverse_inertia[i]      = R * scene.bodies[i].inertia_body.inverse() * R.transpose();
+  }
+  for (size_t j = 0; j < nj; ++j) {
+    const BallJoint &jt = scene.joints[j];
+    arm_a[j]            = jt.body_a == kWorld ? Eigen::Vector3d::Zero() : Eigen::Vector3d(orientation(jt.body_a) * jt.anchor_a);
+    arm_b[j]            = jt.body_b == kWorld ? Eigen::Vector3d::Zero() : Eigen::Vector3d(orientation(jt.body_b) * jt.anchor_b);
+  }
+  fill_joint_matrix(scene, pattern, regularisation, inverse_inertia, arm_a, arm_b, block_values);
+}
+
+void fill_joint_matrix(const ArticulatedScene &scene, const JointMatrixPattern &pattern, double regularisation,
+                       const std::vector<Eigen::Matrix3d> &inverse_inertia_world, const std::vector<Eigen::Vector3d> &arm_a,
+                       const std::vector<Eigen::Vector3d> &arm_b, std::vector<double> &block_values)
+{
   block_values.assign(9 * pattern.block_row.size(), 0.0);
-  std::vector<Eigen::Vector3d> arms;
+  // Per joint end q of a body: I^-1 [r_q]x, so that block (p, q) = (1/m) I - [r_p]x (I^-1 [r_q]x) costs one
+  // cross product per column. Most bodies carry 2 joints; the buffer is for the rare crowded one.
+  constexpr int   kInline = 8;
+  Eigen::Matrix3d inline_buffer[kInline];
+  std::vector<Eigen::Matrix3d> overflow;
   for (size_t g = 0; g + 1 < pattern.group_start.size(); ++g) {
-    const int        body  = pattern.body_of_group[g];
-    const RigidBody &b     = scene.bodies[body];
-    const Eigen::Quaterniond q = orientations ? (*orientations)[body] : b.orientation;
-    const Eigen::Matrix3d R = q.toRotationMatrix();
-    const Eigen::Matrix3d inv_inertia = R * b.inertia_body.inverse() * R.transpose();
-    const int        first = pattern.group_start[g], n = pattern.group_start[g + 1] - first;
-    arms.resize(n);
-    for (int p = 0; p < n; ++p) {
-      const BallJoint &jt = scene.joints[pattern.group_joint[first + p]];
-      arms[p]             = q * (pattern.group_sign[first + p] > 0 ? jt.anchor_a : jt.anchor_b);
+    const int              body  = pattern.body_of_group[g];
+    const double           inv_m = 1.0 / scene.bodies[body].mass;
+    const Eigen::Matrix3d &inv_inertia = inverse_inertia_world[body];
+    const int              first = pattern.group_start[g], n = pattern.group_start[g + 1] - first;
+    Eigen::Matrix3d       *turn  = inline_buffer;
+    if (n > kInline) overflow.resize(n), turn = overflow.data();
+    for (int q = 0; q < n; ++q) {
+      const int              j = pattern.group_joint[first + q];
+      const Eigen::Vector3d &r = pattern.group_sign[first + q] > 0 ? arm_a[j] : arm_b[j];
+      for (int c = 0; c < 3; ++c) turn[q].col(c) = inv_inertia * r.cross(Eigen::Vector3d::Unit(c));
     }
-    for (int p = 0; p < n; ++p)
+    for (int p = 0; p < n; ++p) {
+      const int              jp = pattern.group_joint[first + p];
+      const Eigen::Vector3d &rp = pattern.group_sign[first + p] > 0 ? arm_a[jp] : arm_b[jp];
       for (int q = 0; q < n; ++q) {
-        const Eigen::Matrix3d block = (pattern.group_sign[first + p] * pattern.group_sign[first + q]) * body_coupling_block(b.mass, inv_inertia, arms[p], arms[q]);
-        double *out = &block_values[9 * pattern.pair_block[pattern.pair_start[g] + p * n + q]];
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c) out[3 * r + c] += block(r, c);
+        const double sign = pattern.group_sign[first + p] * pattern.group_sign[first + q];
+        double      *out  = &block_values[9 * pattern.pair_block[pattern.pair_start[g] + p * n + q]];
+        for (int c = 0; c < 3; ++c) {
+          const Eigen::Vector3d col = -rp.cross(turn[q].col(c));
+          for (int r = 0; r < 3; ++r) out[3 * r + c] += sign * (col[r] + (r == c ? inv_m : 0.0));
+        }
       }
+    }
   }
   if (regularisation > 0)
     for (int j = 0; j < pattern.n_joints; ++j) {
-      double *d     = &block_values[9 * pattern.diagonal_block[j]];
+      double      *d     = &block_values[9 * pattern.diagonal_block[j]];
       const double shift = regularisation * (d[0] + d[4] + d[8]) / 3.0;
       d[0] += shift, d[4] += shift, d[8] += shift;
     }

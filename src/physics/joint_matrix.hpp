@@ -21,16 +21,20 @@ struct JointMatrixPattern {
 
 JointMatrixPattern build_joint_matrix_pattern(const ArticulatedScene &scene);
 
-// Block contribution of one body to A: the velocity change of the point at world arm r1 per unit impulse at
-// arm r2, (1/m) I - [r1]x I^-1 [r2]x.
-Eigen::Matrix3d body_coupling_block(double mass, const Eigen::Matrix3d &inverse_inertia_world, const Eigen::Vector3d &r1,
-                                    const Eigen::Vector3d &r2);
-
-// Fills 9 values per COO block (row-major) for the scene's current orientations. regularisation > 0
+// Fills 9 values per COO block (row-major) for the scene's current orientations. Body i adds to block
+// (p, q) of two of its joints s_p s_q ((1/m) I - [r_p]x I^-1 [r_q]x): the velocity change of the point at
+// world arm r_p per unit impulse at arm r_q (s = +1 at end a, -1 at end b). regularisation > 0
 // adds regularisation * (mean diagonal entry of the block) * I to each diagonal block.
 // `orientations`, when given, replaces the bodies' orientations (the matrix at predicted positions).
 void fill_joint_matrix(const ArticulatedScene &scene, const JointMatrixPattern &pattern, double regularisation,
                        std::vector<double> &block_values, const std::vector<Eigen::Quaterniond> *orientations = nullptr);
+
+// The same from what a time step has at hand already: every body's world inverse inertia and every joint's
+// world arms (arm_a of end a, arm_b of end b; ignored for the world). Allocates nothing once block_values
+// has its size.
+void fill_joint_matrix(const ArticulatedScene &scene, const JointMatrixPattern &pattern, double regularisation,
+                       const std::vector<Eigen::Matrix3d> &inverse_inertia_world, const std::vector<Eigen::Vector3d> &arm_a,
+                       const std::vector<Eigen::Vector3d> &arm_b, std::vector<double> &block_values);
 
 // y = A x with the block values (reference product for tests and diagnostics).
 void joint_matrix_multiply(const JointMatrixPattern &pattern, const std::vector<double> &block_values, const std::vector<double> &x,

@@ -1,5 +1,7 @@
 #include "physics/rigid_body.hpp"
 
+#include <cmath>
+
 namespace physics {
 
 Eigen::Matrix3d box_inertia(double mass, const Eigen::Vector3d &size)
@@ -16,9 +18,12 @@ Eigen::Matrix3d world_inverse_inertia(const RigidBody &body)
 
 Eigen::Quaterniond rotated(const Eigen::Quaterniond &q, const Eigen::Vector3d &angular_velocity, double dt)
 {
-  const double angle = angular_velocity.norm() * dt;
+  const double speed = angular_velocity.norm();
+  const double angle = speed * dt;
   if (angle < 1e-300) return q;
-  Eigen::Quaterniond r(Eigen::AngleAxisd(angle, angular_velocity.normalized()));
+  // exp of the half angle about w / |w|, written out (Eigen's AngleAxis path normalises twice)
+  const double       s = std::sin(0.5 * angle) / speed, c = std::cos(0.5 * angle);
+  Eigen::Quaterniond r(c, s * angular_velocity.x(), s * angular_velocity.y(), s * angular_velocity.z());
   Eigen::Quaterniond out = r * q;
   out.normalize();
   return out;
@@ -33,15 +38,20 @@ static Eigen::Matrix3d cross_matrix(const Eigen::Vector3d &a)
 
 void apply_unconstrained_velocity_update(RigidBody &body, const Eigen::Vector3d &gravity, double dt)
 {
+  apply_unconstrained_velocity_update(body, body.orientation.toRotationMatrix(), gravity, dt);
+}
+
+void apply_unconstrained_velocity_update(RigidBody &body, const Eigen::Matrix3d &R, const Eigen::Vector3d &gravity, double dt)
+{
   body.velocity += dt * gravity;
   // Solve I (w' - w) + dt w' x (I w') = 0 in the body frame with one Newton step from w (Catto 2015):
   // explicit treatment of the gyroscopic term adds energy to bodies spinning about unstable axes.
-  const Eigen::Matrix3d  R  = body.orientation.toRotationMatrix();
   const Eigen::Matrix3d &I  = body.inertia_body;
   const Eigen::Vector3d  wb = R.transpose() * body.angular_velocity;
   const Eigen::Vector3d  residual = dt * wb.cross(I * wb);
   const Eigen::Matrix3d  jacobian = I + dt * (cross_matrix(wb) * I - cross_matrix(I * wb));
-  const Eigen::Vector3d  wb_new   = wb - jacobian.partialPivLu().solve(residual);
+  // The Jacobian is I plus O(dt |w|) terms: far from singular, and the closed-form 3x3 inverse is cheap.
+  const Eigen::Vector3d  wb_new   = wb - jacobian.inverse() * residual;
   body.angular_velocity           = R * wb_new;
 }
 

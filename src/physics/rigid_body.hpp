@@ -25,6 +25,8 @@ Eigen::Quaterniond rotated(const Eigen::Quaterniond &q, const Eigen::Vector3d &a
 // Velocity update of the free body over dt: gravity, and the gyroscopic torque -w x (I w) taken
 // implicitly (one Newton step in the body frame) so that fast spinning bodies do not gain energy.
 void apply_unconstrained_velocity_update(RigidBody &body, const Eigen::Vector3d &gravity, double dt);
+// The same with the body's rotation matrix already at hand (R = orientation.toRotationMatrix()).
+void apply_unconstrained_velocity_update(RigidBody &body, const Eigen::Matrix3d &R, const Eigen::Vector3d &gravity, double dt);
 
 // Where position/orientation go after dt with the current velocities (symplectic Euler position step).
 void advance_positions(RigidBody &body, double dt);
