@@ -44,10 +44,12 @@ void mult_bins_fixed(const BinSweep<V> &m, const double *x, const double *z, dou
     for (int i = 0; i < BS; i++)
       for (int l = 0; l < BW; l++) acc[i][l] = 0.0;
     for (PetscInt k = 0; k < len; k++, c += BW, t += BW * BS2) {
+      binbcsr::prefetch_values(t, BW * BS2 * (int)sizeof(V));
       BINBCSR_LANE_LOOP
       for (int l = 0; l < BW; l++) {
-        double xc[BS], yl[BS];
-        for (int j = 0; j < BS; j++) xc[j] = x[(size_t)c[l] * BS + j];
+        const int ci = (int)c[l] * BS; /* 32-bit offsets (PetscInt is 32-bit here): vgatherdpd */
+        double    xc[BS], yl[BS];
+        for (int j = 0; j < BS; j++) xc[j] = x[ci + j];
         for (int i = 0; i < BS; i++) yl[i] = acc[i][l];
         binbcsr::slot_mult<BS, V>(t + l, BW, BS, xc, yl);
         for (int i = 0; i < BS; i++) acc[i][l] = yl[i];
