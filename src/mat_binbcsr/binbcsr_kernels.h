@@ -37,7 +37,7 @@ BINBCSR_HD void prefetch_values(const V *tile, int nbytes)
 {
 #if !defined(__CUDACC__) && defined(__GNUC__)
   if (sizeof(V) < sizeof(double))
-    for (int q = 0; q < nbytes; q += 64) __builtin_prefetch((const char *)tile + prefetch_ahead_bytes + q, 0, 0);
+    for (int q = 0; q < nbytes; q += 64) __builtin_prefetch((const char *)tile + prefetch_ahead_bytes + q, 0, 3);
 #else
   (void)tile;
   (void)nbytes;
