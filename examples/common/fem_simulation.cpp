@@ -60,7 +60,15 @@ PetscErrorCode FemSimulationCreate(MPI_Comm comm, const FemScene &scene, FemSimu
     const int first = sim->model.mesh.elements[(size_t)e * npe];
     if (first >= sim->own_begin && first < sim->own_end) sim->elements.push_back(e);
   }
-  sim->pattern = physics::make_block_pattern(sim->model, sim->elements, sim->fixed, sim->own_begin, sim->own_end, scene.merge_blocks);
+  physics::LowerTriangle lower; // list and compute only the blocks the Mat type stores
+  {
+    PetscBool upper_only, offrank_full;
+    PetscCall(BlockSystemStoredTriangle(comm, &upper_only, &offrank_full));
+    lower.drop = upper_only;
+    if (upper_only && offrank_full) lower.part_offsets = sim->part_offsets;
+  }
+  sim->pattern = physics::make_block_pattern(sim->model, sim->elements, sim->fixed, sim->own_begin, sim->own_end, scene.merge_blocks,
+                                             lower);
   PetscCall(BlockSystemCreate(comm, n_nodes, sim->own_end - sim->own_begin, sim->pattern.rows, sim->pattern.cols, &sim->sys));
   PetscCheck(sim->sys.row_begin == 3 * sim->own_begin && sim->sys.row_end == 3 * sim->own_end, PETSC_COMM_SELF, PETSC_ERR_PLIB,
              "matrix ownership does not match the node partition");

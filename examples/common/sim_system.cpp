@@ -114,7 +114,36 @@ PetscErrorCode PreallocateFromBlockPattern(MPI_Comm comm, PetscInt n_local, Pets
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode MatStoredTriangle(Mat A, PetscBool *upper_only, PetscBool *offrank_full)
+{
+  PetscBool is_sbaij, sym = PETSC_FALSE;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)A, &is_sbaij, MATSEQSBAIJ, MATMPISBAIJ, MATSBAIJ, ""));
+  PetscCall(MatBinBCSRGetSymmetricStorage(A, &sym)); // PETSC_FALSE for other types
+  *upper_only   = (is_sbaij || sym) ? PETSC_TRUE : PETSC_FALSE;
+  *offrank_full = (!is_sbaij && sym) ? PETSC_TRUE : PETSC_FALSE;
+  PetscFunctionReturn(0);
+}
+
 } // namespace
+
+PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, PetscBool *offrank_full)
+{
+  Mat probe;
+
+  PetscFunctionBegin;
+  PetscCall(CheckMatTypeAvailable(comm));
+  // A one-block-row-per-rank matrix of the type the options select, thrown away after the question.
+  PetscCall(MatCreate(comm, &probe));
+  PetscCall(MatSetSizes(probe, 3, 3, PETSC_DETERMINE, PETSC_DETERMINE));
+  PetscCall(MatSetBlockSize(probe, 3));
+  PetscCall(MatSetType(probe, MATAIJ));
+  PetscCall(MatSetFromOptions(probe));
+  PetscCall(MatStoredTriangle(probe, upper_only, offrank_full));
+  PetscCall(MatDestroy(&probe));
+  PetscFunctionReturn(0);
+}
 
 PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, PetscInt n_block_rows_local,
                                  const std::vector<PetscInt> &coo_block_row,
@@ -152,7 +181,20 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
   PetscCall(MatSetBlockSize(sys->A, 3));
   PetscCall(MatSetType(sys->A, MATAIJ));
   PetscCall(MatSetFromOptions(sys->A));
+  {
+    PetscBool offrank_full;
+    PetscCall(MatStoredTriangle(sys->A, &sys->upper_only, &offrank_full));
+  }
 
+  // The block graph for the structural count (and the row lengths): an upper-triangle list stands
+  // for its mirror image too, so nnz counts the whole symmetric matrix whatever the caller listed.
+  std::vector<PetscInt> graph_row(coo_block_row), graph_col(coo_block_col);
+  if (sys->upper_only)
+    for (size_t k = 0; k < coo_block_row.size(); ++k)
+      if (coo_block_row[k] < coo_block_col[k]) {
+        graph_row.push_back(coo_block_col[k]);
+        graph_col.push_back(coo_block_row[k]);
+      }
   {
     PetscErrorCode (*f)(Mat, PetscCount, const PetscInt[], const PetscInt[]) = nullptr;
     PetscCall(PetscObjectQueryFunction((PetscObject)sys->A, "MatSetPreallocationCOO_C", &f));
@@ -169,11 +211,11 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
           cj[9 * k + 3 * r + c] = 3 * coo_block_col[k] + c;
         }
     PetscCall(MatSetPreallocationCOO(sys->A, (PetscCount)ci.size(), ci.data(), cj.data()));
-    PetscCall(PreallocateFromBlockPattern(comm, n_local, n_block_rows_global, coo_block_row, coo_block_col, nullptr, &sys->n_blocks));
+    PetscCall(PreallocateFromBlockPattern(comm, n_local, n_block_rows_global, graph_row, graph_col, nullptr, &sys->n_blocks));
   } else {
     // PETSc 3.18's generic COO preallocation cannot preallocate sell; preallocate every other type
     // from the exact row lengths instead.
-    PetscCall(PreallocateFromBlockPattern(comm, n_local, n_block_rows_global, coo_block_row, coo_block_col, sys->A, &sys->n_blocks));
+    PetscCall(PreallocateFromBlockPattern(comm, n_local, n_block_rows_global, graph_row, graph_col, sys->A, &sys->n_blocks));
     PetscCall(MatSetOption(sys->A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
   }
   PetscCall(MatSetOption(sys->A, MAT_SYMMETRIC, PETSC_TRUE));
@@ -261,17 +303,25 @@ PetscErrorCode BlockSystemDumpMatrix(BlockSystem *sys, const char *path)
   PetscCall(MatSetBlockSize(aij, 3));
   PetscCall(MatSetType(aij, MATAIJ));
   {
-    const size_t nb = sys->coo_block_row.size();
-    std::vector<PetscInt> ci(9 * nb), cj(9 * nb);
-    for (size_t k = 0; k < nb; ++k)
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) {
-          ci[9 * k + 3 * r + c] = 3 * sys->coo_block_row[k] + r;
-          cj[9 * k + 3 * r + c] = 3 * sys->coo_block_col[k] + c;
-        }
+    // A matrix that ignores the lower triangle is dumped from the upper blocks and their mirror
+    // images (lower blocks the caller still listed, e.g. across ranks, are left out: the mirror
+    // of their upper twin replaces them).
+    std::vector<PetscInt>    ci, cj;
+    std::vector<PetscScalar> v;
+    for (size_t k = 0; k < sys->coo_block_row.size(); ++k) {
+      const PetscInt br = sys->coo_block_row[k], bc = sys->coo_block_col[k];
+      if (sys->upper_only && br > bc) continue;
+      for (int mirror = 0; mirror < ((sys->upper_only && br < bc) ? 2 : 1); ++mirror)
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) {
+            ci.push_back(3 * (mirror ? bc : br) + r);
+            cj.push_back(3 * (mirror ? br : bc) + c);
+            v.push_back(sys->last_values[9 * k + (mirror ? 3 * c + r : 3 * r + c)]);
+          }
+    }
     PetscCall(MatSetPreallocationCOO(aij, (PetscCount)ci.size(), ci.data(), cj.data()));
+    PetscCall(MatSetValuesCOO(aij, v.data(), INSERT_VALUES));
   }
-  PetscCall(MatSetValuesCOO(aij, sys->last_values, INSERT_VALUES));
   PetscCall(PetscViewerBinaryOpen(comm, path, FILE_MODE_WRITE, &viewer));
   PetscCall(MatView(aij, viewer));
   PetscCall(PetscViewerDestroy(&viewer));

@@ -33,6 +33,7 @@ struct BlockSystem {
   PetscInt n_coo_blocks = 0;            // blocks this rank contributes (length of the COO list)
   PetscInt n_blocks = 0;                // distinct blocks of the pattern over all ranks
   PetscBool native_coo = PETSC_FALSE;   // the type implements MatSetValuesCOO itself
+  PetscBool upper_only = PETSC_FALSE;   // blocks below the diagonal are ignored (sbaij, binbcsr symmetric storage)
   std::vector<PetscInt> coo_block_row, coo_block_col; // kept for the fallback path and for dumps
   const PetscScalar *last_values = nullptr; // the caller's array from the last SetValues (for dumps)
 };
@@ -48,6 +49,12 @@ struct SolveStats {
 PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, PetscInt n_block_rows_local,
                                  const std::vector<PetscInt> &coo_block_row,
                                  const std::vector<PetscInt> &coo_block_col, BlockSystem *sys);
+
+// What the Mat type the options select stores, known before any pattern is built, so a driver can
+// list and compute only the blocks that are kept: *upper_only when blocks below the block diagonal are
+// ignored (sbaij; binbcsr with -mat_binbcsr_symmetric_storage), and then *offrank_full when blocks that
+// couple two ranks are kept in both triangles all the same (binbcsr stores its off-rank part in full).
+PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, PetscBool *offrank_full);
 
 // block_values: 9 * n_coo_blocks values, block k row-major at [9k, 9k+9). Summed over duplicates,
 // replacing the previous values. The array is remembered (not copied) for BlockSystemDumpMatrix: keep

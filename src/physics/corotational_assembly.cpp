@@ -18,7 +18,7 @@ StepCoefficients implicit_euler_coefficients(double dt, double alpha, double bet
 }
 
 BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &elements, const std::vector<char> &fixed,
-                                int owned_begin, int owned_end, bool merge)
+                                int owned_begin, int owned_end, bool merge, const LowerTriangle &lower)
 {
   BlockPattern p;
   p.merged      = merge;
@@ -27,11 +27,18 @@ BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &e
   p.element_slots.assign(elements.size() * npe * npe, -1);
   std::vector<std::pair<long long, size_t>> keyed; // (row * n + col, position in element_slots)
   const long long n = model.node_count();
+  std::vector<int> part; // part of each node, when lower blocks across parts are kept
+  if (lower.drop && !lower.part_offsets.empty()) {
+    part.assign(n, 0);
+    for (size_t p = 0; p + 1 < lower.part_offsets.size(); ++p)
+      for (int v = lower.part_offsets[p]; v < lower.part_offsets[p + 1]; ++v) part[v] = static_cast<int>(p);
+  }
   for (size_t i = 0; i < elements.size(); ++i) {
     const int *nodes = &model.mesh.elements[static_cast<size_t>(elements[i]) * npe];
     for (int a = 0; a < npe; ++a)
       for (int b = 0; b < npe; ++b) {
         if (fixed[nodes[a]] || fixed[nodes[b]]) continue;
+        if (lower.drop && nodes[a] > nodes[b] && (part.empty() || part[nodes[a]] == part[nodes[b]])) continue;
         keyed.emplace_back(nodes[a] * n + nodes[b], (i * npe + a) * npe + b);
       }
   }
@@ -102,8 +109,8 @@ void assemble_kernel(const FemModel &model, const std::vector<int> &elements, co
         s[a].noalias() += K * z[b];
         if (b != a) s[b].noalias() += K.transpose() * z[a];
         if (!slot) continue;
-        const int sab = slot[a * N + b];
-        if (sab < 0) continue; // a or b is fixed: eliminated
+        const int sab = slot[a * N + b], sba = slot[b * N + a];
+        if (sab < 0 && sba < 0) continue; // a or b is fixed (eliminated)
         Mat3 B;
         if (corotational) {
           const Mat3 RK = R * K;
@@ -112,9 +119,10 @@ void assemble_kernel(const FemModel &model, const std::vector<int> &elements, co
           B = c.stiffness_matrix * K;
         }
         B.diagonal().array() += c.mass_matrix * mass * Mref(a, b);
-        // Stored row-major: the Map of a row-major matrix over the slot takes B as is.
-        Eigen::Map<RowMat3>(values + 9 * static_cast<size_t>(sab)) += B;
-        if (b != a) Eigen::Map<RowMat3>(values + 9 * static_cast<size_t>(slot[b * N + a])) += B.transpose();
+        // Stored row-major: the Map of a row-major matrix over the slot takes B as is. One of the
+        // pair may be a lower block the matrix does not store (-1).
+        if (sab >= 0) Eigen::Map<RowMat3>(values + 9 * static_cast<size_t>(sab)) += B;
+        if (b != a && sba >= 0) Eigen::Map<RowMat3>(values + 9 * static_cast<size_t>(sba)) += B.transpose();
       }
     for (int a = 0; a < N; ++a) {
       Vec3 r = -(R * s[a]);
@@ -177,12 +185,12 @@ void assemble_kernel_p1(const FemModel &model, const std::vector<int> &elements,
     const int   *slot = &pattern->element_slots[i * 16];
     for (int a = 0; a < 4; ++a)
       for (int b = a; b < 4; ++b) {
-        const int sab = slot[a * 4 + b];
-        if (sab < 0) continue;
+        const int sab = slot[a * 4 + b], sba = slot[b * 4 + a];
+        if (sab < 0 && sba < 0) continue;
         Mat3 B = (kv * lambda) * rg[a] * rg[b].transpose() + (kv * mu) * rg[b] * rg[a].transpose();
         B.diagonal().array() += kv * mu * g[a].dot(g[b]) + (a == b ? c.mass_matrix * m : 0.0);
-        Eigen::Map<RowMat3>(values + 9 * static_cast<size_t>(sab)) += B;
-        if (b != a) Eigen::Map<RowMat3>(values + 9 * static_cast<size_t>(slot[b * 4 + a])) += B.transpose();
+        if (sab >= 0) Eigen::Map<RowMat3>(values + 9 * static_cast<size_t>(sab)) += B;
+        if (b != a && sba >= 0) Eigen::Map<RowMat3>(values + 9 * static_cast<size_t>(sba)) += B.transpose();
       }
   }
 }

@@ -43,13 +43,22 @@ StepCoefficients implicit_euler_coefficients(double dt, double rayleigh_alpha = 
 struct BlockPattern {
   std::vector<int> rows, cols;     // global block indices, one entry per COO block
   std::vector<int> element_slots;  // per listed element npe*npe: COO block of (a,b), -1 if dropped
+                                   // (fixed node, or a lower block the matrix does not store)
   std::vector<int> identity_slots; // COO blocks that hold the identity (fixed nodes)
   bool             merged = false; // element blocks summed into unique COO blocks by the caller
+};
+// Blocks below the block diagonal (row > column) that the matrix does not store: sbaij keeps only the
+// upper triangle; binbcsr with symmetric storage keeps the upper triangle of each rank's diagonal part
+// and its off-rank part in full. Dropped blocks get no COO entry and the element loop skips them.
+struct LowerTriangle {
+  bool             drop = false;  // leave out blocks with row > column ...
+  std::vector<int> part_offsets;  // ... except those whose row and column lie in different parts
+                                  // [part_offsets[p], part_offsets[p+1]) (empty: no exception)
 };
 // merge_duplicates: rows/cols are unique (sorted by row, then column) and elements add into shared
 // blocks; otherwise every element block has its own COO entry and the Mat type sums duplicates.
 BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &elements, const std::vector<char> &fixed,
-                                int owned_begin, int owned_end, bool merge_duplicates);
+                                int owned_begin, int owned_end, bool merge_duplicates, const LowerTriangle &lower = {});
 
 // Sets the identity blocks and zeroes all others: call before assemble_elements each step.
 void reset_block_values(const BlockPattern &pattern, std::vector<double> &block_values);

@@ -213,6 +213,16 @@ TEST_CASE("same trajectory with aij, baij, sell and binbcsr (double); binbcsr si
       REQUIRE(r.err == 0);
       CHECK(max_abs_diff(r.x, ref.x) < 1e-9 * disp);
     }
+  // Upper-triangle storage: the driver lists and computes only the blocks on or above the diagonal.
+  for (const auto &opts : {std::map<std::string, std::string>{{"-mat_type", "sbaij"}, {"-ksp_type", "cg"}},
+                           std::map<std::string, std::string>{{"-mat_type", "binbcsr"}, {"-mat_binbcsr_symmetric_storage", "1"}, {"-ksp_type", "mcg"}}}) {
+    auto o = opts;
+    o.insert(kTight.begin(), kTight.end());
+    INFO(o.at("-mat_type") << " upper triangle");
+    const Run r = run(PETSC_COMM_SELF, s, o, 5);
+    REQUIRE(r.err == 0);
+    CHECK(max_abs_diff(r.x, ref.x) < 1e-9 * disp);
+  }
   const Run single = run(PETSC_COMM_SELF, s,
                          {{"-mat_type", "binbcsr"}, {"-mat_binbcsr_precision", "single"}, {"-ksp_type", "mcg"}, {"-ksp_rtol", "1e-6"},
                           {"-ksp_max_it", "5000"}},
@@ -275,9 +285,12 @@ TEST_CASE("extremes: E 1e3..1e12, nu 0.499, dt 0.1 finish bounded or report dive
 TEST_CASE("parallel layout: the same trajectory on PETSC_COMM_WORLD and on one rank", "[fem][mpi]")
 {
   const FemScene s = beam_scene(2, true);
-  for (const char *type : {"aij", "baij", "binbcsr"}) {
+  // sbaij and binbcsr symmetric storage: the driver leaves out the lower blocks each type ignores
+  // (binbcsr keeps those that couple the two ranks).
+  for (const char *type : {"aij", "baij", "binbcsr", "sbaij", "binbcsr_sym"}) {
     INFO(type);
-    const auto opts = std::map<std::string, std::string>{{"-mat_type", type}, {"-ksp_rtol", "1e-13"}, {"-ksp_max_it", "5000"}};
+    auto opts = std::map<std::string, std::string>{{"-mat_type", type}, {"-ksp_rtol", "1e-13"}, {"-ksp_max_it", "5000"}};
+    if (std::string(type) == "binbcsr_sym") opts = {{"-mat_type", "binbcsr"}, {"-mat_binbcsr_symmetric_storage", "1"}, {"-ksp_rtol", "1e-13"}, {"-ksp_max_it", "5000"}};
     const Run  all  = run(PETSC_COMM_WORLD, s, opts, 4);
     const Run  one  = run(PETSC_COMM_SELF, s, opts, 4);
     REQUIRE(all.err == 0);

@@ -9,6 +9,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <cmath>
+#include <map>
 #include <random>
 
 using namespace physics;
@@ -233,4 +234,57 @@ TEST_CASE("P1 fast kernel (rotated gradients) equals the generic K0 kernel", "[f
   CHECK(dv < 1e-12 * sv);
   CHECK(dr < 1e-12 * sr);
   CHECK(sr > 0);
+}
+
+TEST_CASE("upper-triangle patterns: kept blocks equal the full assembly's, lower ones dropped", "[fem][kernel]")
+{
+  for (int order : {1, 2}) {
+    INFO("order " << order);
+    const TetMesh mesh = jittered_box(order);
+    const FemModel m   = make_fem_model(mesh, FemSettings{});
+    const auto elements = fem_test::all_elements(m);
+    std::vector<char> fixed(mesh.node_count(), 0);
+    fixed[0] = fixed[5] = 1;
+    const int          n    = mesh.node_count();
+    const BlockPattern full = make_block_pattern(m, elements, fixed, 0, n, true);
+    LowerTriangle      drop;
+    drop.drop = true;
+    LowerTriangle across = drop;
+    across.part_offsets  = {0, n / 3, n}; // two parts: lower blocks between them are kept
+    std::vector<double> x(mesh.nodes), v(x.size());
+    const Eigen::Matrix3d Q = some_rotation();
+    for (int i = 0; i < n; ++i) {
+      Eigen::Vector3d::Map(&x[3 * i]) = Q * (Eigen::Vector3d::Map(&mesh.nodes[3 * i]) * 1.05);
+      v[3 * i] = std::sin(i * 0.3), v[3 * i + 1] = std::cos(i * 0.7), v[3 * i + 2] = 0.1 * i;
+    }
+    const StepCoefficients c = implicit_euler_coefficients(0.02, 0.3, 0.001);
+    std::vector<double> vf, rf(x.size(), 0.0);
+    reset_block_values(full, vf);
+    assemble_elements(m, elements, x.data(), v.data(), c, &full, vf.data(), rf.data());
+    std::map<std::pair<int, int>, int> full_slot;
+    for (size_t k = 0; k < full.rows.size(); ++k) full_slot[{full.rows[k], full.cols[k]}] = static_cast<int>(k);
+    for (const LowerTriangle &lower : {drop, across}) {
+      const BlockPattern p = make_block_pattern(m, elements, fixed, 0, n, true, lower);
+      std::vector<double> vp, rp(x.size(), 0.0);
+      reset_block_values(p, vp);
+      assemble_elements(m, elements, x.data(), v.data(), c, &p, vp.data(), rp.data());
+      size_t expected = 0;
+      for (size_t k = 0; k < full.rows.size(); ++k) {
+        const int r = full.rows[k], q = full.cols[k];
+        const bool crosses = !lower.part_offsets.empty() && ((r < n / 3) != (q < n / 3));
+        expected += (r <= q || crosses) ? 1 : 0;
+      }
+      CHECK(p.rows.size() == expected);
+      double diff = 0, scale = 0;
+      for (size_t k = 0; k < p.rows.size(); ++k) {
+        const bool crosses = !lower.part_offsets.empty() && ((p.rows[k] < n / 3) != (p.cols[k] < n / 3));
+        CHECK((p.rows[k] <= p.cols[k] || crosses));
+        const int f = full_slot.at({p.rows[k], p.cols[k]});
+        for (int j = 0; j < 9; ++j) diff = std::max(diff, std::fabs(vp[9 * k + j] - vf[9 * f + j])), scale = std::max(scale, std::fabs(vf[9 * f + j]));
+      }
+      CHECK(diff == 0.0);
+      CHECK(scale > 0);
+      CHECK(rp == rf);
+    }
+  }
 }
