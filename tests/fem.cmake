@@ -15,7 +15,7 @@ fem_test(fem_p2_binbcsr_mcg "order=2.*status=ok" ${FEM} ${FEM_SMALL} -fem_order 
 fem_test(fem_p2_baij_pipecg "mat_type=seqbaij.*status=ok" ${FEM} ${FEM_SMALL} -fem_order 2 -mat_type baij -ksp_type pipecg)
 fem_test(fem_p2_sell_linear "mat_type=seqsell.*status=ok" ${FEM} ${FEM_SMALL} -fem_order 2 -mat_type sell -fem_corotational 0
          -fem_mass_lumped)
-fem_test(fem_fixed_iterations "cg_its=30 .*status=ok" ${FEM} ${FEM_SMALL} -mat_type binbcsr -ksp_type mcg
+fem_test(fem_fixed_iterations "timer=cpu .*cg_its=30 .*status=ok" ${FEM} ${FEM_SMALL} -fem_timer cpu -mat_type binbcsr -ksp_type mcg
          -ksp_mcg_fixed_iterations 30 -ksp_max_it 30)
 fem_test(fem_static_cantilever "status=ok" ${FEM} -options_file options/cantilever.opts -static -steps 3)
 fem_test(fem_scene_files "mat_type=seqaij ksp_type=cg .*cg_its=30 .*status=ok" ${FEM} -options_file options/cantilever.opts

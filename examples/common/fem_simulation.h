@@ -50,6 +50,7 @@ struct FemSimulation {
   std::vector<double>   f_gravity;
   double                dt = 0, rhs_gravity_scale = 0;
   bool                  is_static = false;
+  bool                  cpu_timer = false; // FemStepInfo times in process CPU time instead of wall time
   // work arrays
   std::vector<double>   values, rhs_full, rhs_local, dv_local, dv_full;
   std::vector<int>      counts, displs;

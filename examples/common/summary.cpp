@@ -1,5 +1,7 @@
 #include "common/summary.h"
 
+#include <ctime>
+
 #include <cstdio>
 
 void SummaryLine::add(const std::string &key, double value)
@@ -23,3 +25,10 @@ PetscErrorCode PrintSummary(MPI_Comm comm, const SummaryLine &line)
 }
 
 double WallTime() { return MPI_Wtime(); }
+
+double ProcessCpuTime()
+{
+  timespec ts;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}

@@ -17,3 +17,7 @@ PetscErrorCode PrintSummary(MPI_Comm comm, const SummaryLine &line);
 
 // Wall-clock seconds (MPI_Wtime), for the per-step timings the drivers report.
 double WallTime();
+
+// CPU seconds of this process (all threads): leaves out the time it was descheduled, for timings on a
+// machine shared with other jobs (memory and cache contention still count; MPI waits that poll count).
+double ProcessCpuTime();
