@@ -16,7 +16,8 @@ set(CLOTH_SAME "${CLOTH} -cloth_n 12 -steps 30 -sphere -ksp_rtol 1e-12 -progress
 add_test(NAME cloth_same_result_mat_types
          COMMAND ${SUMMARY_SAME} "energy_final max_stretch contacts" 1e-6
                  "${CLOTH_SAME} -mat_type aij" "${CLOTH_SAME} -mat_type baij" "${CLOTH_SAME} -mat_type aij -ksp_type pipecg"
-                 "${CLOTH_SAME} -mat_type binbcsr" "${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg")
+                 "${CLOTH_SAME} -mat_type binbcsr" "${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg"
+                 "${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg -mat_binbcsr_symmetric_storage")
 add_test(NAME cloth_bad_dt COMMAND ${CLOTH} -cloth_n 4 -dt 0)
 set_tests_properties(cloth_bad_dt PROPERTIES PASS_REGULAR_EXPRESSION "time step must be positive")
 add_test(NAME cloth_bad_n COMMAND ${CLOTH} -cloth_n 1)

@@ -10,6 +10,17 @@ struct SpringLinearisation {
   Eigen::Matrix3d damping;      // D = -df_a/dv_a, same pattern
 };
 
+// The same in the compact form the assembly uses: K = k_iso I + k_dir d d^T, D = damping d d^T
+// (d = unit direction from a to b; zero, with k_iso = k, for coincident particles).
+struct SpringTerms {
+  Eigen::Vector3d direction;
+  Eigen::Vector3d force_on_a;
+  double          k_iso = 0, k_dir = 0, damping = 0;
+};
+
+SpringTerms spring_terms(const Spring &s, const Eigen::Vector3d &xa, const Eigen::Vector3d &xb, const Eigen::Vector3d &va, const Eigen::Vector3d &vb,
+                         double damping, bool choi_ko = true);
+
 // Hooke spring plus damping along the spring. The exact stiffness is
 //   k [ d d^T + (1 - L/l) (I - d d^T) ]   (d = unit direction, l = length, L = rest length),
 // whose transverse term is negative for a compressed spring (l < L) and can make M + h^2 K indefinite.

@@ -27,38 +27,40 @@ std::string validate_params(const ClothParams &p)
   return "";
 }
 
-static void add_block(double *out, const Eigen::Matrix3d &m, double scale)
-{
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) out[3 * r + c] += scale * m(r, c);
-}
-
 void assemble_cloth_system(const Cloth &cloth, const ClothParams &params, ClothSystem &sys)
 {
-  const double h = params.dt;
+  const double h = params.dt, h2 = h * h;
   const int    np = sys.n_particles;
-  std::fill(sys.block_values.begin(), sys.block_values.end(), 0.0);
-  // rhs = h (f - h K v), built as h f first, then the -h^2 K v terms spring by spring.
+  // rhs = h (f - h K v), built as h m g first, then spring by spring. Diagonal blocks start at M and
+  // accumulate; every off-diagonal block belongs to one spring and is written once (no clearing pass).
   for (int p = 0; p < np; ++p) {
     double *d = &sys.block_values[9 * p];
+    for (int k = 0; k < 9; ++k) d[k] = 0.0;
     d[0] = d[4] = d[8] = cloth.mass[p];
-    const Eigen::Vector3d f = h * cloth.mass[p] * cloth.gravity;
-    for (int k = 0; k < 3; ++k) sys.rhs[3 * p + k] = f[k];
+    for (int k = 0; k < 3; ++k) sys.rhs[3 * p + k] = h * cloth.mass[p] * cloth.gravity[k];
   }
   for (size_t s = 0; s < cloth.springs.size(); ++s) {
-    const Spring             &sp = cloth.springs[s];
-    const SpringLinearisation lin = linearise_spring(sp, cloth.position[sp.a], cloth.position[sp.b], cloth.velocity[sp.a], cloth.velocity[sp.b], cloth.damping, params.choi_ko);
-    const Eigen::Matrix3d     A   = h * lin.damping + h * h * lin.stiffness;
+    const Spring     &sp = cloth.springs[s];
+    const SpringTerms t  = spring_terms(sp, cloth.position[sp.a], cloth.position[sp.b], cloth.velocity[sp.a], cloth.velocity[sp.b], cloth.damping, params.choi_ko);
+    // The spring's block of M + h D + h^2 K: alpha I + beta d d^T (symmetric).
+    const double           alpha = h2 * t.k_iso, beta = h2 * t.k_dir + h * t.damping;
+    const Eigen::Vector3d &d     = t.direction;
+    double                 block[9];
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) block[3 * r + c] = beta * d[r] * d[c] + (r == c ? alpha : 0.0);
     const bool fa = cloth.fixed[sp.a], fb = cloth.fixed[sp.b];
     // The spring's K acts on dv_a - dv_b; a pinned end has dv = 0, so its row, column and rhs stay out.
-    if (!fa) add_block(&sys.block_values[9 * sp.a], A, 1.0);
-    if (!fb) add_block(&sys.block_values[9 * sp.b], A, 1.0);
-    if (!fa && !fb) {
-      add_block(&sys.block_values[9 * (np + 2 * s)], A, -1.0);
-      add_block(&sys.block_values[9 * (np + 2 * s + 1)], A, -1.0);
+    double *da = &sys.block_values[9 * sp.a], *db = &sys.block_values[9 * sp.b];
+    double *ab = &sys.block_values[9 * (np + 2 * s)], *ba = &sys.block_values[9 * (np + 2 * s + 1)];
+    const bool coupled = !fa && !fb;
+    for (int k = 0; k < 9; ++k) {
+      if (!fa) da[k] += block[k];
+      if (!fb) db[k] += block[k];
+      ab[k] = ba[k] = coupled ? -block[k] : 0.0;
     }
-    const Eigen::Vector3d Kv = h * h * lin.stiffness * (cloth.velocity[sp.a] - cloth.velocity[sp.b]);
-    const Eigen::Vector3d fa_term = h * lin.force_on_a - Kv;
+    // h f_a - h^2 K (v_a - v_b), K = k_iso I + k_dir d d^T
+    const Eigen::Vector3d dvel    = cloth.velocity[sp.a] - cloth.velocity[sp.b];
+    const Eigen::Vector3d fa_term = h * t.force_on_a - h2 * (t.k_iso * dvel + t.k_dir * d.dot(dvel) * d);
     for (int k = 0; k < 3; ++k) {
       if (!fa) sys.rhs[3 * sp.a + k] += fa_term[k];
       if (!fb) sys.rhs[3 * sp.b + k] -= fa_term[k];

@@ -110,6 +110,48 @@ TEST_CASE("system matrix is symmetric positive definite, also with compressed sp
   CHECK(eig_exact.eigenvalues().minCoeff() < 0);
 }
 
+TEST_CASE("assembled system equals M + h D + h^2 K and h (f - h K v) built from each spring's Jacobians", "[cloth]")
+{
+  ClothOptions opt;
+  opt.n = 5, opt.damping = 0.3;
+  Cloth cloth = make_cloth(opt);
+  srand(11);
+  for (auto &x : cloth.position) x = 0.8 * x + 0.02 * Eigen::Vector3d::Random(); // some springs compressed, some stretched
+  for (auto &v : cloth.velocity) v = Eigen::Vector3d::Random();
+  ClothParams params;
+  params.dt = 1.0 / 60;
+  const double h = params.dt;
+  ClothSystem  sys = make_cloth_system(cloth);
+  assemble_cloth_system(cloth, params, sys);
+  // Reference: dense matrices from linearise_spring, pinned rows and columns reduced to M.
+  const int       n = cloth.particle_count();
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(3 * n, 3 * n), D = K;
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * n), v(3 * n);
+  for (int p = 0; p < n; ++p) f.segment<3>(3 * p) = cloth.mass[p] * cloth.gravity, v.segment<3>(3 * p) = cloth.velocity[p];
+  for (const Spring &sp : cloth.springs) {
+    const SpringLinearisation lin = linearise_spring(sp, cloth.position[sp.a], cloth.position[sp.b], cloth.velocity[sp.a], cloth.velocity[sp.b], cloth.damping);
+    for (int a : {sp.a, sp.b})
+      for (int b : {sp.a, sp.b}) {
+        const double s = a == b ? 1.0 : -1.0;
+        K.block<3, 3>(3 * a, 3 * b) += s * lin.stiffness;
+        D.block<3, 3>(3 * a, 3 * b) += s * lin.damping;
+      }
+    f.segment<3>(3 * sp.a) += lin.force_on_a;
+    f.segment<3>(3 * sp.b) -= lin.force_on_a;
+  }
+  Eigen::MatrixXd A   = h * D + h * h * K;
+  Eigen::VectorXd rhs = h * (f - h * K * v);
+  for (int p = 0; p < n; ++p) {
+    A.block<3, 3>(3 * p, 3 * p) += cloth.mass[p] * Eigen::Matrix3d::Identity();
+    if (!cloth.fixed[p]) continue;
+    A.block(3 * p, 0, 3, 3 * n).setZero(), A.block(0, 3 * p, 3 * n, 3).setZero();
+    A.block<3, 3>(3 * p, 3 * p) = cloth.mass[p] * Eigen::Matrix3d::Identity();
+    rhs.segment<3>(3 * p).setZero();
+  }
+  CHECK((dense(sys) - A).norm() < 1e-12 * A.norm());
+  CHECK((Eigen::Map<const Eigen::VectorXd>(sys.rhs.data(), 3 * n) - rhs).norm() < 1e-12 * rhs.norm());
+}
+
 TEST_CASE("stiff cloth at dt 1/30 stays finite and bounded", "[cloth]")
 {
   ClothOptions opt;
