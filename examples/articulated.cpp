@@ -9,8 +9,7 @@
 // -velocity_stabilisation, -joint_warm_start (previous step's impulses as initial guesses). Output: a progress
 // line every -progress_every steps, -vtk PREFIX (.vtu per -vtk_every steps plus PREFIX.pvd), -dump_matrix FILE
 // (J M^-1 J^T of the first step, PETSc binary), and a final `summary key=value ...` line.
-#include "common/replicated_solver.h"
-#include "common/summary.h"
+#include "common/sim_driver.h"
 #include "physics/articulated_scenes.hpp"
 #include "physics/articulated_step.hpp"
 #include "physics/kinematic_loops.hpp"
@@ -111,10 +110,10 @@ int main(int argc, char **argv)
   PetscCall(BuildScene(comm, scene_name, scene));
 
   physics::ArticulatedParams params;
-  PetscInt                   steps = 100, progress_every = 1, vtk_every = 1, max_corr = params.max_corrections;
-  PetscBool                  vel_stab = PETSC_TRUE, refresh = PETSC_FALSE, warm = PETSC_FALSE, vtk_points = PETSC_FALSE, set_vtk, set_dump;
-  char                       vtk_prefix[PETSC_MAX_PATH_LEN] = "", dump_path[PETSC_MAX_PATH_LEN] = "";
-  PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-steps", &steps, nullptr));
+  DriverOutput               out;
+  PetscInt                   max_corr = params.max_corrections;
+  PetscBool                  vel_stab = PETSC_TRUE, refresh = PETSC_FALSE, warm = PETSC_FALSE, vtk_points = PETSC_FALSE;
+  PetscCall(DriverOutputFromOptions(comm, &out));
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-dt", &params.dt, nullptr));
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-joint_tol", &params.joint_tol, nullptr));
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-max_corrections", &max_corr, nullptr));
@@ -126,15 +125,10 @@ int main(int argc, char **argv)
   params.warm_start             = warm;
   params.refresh_matrix         = refresh;
   params.velocity_stabilisation = vel_stab;
-  PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-progress_every", &progress_every, nullptr));
-  PetscCall(PetscOptionsGetString(nullptr, nullptr, "-vtk", vtk_prefix, sizeof vtk_prefix, &set_vtk));
-  PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-vtk_every", &vtk_every, nullptr));
   PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-vtk_points", &vtk_points, nullptr));
-  PetscCall(PetscOptionsGetString(nullptr, nullptr, "-dump_matrix", dump_path, sizeof dump_path, &set_dump));
   const std::string bad = physics::validate_params(params);
   PetscCheck(bad.empty(), comm, PETSC_ERR_ARG_OUTOFRANGE, "%s (-dt %g, -joint_tol %g, -max_corrections %d)", bad.c_str(), (double)params.dt,
              (double)params.joint_tol, params.max_corrections);
-  PetscCheck(steps >= 0 && progress_every >= 1 && vtk_every >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-steps must be >= 0, -progress_every and -vtk_every >= 1");
   PetscCheck(!scene.joints.empty(), comm, PETSC_ERR_ARG_WRONG, "scene %s has no joints: nothing to solve", scene_name.c_str());
 
   physics::ArticulatedSolver solver = physics::make_articulated_solver(scene, params);
@@ -149,25 +143,13 @@ int main(int argc, char **argv)
   PetscCall(PetscPrintf(comm, "articulated: scene %s, %zu bodies, %zu joints (%zu rows), %zu loops, %" PetscInt_FMT " nonzeros, mat %s, ksp %s, %d ranks\n",
                         scene_name.c_str(), scene.bodies.size(), scene.joints.size(), 3 * scene.joints.size(), loops, nnz, mat_type, ksp_type, size));
 
-  std::vector<std::pair<std::string, double>> frames;
-  auto write_frame = [&](PetscInt n) -> PetscErrorCode {
-    PetscFunctionBegin;
-    if (set_vtk && rank == 0 && n % vtk_every == 0) {
-      char path[PETSC_MAX_PATH_LEN + 32];
-      std::snprintf(path, sizeof path, "%s_%05d.vtu", vtk_prefix, (int)n);
-      PetscCheck(WriteFrame(path, scene, vtk_points), PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "cannot write %s", path);
-      const char *base = std::strrchr(path, '/');
-      frames.push_back({base ? base + 1 : path, n * params.dt});
-      PetscCheck(physics::write_pvd(std::string(vtk_prefix) + ".pvd", frames), PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "cannot write %s.pvd", vtk_prefix);
-    }
-    PetscFunctionReturn(0);
-  };
+  auto write_frame = [&](PetscInt n) { return DriverWriteFrame(comm, &out, n, n * params.dt, [&](const std::string &path) { return WriteFrame(path, scene, vtk_points); }); };
   PetscCall(write_frame(0));
 
   const double e0 = physics::total_energy(scene);
   double       e_max = e0, worst_error = 0, worst_velocity = 0, step_ms_total = 0;
   long long    corrections = 0, max_corrections_seen = 0, unconverged = 0, stalled = 0, singular_steps = 0, nan_steps = 0;
-  for (PetscInt n = 1; n <= steps; ++n) {
+  for (PetscInt n = 1; n <= out.steps; ++n) {
     const long long its0 = rs.iterations, solves0 = rs.solves;
     const double    solve0 = rs.solve_ms, t0 = WallTime();
     const physics::ArticulatedStepReport r = physics::articulated_step(scene, solver, params, linear);
@@ -186,11 +168,11 @@ int main(int argc, char **argv)
     worst_velocity = std::max(worst_velocity, r.velocity_error);
     const double energy = physics::total_energy(scene);
     e_max               = std::max(e_max, energy);
-    if (n % progress_every == 0 || n == steps)
+    if (n % out.progress_every == 0 || n == out.steps)
       PetscCall(PetscPrintf(comm, "step %" PetscInt_FMT " t=%.4f corrections=%d solves=%lld cg_its=%lld joint_err=%.3e vel_err=%.3e energy=%.6e ms=%.2f solve_ms=%.2f%s%s\n",
                             n, n * params.dt, r.corrections, rs.solves - solves0, rs.iterations - its0, r.joint_error, r.velocity_error, energy, step_ms,
                             rs.solve_ms - solve0, r.converged ? "" : " UNCONVERGED", r.singular_detected ? " SINGULAR->regularised" : ""));
-    if (n == 1 && set_dump) PetscCall(BlockSystemDumpMatrix(&rs.sys, dump_path));
+    if (n == 1 && out.dump) PetscCall(BlockSystemDumpMatrix(&rs.sys, out.dump_path));
     PetscCall(write_frame(n));
     if (!finite) break;
   }
@@ -206,21 +188,15 @@ int main(int argc, char **argv)
   s.add("loops", (long long)loops);
   s.add("mat_type", std::string(mat_type));
   s.add("ksp_type", std::string(ksp_type));
-  s.add("steps", (long long)steps);
+  s.add("steps", (long long)out.steps);
   s.add("dt", params.dt);
-  s.add("ms_per_step", steps ? step_ms_total / steps : 0.0);
-  s.add("solve_ms", steps ? rs.solve_ms / steps : 0.0);
-  s.add("setvalues_ms", steps ? rs.setvalues_ms / steps : 0.0);
-  // Everything but the PETSc calls: prediction, matrix values, impulses (replicated on every rank).
-  s.add("physics_ms", steps ? (step_ms_total - rs.solve_ms - rs.setvalues_ms) / steps : 0.0);
+  DriverAddSolverSummary(s, rs, out.steps, step_ms_total);
   s.add("solves", rs.solves);
-  s.add("cg_its", rs.solves ? (double)rs.iterations / rs.solves : 0.0);
-  s.add("cg_its_per_step", steps ? (double)rs.iterations / steps : 0.0);
-  s.add("corrections_per_step", steps ? (double)corrections / steps : 0.0);
+  s.add("cg_its_per_step", out.steps ? (double)rs.iterations / out.steps : 0.0);
+  s.add("corrections_per_step", out.steps ? (double)corrections / out.steps : 0.0);
   s.add("corrections_max", max_corrections_seen);
   s.add("unconverged_steps", unconverged);
   s.add("stalled_steps", stalled);
-  s.add("diverged_solves", rs.diverged_solves);
   s.add("regularised", (long long)solver.regularised);
   s.add("singular_detections", singular_steps);
   s.add("joint_error_max", worst_error);

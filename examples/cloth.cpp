@@ -8,8 +8,7 @@
 // -sphere_radius, -sphere_centre x,y,z). Time: -dt, -steps, -cloth_exact_jacobian (drop Choi-Ko). Output:
 // a progress line every -progress_every steps, -vtk PREFIX (triangle surface per -vtk_every steps),
 // -dump_matrix FILE (first step's matrix), and a final `summary key=value ...` line.
-#include "common/replicated_solver.h"
-#include "common/summary.h"
+#include "common/sim_driver.h"
 #include "physics/cloth_step.hpp"
 #include "physics/vtk_writer.hpp"
 
@@ -48,9 +47,10 @@ int main(int argc, char **argv)
   PetscCallMPI(MPI_Comm_size(comm, &size));
 
   physics::ClothOptions opt;
-  PetscInt              n = opt.n, steps = 100, progress_every = 1, vtk_every = 1;
-  PetscBool             hanging = PETSC_FALSE, sphere = PETSC_FALSE, exact = PETSC_FALSE, set_vtk, set_dump, set;
-  char                  pins[32] = "corners", vtk_prefix[PETSC_MAX_PATH_LEN] = "", dump_path[PETSC_MAX_PATH_LEN] = "";
+  PetscInt              n = opt.n;
+  PetscBool             hanging = PETSC_FALSE, sphere = PETSC_FALSE, exact = PETSC_FALSE, set;
+  char                  pins[32] = "corners";
+  DriverOutput          out;
   PetscReal             radius = 0.3, centre[3] = {0, -0.5, 0};
   PetscInt              ncentre = 3;
   physics::ClothParams  params;
@@ -69,11 +69,7 @@ int main(int argc, char **argv)
   PetscCheck(!set || ncentre == 3, comm, PETSC_ERR_ARG_SIZ, "-sphere_centre needs 3 numbers, got %" PetscInt_FMT, ncentre);
   PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-cloth_exact_jacobian", &exact, nullptr));
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-dt", &params.dt, nullptr));
-  PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-steps", &steps, nullptr));
-  PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-progress_every", &progress_every, nullptr));
-  PetscCall(PetscOptionsGetString(nullptr, nullptr, "-vtk", vtk_prefix, sizeof vtk_prefix, &set_vtk));
-  PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-vtk_every", &vtk_every, nullptr));
-  PetscCall(PetscOptionsGetString(nullptr, nullptr, "-dump_matrix", dump_path, sizeof dump_path, &set_dump));
+  PetscCall(DriverOutputFromOptions(comm, &out));
   params.choi_ko = !exact;
   opt.n          = (int)n;
   opt.hanging    = hanging;
@@ -84,7 +80,6 @@ int main(int argc, char **argv)
   else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "unknown -cloth_pins %s (corners, four, top, none)", pins);
   const std::string bad = physics::validate_params(params);
   PetscCheck(bad.empty(), comm, PETSC_ERR_ARG_OUTOFRANGE, "%s (-dt %g)", bad.c_str(), (double)params.dt);
-  PetscCheck(steps >= 0 && progress_every >= 1 && vtk_every >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-steps must be >= 0, -progress_every and -vtk_every >= 1");
   PetscCheck(!sphere || radius > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-sphere_radius must be positive, got %g", (double)radius);
 
   physics::Cloth cloth;
@@ -109,25 +104,13 @@ int main(int argc, char **argv)
   PetscCall(PetscPrintf(comm, "cloth: %d x %d particles (%d unknowns), %zu springs, %" PetscInt_FMT " nonzeros, mat %s, ksp %s, %d ranks\n", cloth.n, cloth.n,
                         3 * cloth.particle_count(), cloth.springs.size(), nnz, mat_type, ksp_type, size));
 
-  std::vector<std::pair<std::string, double>> frames;
-  auto write_frame = [&](PetscInt step) -> PetscErrorCode {
-    PetscFunctionBegin;
-    if (set_vtk && rank == 0 && step % vtk_every == 0) {
-      char path[PETSC_MAX_PATH_LEN + 32];
-      std::snprintf(path, sizeof path, "%s_%05d.vtu", vtk_prefix, (int)step);
-      PetscCheck(WriteFrame(path, cloth), PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "cannot write %s", path);
-      const char *base = std::strrchr(path, '/');
-      frames.push_back({base ? base + 1 : path, step * params.dt});
-      PetscCheck(physics::write_pvd(std::string(vtk_prefix) + ".pvd", frames), PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "cannot write %s.pvd", vtk_prefix);
-    }
-    PetscFunctionReturn(0);
-  };
+  auto write_frame = [&](PetscInt step) { return DriverWriteFrame(comm, &out, step, step * params.dt, [&](const std::string &path) { return WriteFrame(path, cloth); }); };
   PetscCall(write_frame(0));
 
   const double e0 = physics::cloth_energy(cloth);
   double       step_ms_total = 0, max_stretch = 0;
   long long    nan_steps = 0, unconverged = 0, contacts = 0, done = 0;
-  for (PetscInt step = 1; step <= steps; ++step) {
+  for (PetscInt step = 1; step <= out.steps; ++step) {
     const long long its0 = rs.iterations;
     const double    solve0 = rs.solve_ms, t0 = WallTime();
     const physics::ClothStepReport r = physics::cloth_step(cloth, sys, params, linear);
@@ -141,11 +124,11 @@ int main(int argc, char **argv)
     unconverged += !r.converged;
     contacts += r.contacts;
     max_stretch = std::max(max_stretch, r.max_stretch);
-    if (step % progress_every == 0 || step == steps)
+    if (step % out.progress_every == 0 || step == out.steps)
       PetscCall(PetscPrintf(comm, "step %" PetscInt_FMT " t=%.4f cg_its=%lld stretch=%.5f contacts=%d energy=%.6e ms=%.2f solve_ms=%.2f%s\n", step, step * params.dt,
                             rs.iterations - its0, r.max_stretch, r.contacts, physics::cloth_energy(cloth), step_ms, rs.solve_ms - solve0,
                             r.converged ? "" : " UNCONVERGED"));
-    if (step == 1 && set_dump) PetscCall(BlockSystemDumpMatrix(&rs.sys, dump_path));
+    if (step == 1 && out.dump) PetscCall(BlockSystemDumpMatrix(&rs.sys, out.dump_path));
     PetscCall(write_frame(step));
     if (!finite) break;
   }
@@ -163,15 +146,9 @@ int main(int argc, char **argv)
   s.add("ksp_type", std::string(ksp_type));
   s.add("steps", (long long)done);
   s.add("dt", params.dt);
-  const double ms = done ? step_ms_total / done : 0.0;
-  s.add("ms_per_step", ms);
-  s.add("steps_per_s", ms > 0 ? 1e3 / ms : 0.0);
-  s.add("solve_ms", done ? rs.solve_ms / done : 0.0);
-  s.add("setvalues_ms", done ? rs.setvalues_ms / done : 0.0);
-  s.add("physics_ms", done ? (step_ms_total - rs.solve_ms - rs.setvalues_ms) / done : 0.0); // springs, assembly, update
-  s.add("cg_its", rs.solves ? (double)rs.iterations / rs.solves : 0.0);
+  DriverAddSolverSummary(s, rs, done, step_ms_total);
+  s.add("steps_per_s", step_ms_total > 0 ? 1e3 * done / step_ms_total : 0.0);
   s.add("unconverged_steps", unconverged);
-  s.add("diverged_solves", rs.diverged_solves);
   s.add("max_stretch", max_stretch);
   s.add("contacts", contacts);
   s.add("energy_initial", e0);
