@@ -2,6 +2,7 @@
 //
 //   solve_bench [-stencil_n 32 | -stencil_nx/ny/nz] [-stencil_shift 1e-2]
 //               [-solvers cg,cg_sr,pipecg,mcg] [-formats aij,baij,binbcsr,binbcsr_single]
+//               (also binbcsr_sym, binbcsr_sym_single: -mat_binbcsr_symmetric_storage)
 //               [-rtol 1e-6] [-repeats 3] [-timed_its 50] [-csv FILE]
 //               [-history_csv FILE] [-history_its 200]
 //
@@ -42,6 +43,7 @@ namespace {
 struct Format {
   std::string label, type;
   bool        single = false;
+  bool        sym    = false; // binbcsr symmetric storage
 };
 
 struct Solver {
@@ -66,6 +68,7 @@ PetscErrorCode BuildMatrix(MPI_Comm comm, const StencilGrid &grid, const Format 
 {
   PetscFunctionBegin;
   PetscCall(CreateStencilMatrix(comm, grid, f.type.c_str(), nullptr, A));
+  if (f.sym) PetscCall(ReplaceWithBinBCSRSymmetric(A));
   if (f.single) {
     MatBinBCSRPrecision p;
     PetscCall(MatBinBCSRSetPrecision(*A, MAT_BINBCSR_PRECISION_SINGLE));
@@ -249,6 +252,8 @@ int main(int argc, char **argv)
   std::vector<Format> formats;
   for (const std::string &f : SplitList(formats_opt)) {
     if (f == "binbcsr_single") formats.push_back({f, MATBINBCSR, true});
+    else if (f == "binbcsr_sym") formats.push_back({f, MATBINBCSR, false, true});
+    else if (f == "binbcsr_sym_single") formats.push_back({f, MATBINBCSR, true, true});
     else formats.push_back({f, f, false});
   }
 

@@ -198,34 +198,7 @@ PetscErrorCode BuildCandidate(MPI_Comm comm, const MatrixSource &src, Mat aij_fi
   } else {
     PetscCall(CreateStencilMatrix(comm, src.grid, c->spec.type.c_str(), nullptr, &c->A));
   }
-  if (c->spec.sym) { /* the same entries (both triangles handed over) into symmetric storage */
-    Mat      S;
-    PetscInt bs, rlo, rhi, mloc, nloc;
-    PetscCall(MatGetLocalSize(c->A, &mloc, &nloc));
-    PetscCall(MatCreate(comm, &S));
-    PetscCall(MatSetSizes(S, mloc, nloc, PETSC_DETERMINE, PETSC_DETERMINE));
-    PetscCall(MatGetBlockSize(c->A, &bs));
-    PetscCall(MatSetBlockSize(S, bs));
-    PetscCall(MatSetType(S, MATBINBCSR));
-    PetscCall(MatBinBCSRSetSymmetricStorage(S, PETSC_TRUE));
-    PetscCall(MatSetUp(S));
-    PetscCall(MatGetOwnershipRange(c->A, &rlo, &rhi));
-    for (PetscInt r = rlo; r < rhi; r++) {
-      PetscInt           n;
-      const PetscInt    *cols;
-      const PetscScalar *vals;
-      PetscCall(MatGetRow(c->A, r, &n, &cols, &vals));
-      PetscCall(MatSetValues(S, 1, &r, n, cols, vals, INSERT_VALUES));
-      PetscCall(MatRestoreRow(c->A, r, &n, &cols, &vals));
-    }
-    PetscCall(MatAssemblyBegin(S, MAT_FINAL_ASSEMBLY));
-    PetscCall(MatAssemblyEnd(S, MAT_FINAL_ASSEMBLY));
-    PetscCall(MatDestroy(&c->A));
-    c->A = S;
-    PetscBool sym;
-    PetscCall(MatBinBCSRGetSymmetricStorage(c->A, &sym));
-    PetscCheck(sym, comm, PETSC_ERR_SUP, "symmetric storage not available");
-  }
+  if (c->spec.sym) PetscCall(ReplaceWithBinBCSRSymmetric(&c->A)); /* the same entries, upper triangle kept */
   if (c->spec.single) {
     MatBinBCSRPrecision p;
     PetscCall(MatBinBCSRSetPrecision(c->A, MAT_BINBCSR_PRECISION_SINGLE));

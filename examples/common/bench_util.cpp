@@ -1,5 +1,40 @@
 #include "common/bench_util.h"
 
+#include <petscbinbcsr.h>
+
+PetscErrorCode ReplaceWithBinBCSRSymmetric(Mat *A)
+{
+  Mat       S;
+  PetscInt  bs, rlo, rhi, m, n;
+  PetscBool sym;
+
+  PetscFunctionBegin;
+  PetscCall(MatGetLocalSize(*A, &m, &n));
+  PetscCall(MatGetBlockSize(*A, &bs));
+  PetscCall(MatCreate(PetscObjectComm((PetscObject)*A), &S));
+  PetscCall(MatSetSizes(S, m, n, PETSC_DETERMINE, PETSC_DETERMINE));
+  PetscCall(MatSetBlockSize(S, bs));
+  PetscCall(MatSetType(S, MATBINBCSR));
+  PetscCall(MatBinBCSRSetSymmetricStorage(S, PETSC_TRUE));
+  PetscCall(MatSetUp(S));
+  PetscCall(MatGetOwnershipRange(*A, &rlo, &rhi));
+  for (PetscInt r = rlo; r < rhi; r++) {
+    PetscInt           nz;
+    const PetscInt    *cols;
+    const PetscScalar *vals;
+    PetscCall(MatGetRow(*A, r, &nz, &cols, &vals));
+    PetscCall(MatSetValues(S, 1, &r, nz, cols, vals, INSERT_VALUES));
+    PetscCall(MatRestoreRow(*A, r, &nz, &cols, &vals));
+  }
+  PetscCall(MatAssemblyBegin(S, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(S, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatBinBCSRGetSymmetricStorage(S, &sym));
+  PetscCheck(sym, PetscObjectComm((PetscObject)S), PETSC_ERR_SUP, "symmetric storage not available");
+  PetscCall(MatDestroy(A));
+  *A = S;
+  PetscFunctionReturn(0);
+}
+
 std::vector<std::string> SplitList(const std::string &s)
 {
   std::vector<std::string> out;

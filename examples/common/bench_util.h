@@ -1,8 +1,12 @@
 // Small helpers shared by the benchmark programs.
 #pragma once
-#include <petscsys.h>
+#include <petscmat.h>
 #include <string>
 #include <vector>
+
+// Replaces *A (any assembled matrix type) by a MATBINBCSR copy with symmetric storage: all its rows
+// are handed over, the type keeps the upper block triangle (the _sym formats of the benchmarks).
+PetscErrorCode ReplaceWithBinBCSRSymmetric(Mat *A);
 
 // "a,b,,c" -> {"a", "b", "c"}: comma lists given as options.
 std::vector<std::string> SplitList(const std::string &s);
