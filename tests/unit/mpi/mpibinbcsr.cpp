@@ -521,3 +521,33 @@ TEST_CASE("mpibinbcsr with symmetric storage (upper diagonal part, full off-diag
   }
   PCHK(PetscOptionsClearValue(nullptr, "-mat_binbcsr_symmetric_storage"));
 }
+
+TEST_CASE("mpibinbcsr with symmetric storage: MatZeroRowsColumns with rows named by any rank", "[mpi][sym]")
+{
+  const FemProblem fem(4, 3, 3, true);
+  PetscMPIInt      rank, size;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  MPI_Comm_size(PETSC_COMM_WORLD, &size);
+  std::vector<PetscInt> rows, all_rows;
+  for (PetscInt r = rank; r < fem.rows(); r += 7) rows.push_back(r);
+  for (PetscInt r = 0; r < fem.rows(); ++r)
+    if (r % 7 < size) all_rows.push_back(r);
+  PCHK(PetscOptionsSetValue(nullptr, "-mat_binbcsr_symmetric_storage", "1"));
+  Mat A, S;
+  PCHK(assemble(fem, MATMPIBINBCSR, Fill::Coo, false, &A));
+  PCHK(PetscOptionsClearValue(nullptr, "-mat_binbcsr_symmetric_storage"));
+  PCHK(serial_reference(fem, &S));
+  Vec x, b, xs, bs;
+  PCHK(MatCreateVecs(A, &x, &b));
+  PCHK(fill_test_vector(x));
+  PCHK(fill_test_vector(b, 1));
+  PCHK(serial_test_vector(fem.rows(), 0, &xs));
+  PCHK(serial_test_vector(fem.rows(), 1, &bs));
+  PCHK(MatZeroRowsColumns(A, static_cast<PetscInt>(rows.size()), rows.data(), 2.5, x, b));
+  PCHK(MatZeroRowsColumns(S, static_cast<PetscInt>(all_rows.size()), all_rows.data(), 2.5, xs, bs));
+  CHECK(all_ranks(local_rel_diff(b, bs) < tol));
+  check_products(A, S);
+  for (Vec *v : {&x, &b, &xs, &bs}) PCHK(VecDestroy(v));
+  PCHK(MatDestroy(&A));
+  PCHK(MatDestroy(&S));
+}
