@@ -9,6 +9,8 @@
 
 #include <petscbinbcsr.h>
 
+#include "common/bench_util.h"
+
 #include <algorithm>
 #include <functional>
 #include <limits>
@@ -21,6 +23,7 @@ struct Flavour {
   const char         *label;
   MatType             type;
   MatBinBCSRPrecision precision;
+  bool                sym = false; // -mat_binbcsr_symmetric_storage
 };
 
 PetscErrorCode Time(PetscInt repeats, const std::function<PetscErrorCode()> &op, double *ms)
@@ -53,6 +56,8 @@ int main(int argc, char **argv)
     {"seqbaij", MATSEQBAIJ, MAT_BINBCSR_PRECISION_DOUBLE},
     {"binbcsr", MATSEQBINBCSR, MAT_BINBCSR_PRECISION_DOUBLE},
     {"binbcsr-single", MATSEQBINBCSR, MAT_BINBCSR_PRECISION_SINGLE},
+    {"binbcsr-sym", MATSEQBINBCSR, MAT_BINBCSR_PRECISION_DOUBLE, true},
+    {"binbcsr-sym-single", MATSEQBINBCSR, MAT_BINBCSR_PRECISION_SINGLE, true},
   };
   const char *ops[] = {"axpy_same", "scale", "shift", "norm_frobenius", "norm_1", "zero_rows_columns"};
   PetscCall(PetscPrintf(PETSC_COMM_SELF, "27-point 3x3-block stencil, %" PetscInt_FMT "^3 nodes, %" PetscInt_FMT " rows; minimum of %" PetscInt_FMT " runs, ms\n", grid.nx, 3 * grid.nodes(), repeats));
@@ -68,6 +73,7 @@ int main(int argc, char **argv)
     double              t;
 
     PetscCall(CreateStencilMatrix(PETSC_COMM_SELF, grid, f.type, nullptr, &A));
+    if (f.sym) PetscCall(ReplaceWithBinBCSRSymmetric(&A));
     PetscCall(MatBinBCSRSetPrecision(A, f.precision));
     PetscCall(MatDuplicate(A, MAT_COPY_VALUES, &X));
     PetscCall(MatCreateVecs(A, &x, &b));

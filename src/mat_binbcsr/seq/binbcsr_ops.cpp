@@ -458,13 +458,17 @@ static PetscErrorCode MatNorm_SeqBinBCSR(Mat A, NormType type, PetscReal *nrm)
   if (a->sym) {
     /* Frobenius: off-diagonal blocks count twice; 1 = infinity (symmetric): row sums of the full
        matrix, i.e. the stored rows plus the stored off-diagonal blocks' columns */
-    if (type == NORM_FROBENIUS) {
-      double sum = 0.0;
-      ForEachRealValue(a, [&](PetscInt v, PetscInt r, PetscInt c, PetscInt, PetscInt) {
-        const double x = PetscAbsScalar(BinBCSRGetValue(a, v));
-        sum += (c == r ? 1.0 : 2.0) * x * x;
-      });
-      *nrm = PetscSqrtReal(sum);
+    if (type == NORM_FROBENIUS) { /* twice the contiguous sum over all values (padding is zero), less the diagonal blocks once */
+      const long n   = (long)a->nslots * a->bs2;
+      double     sum = 2.0 * (a->val ? binbcsr::values_sum_squares(n, a->val) : binbcsr::values_sum_squares(n, a->valf));
+      for (PetscInt r = 0; r < a->mbs; r++) {
+        if (a->diag_slot[r] < 0) continue;
+        for (PetscInt e = 0; e < a->bs2; e++) {
+          const double x = PetscAbsScalar(BinBCSRGetValue(a, BinBCSRValueIndex(a->diag_slot[r], e, a->bw, a->bs2)));
+          sum -= x * x;
+        }
+      }
+      *nrm = PetscSqrtReal(PetscMax(sum, 0.0));
     } else if (type == NORM_1 || type == NORM_INFINITY) {
       double *row_sum;
       PetscCall(PetscCalloc1((size_t)a->mbs * bs, &row_sum));
