@@ -5,7 +5,7 @@
 //
 // Scenes (-scene): chain (-chain_links, -chain_length, -chain_angle, -chain_mass_first, -chain_mass_last),
 // bridge (-bridge_chains, -bridge_links, -bridge_tie_every, -bridge_sag), loop (four-bar linkage).
-// Solver options: -joint_tol (m), -max_corrections, -joint_regularisation, -joint_refresh,
+// Solver options: -joint_tol (m), -max_corrections, -joint_max_halvings, -joint_regularisation, -joint_refresh,
 // -velocity_stabilisation, -joint_warm_start (previous step's impulses as initial guesses). Output: a progress
 // line every -progress_every steps, -vtk PREFIX (.vtu per -vtk_every steps plus PREFIX.pvd), -dump_matrix FILE
 // (J M^-1 J^T of the first step, PETSc binary), and a final `summary key=value ...` line.
@@ -111,13 +111,15 @@ int main(int argc, char **argv)
 
   physics::ArticulatedParams params;
   DriverOutput               out;
-  PetscInt                   max_corr = params.max_corrections;
+  PetscInt                   max_corr = params.max_corrections, max_halvings = params.max_halvings;
   PetscBool                  vel_stab = PETSC_TRUE, refresh = PETSC_FALSE, warm = PETSC_FALSE, vtk_points = PETSC_FALSE;
   PetscCall(DriverOutputFromOptions(comm, &out));
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-dt", &params.dt, nullptr));
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-joint_tol", &params.joint_tol, nullptr));
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-max_corrections", &max_corr, nullptr));
   params.max_corrections = (int)max_corr;
+  PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-joint_max_halvings", &max_halvings, nullptr));
+  params.max_halvings = (int)max_halvings;
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-joint_regularisation", &params.regularisation, nullptr));
   PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-joint_refresh", &refresh, nullptr));
   PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-velocity_stabilisation", &vel_stab, nullptr));
@@ -148,7 +150,7 @@ int main(int argc, char **argv)
 
   const double e0 = physics::total_energy(scene);
   double       e_max = e0, worst_error = 0, worst_velocity = 0, step_ms_total = 0;
-  long long    corrections = 0, max_corrections_seen = 0, unconverged = 0, stalled = 0, singular_steps = 0, nan_steps = 0;
+  long long    corrections = 0, halvings = 0, max_corrections_seen = 0, unconverged = 0, stalled = 0, singular_steps = 0, nan_steps = 0;
   for (PetscInt n = 1; n <= out.steps; ++n) {
     const long long its0 = rs.iterations, solves0 = rs.solves;
     const double    solve0 = rs.solve_ms, t0 = WallTime();
@@ -160,6 +162,7 @@ int main(int argc, char **argv)
     for (const physics::RigidBody &b : scene.bodies) finite &= b.position.allFinite() && b.velocity.allFinite() && b.angular_velocity.allFinite();
     nan_steps += !finite;
     corrections += r.corrections;
+    halvings += r.halvings;
     max_corrections_seen = std::max<long long>(max_corrections_seen, r.corrections);
     unconverged += !r.converged;
     stalled += r.stalled;
@@ -195,6 +198,7 @@ int main(int argc, char **argv)
   s.add("cg_its_per_step", out.steps ? (double)rs.iterations / out.steps : 0.0);
   s.add("corrections_per_step", out.steps ? (double)corrections / out.steps : 0.0);
   s.add("corrections_max", max_corrections_seen);
+  s.add("halvings_per_step", out.steps ? (double)halvings / out.steps : 0.0);
   s.add("unconverged_steps", unconverged);
   s.add("stalled_steps", stalled);
   s.add("regularised", (long long)solver.regularised);

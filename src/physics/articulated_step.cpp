@@ -17,6 +17,7 @@ std::string validate_params(const ArticulatedParams &p)
   if (!(p.dt > 0) || !std::isfinite(p.dt)) return "time step must be positive and finite";
   if (!(p.joint_tol > 0)) return "joint tolerance must be positive";
   if (p.max_corrections < 1) return "at least one correction iteration is needed";
+  if (p.max_halvings < 0) return "the number of halvings must be non-negative";
   if (!(p.regularisation >= 0)) return "regularisation must be non-negative";
   return "";
 }
@@ -176,6 +177,7 @@ ArticulatedStepReport articulated_step(ArticulatedScene &scene, ArticulatedSolve
       apply_joint_impulses(scene, s, s.impulses);
       for (double &p : s.impulses) p = -p;
       next = predicted_errors(scene, dt, s);
+      report.halvings++;
     }
     for (size_t k = 0; k < 3 * nj; ++k) s.correction_sum[k] += s.impulses[k]; // what was applied
     // No fraction of the impulse helps: the linearisation has run out (round-off in very unequal masses,

@@ -43,6 +43,7 @@ struct ArticulatedStepReport {
   bool   converged         = false; // joint_error < joint_tol
   bool   singular_detected = false; // this step found A singular and switched to regularisation
   bool   stalled           = false; // a correction could not reduce the error
+  int    halvings          = 0;     // impulses halved back by the line search (each costs a prediction)
 };
 
 struct ArticulatedSolver {
