@@ -19,6 +19,14 @@ add_test(NAME articulated_mass_ratio_1e8_finite
 add_test(NAME articulated_bridge_small
          COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && joint_error_max<1e-6 && loops==26"
                  -- ${ART} -scene bridge -bridge_chains 6 -bridge_links 20 -bridge_tie_every 5 -bridge_sag 2 -steps 60 -ksp_rtol 1e-10 -progress_every 1000)
+# IC(0) in the physics order factorises each chain exactly: one CG iteration per solve where Jacobi needs ~50.
+add_test(NAME articulated_bridge_icc
+         COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && joint_error_max<1e-6 && cg_its<=1.5 && loops==11"
+                 -- ${ART} -scene bridge -bridge_chains 6 -bridge_links 40 -bridge_tie_every 40 -bridge_sag 4 -steps 30 -mat_type aij
+                    -pc_type icc -ksp_rtol 1e-4 -ksp_max_it 3000 -max_corrections 20 -progress_every 1000)
+add_test(NAME articulated_bad_halvings
+         COMMAND ${ART} -options_file ${OPTS}/chain.opts -joint_max_halvings -1)
+set_tests_properties(articulated_bad_halvings PROPERTIES PASS_REGULAR_EXPRESSION "halvings must be non-negative")
 set(ART_SAME "${ART} -options_file ${OPTS}/chain.opts -steps 100 -ksp_rtol 1e-12 -progress_every 1000")
 add_test(NAME articulated_same_result_mat_types
          COMMAND ${SUMMARY_SAME} "energy_final joint_error_final corrections_per_step" 1e-6
@@ -33,7 +41,7 @@ set_tests_properties(articulated_bad_mass PROPERTIES PASS_REGULAR_EXPRESSION "ma
 add_test(NAME articulated_bad_scene
          COMMAND ${ART} -scene trampoline)
 set_tests_properties(articulated_bad_scene PROPERTIES PASS_REGULAR_EXPRESSION "unknown -scene trampoline")
-set_tests_properties(articulated_chain articulated_loop articulated_mass_ratio_1e4 articulated_mass_ratio_1e8_finite
+set_tests_properties(articulated_bridge_icc articulated_bad_halvings articulated_chain articulated_loop articulated_mass_ratio_1e4 articulated_mass_ratio_1e8_finite
                      articulated_bridge_small articulated_same_result_mat_types articulated_bad_dt articulated_bad_mass
                      articulated_bad_scene PROPERTIES LABELS "articulated" TIMEOUT 60)
 
