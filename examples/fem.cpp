@@ -5,8 +5,9 @@
 //   fem -mesh examples/meshes/armadillo.geo -mesh_size 0.08 -fem_order 2 -vtk out/arma
 //
 // Parallel runs (mpiexec -n P): every rank holds the whole mesh and state; METIS splits the nodes
-// into P contiguous ranges (src/physics/partition), each rank assembles the elements whose first
-// corner it owns (COO entries may fall in other ranks' rows), the solve is distributed, and dv is
+// into P contiguous ranges (src/physics/partition), each rank assembles the elements inside its range
+// and a balancing share of the cut ones (COO entries may fall in other ranks' rows), the solve is
+// distributed, and dv is
 // gathered back to every rank.
 //
 // Fixed nodes are eliminated: their rows and columns hold only an identity diagonal block and their

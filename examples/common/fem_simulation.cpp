@@ -56,9 +56,10 @@ PetscErrorCode FemSimulationCreate(MPI_Comm comm, const FemScene &scene, FemSimu
   const int n_nodes = sim->model.node_count(), npe = sim->model.npe;
   sim->own_begin = sim->part_offsets[rank];
   sim->own_end   = sim->part_offsets[rank + 1];
-  for (int e = 0; e < sim->model.element_count(); ++e) {
-    const int first = sim->model.mesh.elements[(size_t)e * npe];
-    if (first >= sim->own_begin && first < sim->own_end) sim->elements.push_back(e);
+  {
+    const std::vector<int> owner = physics::assign_elements_to_parts(sim->model.mesh.elements, npe, sim->part_offsets);
+    for (int e = 0; e < sim->model.element_count(); ++e)
+      if (owner[e] == rank) sim->elements.push_back(e);
   }
   physics::LowerTriangle lower; // list and compute only the blocks the Mat type stores
   {

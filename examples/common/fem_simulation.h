@@ -4,7 +4,8 @@
 //
 // Parallel layout: every rank holds the whole mesh and state; the nodes are renumbered so that rank
 // p owns a contiguous range (METIS partition with RCM inside each part; RCM alone on one rank); each
-// rank assembles the elements whose first corner it owns; the right-hand side is summed with
+// rank assembles the elements inside its range and a balancing share of those cut by the partition
+// (physics::assign_elements_to_parts); the right-hand side is summed with
 // MPI_Reduce_scatter and dv gathered back with MPI_Allgatherv.
 #pragma once
 #include "common/sim_system.h"

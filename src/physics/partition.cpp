@@ -312,4 +312,35 @@ long long cut_edges(const AdjacencyGraph &g, const Renumbering &r)
   return cut;
 }
 
+std::vector<int> assign_elements_to_parts(const std::vector<int> &connectivity, int npe, const std::vector<int> &part_offsets)
+{
+  if (npe <= 0 || connectivity.size() % npe) throw std::invalid_argument("assign_elements_to_parts: bad element size");
+  if (part_offsets.size() < 2) throw std::invalid_argument("assign_elements_to_parts: need at least one part");
+  const int parts = static_cast<int>(part_offsets.size()) - 1;
+  const int ne    = static_cast<int>(connectivity.size() / npe);
+  auto part_of = [&](int v) {
+    if (v < part_offsets.front() || v >= part_offsets.back()) throw std::invalid_argument("assign_elements_to_parts: node outside the parts");
+    return static_cast<int>(std::upper_bound(part_offsets.begin(), part_offsets.end(), v) - part_offsets.begin()) - 1;
+  };
+  std::vector<int>       owner(ne, -1);
+  std::vector<long long> load(parts, 0);
+  for (int e = 0; e < ne; ++e) {
+    const int p = part_of(connectivity[static_cast<size_t>(e) * npe]);
+    bool      one_part = true;
+    for (int k = 1; k < npe && one_part; ++k) one_part = part_of(connectivity[static_cast<size_t>(e) * npe + k]) == p;
+    if (one_part) owner[e] = p, ++load[p];
+  }
+  for (int e = 0; e < ne; ++e) {
+    if (owner[e] >= 0) continue;
+    int best = -1;
+    for (int k = 0; k < npe; ++k) {
+      const int p = part_of(connectivity[static_cast<size_t>(e) * npe + k]);
+      if (best < 0 || load[p] < load[best] || (load[p] == load[best] && p < best)) best = p;
+    }
+    owner[e] = best;
+    ++load[best];
+  }
+  return owner;
+}
+
 } // namespace physics

@@ -3,6 +3,7 @@
 #include "physics/partition.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <numeric>
 #include <random>
 #include <set>
@@ -151,4 +152,24 @@ TEST_CASE("locality: RCM and nested dissection undo a random shuffle", "[partiti
     REQUIRE(parted.new_of_old[v] >= parted.part_offsets[p]);
     REQUIRE(parted.new_of_old[v] < parted.part_offsets[p + 1]);
   }
+}
+
+TEST_CASE("assign_elements_to_parts: uncut elements stay, cut ones balance the parts", "[partition]")
+{
+  // A chain of 2-node "elements" over 12 nodes split 0-5 | 6-11, plus many elements cut by the split.
+  std::vector<int> conn;
+  for (int v = 0; v + 1 < 12; ++v) conn.insert(conn.end(), {v, v + 1});
+  for (int k = 0; k < 20; ++k) conn.insert(conn.end(), {k % 6, 6 + k % 6});
+  const std::vector<int> offsets{0, 6, 12};
+  const std::vector<int> owner = physics::assign_elements_to_parts(conn, 2, offsets);
+  REQUIRE(owner.size() == conn.size() / 2);
+  int count[2] = {0, 0};
+  for (size_t e = 0; e < owner.size(); ++e) {
+    const int a = conn[2 * e] < 6 ? 0 : 1, b = conn[2 * e + 1] < 6 ? 0 : 1;
+    CHECK((owner[e] == a || owner[e] == b));
+    if (a == b) CHECK(owner[e] == a);
+    ++count[owner[e]];
+  }
+  CHECK(std::abs(count[0] - count[1]) <= 1);
+  CHECK_THROWS_AS(physics::assign_elements_to_parts(conn, 2, {0, 6, 11}), std::invalid_argument);
 }
