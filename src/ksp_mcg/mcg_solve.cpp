@@ -68,7 +68,7 @@ static PetscErrorCode MCGUpdateDiagonal(KSP ksp)
   Mat              Pmat;
   PetscObjectId    id;
   PetscObjectState state;
-  PetscBool        reuse, useabs, fixdiag, isset, isspd;
+  PetscBool        reuse, useabs, fixdiag, isset = PETSC_FALSE, isspd = PETSC_FALSE; /* MatIsSPDKnown leaves isspd unset when unknown */
   PetscInt         n, zeros = 0;
   PetscScalar     *d;
 
