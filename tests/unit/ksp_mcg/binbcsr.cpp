@@ -9,40 +9,6 @@
 
 using namespace mcg_test;
 
-// The aij test matrix converted to binbcsr; nullptr (and a warning) where binbcsr is not available
-// for this communicator (MPI binbcsr may not have landed yet).
-static Mat to_binbcsr(Mat aij, MatBinBCSRPrecision precision)
-{
-  Mat         B = nullptr;
-  PetscMPIInt size;
-  MPI_Comm_size(PetscObjectComm((PetscObject)aij), &size);
-  const PetscErrorCode err = MatConvert(aij, MATBINBCSR, MAT_INITIAL_MATRIX, &B);
-  if (size == 1) REQUIRE(err == 0); // the sequential type is there: no skipping
-  if (err) return nullptr;
-  REQUIRE(MatBinBCSRSetPrecision(B, precision) == 0);
-  return B;
-}
-
-static PetscReal rel_residual(Mat A, Vec b, const std::vector<PetscScalar> &x)
-{
-  Vec       xv, r;
-  PetscInt  lo, hi;
-  PetscReal rn, bn;
-  VecDuplicate(b, &xv);
-  VecDuplicate(b, &r);
-  VecGetOwnershipRange(xv, &lo, &hi);
-  for (PetscInt i = lo; i < hi; i++) VecSetValue(xv, i, x[i], INSERT_VALUES);
-  VecAssemblyBegin(xv);
-  VecAssemblyEnd(xv);
-  MatMult(A, xv, r);
-  VecAYPX(r, -1.0, b);
-  VecNorm(r, NORM_2, &rn);
-  VecNorm(b, NORM_2, &bn);
-  VecDestroy(&xv);
-  VecDestroy(&r);
-  return rn / bn;
-}
-
 TEST_CASE("mcg matches cg on binbcsr, double and single storage", "[ksp_mcg][binbcsr]")
 {
   for (PetscInt n : {3, 14}) {

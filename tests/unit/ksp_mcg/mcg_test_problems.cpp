@@ -1,4 +1,5 @@
 #include "mcg_test_problems.h"
+#include <catch2/catch.hpp>
 #include <cmath>
 
 namespace mcg_test {
@@ -135,6 +136,40 @@ PetscReal rel_diff(const std::vector<PetscScalar> &a, const std::vector<PetscSca
   }
   if (a.size() != b.size()) return PETSC_MAX_REAL;
   return n > 0 ? std::sqrt(d / n) : std::sqrt(d);
+}
+
+// The aij test matrix converted to binbcsr; nullptr (and a warning) where binbcsr is not available
+// for this communicator (MPI binbcsr may not have landed yet).
+Mat to_binbcsr(Mat aij, MatBinBCSRPrecision precision)
+{
+  Mat         B = nullptr;
+  PetscMPIInt size;
+  MPI_Comm_size(PetscObjectComm((PetscObject)aij), &size);
+  const PetscErrorCode err = MatConvert(aij, MATBINBCSR, MAT_INITIAL_MATRIX, &B);
+  if (size == 1) REQUIRE(err == 0); // the sequential type is there: no skipping
+  if (err) return nullptr;
+  REQUIRE(MatBinBCSRSetPrecision(B, precision) == 0);
+  return B;
+}
+
+PetscReal rel_residual(Mat A, Vec b, const std::vector<PetscScalar> &x)
+{
+  Vec       xv, r;
+  PetscInt  lo, hi;
+  PetscReal rn, bn;
+  VecDuplicate(b, &xv);
+  VecDuplicate(b, &r);
+  VecGetOwnershipRange(xv, &lo, &hi);
+  for (PetscInt i = lo; i < hi; i++) VecSetValue(xv, i, x[i], INSERT_VALUES);
+  VecAssemblyBegin(xv);
+  VecAssemblyEnd(xv);
+  MatMult(A, xv, r);
+  VecAYPX(r, -1.0, b);
+  VecNorm(r, NORM_2, &rn);
+  VecNorm(b, NORM_2, &bn);
+  VecDestroy(&xv);
+  VecDestroy(&r);
+  return rn / bn;
 }
 
 } // namespace mcg_test

@@ -39,4 +39,10 @@ Result solve(Mat A, Vec b, const Solve &s, Vec x0 = nullptr);
 // ||a - b|| / ||b|| of two gathered vectors.
 PetscReal rel_diff(const std::vector<PetscScalar> &a, const std::vector<PetscScalar> &b);
 
+// The aij test matrix converted to binbcsr with the given value storage; nullptr where binbcsr is not
+// available on this communicator (required, checked, on one rank).
+Mat to_binbcsr(Mat aij, MatBinBCSRPrecision precision);
+// ||b - A x|| / ||b|| with the gathered x.
+PetscReal rel_residual(Mat A, Vec b, const std::vector<PetscScalar> &x);
+
 } // namespace mcg_test

@@ -10,40 +10,6 @@ using namespace mcg_test;
 
 namespace {
 
-// binbcsr copy of an aij matrix; nullptr where the communicator has no binbcsr (sequential: required)
-Mat to_precision(Mat aij, MatBinBCSRPrecision precision)
-{
-  Mat         B = nullptr;
-  PetscMPIInt size;
-  MPI_Comm_size(PetscObjectComm((PetscObject)aij), &size);
-  const PetscErrorCode err = MatConvert(aij, MATBINBCSR, MAT_INITIAL_MATRIX, &B);
-  if (size == 1) REQUIRE(err == 0);
-  if (err) return nullptr;
-  REQUIRE(MatBinBCSRSetPrecision(B, precision) == 0);
-  return B;
-}
-
-// ||b - A x|| / ||b|| with the gathered x
-PetscReal rel_residual(Mat A, Vec b, const std::vector<PetscScalar> &x)
-{
-  Vec       xv, r;
-  PetscInt  lo, hi;
-  PetscReal rn, bn;
-  VecDuplicate(b, &xv);
-  VecDuplicate(b, &r);
-  VecGetOwnershipRange(xv, &lo, &hi);
-  for (PetscInt i = lo; i < hi; i++) VecSetValue(xv, i, x[i], INSERT_VALUES);
-  VecAssemblyBegin(xv);
-  VecAssemblyEnd(xv);
-  MatMult(A, xv, r);
-  VecAYPX(r, -1.0, b);
-  VecNorm(r, NORM_2, &rn);
-  VecNorm(b, NORM_2, &bn);
-  VecDestroy(&xv);
-  VecDestroy(&r);
-  return rn / bn;
-}
-
 PetscReal norm(Vec b)
 {
   PetscReal n;
@@ -111,7 +77,7 @@ TEST_CASE("precision floor: double products have none, any operator can be given
   Result r = solve(A, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-12});
   CHECK(r.reason == KSP_CONVERGED_RTOL);
   CHECK(view_after_solve(A, b, "-ksp_rtol 1e-12").find("precision floor: none (operator products in double precision)") != std::string::npos);
-  if (Mat B = to_precision(A, MAT_BINBCSR_PRECISION_DOUBLE)) {
+  if (Mat B = to_binbcsr(A, MAT_BINBCSR_PRECISION_DOUBLE)) {
     r = solve(B, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-12});
     CHECK(r.reason == KSP_CONVERGED_RTOL);
     MatDestroy(&B);
@@ -150,7 +116,7 @@ TEST_CASE("precision floor: double products have none, any operator can be given
 TEST_CASE("precision floor: single storage, every norm type, error if not converged, view", "[ksp_mcg][floor]")
 {
   Mat A = block_laplacian(12, 12);
-  Mat B = to_precision(A, MAT_BINBCSR_PRECISION_SINGLE);
+  Mat B = to_binbcsr(A, MAT_BINBCSR_PRECISION_SINGLE);
   if (!B) {
     WARN("binbcsr not available on this communicator: skipped");
     MatDestroy(&A);
@@ -217,8 +183,8 @@ TEST_CASE("extremes: single storage on an ill-conditioned system reports its flo
     CHECK(emax / emin > 3e7);
     CHECK(emax / emin < 3e8);
   }
-  Mat B = to_precision(A, MAT_BINBCSR_PRECISION_SINGLE);
-  Mat D = to_precision(A, MAT_BINBCSR_PRECISION_DOUBLE);
+  Mat B = to_binbcsr(A, MAT_BINBCSR_PRECISION_SINGLE);
+  Mat D = to_binbcsr(A, MAT_BINBCSR_PRECISION_DOUBLE);
   if (!B || !D) {
     WARN("binbcsr not available on this communicator: skipped");
   } else {
