@@ -18,6 +18,11 @@ PetscErrorCode FemSimulationCreate(MPI_Comm comm, const FemScene &scene, FemSimu
   sim->comm = comm;
   sim->rank = rank;
   sim->size = size;
+  // Upper-triangle storage wants rows grouped by their upper length, which the order itself decides.
+  PetscBool upper_only = PETSC_FALSE, offrank_full = PETSC_FALSE;
+  PetscInt  bin_width  = 8; // MATBINBCSR's default for 3x3 blocks
+  PetscCall(BlockSystemStoredTriangle(comm, &upper_only, &offrank_full));
+  PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-mat_binbcsr_bin_width", &bin_width, nullptr));
   try {
     physics::TetMesh mesh = scene.mesh;
     sim->fixed            = scene.fixed.empty() ? std::vector<char>(mesh.node_count(), 0) : scene.fixed;
@@ -32,7 +37,10 @@ PetscErrorCode FemSimulationCreate(MPI_Comm comm, const FemScene &scene, FemSimu
       } else {
         r = physics::reorder_for_locality(g, physics::LocalOrder::ReverseCuthillMcKee);
       }
-      if (scene.bin_order_window > 0) r = physics::group_by_row_length(physics::row_lengths_without_fixed(g, sim->fixed), r, scene.bin_order_window);
+      if (scene.bin_order_window > 0) {
+        if (upper_only) r = physics::group_by_upper_row_length(g, sim->fixed, r, scene.bin_order_window, (int)bin_width);
+        else r = physics::group_by_row_length(physics::row_lengths_without_fixed(g, sim->fixed), r, scene.bin_order_window);
+      }
       physics::renumber_nodes(mesh, r.new_of_old);
       physics::sort_elements_by_lowest_node(mesh);
       std::vector<char> f(sim->fixed.size());

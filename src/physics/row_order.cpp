@@ -69,4 +69,43 @@ std::vector<int> row_lengths_in_new_order(const std::vector<int> &row_length_old
   return out;
 }
 
+std::vector<int> upper_row_lengths(const AdjacencyGraph &g, const std::vector<char> &fixed, const Renumbering &r)
+{
+  const int n = g.vertex_count();
+  if (static_cast<int>(fixed.size()) != n || static_cast<int>(r.new_of_old.size()) != n)
+    throw std::invalid_argument("upper_row_lengths: fixed flags or renumbering: wrong size");
+  // part of a new number: parts are contiguous ranges of new numbers
+  std::vector<int> part_of_new(n, 0);
+  for (std::size_t p = 0; p + 1 < r.part_offsets.size(); ++p)
+    for (int k = r.part_offsets[p]; k < r.part_offsets[p + 1]; ++k) part_of_new[k] = static_cast<int>(p);
+  std::vector<int> length(n, 1);
+  for (int v = 0; v < n; ++v) {
+    if (fixed[v]) continue;
+    const int nv = r.new_of_old[v];
+    for (int e = g.xadj[v]; e < g.xadj[v + 1]; ++e) {
+      const int w = g.adjncy[e], nw = r.new_of_old[w];
+      if (!fixed[w] && nw > nv && part_of_new[nw] == part_of_new[nv]) ++length[v];
+    }
+  }
+  return length;
+}
+
+Renumbering group_by_upper_row_length(const AdjacencyGraph &g, const std::vector<char> &fixed, const Renumbering &base,
+                                      int window, int bin_width, int sweeps)
+{
+  validate_graph(g);
+  Renumbering best         = base;
+  double      best_padding = bin_padding_overhead(row_lengths_in_new_order(upper_row_lengths(g, fixed, base), base), bin_width);
+  Renumbering r            = base;
+  for (int s = 0; s < sweeps; ++s) {
+    r                    = group_by_row_length(upper_row_lengths(g, fixed, r), r, window);
+    const double padding = bin_padding_overhead(row_lengths_in_new_order(upper_row_lengths(g, fixed, r), r), bin_width);
+    if (padding < best_padding) {
+      best_padding = padding;
+      best         = r;
+    }
+  }
+  return best;
+}
+
 } // namespace physics

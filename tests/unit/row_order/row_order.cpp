@@ -149,3 +149,50 @@ TEST_CASE("group_by_row_length: bad input throws", "[row_order]")
   CHECK_THROWS_AS(group_by_row_length({1, 2, 3}, broken, 4), std::invalid_argument);
   CHECK_THROWS_AS(row_lengths_without_fixed(g, {0, 1}), std::invalid_argument);
 }
+
+TEST_CASE("upper_row_lengths: the upper triangle of the pattern, per part, fixed rows alone", "[row_order]")
+{
+  // path 0-1-2-3 in two parts {0,1} {2,3}, identity order; vertex 3 fixed
+  const AdjacencyGraph g = graph_from_edges(4, {{0, 1}, {1, 2}, {2, 3}});
+  Renumbering          r;
+  r.new_of_old   = {0, 1, 2, 3};
+  r.old_of_new   = {0, 1, 2, 3};
+  r.part_offsets = {0, 2, 4};
+  const std::vector<char> fixed = {0, 0, 0, 1};
+  // 0: diag + 1; 1: diag only (2 is in the other part); 2: diag only (3 is fixed); 3: fixed
+  CHECK(upper_row_lengths(g, fixed, r) == std::vector<int>{2, 1, 1, 1});
+  // reversed order: the neighbours "after" a vertex are now the lower-numbered old ones
+  r.new_of_old   = {3, 2, 1, 0};
+  r.old_of_new   = {3, 2, 1, 0};
+  r.part_offsets = {0, 4};
+  CHECK(upper_row_lengths(g, {0, 0, 0, 0}, r) == std::vector<int>{1, 2, 2, 2});
+  CHECK_THROWS_AS(upper_row_lengths(g, {0, 0}, r), std::invalid_argument);
+}
+
+TEST_CASE("group_by_upper_row_length: a permutation inside the parts, upper padding no worse and lower than degree grouping", "[row_order]")
+{
+  const AdjacencyGraph    g = hex_grid_graph(12, 10, 9);
+  const int               n = g.vertex_count();
+  const std::vector<char> fixed(n, 0);
+  PartitionOptions        po;
+  po.local_order         = LocalOrder::ReverseCuthillMcKee;
+  const Renumbering base = partition_graph(g, 2, po);
+  const Renumbering by_degree = group_by_degree(g, base, 64);
+  const Renumbering by_upper  = group_by_upper_row_length(g, fixed, by_degree, 64, 8);
+  check_permutation(by_upper, n);
+  REQUIRE(by_upper.part_offsets == base.part_offsets);
+  for (int v = 0; v < n; ++v) {
+    const int p = base.part_of_old[v];
+    CHECK(by_upper.new_of_old[v] >= base.part_offsets[p]);
+    CHECK(by_upper.new_of_old[v] < base.part_offsets[p + 1]);
+  }
+  auto upper_padding = [&](const Renumbering &r) { return bin_padding_overhead(row_lengths_in_new_order(upper_row_lengths(g, fixed, r), r), 8); };
+  // the stored upper triangle is the same size in every order of one partition: n + edges inside parts
+  long long stored_degree = 0, stored_upper = 0;
+  for (int l : upper_row_lengths(g, fixed, by_degree)) stored_degree += l;
+  for (int l : upper_row_lengths(g, fixed, by_upper)) stored_upper += l;
+  CHECK(stored_upper == stored_degree);
+  CHECK(upper_padding(by_upper) <= upper_padding(by_degree));
+  CHECK(upper_padding(by_upper) < 0.75 * upper_padding(by_degree));
+  INFO("upper padding by degree " << upper_padding(by_degree) << ", by upper length " << upper_padding(by_upper));
+}
