@@ -13,6 +13,12 @@ PETSC_EXTERN PetscErrorCode KSPCreate_MCG(KSP);
 /* Inserts src's local rows into dst (INSERT_VALUES) and assembles dst: the generic conversion path. */
 PETSC_INTERN PetscErrorCode MatBinBCSRInsertRows_Private(Mat src, Mat dst);
 
+/* MATSEQBINBCSR parts of MATMPIBINBCSR: after MatSetPreallocationCOO, compose the part's COO map with
+   from[] (part entry -> source index); the two-source refill then reads source p < n from v and
+   p >= n from recv[p - n]. A plain MatSetValuesCOO on the part keeps its own map. */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRComposeCOO(Mat, const PetscCount from[], PetscCount nsrc);
+PETSC_INTERN PetscErrorCode MatSetValuesCOOTwoSources_SeqBinBCSR(Mat, const PetscScalar v[], PetscCount n, const PetscScalar recv[], InsertMode);
+
 /* Registered once by PetscBinBCSRRegisterAll(). */
 PETSC_EXTERN PetscLogEvent MAT_BinBCSR_BuildLayout; /* first final assembly: staging -> bins */
 PETSC_EXTERN PetscLogEvent MAT_BinBCSR_SetValuesCOO; /* slot refill by gather */

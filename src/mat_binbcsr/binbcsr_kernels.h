@@ -166,12 +166,18 @@ BINBCSR_HD void sym_bin_mult(const V *bin_val, const I *bin_col, int len, I r0, 
       for (int i = 0; i < BS; i++) y[(long)(r0 + l) * BS + i] += acc[i][l];
 }
 
-/* COO refill of one value: the sum of the coo entries perm[jmap[v] .. jmap[v+1]-1] of coo_v. */
+/* COO refill of one value: the sum of the entries perm[jmap[v] .. jmap[v+1]-1], where an index p < n
+   reads coo_v[p] and p >= n reads recv[p - n] (the MPI refill: the caller's values and the values
+   received from other ranks, without first copying both into one array). One source: n past every
+   index, recv unused. */
 template <typename I>
-BINBCSR_HD double coo_gather(const double *coo_v, const I *jmap, const I *perm, long v)
+BINBCSR_HD double coo_gather(const double *coo_v, long n, const double *recv, const I *jmap, const I *perm, long v)
 {
   double s = 0.0;
-  for (I j = jmap[v]; j < jmap[v + 1]; j++) s += coo_v[perm[j]];
+  for (I j = jmap[v]; j < jmap[v + 1]; j++) {
+    const long p = perm[j];
+    s += p < n ? coo_v[p] : recv[p - n];
+  }
   return s;
 }
 

@@ -41,7 +41,9 @@ struct MPIBinBCSRCoo {
   PetscInt                 nrecv = 0;
   std::vector<PetscCount>  a_from, b_from; /* source of each entry of A's / B's COO list: k < n is
                                               coo_v[k], k >= n is the (k-n)th received value */
-  std::vector<PetscScalar> sendbuf, recvbuf, a_v, b_v;
+  PetscBool                composed = PETSC_FALSE; /* BIN-BCSR parts hold a_from/b_from composed into
+                                                     their own maps (then a_from, b_from, a_v, b_v are empty) */
+  std::vector<PetscScalar> sendbuf, recvbuf, a_v, b_v; /* a_v, b_v: only for other inner types */
 };
 
 struct Mat_MPIBinBCSR {

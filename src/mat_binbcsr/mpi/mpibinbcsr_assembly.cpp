@@ -268,8 +268,21 @@ PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_MPIBinBCSR(Mat mat, PetscCoun
   PetscCall(MatMPIBinBCSRSetUpScatter(mat));
   coo->sendbuf.resize(coo->send_from.size());
   coo->recvbuf.resize(coo->nrecv);
-  coo->a_v.resize(coo->a_from.size());
-  coo->b_v.resize(coo->b_from.size());
+  /* BIN-BCSR parts read the caller's values and the received ones directly through their composed
+     maps; other inner types get their own COO lists copied out at every refill. */
+  PetscBool abin, bbin;
+  PetscCall(PetscObjectTypeCompare((PetscObject)b->A, MATSEQBINBCSR, &abin));
+  PetscCall(PetscObjectTypeCompare((PetscObject)b->B, MATSEQBINBCSR, &bbin));
+  coo->composed = abin && bbin ? PETSC_TRUE : PETSC_FALSE;
+  if (coo->composed) {
+    PetscCall(MatSeqBinBCSRComposeCOO(b->A, coo->a_from.data(), ncoo + coo->nrecv));
+    PetscCall(MatSeqBinBCSRComposeCOO(b->B, coo->b_from.data(), ncoo + coo->nrecv));
+    std::vector<PetscCount>().swap(coo->a_from);
+    std::vector<PetscCount>().swap(coo->b_from);
+  } else {
+    coo->a_v.resize(coo->a_from.size());
+    coo->b_v.resize(coo->b_from.size());
+  }
   mat->preallocated = PETSC_TRUE;
   mat->assembled    = PETSC_FALSE;
   PetscFunctionReturn(0);
@@ -284,19 +297,25 @@ PETSC_INTERN PetscErrorCode MatSetValuesCOO_MPIBinBCSR(Mat mat, const PetscScala
   PetscCheck(coo, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONGSTATE, "Call MatSetPreallocationCOO() first");
   for (std::size_t q = 0; q < coo->send_from.size(); q++) coo->sendbuf[q] = v[coo->send_from[q]];
   PetscCall(PetscSFReduceBegin(coo->sf, MPIU_SCALAR, coo->sendbuf.data(), coo->recvbuf.data(), MPI_REPLACE));
-  /* the local entries are gathered while the others travel */
   const PetscCount n = coo->n;
-  for (std::size_t k = 0; k < coo->a_from.size(); k++)
-    if (coo->a_from[k] < n) coo->a_v[k] = v[coo->a_from[k]];
-  for (std::size_t k = 0; k < coo->b_from.size(); k++)
-    if (coo->b_from[k] < n) coo->b_v[k] = v[coo->b_from[k]];
-  PetscCall(PetscSFReduceEnd(coo->sf, MPIU_SCALAR, coo->sendbuf.data(), coo->recvbuf.data(), MPI_REPLACE));
-  for (std::size_t k = 0; k < coo->a_from.size(); k++)
-    if (coo->a_from[k] >= n) coo->a_v[k] = coo->recvbuf[coo->a_from[k] - n];
-  for (std::size_t k = 0; k < coo->b_from.size(); k++)
-    if (coo->b_from[k] >= n) coo->b_v[k] = coo->recvbuf[coo->b_from[k] - n];
-  PetscCall(MatSetValuesCOO(b->A, coo->a_v.data(), mode));
-  PetscCall(MatSetValuesCOO(b->B, coo->b_v.data(), mode));
+  if (coo->composed) { /* each part gathers from v and recvbuf itself: no intermediate copy */
+    PetscCall(PetscSFReduceEnd(coo->sf, MPIU_SCALAR, coo->sendbuf.data(), coo->recvbuf.data(), MPI_REPLACE));
+    PetscCall(MatSetValuesCOOTwoSources_SeqBinBCSR(b->A, v, n, coo->recvbuf.data(), mode));
+    PetscCall(MatSetValuesCOOTwoSources_SeqBinBCSR(b->B, v, n, coo->recvbuf.data(), mode));
+  } else {
+    /* the local entries are gathered while the others travel */
+    for (std::size_t k = 0; k < coo->a_from.size(); k++)
+      if (coo->a_from[k] < n) coo->a_v[k] = v[coo->a_from[k]];
+    for (std::size_t k = 0; k < coo->b_from.size(); k++)
+      if (coo->b_from[k] < n) coo->b_v[k] = v[coo->b_from[k]];
+    PetscCall(PetscSFReduceEnd(coo->sf, MPIU_SCALAR, coo->sendbuf.data(), coo->recvbuf.data(), MPI_REPLACE));
+    for (std::size_t k = 0; k < coo->a_from.size(); k++)
+      if (coo->a_from[k] >= n) coo->a_v[k] = coo->recvbuf[coo->a_from[k] - n];
+    for (std::size_t k = 0; k < coo->b_from.size(); k++)
+      if (coo->b_from[k] >= n) coo->b_v[k] = coo->recvbuf[coo->b_from[k] - n];
+    PetscCall(MatSetValuesCOO(b->A, coo->a_v.data(), mode));
+    PetscCall(MatSetValuesCOO(b->B, coo->b_v.data(), mode));
+  }
   b->coo_just_assembled = PETSC_TRUE; /* MatSetValuesCOO() assembles mat next; nothing is stashed */
   PetscFunctionReturn(0);
 }

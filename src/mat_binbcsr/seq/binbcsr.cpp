@@ -40,7 +40,9 @@ PetscErrorCode MatSeqBinBCSRDestroyCOO(Mat_SeqBinBCSR *a)
   PetscFunctionBegin;
   PetscCall(PetscFree(a->coo_jmap));
   PetscCall(PetscFree(a->coo_perm));
-  a->coo_n = 0;
+  PetscCall(PetscFree(a->coo_perm_src));
+  a->coo_composed = PETSC_FALSE;
+  a->coo_n        = 0;
   PetscFunctionReturn(0);
 }
 

@@ -97,6 +97,8 @@ typedef struct {
   PetscCount coo_n;
   PetscInt  *coo_jmap;
   PetscInt  *coo_perm;
+  PetscInt  *coo_perm_src; /* coo_perm composed with a caller's source map (MatSeqBinBCSRComposeCOO), or NULL */
+  PetscBool  coo_composed;
 
   /* scratch */
   PetscBool    getrowactive;

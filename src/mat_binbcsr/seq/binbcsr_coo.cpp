@@ -110,12 +110,13 @@ PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat A, PetscCount n, const Pets
 namespace
 {
 /* Refill in row order q (CSR order: gathers from the same elements follow each other); the writes
-   stay inside one bin's tiles at a time. */
+   stay inside one bin's tiles at a time. perm indices below n read v, the others recv (see
+   binbcsr::coo_gather). */
 template <int BS, bool ADD, typename V>
-void coo_refill(const Mat_SeqBinBCSR *a, V *val, const PetscScalar *v)
+void coo_refill(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const PetscScalar *v, long n, const PetscScalar *recv)
 {
   const PetscInt  bs = BS ? BS : a->bs, bs2 = bs * bs, bw = a->bw;
-  const PetscInt *jmap = a->coo_jmap, *perm = a->coo_perm;
+  const PetscInt *jmap = a->coo_jmap;
   PetscInt        q    = 0;
   for (PetscInt r = 0; r < a->mbs; r++) {
     const PetscInt nr = a->row_nz[r];
@@ -124,7 +125,7 @@ void coo_refill(const Mat_SeqBinBCSR *a, V *val, const PetscScalar *v)
         V *blk = val + BinBCSRValueIndex(BinBCSRSlot(a, r, k), i * bs, bw, bs2); /* entry (i, j): blk[j * bw] */
         for (PetscInt j = 0; j < bs; j++, q++) {
           V           &dst = blk[(size_t)j * bw];
-          const double s   = binbcsr::coo_gather<PetscInt>(v, jmap, perm, q);
+          const double s   = binbcsr::coo_gather<PetscInt>(v, n, recv, jmap, perm, q);
           dst              = (V)(ADD ? (double)dst + s : s);
         }
       }
@@ -132,28 +133,27 @@ void coo_refill(const Mat_SeqBinBCSR *a, V *val, const PetscScalar *v)
 }
 
 template <int BS, typename V>
-void coo_refill_mode(const Mat_SeqBinBCSR *a, V *val, const PetscScalar *v, InsertMode imode)
+void coo_refill_mode(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const PetscScalar *v, long n, const PetscScalar *recv, InsertMode imode)
 {
-  if (imode == ADD_VALUES) coo_refill<BS, true, V>(a, val, v);
-  else coo_refill<BS, false, V>(a, val, v);
+  if (imode == ADD_VALUES) coo_refill<BS, true, V>(a, val, perm, v, n, recv);
+  else coo_refill<BS, false, V>(a, val, perm, v, n, recv);
 }
 
 template <typename V>
-void coo_refill_any(const Mat_SeqBinBCSR *a, V *val, const PetscScalar *v, InsertMode imode)
+void coo_refill_any(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const PetscScalar *v, long n, const PetscScalar *recv, InsertMode imode)
 {
-  if (a->bs == 3) coo_refill_mode<3, V>(a, val, v, imode);
-  else if (a->bs == 1) coo_refill_mode<1, V>(a, val, v, imode);
-  else coo_refill_mode<0, V>(a, val, v, imode);
+  if (a->bs == 3) coo_refill_mode<3, V>(a, val, perm, v, n, recv, imode);
+  else if (a->bs == 1) coo_refill_mode<1, V>(a, val, perm, v, n, recv, imode);
+  else coo_refill_mode<0, V>(a, val, perm, v, n, recv, imode);
 }
-} // namespace
 
-PetscErrorCode MatSetValuesCOO_SeqBinBCSR(Mat A, const PetscScalar v[], InsertMode imode)
+/* The refill both entry points share; v == NULL means zeros. */
+PetscErrorCode SetValuesCOO(Mat A, const PetscInt *perm, const PetscScalar v[], long n, const PetscScalar recv[], InsertMode imode)
 {
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  Mat_SeqBinBCSR *a  = (Mat_SeqBinBCSR *)A->data;
   const PetscInt  nv = a->nslots * a->bs2; /* padding included: it stays zero */
 
   PetscFunctionBegin;
-  PetscCheck(a->built && a->coo_jmap, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatSetValuesCOO needs MatSetPreallocationCOO first");
   PetscCheck(imode == INSERT_VALUES || imode == ADD_VALUES, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "MatSetValuesCOO supports INSERT_VALUES and ADD_VALUES only");
   PetscCall(PetscLogEventBegin(MAT_BinBCSR_SetValuesCOO, A, 0, 0, 0));
   if (!v) { /* no values: zeros */
@@ -161,8 +161,47 @@ PetscErrorCode MatSetValuesCOO_SeqBinBCSR(Mat A, const PetscScalar v[], InsertMo
       if (a->val) PetscCall(PetscArrayzero(a->val, nv));
       else PetscCall(PetscArrayzero(a->valf, nv));
     }
-  } else if (a->val) coo_refill_any<double>(a, a->val, v, imode);
-  else coo_refill_any<float>(a, a->valf, v, imode);
+  } else if (a->val) coo_refill_any<double>(a, a->val, perm, v, n, recv, imode);
+  else coo_refill_any<float>(a, a->valf, perm, v, n, recv, imode);
   PetscCall(PetscLogEventEnd(MAT_BinBCSR_SetValuesCOO, A, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+} // namespace
+
+PetscErrorCode MatSetValuesCOO_SeqBinBCSR(Mat A, const PetscScalar v[], InsertMode imode)
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+
+  PetscFunctionBegin;
+  PetscCheck(a->built && a->coo_jmap, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatSetValuesCOO needs MatSetPreallocationCOO first");
+  PetscCall(SetValuesCOO(A, a->coo_perm, v, (long)a->coo_n, nullptr, imode));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatSeqBinBCSRComposeCOO(Mat A, const PetscCount from[], PetscCount nsrc)
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+
+  PetscFunctionBegin;
+  PetscCheck(a->built && a->coo_jmap, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatSeqBinBCSRComposeCOO needs MatSetPreallocationCOO first");
+  PetscCheck(nsrc <= PETSC_MAX_INT, PETSC_COMM_SELF, PETSC_ERR_SUP, "%" PetscCount_FMT " COO sources overflow the 32-bit indices of MATSEQBINBCSR", nsrc);
+  const PetscInt nperm = a->coo_jmap[a->nz * a->bs2];
+  PetscCall(PetscFree(a->coo_perm_src));
+  PetscCall(PetscMalloc1(nperm, &a->coo_perm_src));
+  for (PetscInt t = 0; t < nperm; t++) a->coo_perm_src[t] = (PetscInt)from[a->coo_perm[t]];
+  a->coo_composed = PETSC_TRUE; /* coo_perm_src is NULL when the part has no entries */
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatSetValuesCOOTwoSources_SeqBinBCSR(Mat A, const PetscScalar v[], PetscCount n, const PetscScalar recv[], InsertMode imode)
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+
+  PetscFunctionBegin;
+  PetscCheck(a->built && a->coo_composed, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatSetValuesCOOTwoSources_SeqBinBCSR needs MatSeqBinBCSRComposeCOO first");
+  PetscCall(SetValuesCOO(A, a->coo_perm_src, v, (long)n, recv, imode));
+  /* as MatSetValuesCOO() does after the type's refill */
+  PetscCall(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY));
   PetscFunctionReturn(0);
 }
