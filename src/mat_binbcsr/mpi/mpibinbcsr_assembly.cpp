@@ -295,6 +295,12 @@ PETSC_INTERN PetscErrorCode MatSetValuesCOO_MPIBinBCSR(Mat mat, const PetscScala
 
   PetscFunctionBegin;
   PetscCheck(coo, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONGSTATE, "Call MatSetPreallocationCOO() first");
+  /* no values on this rank: its entries are zeros (as for the seq type); the exchange stays collective */
+  std::vector<PetscScalar> zeros;
+  if (!v) {
+    zeros.assign((std::size_t)coo->n, 0.0);
+    v = zeros.data();
+  }
   for (std::size_t q = 0; q < coo->send_from.size(); q++) coo->sendbuf[q] = v[coo->send_from[q]];
   PetscCall(PetscSFReduceBegin(coo->sf, MPIU_SCALAR, coo->sendbuf.data(), coo->recvbuf.data(), MPI_REPLACE));
   const PetscCount n = coo->n;

@@ -229,6 +229,9 @@ TEST_CASE("mpibinbcsr: refill in place (COO and MatSetValues) keeps the pattern 
   PCHK(MatSetValuesCOO(A, cv.data(), ADD_VALUES));
   PCHK(MatScale(S, 2.0));
   check_products(A, S);
+  // no values (NULL) are zeros, with off-rank entries too: ADD leaves the matrix as it is
+  PCHK(MatSetValuesCOO(A, nullptr, ADD_VALUES));
+  check_products(A, S);
 
   // zero, then refill through the blocked/stash path into the frozen pattern
   PCHK(MatZeroEntries(A));
