@@ -18,11 +18,12 @@ PetscErrorCode FemSimulationCreate(MPI_Comm comm, const FemScene &scene, FemSimu
   sim->comm = comm;
   sim->rank = rank;
   sim->size = size;
-  // Upper-triangle storage wants rows grouped by their upper length, which the order itself decides.
+  // What the Mat stores decides the row grouping and the blocks listed below: upper-triangle storage
+  // wants rows grouped by their upper length, which the order itself decides.
   PetscBool upper_only = PETSC_FALSE, offrank_full = PETSC_FALSE;
-  PetscInt  bin_width  = 8; // MATBINBCSR's default for 3x3 blocks
-  PetscCall(BlockSystemStoredTriangle(comm, &upper_only, &offrank_full));
-  PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-mat_binbcsr_bin_width", &bin_width, nullptr));
+  PetscInt  bin_width  = 0;
+  PetscCall(BlockSystemStoredTriangle(comm, &upper_only, &offrank_full, &bin_width));
+  if (bin_width < 1) bin_width = 8; // sbaij has no bins; measure padding as binbcsr's default would
   try {
     physics::TetMesh mesh = scene.mesh;
     sim->fixed            = scene.fixed.empty() ? std::vector<char>(mesh.node_count(), 0) : scene.fixed;
@@ -70,12 +71,8 @@ PetscErrorCode FemSimulationCreate(MPI_Comm comm, const FemScene &scene, FemSimu
       if (owner[e] == rank) sim->elements.push_back(e);
   }
   physics::LowerTriangle lower; // list and compute only the blocks the Mat type stores
-  {
-    PetscBool upper_only, offrank_full;
-    PetscCall(BlockSystemStoredTriangle(comm, &upper_only, &offrank_full));
-    lower.drop = upper_only;
-    if (upper_only && offrank_full) lower.part_offsets = sim->part_offsets;
-  }
+  lower.drop = upper_only;
+  if (upper_only && offrank_full) lower.part_offsets = sim->part_offsets;
   sim->pattern = physics::make_block_pattern(sim->model, sim->elements, sim->fixed, sim->own_begin, sim->own_end, scene.merge_blocks,
                                              lower);
   PetscCall(BlockSystemCreate(comm, n_nodes, sim->own_end - sim->own_begin, sim->pattern.rows, sim->pattern.cols, &sim->sys));

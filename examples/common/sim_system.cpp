@@ -128,7 +128,7 @@ PetscErrorCode MatStoredTriangle(Mat A, PetscBool *upper_only, PetscBool *offran
 
 } // namespace
 
-PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, PetscBool *offrank_full)
+PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, PetscBool *offrank_full, PetscInt *bin_width)
 {
   Mat probe;
 
@@ -141,6 +141,7 @@ PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, P
   PetscCall(MatSetType(probe, MATAIJ));
   PetscCall(MatSetFromOptions(probe));
   PetscCall(MatStoredTriangle(probe, upper_only, offrank_full));
+  if (bin_width) PetscCall(MatBinBCSRGetBinWidth(probe, bin_width)); // 0 for other types
   PetscCall(MatDestroy(&probe));
   PetscFunctionReturn(0);
 }

@@ -54,7 +54,8 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
 // list and compute only the blocks that are kept: *upper_only when blocks below the block diagonal are
 // ignored (sbaij; binbcsr with -mat_binbcsr_symmetric_storage), and then *offrank_full when blocks that
 // couple two ranks are kept in both triangles all the same (binbcsr stores its off-rank part in full).
-PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, PetscBool *offrank_full);
+// bin_width (may be null): the binbcsr bin width in block rows, 0 for other types.
+PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, PetscBool *offrank_full, PetscInt *bin_width = nullptr);
 
 // block_values: 9 * n_coo_blocks values, block k row-major at [9k, 9k+9). Summed over duplicates,
 // replacing the previous values. The array is remembered (not copied) for BlockSystemDumpMatrix: keep

@@ -94,12 +94,15 @@ Renumbering group_by_upper_row_length(const AdjacencyGraph &g, const std::vector
                                       int window, int bin_width, int sweeps)
 {
   validate_graph(g);
-  Renumbering best         = base;
-  double      best_padding = bin_padding_overhead(row_lengths_in_new_order(upper_row_lengths(g, fixed, base), base), bin_width);
-  Renumbering r            = base;
+  // the lengths counted to measure one order are the ones the next sweep sorts by
+  std::vector<int> length       = upper_row_lengths(g, fixed, base);
+  Renumbering      best         = base;
+  double           best_padding = bin_padding_overhead(row_lengths_in_new_order(length, base), bin_width);
+  Renumbering      r            = base;
   for (int s = 0; s < sweeps; ++s) {
-    r                    = group_by_row_length(upper_row_lengths(g, fixed, r), r, window);
-    const double padding = bin_padding_overhead(row_lengths_in_new_order(upper_row_lengths(g, fixed, r), r), bin_width);
+    r                    = group_by_row_length(length, r, window);
+    length               = upper_row_lengths(g, fixed, r);
+    const double padding = bin_padding_overhead(row_lengths_in_new_order(length, r), bin_width);
     if (padding < best_padding) {
       best_padding = padding;
       best         = r;
