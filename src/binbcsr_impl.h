@@ -9,6 +9,8 @@
 PETSC_EXTERN PetscErrorCode MatCreate_SeqBinBCSR(Mat);
 PETSC_EXTERN PetscErrorCode MatCreate_MPIBinBCSR(Mat);
 PETSC_EXTERN PetscErrorCode KSPCreate_MCG(KSP);
+/* ICC, Cholesky (through seqsbaij), ILU, LU (through seqbaij) for MATSOLVERPETSC: seq/binbcsr_factor.cpp */
+PETSC_INTERN PetscErrorCode MatGetFactor_SeqBinBCSR_Petsc(Mat, MatFactorType, Mat *);
 
 /* Inserts src's local rows into dst (INSERT_VALUES) and assembles dst: the generic conversion path. */
 PETSC_INTERN PetscErrorCode MatBinBCSRInsertRows_Private(Mat src, Mat dst);

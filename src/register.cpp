@@ -19,6 +19,7 @@ PetscErrorCode PetscBinBCSRRegisterAll(void)
   PetscCall(MatRegister(MATMPIBINBCSR, MatCreate_MPIBinBCSR));
   PetscCall(MatRegisterRootName(MATBINBCSR, MATSEQBINBCSR, MATMPIBINBCSR));
   PetscCall(KSPRegister(KSPMCG, KSPCreate_MCG));
+  for (MatFactorType ft : {MAT_FACTOR_ICC, MAT_FACTOR_CHOLESKY, MAT_FACTOR_ILU, MAT_FACTOR_LU}) PetscCall(MatSolverTypeRegister(MATSOLVERPETSC, MATSEQBINBCSR, ft, MatGetFactor_SeqBinBCSR_Petsc));
   PetscCall(PetscLogEventRegister("BinBCSRBuildLay", MAT_CLASSID, &MAT_BinBCSR_BuildLayout));
   PetscCall(PetscLogEventRegister("BinBCSRSetCOO", MAT_CLASSID, &MAT_BinBCSR_SetValuesCOO));
   PetscCall(PetscLogEventRegister("BinBCSRMultDot", MAT_CLASSID, &MAT_BinBCSR_MultDot));

@@ -1,0 +1,294 @@
+/* MATSEQBINBCSR factorisations (MATSOLVERPETSC): ICC and Cholesky through a seqsbaij shadow copy,
+   ILU and LU through a seqbaij one.
+
+   The bin layout is made for products, not for the row-by-row elimination of a factorisation, so the
+   factor is PETSc's own: MatGetFactor converts the matrix once into a shadow of the type PETSc factors
+   (seqsbaij: blocks on and above the diagonal; seqbaij: all blocks) and asks that shadow for its
+   factor Mat. The factor's symbolic and numeric ops are then wrapped: they refill the shadow's values
+   from the binbcsr matrix (a gather through a slot map built once, no MatSetValues) and call PETSc's
+   own routine with the shadow in place of the binbcsr matrix. Solves are the factor's own.
+
+   The shadow and the map live as long as the factor Mat (a PC keeps it between solves, so a refilled
+   matrix costs one value copy plus the numeric factorisation). Orderings: the factor's preferred
+   ordering is natural for every type (PETSc's sbaij supports nothing else; LU would otherwise ask for
+   nested dissection, which needs MatGetRowIJ). */
+#include "binbcsr.h"
+#include <vector>
+
+namespace
+{
+struct FactorShadow {
+  Mat              S = nullptr;     /* seqsbaij (ICC, Cholesky) or seqbaij (ILU, LU) */
+  PetscObjectState nzstate = 0;     /* the binbcsr matrix's nonzero state when S was built */
+  PetscInt         bs = 0, bw = 0;  /* of the binbcsr matrix */
+  std::vector<PetscInt>  src;       /* per block of S: value index of the binbcsr slot's entry 0 */
+  std::vector<char>      transpose; /* per block of S: read the stored block (c, r) transposed */
+  /* PETSc's ops of the factor, called with S in place of the binbcsr matrix */
+  PetscErrorCode (*iccsymbolic)(Mat, Mat, IS, const MatFactorInfo *)            = nullptr;
+  PetscErrorCode (*choleskysymbolic)(Mat, Mat, IS, const MatFactorInfo *)       = nullptr;
+  PetscErrorCode (*ilusymbolic)(Mat, Mat, IS, IS, const MatFactorInfo *)        = nullptr;
+  PetscErrorCode (*lusymbolic)(Mat, Mat, IS, IS, const MatFactorInfo *)         = nullptr;
+  PetscErrorCode (*choleskynumeric)(Mat, Mat, const MatFactorInfo *)            = nullptr;
+  PetscErrorCode (*lunumeric)(Mat, Mat, const MatFactorInfo *)                  = nullptr;
+};
+
+const char shadow_key[] = "MatSeqBinBCSR_FactorShadow";
+
+PetscErrorCode DestroyShadow(void *ctx)
+{
+  FactorShadow *f = (FactorShadow *)ctx;
+
+  PetscFunctionBegin;
+  PetscCall(MatDestroy(&f->S));
+  delete f;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode GetShadow(Mat F, FactorShadow **f)
+{
+  PetscContainer c;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectQuery((PetscObject)F, shadow_key, (PetscObject *)&c));
+  PetscCheck(c, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Factor of a MATSEQBINBCSR matrix without its shadow");
+  PetscCall(PetscContainerGetPointer(c, (void **)f));
+  PetscFunctionReturn(0);
+}
+
+/* The block pattern of S from A's: upper = blocks with column >= row (for seqsbaij), else all blocks
+   (with symmetric storage the lower ones are the stored upper ones transposed). Fills f->src and
+   f->transpose in the order of S's blocks (CSR, ascending columns). */
+PetscErrorCode BuildShadowPattern(Mat A, PetscBool upper, FactorShadow *f, std::vector<PetscInt> &bi, std::vector<PetscInt> &bj)
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  const PetscInt  bw = a->bw, bs2 = a->bs2;
+
+  PetscFunctionBegin;
+  auto base = [&](PetscInt s) { return (s - s % bw) * bs2 + s % bw; };
+  if (a->sym && !upper) PetscCall(MatSeqBinBCSRBuildLowerIndex(a));
+  bi.assign(1, 0);
+  bj.clear();
+  f->src.clear();
+  f->transpose.clear();
+  for (PetscInt r = 0; r < a->mbs; r++) {
+    if (!upper) {
+      if (a->sym) {
+        for (PetscInt p = a->lower_off[r]; p < a->lower_off[r + 1]; p++) {
+          bj.push_back(a->lower_slot[2 * p + 1]);
+          f->src.push_back(base(a->lower_slot[2 * p]));
+          f->transpose.push_back(1);
+        }
+      }
+    }
+    for (PetscInt k = 0; k < a->row_nz[r]; k++) {
+      const PetscInt s = BinBCSRSlot(a, r, k);
+      if (upper && a->col[s] < r) continue;
+      bj.push_back(a->col[s]);
+      f->src.push_back(base(s));
+      f->transpose.push_back(0);
+    }
+    bi.push_back((PetscInt)bj.size());
+  }
+  PetscFunctionReturn(0);
+}
+
+/* S's values from A's: one pass over S's blocks (column-major bs x bs, as BAIJ and SBAIJ store them). */
+template <typename T>
+void GatherValues(const T *val, const FactorShadow *f, PetscScalar *dst)
+{
+  const PetscInt bs = f->bs, bw = f->bw, bs2 = bs * bs, nb = (PetscInt)f->src.size();
+  for (PetscInt k = 0; k < nb; k++) {
+    const T     *v = val + f->src[k];
+    PetscScalar *d = dst + k * bs2;
+    if (!f->transpose[k]) {
+      for (PetscInt i = 0; i < bs; i++)
+        for (PetscInt j = 0; j < bs; j++) d[j * bs + i] = v[(i * bs + j) * bw];
+    } else {
+      for (PetscInt i = 0; i < bs; i++)
+        for (PetscInt j = 0; j < bs; j++) d[j * bs + i] = v[(j * bs + i) * bw];
+    }
+  }
+}
+
+PetscErrorCode RefillShadow(Mat A, FactorShadow *f)
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  PetscBool       upper;
+  PetscScalar    *dst;
+
+  PetscFunctionBegin;
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Factorisation needs an assembled MATSEQBINBCSR matrix");
+  PetscCheck(A->nonzerostate == f->nzstate, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "The MATSEQBINBCSR pattern changed after the symbolic factorisation; redo it (MatGetFactor)");
+  PetscCall(PetscObjectTypeCompare((PetscObject)f->S, MATSEQSBAIJ, &upper));
+  if (upper) PetscCall(MatSeqSBAIJGetArray(f->S, &dst));
+  else PetscCall(MatSeqBAIJGetArray(f->S, &dst));
+  if (a->val) GatherValues(a->val, f, dst);
+  else GatherValues(a->valf, f, dst);
+  if (upper) PetscCall(MatSeqSBAIJRestoreArray(f->S, &dst));
+  else PetscCall(MatSeqBAIJRestoreArray(f->S, &dst));
+  PetscCall(PetscObjectStateIncrease((PetscObject)f->S));
+  PetscFunctionReturn(0);
+}
+
+/* After PETSc's symbolic or numeric routine chose its numeric kernel, route it through the shadow. */
+PetscErrorCode CholeskyNumeric(Mat, Mat, const MatFactorInfo *);
+PetscErrorCode LUNumeric(Mat, Mat, const MatFactorInfo *);
+void WrapNumeric(Mat F, FactorShadow *f)
+{
+  if (F->ops->choleskyfactornumeric && F->ops->choleskyfactornumeric != CholeskyNumeric) {
+    f->choleskynumeric               = F->ops->choleskyfactornumeric;
+    F->ops->choleskyfactornumeric    = CholeskyNumeric;
+  }
+  if (F->ops->lufactornumeric && F->ops->lufactornumeric != LUNumeric) {
+    f->lunumeric            = F->ops->lufactornumeric;
+    F->ops->lufactornumeric = LUNumeric;
+  }
+}
+
+PetscErrorCode CholeskyNumeric(Mat F, Mat A, const MatFactorInfo *info)
+{
+  FactorShadow *f;
+
+  PetscFunctionBegin;
+  PetscCall(GetShadow(F, &f));
+  PetscCall(RefillShadow(A, f));
+  PetscCall((*f->choleskynumeric)(F, f->S, info));
+  WrapNumeric(F, f);
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode LUNumeric(Mat F, Mat A, const MatFactorInfo *info)
+{
+  FactorShadow *f;
+
+  PetscFunctionBegin;
+  PetscCall(GetShadow(F, &f));
+  PetscCall(RefillShadow(A, f));
+  PetscCall((*f->lunumeric)(F, f->S, info));
+  WrapNumeric(F, f);
+  PetscFunctionReturn(0);
+}
+
+/* The permutation PETSc would have computed for S: PCFactor computes its ordering on the binbcsr
+   matrix, which gives point-sized identity index sets; BAIJ and SBAIJ expect block-sized ones. */
+PetscErrorCode ShadowOrdering(FactorShadow *f, IS row, IS col, IS *rperm, IS *cperm)
+{
+  PetscBool rid = PETSC_TRUE, cid = PETSC_TRUE;
+
+  PetscFunctionBegin;
+  if (row) PetscCall(ISIdentity(row, &rid));
+  if (col) PetscCall(ISIdentity(col, &cid));
+  PetscCheck(rid && cid, PETSC_COMM_SELF, PETSC_ERR_SUP, "Factorisations of MATSEQBINBCSR support only the natural ordering (-pc_factor_mat_ordering_type natural)");
+  PetscCall(MatGetOrdering(f->S, MATORDERINGNATURAL, rperm, cperm));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ICCSymbolic(Mat F, Mat A, IS perm, const MatFactorInfo *info)
+{
+  FactorShadow *f;
+  IS            r, c;
+
+  PetscFunctionBegin;
+  PetscCall(GetShadow(F, &f));
+  PetscCall(RefillShadow(A, f));
+  PetscCall(ShadowOrdering(f, perm, nullptr, &r, &c));
+  PetscCall((*f->iccsymbolic)(F, f->S, r, info));
+  PetscCall(ISDestroy(&r));
+  PetscCall(ISDestroy(&c));
+  WrapNumeric(F, f);
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode CholeskySymbolic(Mat F, Mat A, IS perm, const MatFactorInfo *info)
+{
+  FactorShadow *f;
+  IS            r, c;
+
+  PetscFunctionBegin;
+  PetscCall(GetShadow(F, &f));
+  PetscCall(RefillShadow(A, f));
+  PetscCall(ShadowOrdering(f, perm, nullptr, &r, &c));
+  PetscCall((*f->choleskysymbolic)(F, f->S, r, info));
+  PetscCall(ISDestroy(&r));
+  PetscCall(ISDestroy(&c));
+  WrapNumeric(F, f);
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ILUSymbolic(Mat F, Mat A, IS row, IS col, const MatFactorInfo *info)
+{
+  FactorShadow *f;
+  IS            r, c;
+
+  PetscFunctionBegin;
+  PetscCall(GetShadow(F, &f));
+  PetscCall(RefillShadow(A, f));
+  PetscCall(ShadowOrdering(f, row, col, &r, &c));
+  PetscCall((*f->ilusymbolic)(F, f->S, r, c, info));
+  PetscCall(ISDestroy(&r));
+  PetscCall(ISDestroy(&c));
+  WrapNumeric(F, f);
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode LUSymbolic(Mat F, Mat A, IS row, IS col, const MatFactorInfo *info)
+{
+  FactorShadow *f;
+  IS            r, c;
+
+  PetscFunctionBegin;
+  PetscCall(GetShadow(F, &f));
+  PetscCall(RefillShadow(A, f));
+  PetscCall(ShadowOrdering(f, row, col, &r, &c));
+  PetscCall((*f->lusymbolic)(F, f->S, r, c, info));
+  PetscCall(ISDestroy(&r));
+  PetscCall(ISDestroy(&c));
+  WrapNumeric(F, f);
+  PetscFunctionReturn(0);
+}
+} // namespace
+
+PetscErrorCode MatGetFactor_SeqBinBCSR_Petsc(Mat A, MatFactorType ftype, Mat *F)
+{
+  Mat_SeqBinBCSR       *a     = (Mat_SeqBinBCSR *)A->data;
+  const PetscBool       upper = (ftype == MAT_FACTOR_ICC || ftype == MAT_FACTOR_CHOLESKY) ? PETSC_TRUE : PETSC_FALSE;
+  FactorShadow         *f;
+  std::vector<PetscInt> bi, bj;
+  PetscContainer        c;
+
+  PetscFunctionBegin;
+  PetscCheck(ftype == MAT_FACTOR_ICC || ftype == MAT_FACTOR_CHOLESKY || ftype == MAT_FACTOR_ILU || ftype == MAT_FACTOR_LU, PETSC_COMM_SELF, PETSC_ERR_SUP, "MATSEQBINBCSR provides ICC, Cholesky, ILU and LU (MATSOLVERPETSC), not %s", MatFactorTypes[ftype]);
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatGetFactor needs an assembled MATSEQBINBCSR matrix");
+  PetscCheck(A->rmap->n == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Factorisation of a non-square MATSEQBINBCSR matrix (%" PetscInt_FMT " x %" PetscInt_FMT ")", A->rmap->n, A->cmap->n);
+  f          = new FactorShadow;
+  f->bs      = a->bs;
+  f->bw      = a->bw;
+  f->nzstate = A->nonzerostate;
+  PetscCall(BuildShadowPattern(A, upper, f, bi, bj));
+  PetscCall(MatCreate(PETSC_COMM_SELF, &f->S));
+  PetscCall(MatSetSizes(f->S, A->rmap->n, A->cmap->n, A->rmap->n, A->cmap->n));
+  PetscCall(MatSetType(f->S, upper ? MATSEQSBAIJ : MATSEQBAIJ));
+  if (upper) PetscCall(MatSeqSBAIJSetPreallocationCSR(f->S, a->bs, bi.data(), bj.data(), nullptr));
+  else PetscCall(MatSeqBAIJSetPreallocationCSR(f->S, a->bs, bi.data(), bj.data(), nullptr));
+  PetscCall(MatPropagateSymmetryOptions(A, f->S));
+
+  PetscCall(MatGetFactor(f->S, MATSOLVERPETSC, ftype, F));
+  PetscCall(PetscContainerCreate(PETSC_COMM_SELF, &c));
+  PetscCall(PetscContainerSetPointer(c, f));
+  PetscCall(PetscContainerSetUserDestroy(c, DestroyShadow));
+  PetscCall(PetscObjectCompose((PetscObject)*F, shadow_key, (PetscObject)c));
+  PetscCall(PetscContainerDestroy(&c));
+
+  Mat B = *F;
+  f->iccsymbolic      = B->ops->iccfactorsymbolic;
+  f->choleskysymbolic = B->ops->choleskyfactorsymbolic;
+  f->ilusymbolic      = B->ops->ilufactorsymbolic;
+  f->lusymbolic       = B->ops->lufactorsymbolic;
+  if (f->iccsymbolic) B->ops->iccfactorsymbolic = ICCSymbolic;
+  if (f->choleskysymbolic) B->ops->choleskyfactorsymbolic = CholeskySymbolic;
+  if (f->ilusymbolic) B->ops->ilufactorsymbolic = ILUSymbolic;
+  if (f->lusymbolic) B->ops->lufactorsymbolic = LUSymbolic;
+  PetscCall(PetscFree(B->preferredordering[ftype]));
+  PetscCall(PetscStrallocpy(MATORDERINGNATURAL, (char **)&B->preferredordering[ftype]));
+  PetscFunctionReturn(0);
+}
