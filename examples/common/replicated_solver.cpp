@@ -14,11 +14,16 @@ PetscErrorCode ReplicatedSolverCreate(MPI_Comm comm, PetscInt n_blocks, const st
   rs->n_blocks = n_blocks;
   PetscCallMPI(MPI_Comm_size(comm, &rs->size));
   PetscCallMPI(MPI_Comm_rank(comm, &rs->rank));
-  // Only bin-padded formats gain from grouping; other types keep the physics order, which incomplete
-  // factorisations rely on (IC(0) of a chain in its own order is exact, in a shuffled one it is not).
-  char mat_type[64] = "";
+  // Only bin-padded formats gain from grouping, and only under point preconditioners: incomplete
+  // factorisations (on any type, binbcsr's included) rely on the physics order (IC(0) of a chain in its
+  // own order is exact, in a shuffled one it is not).
+  char mat_type[64] = "", pc_type[64] = "", sub_pc_type[64] = "";
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-mat_type", mat_type, sizeof mat_type, nullptr));
-  PetscInt window = std::strstr(mat_type, "binbcsr") || std::strstr(mat_type, "sell") ? 256 : 0;
+  PetscCall(PetscOptionsGetString(nullptr, nullptr, "-pc_type", pc_type, sizeof pc_type, nullptr));
+  PetscCall(PetscOptionsGetString(nullptr, nullptr, "-sub_pc_type", sub_pc_type, sizeof sub_pc_type, nullptr));
+  const bool point_pc = !pc_type[0] || !std::strcmp(pc_type, "jacobi") || !std::strcmp(pc_type, "pbjacobi") || !std::strcmp(pc_type, "none") ||
+                        (!std::strcmp(pc_type, "bjacobi") && (!std::strcmp(sub_pc_type, "jacobi") || !std::strcmp(sub_pc_type, "pbjacobi")));
+  PetscInt window = point_pc && (std::strstr(mat_type, "binbcsr") || std::strstr(mat_type, "sell")) ? 256 : 0;
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-rows_group_window", &window, nullptr));
   PetscCheck(window >= 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-rows_group_window must be >= 0 (0 = off), got %" PetscInt_FMT, window);
   std::vector<std::pair<int, int>> edges;
