@@ -1,6 +1,8 @@
 #include "mcg_test_problems.h"
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstdio>
+#include <unistd.h>
 
 namespace mcg_test {
 
@@ -170,6 +172,47 @@ PetscReal rel_residual(Mat A, Vec b, const std::vector<PetscScalar> &x)
   VecDestroy(&xv);
   VecDestroy(&r);
   return rn / bn;
+}
+
+std::string view_after_solve(Mat A, Vec b, const char *options)
+{
+  KSP         ksp;
+  PC          pc;
+  Vec         x;
+  PetscViewer viewer;
+  char        path[] = "/tmp/ksp_mcg_view_XXXXXX";
+  PetscMPIInt rank;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  if (rank == 0) {
+    const int fd = mkstemp(path);
+    REQUIRE(fd >= 0);
+    close(fd);
+  }
+  MPI_Bcast(path, sizeof path, MPI_CHAR, 0, PETSC_COMM_WORLD);
+  VecDuplicate(b, &x);
+  KSPCreate(PETSC_COMM_WORLD, &ksp);
+  KSPSetOperators(ksp, A, A);
+  KSPSetType(ksp, KSPMCG);
+  KSPGetPC(ksp, &pc);
+  PCSetType(pc, PCJACOBI);
+  PetscOptionsInsertString(nullptr, options);
+  KSPSetFromOptions(ksp);
+  REQUIRE(KSPSolve(ksp, b, x) == 0);
+  PetscViewerASCIIOpen(PETSC_COMM_WORLD, path, &viewer);
+  KSPView(ksp, viewer);
+  PetscViewerDestroy(&viewer);
+  PetscOptionsClear(nullptr);
+  MPI_Barrier(PETSC_COMM_WORLD);
+  FILE       *fp = fopen(path, "r");
+  std::string text;
+  char        line[512];
+  while (fp && fgets(line, sizeof line, fp)) text += line;
+  if (fp) fclose(fp);
+  MPI_Barrier(PETSC_COMM_WORLD);
+  if (rank == 0) remove(path);
+  KSPDestroy(&ksp);
+  VecDestroy(&x);
+  return text;
 }
 
 } // namespace mcg_test

@@ -45,4 +45,8 @@ Mat to_binbcsr(Mat aij, MatBinBCSRPrecision precision);
 // ||b - A x|| / ||b|| with the gathered x.
 PetscReal rel_residual(Mat A, Vec b, const std::vector<PetscScalar> &x);
 
+// KSPView (as text, the same on every rank) of an mcg + Jacobi solve of A x = b after the given options
+// are inserted (cleared again afterwards).
+std::string view_after_solve(Mat A, Vec b, const char *options = "");
+
 } // namespace mcg_test

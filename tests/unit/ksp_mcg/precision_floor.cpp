@@ -4,7 +4,6 @@
 #include "mcg_test_problems.h"
 #include <cstdio>
 #include <string>
-#include <unistd.h>
 
 using namespace mcg_test;
 
@@ -23,48 +22,6 @@ PetscErrorCode ShellMult(Mat S, Vec x, Vec y)
   Mat A;
   PetscCall(MatShellGetContext(S, &A));
   return MatMult(A, x, y);
-}
-
-// KSPView of a solve of A x = b with the given options, as text
-std::string view_after_solve(Mat A, Vec b, const char *options)
-{
-  KSP         ksp;
-  PC          pc;
-  Vec         x;
-  PetscViewer viewer;
-  char        path[] = "/tmp/ksp_mcg_floor_XXXXXX";
-  PetscMPIInt rank;
-  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
-  if (rank == 0) {
-    const int fd = mkstemp(path);
-    REQUIRE(fd >= 0);
-    close(fd);
-  }
-  MPI_Bcast(path, sizeof path, MPI_CHAR, 0, PETSC_COMM_WORLD);
-  VecDuplicate(b, &x);
-  KSPCreate(PETSC_COMM_WORLD, &ksp);
-  KSPSetOperators(ksp, A, A);
-  KSPSetType(ksp, KSPMCG);
-  KSPGetPC(ksp, &pc);
-  PCSetType(pc, PCJACOBI);
-  PetscOptionsInsertString(nullptr, options);
-  KSPSetFromOptions(ksp);
-  REQUIRE(KSPSolve(ksp, b, x) == 0);
-  PetscViewerASCIIOpen(PETSC_COMM_WORLD, path, &viewer);
-  KSPView(ksp, viewer);
-  PetscViewerDestroy(&viewer);
-  PetscOptionsClear(nullptr);
-  MPI_Barrier(PETSC_COMM_WORLD);
-  FILE       *fp = fopen(path, "r");
-  std::string text;
-  char        line[512];
-  while (fp && fgets(line, sizeof line, fp)) text += line;
-  if (fp) fclose(fp);
-  MPI_Barrier(PETSC_COMM_WORLD);
-  if (rank == 0) remove(path);
-  KSPDestroy(&ksp);
-  VecDestroy(&x);
-  return text;
 }
 
 } // namespace
