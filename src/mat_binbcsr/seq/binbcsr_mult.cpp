@@ -4,6 +4,7 @@
 #include "binbcsr.h"
 #include "../binbcsr_kernels.h"
 #include <petsc/private/kernels/blockinvert.h>
+#include <type_traits>
 
 /* The loop over the lanes of a bin is the SIMD loop. GCC 12 does not vectorise it under `omp simd`
    once the lane kernel is inlined (its private arrays stay in memory), but does with ivdep: lanes are
@@ -89,25 +90,33 @@ void mult_bins_any(const BinSweep<V> &m, PetscInt bw, const double *x, const dou
   if (dot) *dot += d;
 }
 
-template <int BS, typename V>
-void mult_dispatch_bw(const BinSweep<V> &m, PetscInt bw, const double *x, const double *z, double *y, double *dot, double *acc)
+/* Calls f(block size, bin width) with each as a compile-time constant where a specialised sweep exists
+   (bs 1 and 3; bin widths 4, 8, 16, 32) and 0 where the generic sweep must take it from the matrix. */
+template <class F>
+void with_constant_shape(PetscInt bs, PetscInt bw, F &&f)
 {
-  switch (bw) {
-  case 4:
-    mult_bins_fixed<BS, 4, V>(m, x, z, y, dot);
-    break;
-  case 8:
-    mult_bins_fixed<BS, 8, V>(m, x, z, y, dot);
-    break;
-  case 16:
-    mult_bins_fixed<BS, 16, V>(m, x, z, y, dot);
-    break;
-  case 32:
-    mult_bins_fixed<BS, 32, V>(m, x, z, y, dot);
-    break;
-  default:
-    mult_bins_any<BS, V>(m, bw, x, z, y, dot, acc);
-  }
+  using std::integral_constant;
+  const auto width = [&](auto BS) {
+    switch (bw) {
+    case 4:
+      f(BS, integral_constant<int, 4>{});
+      break;
+    case 8:
+      f(BS, integral_constant<int, 8>{});
+      break;
+    case 16:
+      f(BS, integral_constant<int, 16>{});
+      break;
+    case 32:
+      f(BS, integral_constant<int, 32>{});
+      break;
+    default:
+      f(BS, integral_constant<int, 0>{});
+    }
+  };
+  if (bs == 3) width(integral_constant<int, 3>{});
+  else if (bs == 1) width(integral_constant<int, 1>{});
+  else f(integral_constant<int, 0>{}, integral_constant<int, 0>{});
 }
 
 template <typename V>
@@ -115,9 +124,10 @@ void mult_dispatch(const Mat_SeqBinBCSR *a, const V *val, const double *x, const
 {
   const BinSweep<V> m = {a->bin_start, a->col, val, a->nbins, a->mbs, a->bs};
   if (dot) *dot = 0.0;
-  if (a->bs == 3) mult_dispatch_bw<3, V>(m, a->bw, x, z, y, dot, acc);
-  else if (a->bs == 1) mult_dispatch_bw<1, V>(m, a->bw, x, z, y, dot, acc);
-  else mult_bins_any<0, V>(m, a->bw, x, z, y, dot, acc);
+  with_constant_shape(a->bs, a->bw, [&](auto BS, auto BW) {
+    if constexpr (BS > 0 && BW > 0) mult_bins_fixed<BS, BW, V>(m, x, z, y, dot);
+    else mult_bins_any<BS, V>(m, a->bw, x, z, y, dot, acc);
+  });
 }
 
 /* Symmetric storage: y += A x with the upper triangle (y holds z or zero on entry); *dot += x.y over
@@ -155,34 +165,14 @@ void sym_mult_bins_any(const Mat_SeqBinBCSR *a, const V *val, const double *x, d
   if (dot) *dot += d;
 }
 
-template <int BS, typename V>
-void sym_mult_dispatch_bw(const Mat_SeqBinBCSR *a, const V *val, const double *x, double *y, double *dot, double *acc)
-{
-  switch (a->bw) {
-  case 4:
-    sym_mult_bins_fixed<BS, 4, V>(a, val, x, y, dot);
-    break;
-  case 8:
-    sym_mult_bins_fixed<BS, 8, V>(a, val, x, y, dot);
-    break;
-  case 16:
-    sym_mult_bins_fixed<BS, 16, V>(a, val, x, y, dot);
-    break;
-  case 32:
-    sym_mult_bins_fixed<BS, 32, V>(a, val, x, y, dot);
-    break;
-  default:
-    sym_mult_bins_any<BS, V>(a, val, x, y, dot, acc);
-  }
-}
-
 template <typename V>
 void sym_mult_dispatch(const Mat_SeqBinBCSR *a, const V *val, const double *x, double *y, double *dot, double *acc)
 {
   if (dot) *dot = 0.0;
-  if (a->bs == 3) sym_mult_dispatch_bw<3, V>(a, val, x, y, dot, acc);
-  else if (a->bs == 1) sym_mult_dispatch_bw<1, V>(a, val, x, y, dot, acc);
-  else sym_mult_bins_any<0, V>(a, val, x, y, dot, acc);
+  with_constant_shape(a->bs, a->bw, [&](auto BS, auto BW) {
+    if constexpr (BS > 0 && BW > 0) sym_mult_bins_fixed<BS, BW, V>(a, val, x, y, dot);
+    else sym_mult_bins_any<BS, V>(a, val, x, y, dot, acc);
+  });
 }
 
 /* y += A^T x (y holds z or zero on entry). Scatter: rows are visited lane by lane. */
