@@ -32,7 +32,9 @@ set_tests_properties(cloth_drape_sphere cloth_stiff_dt30 cloth_same_result_mat_t
 string(REPLACE ";" " " MPIEXEC_LINE "${MPIEXEC_CMD}")
 add_test(NAME cloth_mpi_np2
          COMMAND ${SUMMARY_SAME} "energy_final max_stretch contacts" 1e-6
-                 "${CLOTH_SAME}" "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME}" "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg")
+                 "${CLOTH_SAME}" "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME}" "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg"
+                 "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg -mat_binbcsr_symmetric_storage"
+                 "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type sbaij")
 set_tests_properties(cloth_mpi_np2 PROPERTIES LABELS "cloth;mpi" TIMEOUT 60)
 
 add_test(NAME cloth_vtk_dump

@@ -1,4 +1,5 @@
 #include "common/replicated_solver.h"
+#include "common/summary.h"
 
 #include "physics/partition.hpp"
 #include "physics/row_order.hpp"
@@ -6,7 +7,7 @@
 #include <cstring>
 #include <numeric>
 
-PetscErrorCode ReplicatedSolverCreate(MPI_Comm comm, PetscInt n_blocks, const std::vector<int> &block_row, const std::vector<int> &block_col,
+PetscErrorCode ReplicatedSolverNumber(MPI_Comm comm, PetscInt n_blocks, const std::vector<int> &block_row, const std::vector<int> &block_col,
                                       ReplicatedSolver *rs)
 {
   PetscFunctionBegin;
@@ -49,20 +50,42 @@ PetscErrorCode ReplicatedSolverCreate(MPI_Comm comm, PetscInt n_blocks, const st
   for (PetscInt i = 0; i < n_blocks && !rs->renumbered; ++i) rs->renumbered = rs->new_of_old[i] != i;
   rs->old_of_new.resize(n_blocks);
   for (PetscInt i = 0; i < n_blocks; ++i) rs->old_of_new[rs->new_of_old[i]] = (int)i;
+  PetscCall(BlockSystemStoredTriangle(comm, &rs->upper_only, &rs->offrank_full));
+  PetscFunctionReturn(0);
+}
+
+bool ReplicatedSolverOwnsRow(const ReplicatedSolver *rs, int row)
+{
+  const int r = rs->new_of_old[row];
+  return r >= rs->row_offsets[rs->rank] && r < rs->row_offsets[rs->rank + 1];
+}
+
+bool ReplicatedSolverStoresBlock(const ReplicatedSolver *rs, int row, int col)
+{
+  if (!rs->upper_only || rs->new_of_old[row] <= rs->new_of_old[col]) return true;
+  return rs->offrank_full && !ReplicatedSolverOwnsRow(rs, col);
+}
+
+PetscErrorCode ReplicatedSolverSetLocalPattern(ReplicatedSolver *rs, const std::vector<int> &block_row, const std::vector<int> &block_col)
+{
+  PetscFunctionBegin;
   const int begin = rs->row_offsets[rs->rank], end = rs->row_offsets[rs->rank + 1];
-  std::vector<PetscInt> rows, cols;
+  PetscCheck(block_row.size() == block_col.size(), PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "COO block lists differ in length: %zu rows, %zu columns",
+             block_row.size(), block_col.size());
+  std::vector<PetscInt> rows(block_row.size()), cols(block_col.size());
   for (size_t k = 0; k < block_row.size(); ++k) {
-    const int r = rs->new_of_old[block_row[k]];
-    if (r < begin || r >= end) continue;
-    rs->local_blocks.push_back(k);
-    rows.push_back(r);
-    cols.push_back(rs->new_of_old[block_col[k]]);
+    PetscCheck(block_row[k] >= 0 && block_row[k] < rs->n_blocks && block_col[k] >= 0 && block_col[k] < rs->n_blocks, PETSC_COMM_SELF,
+               PETSC_ERR_ARG_OUTOFRANGE, "COO block %zu is (%d, %d), outside [0, %" PetscInt_FMT ")", k, block_row[k], block_col[k], rs->n_blocks);
+    rows[k] = rs->new_of_old[block_row[k]];
+    cols[k] = rs->new_of_old[block_col[k]];
+    PetscCheck(rows[k] >= begin && rows[k] < end, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "COO block %zu is in row %d, which rank %d does not own", k,
+               block_row[k], rs->rank);
   }
-  PetscCall(BlockSystemCreate(comm, n_blocks, end - begin, rows, cols, &rs->sys));
-  rs->local_values.resize(9 * rs->local_blocks.size());
+  PetscCall(BlockSystemCreate(rs->comm, rs->n_blocks, end - begin, rows, cols, &rs->sys));
   rs->rhs_local.resize(3 * (end - begin));
   rs->sol_local.assign(3 * (end - begin), 0.0);
-  rs->sol_all.resize(3 * n_blocks);
+  rs->sol_all.resize(3 * rs->n_blocks);
+  rs->counts.clear(), rs->displs.clear();
   for (int p = 0; p < rs->size; ++p) {
     rs->counts.push_back(3 * (rs->row_offsets[p + 1] - rs->row_offsets[p]));
     rs->displs.push_back(3 * rs->row_offsets[p]);
@@ -70,19 +93,42 @@ PetscErrorCode ReplicatedSolverCreate(MPI_Comm comm, PetscInt n_blocks, const st
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode ReplicatedSolverCreate(MPI_Comm comm, PetscInt n_blocks, const std::vector<int> &block_row, const std::vector<int> &block_col,
+                                      ReplicatedSolver *rs)
+{
+  PetscFunctionBegin;
+  PetscCall(ReplicatedSolverNumber(comm, n_blocks, block_row, block_col, rs));
+  if (rs->size == 1) PetscCall(ReplicatedSolverSetLocalPattern(rs, block_row, block_col)); // identical order: values need no copy
+  else {
+    std::vector<int> rows, cols;
+    for (size_t k = 0; k < block_row.size(); ++k) {
+      if (!ReplicatedSolverOwnsRow(rs, block_row[k])) continue;
+      rs->local_blocks.push_back(k);
+      rows.push_back(block_row[k]);
+      cols.push_back(block_col[k]);
+    }
+    PetscCall(ReplicatedSolverSetLocalPattern(rs, rows, cols));
+    rs->copy_local = true;
+    rs->local_values.resize(9 * rs->local_blocks.size());
+  }
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode SetMatrix(ReplicatedSolver *rs, const std::vector<double> &values)
 {
   PetscFunctionBegin;
-  const double t0 = MPI_Wtime();
-  if (rs->size == 1) {
-    rs->all_values = &values; // identical order: no copy
-    PetscCall(BlockSystemSetValues(&rs->sys, values.data()));
-  } else {
+  const auto   now = rs->cpu_timer ? ProcessCpuTime : WallTime;
+  const double t0  = now();
+  if (rs->copy_local) {
     for (size_t i = 0; i < rs->local_blocks.size(); ++i)
       for (int k = 0; k < 9; ++k) rs->local_values[9 * i + k] = values[9 * rs->local_blocks[i] + k];
     PetscCall(BlockSystemSetValues(&rs->sys, rs->local_values.data()));
+  } else {
+    PetscCheck(values.size() == 9 * (size_t)rs->sys.n_coo_blocks, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "%zu block values for %" PetscInt_FMT " COO blocks",
+               values.size(), rs->sys.n_coo_blocks);
+    PetscCall(BlockSystemSetValues(&rs->sys, values.data()));
   }
-  rs->setvalues_ms += 1e3 * (MPI_Wtime() - t0);
+  rs->setvalues_ms += 1e3 * (now() - t0);
   PetscFunctionReturn(0);
 }
 
@@ -91,18 +137,24 @@ static PetscErrorCode Solve(ReplicatedSolver *rs, const std::vector<double> &rhs
   PetscBool nonzero_guess;
 
   PetscFunctionBegin;
+  const auto now = rs->cpu_timer ? ProcessCpuTime : WallTime;
+  double     t0  = 0, t1 = 0;
   const int begin = rs->row_offsets[rs->rank], end = rs->row_offsets[rs->rank + 1];
   PetscCall(KSPGetInitialGuessNonzero(rs->sys.ksp, &nonzero_guess));
   if (sol.size() != (size_t)(3 * rs->n_blocks)) sol.assign(3 * rs->n_blocks, 0.0);
   if (rs->size == 1 && !rs->renumbered) {
+    t0 = now();
     PetscCall(BlockSystemSolve(&rs->sys, rhs.data(), sol.data(), &rs->last));
+    t1 = now();
   } else {
     for (int i = begin; i < end; ++i)
       for (int k = 0; k < 3; ++k) {
         rs->rhs_local[3 * (i - begin) + k] = rhs[3 * rs->old_of_new[i] + k];
         if (nonzero_guess) rs->sol_local[3 * (i - begin) + k] = sol[3 * rs->old_of_new[i] + k];
       }
+    t0 = now();
     PetscCall(BlockSystemSolve(&rs->sys, rs->rhs_local.data(), rs->sol_local.data(), &rs->last));
+    t1 = now();
     if (rs->size == 1) {
       for (PetscInt i = 0; i < rs->n_blocks; ++i)
         for (int k = 0; k < 3; ++k) sol[3 * rs->old_of_new[i] + k] = rs->sol_local[3 * i + k];
@@ -115,7 +167,7 @@ static PetscErrorCode Solve(ReplicatedSolver *rs, const std::vector<double> &rhs
   }
   rs->solves++;
   rs->iterations += rs->last.iterations;
-  rs->solve_ms += rs->last.ms;
+  rs->solve_ms += 1e3 * (t1 - t0);
   if (rs->last.reason < 0) rs->worst_reason = rs->last.reason, rs->diverged_solves++;
   PetscFunctionReturn(0);
 }

@@ -9,6 +9,13 @@
 // permuted here, the COO values keep their order).
 // The solution vector passed to the solve is the initial guess when the KSP uses one
 // (KSPSetInitialGuessNonzero / -ksp_initial_guess_nonzero).
+//
+// Two ways to hand over the values:
+// - ReplicatedSolverCreate with the whole COO list: every rank assembles every block and set_matrix
+//   copies out its own rows' (articulated).
+// - ReplicatedSolverNumber, then ReplicatedSolverSetLocalPattern with only the blocks of this rank's rows
+//   that its Mat type stores (ReplicatedSolverOwnsRow, ReplicatedSolverStoresBlock): the physics computes
+//   just those and set_matrix passes its values straight to the COO refill (cloth).
 #pragma once
 #include "common/sim_system.h"
 #include "physics/block_solver.hpp"
@@ -24,9 +31,11 @@ struct ReplicatedSolver {
   bool                     renumbered = false;            // new_of_old is not the identity
   std::vector<int>         row_offsets;                   // block rows per rank, size + 1 entries
   std::vector<size_t>      local_blocks;                  // indices into the physics COO list, this rank's rows
+  bool                     copy_local = false;            // set_matrix gets the whole list and copies out local_blocks
+  PetscBool                upper_only = PETSC_FALSE, offrank_full = PETSC_FALSE; // what the Mat type stores (BlockSystemStoredTriangle)
   std::vector<PetscScalar> local_values, rhs_local, sol_local, sol_all;
   std::vector<int>         counts, displs;                // scalars per rank for the gather
-  const std::vector<double> *all_values = nullptr;        // physics values of the last set_matrix (1 rank)
+  bool      cpu_timer = false; // solve_ms and setvalues_ms in process CPU time instead of wall time (a shared machine)
   // Totals since creation (or the last reset by the caller).
   long long solves = 0, iterations = 0;
   double    solve_ms = 0, setvalues_ms = 0;
@@ -39,6 +48,18 @@ struct ReplicatedSolver {
 // block_row/block_col: the physics COO list of 3x3 blocks (both triangles, physics numbering).
 PetscErrorCode ReplicatedSolverCreate(MPI_Comm comm, PetscInt n_blocks, const std::vector<int> &block_row,
                                       const std::vector<int> &block_col, ReplicatedSolver *rs);
+// The numbering only (partition and row grouping) from the pattern's graph (both triangles, physics
+// numbering); the matrix comes with ReplicatedSolverSetLocalPattern.
+PetscErrorCode ReplicatedSolverNumber(MPI_Comm comm, PetscInt n_blocks, const std::vector<int> &block_row,
+                                      const std::vector<int> &block_col, ReplicatedSolver *rs);
+// Whether this rank owns block row `row` (physics numbering).
+bool ReplicatedSolverOwnsRow(const ReplicatedSolver *rs, int row);
+// Whether the Mat type keeps block (row, col) of one of this rank's rows (physics numbering): with
+// upper-triangle storage, not the blocks below the diagonal of the solver's numbering, except those
+// coupling two ranks where the type keeps them (binbcsr).
+bool ReplicatedSolverStoresBlock(const ReplicatedSolver *rs, int row, int col);
+// This rank's COO list (rows it owns, physics numbering); set_matrix then takes values in this order.
+PetscErrorCode ReplicatedSolverSetLocalPattern(ReplicatedSolver *rs, const std::vector<int> &block_row, const std::vector<int> &block_col);
 // The callbacks for the physics step; check rs->error after each step.
 physics::BlockLinearSolver ReplicatedSolverAdapter(ReplicatedSolver *rs);
 PetscErrorCode ReplicatedSolverDestroy(ReplicatedSolver *rs);

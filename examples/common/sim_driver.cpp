@@ -45,4 +45,5 @@ void DriverAddSolverSummary(SummaryLine &s, const ReplicatedSolver &rs, long lon
   s.add("physics_ms", (step_ms_total - rs.solve_ms - rs.setvalues_ms) * per);
   s.add("cg_its", rs.solves ? (double)rs.iterations / rs.solves : 0.0);
   s.add("diverged_solves", rs.diverged_solves);
+  s.add("timer", std::string(rs.cpu_timer ? "cpu" : "wall"));
 }

@@ -3,17 +3,37 @@
 #include "physics/cloth_springs.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 namespace physics {
 
 ClothSystem make_cloth_system(const Cloth &cloth)
 {
+  return make_cloth_system(cloth, std::vector<char>(cloth.particle_count(), 1), [](int, int) { return true; });
+}
+
+ClothSystem make_cloth_system(const Cloth &cloth, const std::vector<char> &own, const std::function<bool(int row, int col)> &keep)
+{
+  if ((int)own.size() != cloth.particle_count()) throw std::invalid_argument("make_cloth_system: one ownership flag per particle needed");
   ClothSystem s;
   s.n_particles = cloth.particle_count();
-  for (int p = 0; p < s.n_particles; ++p) s.block_row.push_back(p), s.block_col.push_back(p);
-  for (const Spring &sp : cloth.springs) {
-    s.block_row.push_back(sp.a), s.block_col.push_back(sp.b);
-    s.block_row.push_back(sp.b), s.block_col.push_back(sp.a);
+  s.diagonal_block.assign(s.n_particles, -1);
+  for (int p = 0; p < s.n_particles; ++p)
+    if (own[p]) {
+      s.diagonal_block[p] = (int)s.block_row.size();
+      s.block_row.push_back(p), s.block_col.push_back(p);
+    }
+  auto list = [&](int row, int col) {
+    if (!own[row] || !keep(row, col)) return -1;
+    s.block_row.push_back(row), s.block_col.push_back(col);
+    return (int)s.block_row.size() - 1;
+  };
+  for (size_t k = 0; k < cloth.springs.size(); ++k) {
+    const Spring &sp = cloth.springs[k];
+    if (!own[sp.a] && !own[sp.b]) continue;
+    s.springs.push_back((int)k);
+    s.block_ab.push_back(list(sp.a, sp.b));
+    s.block_ba.push_back(list(sp.b, sp.a));
   }
   s.block_values.assign(9 * s.block_row.size(), 0.0);
   s.rhs.assign(3 * s.n_particles, 0.0);
@@ -30,17 +50,17 @@ std::string validate_params(const ClothParams &p)
 void assemble_cloth_system(const Cloth &cloth, const ClothParams &params, ClothSystem &sys)
 {
   const double h = params.dt, h2 = h * h;
-  const int    np = sys.n_particles;
   // rhs = h (f - h K v), built as h m g first, then spring by spring. Diagonal blocks start at M and
   // accumulate; every off-diagonal block belongs to one spring and is written once (no clearing pass).
-  for (int p = 0; p < np; ++p) {
-    double *d = &sys.block_values[9 * p];
+  for (int p = 0; p < sys.n_particles; ++p) {
+    if (sys.diagonal_block[p] < 0) continue;
+    double *d = &sys.block_values[9 * sys.diagonal_block[p]];
     for (int k = 0; k < 9; ++k) d[k] = 0.0;
     d[0] = d[4] = d[8] = cloth.mass[p];
     for (int k = 0; k < 3; ++k) sys.rhs[3 * p + k] = h * cloth.mass[p] * cloth.gravity[k];
   }
-  for (size_t s = 0; s < cloth.springs.size(); ++s) {
-    const Spring     &sp = cloth.springs[s];
+  for (size_t s = 0; s < sys.springs.size(); ++s) {
+    const Spring     &sp = cloth.springs[sys.springs[s]];
     const SpringTerms t  = spring_terms(sp, cloth.position[sp.a], cloth.position[sp.b], cloth.velocity[sp.a], cloth.velocity[sp.b], cloth.damping, params.choi_ko);
     // The spring's block of M + h D + h^2 K: alpha I + beta d d^T (symmetric).
     const double           alpha = h2 * t.k_iso, beta = h2 * t.k_dir + h * t.damping;
@@ -48,25 +68,28 @@ void assemble_cloth_system(const Cloth &cloth, const ClothParams &params, ClothS
     double                 block[9];
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) block[3 * r + c] = beta * d[r] * d[c] + (r == c ? alpha : 0.0);
-    const bool fa = cloth.fixed[sp.a], fb = cloth.fixed[sp.b];
     // The spring's K acts on dv_a - dv_b; a pinned end has dv = 0, so its row, column and rhs stay out.
-    double *da = &sys.block_values[9 * sp.a], *db = &sys.block_values[9 * sp.b];
-    double *ab = &sys.block_values[9 * (np + 2 * s)], *ba = &sys.block_values[9 * (np + 2 * s + 1)];
-    const bool coupled = !fa && !fb;
+    // An end whose row is assembled elsewhere (diagonal_block < 0) is skipped the same way here.
+    const bool   fa = cloth.fixed[sp.a], fb = cloth.fixed[sp.b];
+    const int    ia = fa ? -1 : sys.diagonal_block[sp.a], ib = fb ? -1 : sys.diagonal_block[sp.b];
+    const double coupling = !fa && !fb ? -1.0 : 0.0;
+    double      *ab = sys.block_ab[s] < 0 ? nullptr : &sys.block_values[9 * sys.block_ab[s]];
+    double      *ba = sys.block_ba[s] < 0 ? nullptr : &sys.block_values[9 * sys.block_ba[s]];
     for (int k = 0; k < 9; ++k) {
-      if (!fa) da[k] += block[k];
-      if (!fb) db[k] += block[k];
-      ab[k] = ba[k] = coupled ? -block[k] : 0.0;
+      if (ia >= 0) sys.block_values[9 * ia + k] += block[k];
+      if (ib >= 0) sys.block_values[9 * ib + k] += block[k];
+      if (ab) ab[k] = coupling * block[k];
+      if (ba) ba[k] = coupling * block[k];
     }
     // h f_a - h^2 K (v_a - v_b), K = k_iso I + k_dir d d^T
     const Eigen::Vector3d dvel    = cloth.velocity[sp.a] - cloth.velocity[sp.b];
     const Eigen::Vector3d fa_term = h * t.force_on_a - h2 * (t.k_iso * dvel + t.k_dir * d.dot(dvel) * d);
     for (int k = 0; k < 3; ++k) {
-      if (!fa) sys.rhs[3 * sp.a + k] += fa_term[k];
-      if (!fb) sys.rhs[3 * sp.b + k] -= fa_term[k];
+      if (ia >= 0) sys.rhs[3 * sp.a + k] += fa_term[k];
+      if (ib >= 0) sys.rhs[3 * sp.b + k] -= fa_term[k];
     }
   }
-  for (int p = 0; p < np; ++p)
+  for (int p = 0; p < sys.n_particles; ++p)
     if (cloth.fixed[p])
       for (int k = 0; k < 3; ++k) sys.rhs[3 * p + k] = 0;
 }

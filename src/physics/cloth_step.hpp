@@ -9,6 +9,7 @@
 #include "physics/block_solver.hpp"
 #include "physics/cloth_model.hpp"
 
+#include <functional>
 #include <vector>
 
 namespace physics {
@@ -18,12 +19,18 @@ struct ClothParams {
   bool   choi_ko = true; // false keeps the exact (possibly indefinite) Jacobian of compressed springs
 };
 
+// The blocks one process assembles. On one process: every row and both triangles. With replicated state
+// on several processes (examples/common/replicated_solver.h) each one assembles only the rows it owns,
+// so it visits only the springs that touch them, and lists only the off-diagonal blocks its matrix type
+// stores (one per spring with upper-triangle storage), which is all the COO refill then reads.
 struct ClothSystem {
   int                 n_particles = 0;
-  std::vector<int>    block_row, block_col; // blocks 0..n-1: diagonal; then (a,b), (b,a) per spring
-  std::vector<double> block_values, rhs, dv;
+  std::vector<int>    block_row, block_col;   // the COO list: own particles' diagonal blocks, then the kept spring blocks
+  std::vector<int>    diagonal_block;         // per particle: its diagonal block, -1 when its row is not assembled here
+  std::vector<int>    springs;                // springs with at least one end in an assembled row
+  std::vector<int>    block_ab, block_ba;     // per listed spring: block of (a, b) and of (b, a), -1 when not listed
+  std::vector<double> block_values, rhs, dv;  // rhs: 3 per particle, meaningful in assembled rows only
 };
-
 struct ClothStepReport {
   int    iterations = 0;
   bool   converged  = true;
@@ -32,7 +39,12 @@ struct ClothStepReport {
   double max_stretch = 0;
 };
 
+// Every row, both triangles.
 ClothSystem make_cloth_system(const Cloth &cloth);
+
+// The rows of particles with own[p] != 0; of their off-diagonal blocks, those with keep(row, col) true
+// (physics numbering). Throws std::invalid_argument if own has the wrong size.
+ClothSystem make_cloth_system(const Cloth &cloth, const std::vector<char> &own, const std::function<bool(int row, int col)> &keep);
 
 std::string validate_params(const ClothParams &params);
 

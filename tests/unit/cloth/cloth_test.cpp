@@ -152,6 +152,46 @@ TEST_CASE("assembled system equals M + h D + h^2 K and h (f - h K v) built from 
   CHECK((Eigen::Map<const Eigen::VectorXd>(sys.rhs.data(), 3 * n) - rhs).norm() < 1e-12 * rhs.norm());
 }
 
+TEST_CASE("rows assembled in parts, upper triangle only, add up to the whole system", "[cloth]")
+{
+  // What each rank of the driver does: its own rows, only the spring blocks its Mat type keeps.
+  ClothOptions opt;
+  opt.n = 6, opt.damping = 0.2, opt.pins = ClothPins::FourCorners;
+  Cloth cloth = make_cloth(opt);
+  srand(5);
+  for (auto &x : cloth.position) x = 0.85 * x + 0.02 * Eigen::Vector3d::Random();
+  for (auto &v : cloth.velocity) v = Eigen::Vector3d::Random();
+  ClothParams params;
+  ClothSystem whole = make_cloth_system(cloth);
+  assemble_cloth_system(cloth, params, whole);
+  const Eigen::MatrixXd A = dense(whole);
+  const int             n = cloth.particle_count();
+  Eigen::MatrixXd upper_sum = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  Eigen::VectorXd rhs_sum   = Eigen::VectorXd::Zero(3 * n);
+  size_t          springs_visited = 0, blocks = 0;
+  for (int part = 0; part < 3; ++part) {
+    std::vector<char> own(n);
+    for (int p = 0; p < n; ++p) own[p] = (p * 7) % 3 == part; // interleaved rows: many springs cross parts
+    ClothSystem sys = make_cloth_system(cloth, own, [](int row, int col) { return row < col; });
+    assemble_cloth_system(cloth, params, sys);
+    upper_sum += dense(sys);
+    for (int p = 0; p < n; ++p)
+      if (own[p]) rhs_sum.segment<3>(3 * p) = Eigen::Map<const Eigen::Vector3d>(&sys.rhs[3 * p]);
+    for (size_t k = 0; k < sys.block_row.size(); ++k) CHECK((own[sys.block_row[k]] && sys.block_row[k] <= sys.block_col[k]));
+    springs_visited += sys.springs.size();
+    blocks += sys.block_row.size();
+  }
+  Eigen::MatrixXd upper = A; // the block upper triangle
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < i; ++j) upper.block<3, 3>(3 * i, 3 * j).setZero();
+  CHECK((upper_sum - upper).norm() < 1e-14 * A.norm());
+  CHECK((rhs_sum - Eigen::Map<const Eigen::VectorXd>(whole.rhs.data(), 3 * n)).norm() < 1e-14 * rhs_sum.norm());
+  CHECK(blocks == (size_t)n + cloth.springs.size()); // one block per spring, one per particle
+  CHECK(springs_visited > cloth.springs.size());     // springs between parts are visited on both sides
+  CHECK(springs_visited < 2 * cloth.springs.size());
+  CHECK_THROWS_WITH(make_cloth_system(cloth, std::vector<char>(3, 1), [](int, int) { return true; }), Catch::Contains("one ownership flag per particle"));
+}
+
 TEST_CASE("stiff cloth at dt 1/30 stays finite and bounded", "[cloth]")
 {
   ClothOptions opt;
