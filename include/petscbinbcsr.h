@@ -47,6 +47,15 @@ PETSC_EXTERN PetscErrorCode MatBinBCSRGetPrecision(Mat, MatBinBCSRPrecision *);
    and the getter answers PETSC_FALSE on matrices of other types. */
 PETSC_EXTERN PetscErrorCode MatBinBCSRSetSymmetricStorage(Mat, PetscBool);
 PETSC_EXTERN PetscErrorCode MatBinBCSRGetSymmetricStorage(Mat, PetscBool *);
+/* COO mirror: every COO entry (i, j) whose block row and block column differ also adds its value at
+   (j, i) (scalar (r, c) of block (I, J) lands at (c, r) of block (J, I)), so the caller of
+   MatSetPreallocationCOO/MatSetValuesCOO lists one triangle of a symmetric matrix (plus the diagonal
+   blocks in full) and the whole matrix is filled. Entries are summed as usual: a block listed in both
+   triangles gets both its own and its twin's values. Square matrices; takes effect at the next
+   MatSetPreallocationCOO. Option -mat_binbcsr_coo_mirror. The setter is a no-op and the getter
+   answers PETSC_FALSE on matrices of other types. */
+PETSC_EXTERN PetscErrorCode MatBinBCSRSetCOOMirror(Mat, PetscBool);
+PETSC_EXTERN PetscErrorCode MatBinBCSRGetCOOMirror(Mat, PetscBool *);
 
 /* y = A x and *xdoty = the local (this rank's rows, unreduced) part of x^T y, in one pass over A when
    the matrix type provides it (composed "MatMultDotLocal_C"), otherwise MatMult and a local dot.

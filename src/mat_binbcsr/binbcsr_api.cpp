@@ -59,6 +59,25 @@ PetscErrorCode MatBinBCSRGetSymmetricStorage(Mat A, PetscBool *flg)
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode MatBinBCSRSetCOOMirror(Mat A, PetscBool flg)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidLogicalCollectiveBool(A, flg, 2);
+  PetscTryMethod(A, "MatBinBCSRSetCOOMirror_C", (Mat, PetscBool), (A, flg));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatBinBCSRGetCOOMirror(Mat A, PetscBool *flg)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidBoolPointer(flg, 2);
+  *flg = PETSC_FALSE;
+  PetscTryMethod(A, "MatBinBCSRGetCOOMirror_C", (Mat, PetscBool *), (A, flg));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode MatMultDotLocal(Mat A, Vec x, Vec y, PetscScalar *xdoty)
 {
   PetscErrorCode (*fused)(Mat, Vec, Vec, PetscScalar *) = nullptr;

@@ -12,7 +12,7 @@ static PetscErrorCode MatDestroy_MPIBinBCSR(Mat mat)
   delete MPIBinBCSR(mat);
   mat->data = nullptr;
   PetscCall(PetscObjectChangeTypeName((PetscObject)mat, nullptr));
-  const char *names[] = {"MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatMPIAIJSetPreallocation_C", "MatMPIBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatGetDiagonalBlock_C", "MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatConvert_mpibinbcsr_mpiaij_C"};
+  const char *names[] = {"MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatBinBCSRSetCOOMirror_C", "MatBinBCSRGetCOOMirror_C", "MatMPIAIJSetPreallocation_C", "MatMPIBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatGetDiagonalBlock_C", "MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatConvert_mpibinbcsr_mpiaij_C"};
   for (const char *name : names) PetscCall(PetscObjectComposeFunction((PetscObject)mat, name, (void (*)(void)) nullptr));
   PetscFunctionReturn(0);
 }
@@ -156,6 +156,22 @@ static PetscErrorCode MatBinBCSRGetSymmetricStorage_MPIBinBCSR(Mat mat, PetscBoo
   PetscFunctionReturn(0);
 }
 
+/* The mirror is applied to the whole COO list before it is routed (a mirrored entry may belong to
+   another rank's rows); the parts get plain lists. */
+static PetscErrorCode MatBinBCSRSetCOOMirror_MPIBinBCSR(Mat mat, PetscBool flg)
+{
+  PetscFunctionBegin;
+  MPIBinBCSR(mat)->coo_mirror = flg;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRGetCOOMirror_MPIBinBCSR(Mat mat, PetscBool *flg)
+{
+  PetscFunctionBegin;
+  *flg = MPIBinBCSR(mat)->coo_mirror;
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MatGetDiagonalBlock_MPIBinBCSR(Mat mat, Mat *a)
 {
   PetscFunctionBegin;
@@ -185,6 +201,7 @@ static PetscErrorCode MatSetFromOptions_MPIBinBCSR(Mat mat, PetscOptionItems *Pe
   sym = b->sym;
   PetscCall(PetscOptionsBool("-mat_binbcsr_symmetric_storage", "Store the upper triangle of the diagonal part only (symmetric matrices; the lower triangle given is ignored)", "MatBinBCSRSetSymmetricStorage", sym, &sym, &flg));
   if (flg) PetscCall(MatBinBCSRSetSymmetricStorage_MPIBinBCSR(mat, sym));
+  PetscCall(PetscOptionsBool("-mat_binbcsr_coo_mirror", "COO entries of off-diagonal blocks also fill the transposed place (give one triangle of a symmetric matrix)", "MatBinBCSRSetCOOMirror", b->coo_mirror, &b->coo_mirror, nullptr));
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }
@@ -394,6 +411,8 @@ PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetBinWidth_C", MatBinBCSRSetBinWidth_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetSymmetricStorage_C", MatBinBCSRSetSymmetricStorage_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetSymmetricStorage_C", MatBinBCSRGetSymmetricStorage_MPIBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetCOOMirror_C", MatBinBCSRSetCOOMirror_MPIBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetCOOMirror_C", MatBinBCSRGetCOOMirror_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetBinWidth_C", MatBinBCSRGetBinWidth_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetPrecision_C", MatBinBCSRSetPrecision_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetPrecision_C", MatBinBCSRGetPrecision_MPIBinBCSR));

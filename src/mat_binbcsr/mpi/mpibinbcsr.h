@@ -72,6 +72,7 @@ struct Mat_MPIBinBCSR {
   PetscBool                                    precision_set = PETSC_FALSE;
   MatBinBCSRPrecision                          precision = MAT_BINBCSR_PRECISION_DOUBLE;
   PetscBool                                    sym = PETSC_FALSE; /* symmetric storage of the diagonal part (B stays full) */
+  PetscBool                                    coo_mirror = PETSC_FALSE; /* MatBinBCSRSetCOOMirror */
 
   /* MatGetRow buffers */
   std::vector<PetscInt>    row_cols;

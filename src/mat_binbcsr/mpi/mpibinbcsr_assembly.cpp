@@ -213,15 +213,29 @@ PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_MPIBinBCSR(Mat mat, PetscCoun
   b->coo             = coo;
   coo->n             = ncoo;
 
+  /* With the COO mirror, entry ncoo + t is the transpose of entry mirror_of[t] and reads its value;
+     it is routed like any other (its row may be another rank's). */
+  std::vector<PetscCount> mirror_of;
+  if (b->coo_mirror) {
+    PetscCheck(M == N && mat->rmap->n == mat->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "The COO mirror needs a square matrix with equal row and column layouts");
+    for (PetscCount k = 0; k < ncoo; k++)
+      if (coo_i[k] >= 0 && coo_j[k] >= 0 && coo_i[k] / bs != coo_j[k] / bs) mirror_of.push_back(k);
+  }
+  const PetscCount nall   = ncoo + static_cast<PetscCount>(mirror_of.size());
+  auto             src_of = [&](PetscCount e) { return e < ncoo ? e : mirror_of[e - ncoo]; };
+  auto             row_of = [&](PetscCount e) { return e < ncoo ? coo_i[e] : coo_j[mirror_of[e - ncoo]]; };
+  auto             col_of = [&](PetscCount e) { return e < ncoo ? coo_j[e] : coo_i[mirror_of[e - ncoo]]; };
+
   std::vector<PetscCount>  own;
   std::vector<PetscMPIInt> dest;
   std::vector<PetscInt>    send_i, send_j;
-  for (PetscCount k = 0; k < ncoo; k++) {
-    const PetscInt i = coo_i[k], j = coo_j[k];
+  for (PetscCount e = 0; e < nall; e++) {
+    const PetscInt   i = row_of(e), j = col_of(e);
+    const PetscCount k = src_of(e);
     if (i < 0 || j < 0) continue; /* PETSc's convention: negative indices are ignored */
     PetscCheck(i < M && j < N, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "COO entry %" PetscCount_FMT " (%" PetscInt_FMT ",%" PetscInt_FMT ") out of range for a %" PetscInt_FMT " x %" PetscInt_FMT " matrix", k, i, j, M, N);
     if (i >= rstart && i < rend) {
-      own.push_back(k);
+      own.push_back(e);
     } else {
       PetscMPIInt owner;
       PetscCall(PetscLayoutFindOwner(mat->rmap, i, &owner));
@@ -251,7 +265,7 @@ PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_MPIBinBCSR(Mat mat, PetscCoun
       coo->b_from.push_back(from);
     }
   };
-  for (PetscCount k : own) route(coo_i[k], coo_j[k], k);
+  for (PetscCount e : own) route(row_of(e), col_of(e), src_of(e));
   for (PetscInt r = 0; r < coo->nrecv; r++) route(recv_i[r], recv_j[r], ncoo + r);
 
   b->garray.resize(bj.size());

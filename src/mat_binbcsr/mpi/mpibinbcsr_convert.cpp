@@ -168,6 +168,7 @@ PETSC_INTERN PetscErrorCode MatDuplicate_MPIBinBCSR(Mat mat, MatDuplicateOption 
   c->precision_set      = b->precision_set;
   c->precision          = b->precision;
   c->sym                = b->sym;
+  c->coo_mirror         = b->coo_mirror;
   c->garray             = b->garray;
   c->compressed         = b->compressed;
   c->b_staging          = b->b_staging;

@@ -41,6 +41,8 @@ PetscErrorCode MatSeqBinBCSRDestroyCOO(Mat_SeqBinBCSR *a)
   PetscCall(PetscFree(a->coo_jmap));
   PetscCall(PetscFree(a->coo_perm));
   PetscCall(PetscFree(a->coo_perm_src));
+  PetscCall(PetscFree(a->coo_slot_src));
+  a->coo_slot_state = 0;
   a->coo_composed = PETSC_FALSE;
   a->coo_n        = 0;
   PetscFunctionReturn(0);
@@ -640,6 +642,20 @@ static PetscErrorCode MatBinBCSRGetSymmetricStorage_SeqBinBCSR(Mat A, PetscBool 
   PetscFunctionReturn(0);
 }
 
+static PetscErrorCode MatBinBCSRSetCOOMirror_SeqBinBCSR(Mat A, PetscBool flg)
+{
+  PetscFunctionBegin;
+  ((Mat_SeqBinBCSR *)A->data)->coo_mirror = flg;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRGetCOOMirror_SeqBinBCSR(Mat A, PetscBool *flg)
+{
+  PetscFunctionBegin;
+  *flg = ((Mat_SeqBinBCSR *)A->data)->coo_mirror;
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MatSetFromOptions_SeqBinBCSR(Mat A, PetscOptionItems *PetscOptionsObject)
 {
   Mat_SeqBinBCSR     *a = (Mat_SeqBinBCSR *)A->data;
@@ -657,6 +673,7 @@ static PetscErrorCode MatSetFromOptions_SeqBinBCSR(Mat A, PetscOptionItems *Pets
   sym = a->sym;
   PetscCall(PetscOptionsBool("-mat_binbcsr_symmetric_storage", "Store the upper triangle only (symmetric matrices; the lower triangle given is ignored)", "MatBinBCSRSetSymmetricStorage", sym, &sym, &set));
   if (set) PetscCall(MatBinBCSRSetSymmetricStorage_SeqBinBCSR(A, sym));
+  PetscCall(PetscOptionsBool("-mat_binbcsr_coo_mirror", "COO entries of off-diagonal blocks also fill the transposed place (give one triangle of a symmetric matrix)", "MatBinBCSRSetCOOMirror", a->coo_mirror, &a->coo_mirror, nullptr));
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }
@@ -679,7 +696,7 @@ static PetscErrorCode MatGetInfo_SeqBinBCSR_Basic(Mat A, MatInfoType flag, MatIn
   PetscFunctionReturn(0);
 }
 
-static const char *const composed_names[] = {"MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatSeqAIJSetPreallocation_C", "MatSeqBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatConvert_seqbinbcsr_seqaij_C", "MatConvert_seqbinbcsr_seqbaij_C"};
+static const char *const composed_names[] = {"MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatBinBCSRSetCOOMirror_C", "MatBinBCSRGetCOOMirror_C", "MatSeqAIJSetPreallocation_C", "MatSeqBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatConvert_seqbinbcsr_seqaij_C", "MatConvert_seqbinbcsr_seqbaij_C"};
 
 static PetscErrorCode MatDestroy_SeqBinBCSR(Mat A)
 {
@@ -742,6 +759,8 @@ PetscErrorCode MatCreate_SeqBinBCSR(Mat A)
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRGetPrecision_C", MatBinBCSRGetPrecision_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRSetSymmetricStorage_C", MatBinBCSRSetSymmetricStorage_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRGetSymmetricStorage_C", MatBinBCSRGetSymmetricStorage_SeqBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRSetCOOMirror_C", MatBinBCSRSetCOOMirror_SeqBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRGetCOOMirror_C", MatBinBCSRGetCOOMirror_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatSeqAIJSetPreallocation_C", MatSeqAIJSetPreallocation_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatSeqBAIJSetPreallocation_C", MatSeqBAIJSetPreallocation_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatSetPreallocationCOO_C", MatSetPreallocationCOO_SeqBinBCSR));

@@ -94,11 +94,20 @@ typedef struct {
      the block (the order of a CSR row, so consecutive values gather from the same elements).
      Value q is the sum of the COO entries coo_perm[coo_jmap[q] .. coo_jmap[q+1]-1]; coo_jmap has
      nz*bs2 + 1 entries. 32-bit indices (checked at preallocation) halve the bytes of the refill. */
+  PetscBool  coo_mirror;   /* MatBinBCSRSetCOOMirror: entries of off-diagonal blocks also fill their transposed place */
   PetscCount coo_n;
   PetscInt  *coo_jmap;
   PetscInt  *coo_perm;
   PetscInt  *coo_perm_src; /* coo_perm composed with a caller's source map (MatSeqBinBCSRComposeCOO), or NULL */
   PetscBool  coo_composed;
+  /* When every stored block is one whole COO block of the source (bs2 entries, no duplicates; row-major,
+     or transposed as the COO mirror makes them), the refill copies blocks: coo_slot_src[s] is the
+     source index of slot s's entry (0, 0) (transposed: -1 - index; padding: PETSC_MIN_INT). Built at
+     the first refill, for the split n between the two sources it was called with (coo_slot_n);
+     coo_slot_state 0: not tried, 1: built, -1: the list is not made of whole blocks. */
+  PetscInt  *coo_slot_src;
+  PetscCount coo_slot_n;
+  PetscInt   coo_slot_state;
 
   /* scratch */
   PetscBool    getrowactive;

@@ -1,13 +1,18 @@
 /* MATSEQBINBCSR COO assembly. Preallocation builds the bin layout straight from the COO pattern and,
    for every stored value (slot, entry), the list of COO entries that sum into it (jmap/perm, as PETSc's
    seqaij does per nonzero). The refill then writes each value once, in storage order, by gathering:
-   no atomics, no search, no sort per call. */
+   no atomics, no search, no sort per call.
+   With the COO mirror (MatBinBCSRSetCOOMirror) every entry (i, j) of an off-diagonal block also
+   fills (j, i): the list is extended by those transposed entries at preallocation, and their
+   places in coo_perm then name the entry they mirror, so the refill reads the caller's value twice
+   and needs no copy. */
 #include "binbcsr.h"
 #include "../binbcsr_kernels.h"
 #include <algorithm>
 #include <cstdint>
+#include <vector>
 
-PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat A, PetscCount n, const PetscInt ci[], const PetscInt cj[])
+static PetscErrorCode PreallocateCOO(Mat A, PetscCount n, const PetscInt ci[], const PetscInt cj[])
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
   PetscInt        rbs, cbs, bs, mbs, nvalid = 0, *rowptr, *bi, *bj, *vk, *fill;
@@ -107,6 +112,37 @@ PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat A, PetscCount n, const Pets
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat A, PetscCount n, const PetscInt ci[], const PetscInt cj[])
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  PetscInt        rbs, cbs;
+
+  PetscFunctionBegin;
+  if (!a->coo_mirror) {
+    PetscCall(PreallocateCOO(A, n, ci, cj));
+    PetscFunctionReturn(0);
+  }
+  PetscCall(PetscLayoutSetUp(A->rmap));
+  PetscCall(PetscLayoutSetUp(A->cmap));
+  PetscCall(MatGetBlockSizes(A, &rbs, &cbs));
+  PetscCheck(A->rmap->n == A->cmap->n && rbs == cbs, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "The COO mirror needs a square matrix with equal block sizes, this one is %" PetscInt_FMT " x %" PetscInt_FMT, A->rmap->n, A->cmap->n);
+  /* entries n + t: the transposes of the off-diagonal-block entries mirror_of[t] (the original
+     entries come first, so a bad index is reported by its own position) */
+  std::vector<PetscInt> ei(ci, ci + n), ej(cj, cj + n), mirror_of;
+  for (PetscCount k = 0; k < n; k++)
+    if (ci[k] >= 0 && cj[k] >= 0 && ci[k] / rbs != cj[k] / rbs) {
+      ei.push_back(cj[k]);
+      ej.push_back(ci[k]);
+      mirror_of.push_back((PetscInt)k);
+    }
+  PetscCall(PreallocateCOO(A, (PetscCount)ei.size(), ei.data(), ej.data()));
+  const PetscInt nperm = a->coo_jmap[a->nz * a->bs2];
+  for (PetscInt t = 0; t < nperm; t++)
+    if (a->coo_perm[t] >= n) a->coo_perm[t] = mirror_of[a->coo_perm[t] - n];
+  a->coo_n = n;
+  PetscFunctionReturn(0);
+}
+
 namespace
 {
 /* Refill in row order q (CSR order: gathers from the same elements follow each other); the writes
@@ -132,6 +168,66 @@ void coo_refill(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const Pet
   }
 }
 
+/* The block map (see coo_slot_src in binbcsr.h) from the value map; false if some stored block is
+   not exactly one whole COO block of a single source (*why: which test failed, for -info). */
+bool build_slot_map(const Mat_SeqBinBCSR *a, const PetscInt *perm, long n, PetscInt *slot_src, const char **why)
+{
+  const PetscInt  bs = a->bs, bs2 = a->bs2;
+  const PetscInt *jmap = a->coo_jmap;
+  for (PetscInt s = 0; s < a->nslots; s++) slot_src[s] = PETSC_MIN_INT;
+  PetscInt qbase = 0;
+  for (PetscInt r = 0; r < a->mbs; r++) {
+    const PetscInt nr = a->row_nz[r];
+    for (PetscInt k = 0; k < nr; k++) {
+      const PetscInt q00 = qbase + k * bs;
+      *why = "a value with no or several COO entries";
+      if (jmap[q00 + 1] - jmap[q00] != 1) return false;
+      const long base = perm[jmap[q00]];
+      *why            = "a block split between the two sources";
+      if ((base < n) != (base + bs2 - 1 < n)) return false; /* both ends in the same source */
+      *why = "a value with no or several COO entries";
+      bool plain = true, transposed = true;
+      for (PetscInt i = 0; i < bs; i++)
+        for (PetscInt j = 0; j < bs; j++) {
+          const PetscInt q = qbase + i * nr * bs + k * bs + j;
+          if (jmap[q + 1] - jmap[q] != 1) return false;
+          const long p = perm[jmap[q]];
+          plain      = plain && p == base + i * bs + j;
+          transposed = transposed && p == base + j * bs + i;
+        }
+      *why = "a block whose entries are not one whole block of the list";
+      if (!plain && !transposed) return false;
+      slot_src[BinBCSRSlot(a, r, k)] = plain ? (PetscInt)base : (PetscInt)(-1 - base);
+    }
+    qbase += nr * bs2;
+  }
+  return true;
+}
+
+/* The refill by blocks: slot by slot in storage order, so the values are written in sequence. */
+template <int BS, bool ADD, typename V>
+void coo_refill_blocks(const Mat_SeqBinBCSR *a, V *val, const PetscInt *slot_src, const PetscScalar *v, long n, const PetscScalar *recv)
+{
+  const PetscInt bs = BS ? BS : a->bs, bs2 = bs * bs, bw = a->bw;
+  for (PetscInt s0 = 0; s0 < a->nslots; s0 += bw) /* one column of a bin: bw lanes */
+    for (PetscInt l = 0; l < bw; l++) {
+      const PetscInt src = slot_src[s0 + l];
+      if (src == PETSC_MIN_INT) continue; /* padding stays zero */
+      const long         base = src >= 0 ? src : -1 - (long)src;
+      const PetscScalar *x    = base < n ? v + base : recv + (base - n);
+      V                 *dst  = val + (size_t)s0 * bs2 + l;
+      if (src >= 0) {
+        for (PetscInt e = 0; e < bs2; e++) dst[(size_t)e * bw] = (V)(ADD ? (double)dst[(size_t)e * bw] + x[e] : x[e]);
+      } else {
+        for (PetscInt i = 0; i < bs; i++)
+          for (PetscInt j = 0; j < bs; j++) {
+            V &d = dst[(size_t)(i * bs + j) * bw];
+            d    = (V)(ADD ? (double)d + x[j * bs + i] : x[j * bs + i]);
+          }
+      }
+    }
+}
+
 template <int BS, typename V>
 void coo_refill_mode(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const PetscScalar *v, long n, const PetscScalar *recv, InsertMode imode)
 {
@@ -142,6 +238,12 @@ void coo_refill_mode(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, cons
 template <typename V>
 void coo_refill_any(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const PetscScalar *v, long n, const PetscScalar *recv, InsertMode imode)
 {
+  if (a->coo_slot_state == 1) {
+    const bool add = imode == ADD_VALUES;
+    if (a->bs == 3) add ? coo_refill_blocks<3, true, V>(a, val, a->coo_slot_src, v, n, recv) : coo_refill_blocks<3, false, V>(a, val, a->coo_slot_src, v, n, recv);
+    else add ? coo_refill_blocks<0, true, V>(a, val, a->coo_slot_src, v, n, recv) : coo_refill_blocks<0, false, V>(a, val, a->coo_slot_src, v, n, recv);
+    return;
+  }
   if (a->bs == 3) coo_refill_mode<3, V>(a, val, perm, v, n, recv, imode);
   else if (a->bs == 1) coo_refill_mode<1, V>(a, val, perm, v, n, recv, imode);
   else coo_refill_mode<0, V>(a, val, perm, v, n, recv, imode);
@@ -156,6 +258,14 @@ PetscErrorCode SetValuesCOO(Mat A, const PetscInt *perm, const PetscScalar v[], 
   PetscFunctionBegin;
   PetscCheck(imode == INSERT_VALUES || imode == ADD_VALUES, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "MatSetValuesCOO supports INSERT_VALUES and ADD_VALUES only");
   PetscCall(PetscLogEventBegin(MAT_BinBCSR_SetValuesCOO, A, 0, 0, 0));
+  if (v && (a->coo_slot_state == 0 || (a->coo_slot_state == 1 && a->coo_slot_n != n))) { /* first refill (or another split) */
+    if (!a->coo_slot_src) PetscCall(PetscMalloc1(PetscMax(a->nslots, 1), &a->coo_slot_src));
+    const char *why   = "";
+    a->coo_slot_state = build_slot_map(a, perm, n, a->coo_slot_src, &why) ? 1 : -1;
+    a->coo_slot_n     = n;
+    if (a->coo_slot_state < 0) PetscCall(PetscFree(a->coo_slot_src));
+    PetscCall(PetscInfo(A, "COO refill %s%s\n", a->coo_slot_state > 0 ? "by whole blocks" : "by values: ", a->coo_slot_state > 0 ? "" : why));
+  }
   if (!v) { /* no values: zeros */
     if (imode == INSERT_VALUES) {
       if (a->val) PetscCall(PetscArrayzero(a->val, nv));
@@ -190,6 +300,8 @@ PetscErrorCode MatSeqBinBCSRComposeCOO(Mat A, const PetscCount from[], PetscCoun
   PetscCall(PetscMalloc1(nperm, &a->coo_perm_src));
   for (PetscInt t = 0; t < nperm; t++) a->coo_perm_src[t] = (PetscInt)from[a->coo_perm[t]];
   a->coo_composed = PETSC_TRUE; /* coo_perm_src is NULL when the part has no entries */
+  PetscCall(PetscFree(a->coo_slot_src)); /* the block map follows the sources */
+  a->coo_slot_state = 0;
   PetscFunctionReturn(0);
 }
 
