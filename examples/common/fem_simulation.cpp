@@ -20,9 +20,9 @@ PetscErrorCode FemSimulationCreate(MPI_Comm comm, const FemScene &scene, FemSimu
   sim->size = size;
   // What the Mat stores decides the row grouping and the blocks listed below: upper-triangle storage
   // wants rows grouped by their upper length, which the order itself decides.
-  PetscBool upper_only = PETSC_FALSE, offrank_full = PETSC_FALSE;
+  PetscBool upper_only = PETSC_FALSE, offrank_full = PETSC_FALSE, lower_mirrored = PETSC_FALSE;
   PetscInt  bin_width  = 0;
-  PetscCall(BlockSystemStoredTriangle(comm, &upper_only, &offrank_full, &bin_width));
+  PetscCall(BlockSystemStoredTriangle(comm, &upper_only, &offrank_full, &bin_width, &lower_mirrored));
   if (bin_width < 1) bin_width = 8; // sbaij has no bins; measure padding as binbcsr's default would
   try {
     physics::TetMesh mesh = scene.mesh;
@@ -70,9 +70,9 @@ PetscErrorCode FemSimulationCreate(MPI_Comm comm, const FemScene &scene, FemSimu
     for (int e = 0; e < sim->model.element_count(); ++e)
       if (owner[e] == rank) sim->elements.push_back(e);
   }
-  physics::LowerTriangle lower; // list and compute only the blocks the Mat type stores
-  lower.drop = upper_only;
-  if (upper_only && offrank_full) lower.part_offsets = sim->part_offsets;
+  physics::LowerTriangle lower; // list and compute only the blocks the Mat type stores or cannot mirror
+  lower.drop = upper_only || lower_mirrored;
+  if (upper_only && offrank_full && !lower_mirrored) lower.part_offsets = sim->part_offsets;
   sim->pattern = physics::make_block_pattern(sim->model, sim->elements, sim->fixed, sim->own_begin, sim->own_end, scene.merge_blocks,
                                              lower);
   PetscCall(BlockSystemCreate(comm, n_nodes, sim->own_end - sim->own_begin, sim->pattern.rows, sim->pattern.cols, &sim->sys));

@@ -114,23 +114,27 @@ PetscErrorCode PreallocateFromBlockPattern(MPI_Comm comm, PetscInt n_local, Pets
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode MatStoredTriangle(Mat A, PetscBool *upper_only, PetscBool *offrank_full)
+PetscErrorCode MatStoredTriangle(Mat A, PetscBool *upper_only, PetscBool *offrank_full, PetscBool *mirrored)
 {
-  PetscBool is_sbaij, sym = PETSC_FALSE;
+  PetscBool is_sbaij, sym = PETSC_FALSE, mirror = PETSC_FALSE;
 
   PetscFunctionBegin;
   PetscCall(PetscObjectTypeCompareAny((PetscObject)A, &is_sbaij, MATSEQSBAIJ, MATMPISBAIJ, MATSBAIJ, ""));
   PetscCall(MatBinBCSRGetSymmetricStorage(A, &sym)); // PETSC_FALSE for other types
+  PetscCall(MatBinBCSRGetCOOMirror(A, &mirror));     // PETSC_FALSE for other types
   *upper_only   = (is_sbaij || sym) ? PETSC_TRUE : PETSC_FALSE;
   *offrank_full = (!is_sbaij && sym) ? PETSC_TRUE : PETSC_FALSE;
+  *mirrored     = mirror;
   PetscFunctionReturn(0);
 }
 
 } // namespace
 
-PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, PetscBool *offrank_full, PetscInt *bin_width)
+PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, PetscBool *offrank_full, PetscInt *bin_width,
+                                         PetscBool *lower_mirrored)
 {
-  Mat probe;
+  Mat       probe;
+  PetscBool mirrored;
 
   PetscFunctionBegin;
   PetscCall(CheckMatTypeAvailable(comm));
@@ -140,7 +144,8 @@ PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, P
   PetscCall(MatSetBlockSize(probe, 3));
   PetscCall(MatSetType(probe, MATAIJ));
   PetscCall(MatSetFromOptions(probe));
-  PetscCall(MatStoredTriangle(probe, upper_only, offrank_full));
+  PetscCall(MatStoredTriangle(probe, upper_only, offrank_full, &mirrored));
+  if (lower_mirrored) *lower_mirrored = mirrored;
   if (bin_width) PetscCall(MatBinBCSRGetBinWidth(probe, bin_width)); // 0 for other types
   PetscCall(MatDestroy(&probe));
   PetscFunctionReturn(0);
@@ -183,8 +188,14 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
   PetscCall(MatSetType(sys->A, MATAIJ));
   PetscCall(MatSetFromOptions(sys->A));
   {
-    PetscBool offrank_full;
-    PetscCall(MatStoredTriangle(sys->A, &sys->upper_only, &offrank_full));
+    PetscBool offrank_full, mirrored;
+    PetscCall(MatStoredTriangle(sys->A, &sys->upper_only, &offrank_full, &mirrored));
+    if (mirrored) sys->upper_only = PETSC_TRUE; // the caller lists the upper triangle, the Mat mirrors it
+    for (size_t k = 0; mirrored && k < coo_block_row.size(); ++k)
+      PetscCheck(coo_block_row[k] <= coo_block_col[k], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
+                 "COO block %zu is (%" PetscInt_FMT ", %" PetscInt_FMT "), below the diagonal, but -mat_binbcsr_coo_mirror "
+                 "fills the lower triangle from the upper one: list the upper triangle only (see BlockSystemStoredTriangle)",
+                 k, coo_block_row[k], coo_block_col[k]);
   }
 
   // The block graph for the structural count (and the row lengths): an upper-triangle list stands

@@ -33,7 +33,8 @@ struct BlockSystem {
   PetscInt n_coo_blocks = 0;            // blocks this rank contributes (length of the COO list)
   PetscInt n_blocks = 0;                // distinct blocks of the pattern over all ranks
   PetscBool native_coo = PETSC_FALSE;   // the type implements MatSetValuesCOO itself
-  PetscBool upper_only = PETSC_FALSE;   // blocks below the diagonal are ignored (sbaij, binbcsr symmetric storage)
+  PetscBool upper_only = PETSC_FALSE;   // blocks below the diagonal are ignored or mirrored from above (sbaij, binbcsr
+                                        // symmetric storage or COO mirror): the caller lists the upper triangle
   std::vector<PetscInt> coo_block_row, coo_block_col; // kept for the fallback path and for dumps
   const PetscScalar *last_values = nullptr; // the caller's array from the last SetValues (for dumps)
 };
@@ -55,7 +56,11 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
 // ignored (sbaij; binbcsr with -mat_binbcsr_symmetric_storage), and then *offrank_full when blocks that
 // couple two ranks are kept in both triangles all the same (binbcsr stores its off-rank part in full).
 // bin_width (may be null): the binbcsr bin width in block rows, 0 for other types.
-PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, PetscBool *offrank_full, PetscInt *bin_width = nullptr);
+// lower_mirrored (may be null): the Mat fills every block below the diagonal from the COO entries of
+// its upper twin (binbcsr with -mat_binbcsr_coo_mirror), so the caller lists only blocks on or above
+// the diagonal (also those coupling two ranks), whatever the Mat stores.
+PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, PetscBool *offrank_full, PetscInt *bin_width = nullptr,
+                                         PetscBool *lower_mirrored = nullptr);
 
 // block_values: 9 * n_coo_blocks values, block k row-major at [9k, 9k+9). Summed over duplicates,
 // replacing the previous values. The array is remembered (not copied) for BlockSystemDumpMatrix: keep

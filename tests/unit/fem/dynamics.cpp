@@ -213,15 +213,21 @@ TEST_CASE("same trajectory with aij, baij, sell and binbcsr (double); binbcsr si
       REQUIRE(r.err == 0);
       CHECK(max_abs_diff(r.x, ref.x) < 1e-9 * disp);
     }
-  // Upper-triangle storage: the driver lists and computes only the blocks on or above the diagonal.
+  // Upper-triangle storage, or the COO mirror (whole matrix stored, lower blocks filled from their
+  // upper twins): the driver lists and computes only the blocks on or above the diagonal.
   for (const auto &opts : {std::map<std::string, std::string>{{"-mat_type", "sbaij"}, {"-ksp_type", "cg"}},
-                           std::map<std::string, std::string>{{"-mat_type", "binbcsr"}, {"-mat_binbcsr_symmetric_storage", "1"}, {"-ksp_type", "mcg"}}}) {
+                           std::map<std::string, std::string>{{"-mat_type", "binbcsr"}, {"-mat_binbcsr_symmetric_storage", "1"}, {"-ksp_type", "mcg"}},
+                           std::map<std::string, std::string>{{"-mat_type", "binbcsr"}, {"-mat_binbcsr_coo_mirror", "1"}, {"-ksp_type", "mcg"}}}) {
     auto o = opts;
     o.insert(kTight.begin(), kTight.end());
-    INFO(o.at("-mat_type") << " upper triangle");
-    const Run r = run(PETSC_COMM_SELF, s, o, 5);
-    REQUIRE(r.err == 0);
-    CHECK(max_abs_diff(r.x, ref.x) < 1e-9 * disp);
+    for (bool merged : {true, false}) {
+      INFO(o.at("-mat_type") << " upper triangle" << (o.count("-mat_binbcsr_coo_mirror") ? ", COO mirror" : "") << (merged ? "" : ", unmerged"));
+      FemScene sm     = s;
+      sm.merge_blocks = merged; // unmerged: the Mat sums the duplicate element blocks (and mirrors them)
+      const Run r     = run(PETSC_COMM_SELF, sm, o, 5);
+      REQUIRE(r.err == 0);
+      CHECK(max_abs_diff(r.x, ref.x) < 1e-9 * disp);
+    }
   }
   const Run single = run(PETSC_COMM_SELF, s,
                          {{"-mat_type", "binbcsr"}, {"-mat_binbcsr_precision", "single"}, {"-ksp_type", "mcg"}, {"-ksp_rtol", "1e-6"},
@@ -287,10 +293,15 @@ TEST_CASE("parallel layout: the same trajectory on PETSC_COMM_WORLD and on one r
   const FemScene s = beam_scene(2, true);
   // sbaij and binbcsr symmetric storage: the driver leaves out the lower blocks each type ignores
   // (binbcsr keeps those that couple the two ranks).
-  for (const char *type : {"aij", "baij", "binbcsr", "sbaij", "binbcsr_sym"}) {
+  // The COO mirror fills lower blocks from upper ones listed by either rank (binbcsr_mirror), also
+  // with symmetric storage, where it replaces the lower blocks across ranks (binbcsr_sym_mirror).
+  for (const char *type : {"aij", "baij", "binbcsr", "sbaij", "binbcsr_sym", "binbcsr_mirror", "binbcsr_sym_mirror"}) {
     INFO(type);
-    auto opts = std::map<std::string, std::string>{{"-mat_type", type}, {"-ksp_rtol", "1e-13"}, {"-ksp_max_it", "5000"}};
-    if (std::string(type) == "binbcsr_sym") opts = {{"-mat_type", "binbcsr"}, {"-mat_binbcsr_symmetric_storage", "1"}, {"-ksp_rtol", "1e-13"}, {"-ksp_max_it", "5000"}};
+    const std::string t    = type;
+    auto              opts = std::map<std::string, std::string>{{"-mat_type", type}, {"-ksp_rtol", "1e-13"}, {"-ksp_max_it", "5000"}};
+    if (t.rfind("binbcsr_", 0) == 0) opts["-mat_type"] = "binbcsr";
+    if (t.find("_sym") != std::string::npos) opts["-mat_binbcsr_symmetric_storage"] = "1";
+    if (t.find("_mirror") != std::string::npos) opts["-mat_binbcsr_coo_mirror"] = "1";
     const Run  all  = run(PETSC_COMM_WORLD, s, opts, 4);
     const Run  one  = run(PETSC_COMM_SELF, s, opts, 4);
     REQUIRE(all.err == 0);
