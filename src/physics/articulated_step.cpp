@@ -60,10 +60,14 @@ double predicted_errors(const ArticulatedScene &scene, double dt, ArticulatedSol
 // Rotation, world inverse inertia and joint arms for the given orientations (the bodies' own when null).
 void update_frames(const ArticulatedScene &scene, ArticulatedSolver &s, const std::vector<Eigen::Quaterniond> *orientations)
 {
+  if (s.inverse_inertia_body.size() != scene.bodies.size()) {
+    s.inverse_inertia_body.resize(scene.bodies.size());
+    for (size_t i = 0; i < scene.bodies.size(); ++i) s.inverse_inertia_body[i] = scene.bodies[i].inertia_body.inverse();
+  }
   for (size_t i = 0; i < scene.bodies.size(); ++i) {
     const RigidBody &b = scene.bodies[i];
     s.rotation[i]      = (orientations ? (*orientations)[i] : b.orientation).toRotationMatrix();
-    s.inverse_inertia[i] = s.rotation[i] * b.inertia_body.inverse() * s.rotation[i].transpose();
+    s.inverse_inertia[i] = s.rotation[i] * s.inverse_inertia_body[i] * s.rotation[i].transpose();
   }
   for (size_t j = 0; j < scene.joints.size(); ++j) {
     const BallJoint &jt = scene.joints[j];
