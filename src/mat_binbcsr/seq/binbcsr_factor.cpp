@@ -92,11 +92,12 @@ PetscErrorCode BuildShadowPattern(Mat A, PetscBool upper, FactorShadow *f, std::
   PetscFunctionReturn(0);
 }
 
-/* S's values from A's: one pass over S's blocks (column-major bs x bs, as BAIJ and SBAIJ store them). */
-template <typename T>
+/* S's values from A's: one pass over S's blocks (column-major bs x bs, as BAIJ and SBAIJ store them).
+   BS > 0: the block size known at compile time (the loops unroll); 0: f->bs. */
+template <typename T, int BS>
 void GatherValues(const T *val, const FactorShadow *f, PetscScalar *dst)
 {
-  const PetscInt bs = f->bs, bw = f->bw, bs2 = bs * bs, nb = (PetscInt)f->src.size();
+  const PetscInt bs = BS ? BS : f->bs, bw = f->bw, bs2 = bs * bs, nb = (PetscInt)f->src.size();
   for (PetscInt k = 0; k < nb; k++) {
     const T     *v = val + f->src[k];
     PetscScalar *d = dst + k * bs2;
@@ -122,8 +123,15 @@ PetscErrorCode RefillShadow(Mat A, FactorShadow *f)
   PetscCall(PetscObjectTypeCompare((PetscObject)f->S, MATSEQSBAIJ, &upper));
   if (upper) PetscCall(MatSeqSBAIJGetArray(f->S, &dst));
   else PetscCall(MatSeqBAIJGetArray(f->S, &dst));
-  if (a->val) GatherValues(a->val, f, dst);
-  else GatherValues(a->valf, f, dst);
+  if (a->val) {
+    if (f->bs == 3) GatherValues<MatScalar, 3>(a->val, f, dst);
+    else if (f->bs == 1) GatherValues<MatScalar, 1>(a->val, f, dst);
+    else GatherValues<MatScalar, 0>(a->val, f, dst);
+  } else {
+    if (f->bs == 3) GatherValues<float, 3>(a->valf, f, dst);
+    else if (f->bs == 1) GatherValues<float, 1>(a->valf, f, dst);
+    else GatherValues<float, 0>(a->valf, f, dst);
+  }
   if (upper) PetscCall(MatSeqSBAIJRestoreArray(f->S, &dst));
   else PetscCall(MatSeqBAIJRestoreArray(f->S, &dst));
   PetscCall(PetscObjectStateIncrease((PetscObject)f->S));

@@ -118,7 +118,7 @@ void check_same(const Solution &got, const Solution &ref, double rtol)
 
 TEST_CASE("ICC, Cholesky, ILU and LU on binbcsr equal PETSc's on seqsbaij/seqbaij", "[mat_factor]")
 {
-  for (PetscInt bs : {1, 3})
+  for (PetscInt bs : {1, 2, 3}) // 2: the generic block-size path of the copy
     for (bool sym : {false, true}) {
       CAPTURE(bs, sym);
       const Pattern p    = fem_pattern(5, 4, 3, bs);
