@@ -50,6 +50,17 @@ PetscErrorCode MatRestoreRow_SeqBinBCSR(Mat A, PetscInt row, PetscInt *nz, Petsc
 }
 
 /* B gets A's layout (and values if copyvalues), in A's precision. B is a fresh MATSEQBINBCSR. */
+/* An empty matrix of the given type with A's sizes and block sizes (a conversion's target). */
+static PetscErrorCode MatCreateLike_Private(Mat A, MatType type, Mat *B)
+{
+  PetscFunctionBegin;
+  PetscCall(MatCreate(PetscObjectComm((PetscObject)A), B));
+  PetscCall(MatSetSizes(*B, A->rmap->n, A->cmap->n, A->rmap->N, A->cmap->N));
+  PetscCall(MatSetBlockSizesFromMats(*B, A, A));
+  PetscCall(MatSetType(*B, type));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues)
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data, *b = (Mat_SeqBinBCSR *)B->data;
@@ -116,10 +127,7 @@ PetscErrorCode MatDuplicate_SeqBinBCSR(Mat A, MatDuplicateOption op, Mat *M)
   Mat B;
 
   PetscFunctionBegin;
-  PetscCall(MatCreate(PetscObjectComm((PetscObject)A), &B));
-  PetscCall(MatSetSizes(B, A->rmap->n, A->cmap->n, A->rmap->N, A->cmap->N));
-  PetscCall(MatSetBlockSizesFromMats(B, A, A));
-  PetscCall(MatSetType(B, ((PetscObject)A)->type_name));
+  PetscCall(MatCreateLike_Private(A, ((PetscObject)A)->type_name, &B));
   PetscCall(PetscLayoutSetUp(B->rmap));
   PetscCall(PetscLayoutSetUp(B->cmap));
   PetscCall(MatSeqBinBCSRCopyLayout(A, B, op == MAT_COPY_VALUES ? PETSC_TRUE : PETSC_FALSE));
@@ -278,10 +286,7 @@ static PetscErrorCode MatConvert_SeqBinBCSR_XAIJ(Mat A, MatType newtype, MatReus
       B = *newmat;
       PetscCall(MatZeroEntries(B));
     } else {
-      PetscCall(MatCreate(PetscObjectComm((PetscObject)A), &B));
-      PetscCall(MatSetSizes(B, A->rmap->n, A->cmap->n, A->rmap->N, A->cmap->N));
-      PetscCall(MatSetBlockSizesFromMats(B, A, A));
-      PetscCall(MatSetType(B, newtype));
+      PetscCall(MatCreateLike_Private(A, newtype, &B));
       PetscCall(MatSeqBinBCSRBuildLowerIndex(a));
       PetscCall(PetscMalloc1(A->rmap->n, &nnz));
       for (PetscInt r = 0; r < A->rmap->n; r++) nnz[r] = (a->row_nz[r / bs] + a->lower_off[r / bs + 1] - a->lower_off[r / bs]) * (blocked ? 1 : bs);
@@ -304,10 +309,7 @@ static PetscErrorCode MatConvert_SeqBinBCSR_XAIJ(Mat A, MatType newtype, MatReus
     B = *newmat;
     PetscCall(MatZeroEntries(B));
   } else {
-    PetscCall(MatCreate(PetscObjectComm((PetscObject)A), &B));
-    PetscCall(MatSetSizes(B, A->rmap->n, A->cmap->n, A->rmap->N, A->cmap->N));
-    PetscCall(MatSetBlockSizesFromMats(B, A, A));
-    PetscCall(MatSetType(B, newtype));
+    PetscCall(MatCreateLike_Private(A, newtype, &B));
     if (blocked) PetscCall(MatSeqBAIJSetPreallocation(B, bs, 0, a->row_nz));
     else {
       PetscCall(PetscMalloc1(A->rmap->n, &nnz));
