@@ -68,6 +68,17 @@ binbcsr_stock_case(ksp_ex72_ilu_bs3
   --ref "${EX72} -mat_type baij -matload_block_size 3 -ksp_type gmres -pc_type ilu"
   --test "${EX72} ${PLUGIN_ARGS} -mat_type binbcsr -matload_block_size 3 -ksp_type gmres -pc_type ilu -ksp_view")
 
+# CG + SSOR (PCSOR, block sweeps with the 3x3 diagonal blocks inverted, as seqbaij): whole and
+# upper-triangle storage take baij's iterations and residuals.
+binbcsr_stock_case(ksp_ex72_ssor_bs3
+  --keep "Number of iterations|Residual norm" --atol 1e-12 --expect "type: seqbinbcsr"
+  --ref "${EX72} -mat_type baij -matload_block_size 3 -pc_type sor"
+  --test "${EX72} ${PLUGIN_ARGS} -mat_type binbcsr -matload_block_size 3 -pc_type sor -ksp_view")
+binbcsr_stock_case(ksp_ex72_ssor_bs3_symmetric_storage
+  --keep "Number of iterations|Residual norm" --atol 1e-12
+  --ref "${EX72} -mat_type baij -matload_block_size 3 -pc_type sor"
+  --test "${EX72} ${PLUGIN_ARGS} -mat_type binbcsr -mat_binbcsr_symmetric_storage -matload_block_size 3 -pc_type sor")
+
 # mat ex18: MatZeroRowsColumns with x and b on a 3x3-block matrix; the program checks b itself and
 # prints it. The matrix listings differ by format and are not compared.
 set(EX18 "@STOCK@/petsc_mat_ex18 -bs 3")

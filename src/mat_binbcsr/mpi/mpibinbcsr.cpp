@@ -384,6 +384,7 @@ PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
   mat->ops->getdiagonal         = MatGetDiagonal_MPIBinBCSR;
   mat->ops->diagonalset         = MatDiagonalSet_MPIBinBCSR;
   mat->ops->invertblockdiagonal = MatInvertBlockDiagonal_MPIBinBCSR;
+  mat->ops->sor                 = MatSOR_MPIBinBCSR;
   mat->ops->scale               = MatScale_MPIBinBCSR;
   mat->ops->shift               = MatShift_MPIBinBCSR;
   mat->ops->zeroentries         = MatZeroEntries_MPIBinBCSR;

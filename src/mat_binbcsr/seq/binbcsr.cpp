@@ -27,6 +27,8 @@ static PetscErrorCode MatSeqBinBCSRFreeLayout(Mat_SeqBinBCSR *a)
   PetscCall(MatSeqBinBCSRStreamFree(&a->valf));
   PetscCall(PetscFree2(a->rowbuf_cols, a->rowbuf_vals));
   PetscCall(PetscFree(a->idiag));
+  PetscCall(PetscFree(a->sor_idiag));
+  a->sor_state = 0;
   PetscCall(MatSeqBinBCSRDestroyCOO(a));
   a->built  = PETSC_FALSE;
   a->nbins  = 0;
@@ -741,6 +743,7 @@ PetscErrorCode MatCreate_SeqBinBCSR(Mat A)
   A->ops->multtransposeadd    = MatMultTransposeAdd_SeqBinBCSR;
   A->ops->getdiagonal         = MatGetDiagonal_SeqBinBCSR;
   A->ops->invertblockdiagonal = MatInvertBlockDiagonal_SeqBinBCSR;
+  A->ops->sor                 = MatSOR_SeqBinBCSR;
   A->ops->assemblyend         = MatAssemblyEnd_SeqBinBCSR;
   A->ops->setoption           = MatSetOption_SeqBinBCSR;
   A->ops->setup               = MatSetUp_SeqBinBCSR;

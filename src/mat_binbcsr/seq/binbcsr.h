@@ -114,6 +114,9 @@ typedef struct {
   PetscInt    *rowbuf_cols; /* [max_row_nz * bs] for MatGetRow */
   PetscScalar *rowbuf_vals;
   MatScalar   *idiag;       /* [mbs * bs2] MatInvertBlockDiagonal result (column-major blocks, as BAIJ) */
+  MatScalar       *sor_idiag; /* [mbs * bs2] (D + sor_shift I)^-1 for MatSOR, valid for sor_state */
+  PetscObjectState sor_state; /* state of the matrix when sor_idiag was computed (0: never) */
+  PetscReal        sor_shift;
 
   /* Viewers other than ASCII (binary, ...): binbcsr_ops.cpp may set this hook in
      MatSeqBinBCSRSetOps_Ops; ops->view (binbcsr.cpp) handles ASCII and forwards the rest here. */
@@ -185,6 +188,8 @@ PETSC_INTERN PetscErrorCode MatMultTransposeAdd_SeqBinBCSR(Mat, Vec, Vec, Vec);
 PETSC_INTERN PetscErrorCode MatMultDotLocal_SeqBinBCSR(Mat, Vec, Vec, PetscScalar *);
 PETSC_INTERN PetscErrorCode MatGetDiagonal_SeqBinBCSR(Mat, Vec);
 PETSC_INTERN PetscErrorCode MatInvertBlockDiagonal_SeqBinBCSR(Mat, const PetscScalar **);
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRInvertDiagonalBlocks(Mat, PetscReal shift, MatScalar *out, PetscInt *zero_row);
+PETSC_INTERN PetscErrorCode MatSOR_SeqBinBCSR(Mat, Vec, PetscReal, MatSORType, PetscReal, PetscInt, PetscInt, Vec);
 PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat, PetscCount, const PetscInt[], const PetscInt[]);
 PETSC_INTERN PetscErrorCode MatSetValuesCOO_SeqBinBCSR(Mat, const PetscScalar[], InsertMode);
 PETSC_INTERN PetscErrorCode MatGetRow_SeqBinBCSR(Mat, PetscInt, PetscInt *, PetscInt **, PetscScalar **);

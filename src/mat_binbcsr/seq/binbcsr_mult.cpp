@@ -381,23 +381,27 @@ static PetscBool InvertBlockGeneric(PetscInt bs, MatScalar *m, MatScalar *aug)
   return PETSC_TRUE;
 }
 
-PetscErrorCode MatInvertBlockDiagonal_SeqBinBCSR(Mat A, const PetscScalar **values)
+/* out[r] = (D_r + shift I)^-1 for every block row r, column-major blocks (BAIJ's order); D_r is the
+   stored diagonal block (zero if the row has none). A zero pivot is an error when the matrix errors on
+   failure (MatSetErrorIfFailure) or zero_row is NULL; otherwise *zero_row is the first block row with
+   one (-1: none) and it is recorded in A->factorerrortype. */
+PetscErrorCode MatSeqBinBCSRInvertDiagonalBlocks(Mat A, PetscReal shift, MatScalar *out, PetscInt *zero_row)
 {
   Mat_SeqBinBCSR *a  = (Mat_SeqBinBCSR *)A->data;
   const PetscInt  bs = a->bs, bs2 = a->bs2;
-  PetscBool       allowzeropivot = PetscNot(A->erroriffailure), zeropivot = PETSC_FALSE;
+  PetscBool       allowzeropivot = (PetscBool)(zero_row && !A->erroriffailure), zeropivot = PETSC_FALSE;
   MatScalar      *aug;
 
   PetscFunctionBegin;
   PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
-  if (!a->idiag) PetscCall(PetscMalloc1((size_t)a->mbs * bs2, &a->idiag));
+  if (zero_row) *zero_row = -1;
   PetscCall(PetscMalloc1(2 * bs2, &aug));
   for (PetscInt r = 0; r < a->mbs; r++) {
-    MatScalar     *d = a->idiag + (size_t)r * bs2;
+    MatScalar     *d = out + (size_t)r * bs2;
     const PetscInt s = a->diag_slot[r];
     /* the block, transposed into BAIJ's column-major order */
     for (PetscInt i = 0; i < bs; i++)
-      for (PetscInt j = 0; j < bs; j++) d[j * bs + i] = s < 0 ? 0.0 : BinBCSRGetValue(a, BinBCSRValueIndex(s, i * bs + j, a->bw, bs2));
+      for (PetscInt j = 0; j < bs; j++) d[j * bs + i] = (s < 0 ? 0.0 : BinBCSRGetValue(a, BinBCSRValueIndex(s, i * bs + j, a->bw, bs2))) + (i == j ? shift : 0.0);
     PetscBool zp = PETSC_FALSE;
     if (bs == 1) {
       zp = PetscAbsScalar(d[0]) < PETSC_MACHINE_EPSILON ? PETSC_TRUE : PETSC_FALSE;
@@ -410,6 +414,7 @@ PetscErrorCode MatInvertBlockDiagonal_SeqBinBCSR(Mat A, const PetscScalar **valu
     if (zp) {
       if (!allowzeropivot) PetscCall(PetscFree(aug));
       PetscCheck(allowzeropivot, PETSC_COMM_SELF, PETSC_ERR_MAT_LU_ZRPVT, "Zero pivot in the diagonal block of block row %" PetscInt_FMT, r);
+      if (!zeropivot) *zero_row = r;
       zeropivot                      = PETSC_TRUE;
       A->factorerror_zeropivot_row   = r * bs;
       A->factorerror_zeropivot_value = 0.0;
@@ -417,6 +422,18 @@ PetscErrorCode MatInvertBlockDiagonal_SeqBinBCSR(Mat A, const PetscScalar **valu
   }
   if (zeropivot) A->factorerrortype = MAT_FACTOR_NUMERIC_ZEROPIVOT;
   PetscCall(PetscFree(aug));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatInvertBlockDiagonal_SeqBinBCSR(Mat A, const PetscScalar **values)
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  PetscInt        zero_row;
+
+  PetscFunctionBegin;
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
+  if (!a->idiag) PetscCall(PetscMalloc1((size_t)a->mbs * a->bs2, &a->idiag));
+  PetscCall(MatSeqBinBCSRInvertDiagonalBlocks(A, 0.0, a->idiag, &zero_row));
   if (values) *values = a->idiag;
   PetscFunctionReturn(0);
 }

@@ -554,3 +554,67 @@ TEST_CASE("mpibinbcsr with symmetric storage: MatZeroRowsColumns with rows named
   PCHK(MatDestroy(&A));
   PCHK(MatDestroy(&S));
 }
+
+TEST_CASE("mpibinbcsr: MatSOR local sweeps and PCSOR in CG equal mpibaij's (whole and symmetric storage)", "[mpi][sor]")
+{
+  const FemProblem fem(6, 5, 4, true);
+  for (const char *sym : {"0", "1"}) {
+    INFO("symmetric storage " << sym);
+    PCHK(PetscOptionsSetValue(nullptr, "-mat_binbcsr_symmetric_storage", sym));
+    Mat A, R;
+    PCHK(assemble(fem, MATMPIBINBCSR, Fill::Coo, true, &A));
+    PCHK(MatConvert(A, MATMPIBAIJ, MAT_INITIAL_MATRIX, &R)); /* through MatGetRow: both triangles */
+    Vec b, x, xr;
+    PCHK(MatCreateVecs(A, &x, &b));
+    PCHK(VecDuplicate(x, &xr));
+    PCHK(fill_test_vector(b));
+    // block SOR with omega 1 (BAIJ's bs 3 sweeps invert the diagonal blocks the same way)
+    for (int flag : {SOR_LOCAL_SYMMETRIC_SWEEP | SOR_ZERO_INITIAL_GUESS, (int)SOR_LOCAL_FORWARD_SWEEP, (int)SOR_LOCAL_BACKWARD_SWEEP})
+      for (PetscInt its : {1, 3}) {
+        INFO("flag " << flag << " its " << its);
+        PCHK(fill_test_vector(x, 1));
+        PCHK(VecCopy(x, xr));
+        PCHK(MatSOR(A, b, 1.0, (MatSORType)flag, 0.0, its, 1, x));
+        PCHK(MatSOR(R, b, 1.0, (MatSORType)flag, 0.0, its, 1, xr));
+        PetscReal diff, ref;
+        PCHK(VecAXPY(x, -1.0, xr));
+        PCHK(VecNorm(x, NORM_INFINITY, &diff));
+        PCHK(VecNorm(xr, NORM_INFINITY, &ref));
+        CHECK(diff <= 1e-12 * ref);
+      }
+    // a global (not processor-local) sweep is refused, as by MPIAIJ
+    CHECK(MatSOR(A, b, 1.0, SOR_FORWARD_SWEEP, 0.0, 1, 1, x) == PETSC_ERR_SUP);
+    // CG + SSOR (PCSOR's default local symmetric sweep): the iterations and solution of mpibaij
+    PetscInt its[2];
+    Mat      mats[2] = {R, A};
+    Vec      sol[2]  = {xr, x};
+    for (int t = 0; t < 2; ++t) {
+      KSP ksp;
+      PC  pc;
+      PCHK(KSPCreate(PETSC_COMM_WORLD, &ksp));
+      PCHK(KSPSetOperators(ksp, mats[t], mats[t]));
+      PCHK(KSPSetType(ksp, KSPCG));
+      PCHK(KSPGetPC(ksp, &pc));
+      PCHK(PCSetType(pc, PCSOR));
+      PCHK(KSPSetTolerances(ksp, 1e-10, 1e-50, PETSC_DEFAULT, 1000));
+      PCHK(KSPSolve(ksp, b, sol[t]));
+      KSPConvergedReason reason;
+      PCHK(KSPGetConvergedReason(ksp, &reason));
+      CHECK(reason > 0);
+      PCHK(KSPGetIterationNumber(ksp, &its[t]));
+      PCHK(KSPDestroy(&ksp));
+    }
+    CHECK(its[0] == its[1]);
+    PetscReal diff, ref;
+    PCHK(VecAXPY(x, -1.0, xr));
+    PCHK(VecNorm(x, NORM_INFINITY, &diff));
+    PCHK(VecNorm(xr, NORM_INFINITY, &ref));
+    CHECK(diff <= 1e-8 * ref);
+    PCHK(VecDestroy(&b));
+    PCHK(VecDestroy(&x));
+    PCHK(VecDestroy(&xr));
+    PCHK(MatDestroy(&A));
+    PCHK(MatDestroy(&R));
+  }
+  PCHK(PetscOptionsClearValue(nullptr, "-mat_binbcsr_symmetric_storage"));
+}
