@@ -43,6 +43,7 @@ PetscErrorCode MatSeqBinBCSRDestroyCOO(Mat_SeqBinBCSR *a)
   PetscCall(PetscFree(a->coo_jmap));
   PetscCall(PetscFree(a->coo_perm));
   PetscCall(PetscFree(a->coo_perm_src));
+  PetscCall(PetscFree(a->coo_slot_ptr));
   PetscCall(PetscFree(a->coo_slot_src));
   a->coo_slot_state = 0;
   a->coo_composed = PETSC_FALSE;

@@ -100,11 +100,13 @@ typedef struct {
   PetscInt  *coo_perm;
   PetscInt  *coo_perm_src; /* coo_perm composed with a caller's source map (MatSeqBinBCSRComposeCOO), or NULL */
   PetscBool  coo_composed;
-  /* When every stored block is one whole COO block of the source (bs2 entries, no duplicates; row-major,
-     or transposed as the COO mirror makes them), the refill copies blocks: coo_slot_src[s] is the
-     source index of slot s's entry (0, 0) (transposed: -1 - index; padding: PETSC_MIN_INT). Built at
-     the first refill, for the split n between the two sources it was called with (coo_slot_n);
-     coo_slot_state 0: not tried, 1: built, -1: the list is not made of whole blocks. */
+  /* When every stored block is a sum of whole COO blocks of the list (bs2 consecutive entries, row-major,
+     or transposed as the COO mirror makes them), the refill sums blocks: slot s sums the source blocks
+     coo_slot_src[coo_slot_ptr[s] .. coo_slot_ptr[s+1]-1], each the source index of its entry (0, 0)
+     (transposed: -1 - index); padding has none. Built at the first refill, for the split n between
+     the two sources it was called with (coo_slot_n); coo_slot_state 0: not tried, 1: built, -1: the
+     list is not made of whole blocks (the refill goes value by value). */
+  PetscInt  *coo_slot_ptr;
   PetscInt  *coo_slot_src;
   PetscCount coo_slot_n;
   PetscInt   coo_slot_state;

@@ -2,6 +2,8 @@
    for every stored value (slot, entry), the list of COO entries that sum into it (jmap/perm, as PETSc's
    seqaij does per nonzero). The refill then writes each value once, in storage order, by gathering:
    no atomics, no search, no sort per call.
+   When the stored blocks are sums of whole COO blocks (a driver that lists 3x3 blocks), the refill
+   goes by blocks instead (coo_slot_ptr/coo_slot_src, built at the first refill).
    With the COO mirror (MatBinBCSRSetCOOMirror) every entry (i, j) of an off-diagonal block also
    fills (j, i): the list is extended by those transposed entries at preallocation, and their
    places in coo_perm then name the entry they mirror, so the refill reads the caller's value twice
@@ -168,61 +170,94 @@ void coo_refill(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const Pet
   }
 }
 
-/* The block map (see coo_slot_src in binbcsr.h) from the value map; false if some stored block is
-   not exactly one whole COO block of a single source (*why: which test failed, for -info). */
-bool build_slot_map(const Mat_SeqBinBCSR *a, const PetscInt *perm, long n, PetscInt *slot_src, const char **why)
+/* The block map (see coo_slot_ptr/coo_slot_src in binbcsr.h) from the value map; false if some
+   stored block is not a sum of whole COO blocks, each in a single source (*why: which test failed,
+   for -info). Each value lists its entries in COO order, and the entries of a COO block are
+   consecutive in that order, so source block t of a stored block is entry t of each of its values. */
+bool build_slot_map(const Mat_SeqBinBCSR *a, const PetscInt *perm, long n, PetscInt *slot_ptr, std::vector<PetscInt> &slot_src, const char **why)
 {
   const PetscInt  bs = a->bs, bs2 = a->bs2;
   const PetscInt *jmap = a->coo_jmap;
-  for (PetscInt s = 0; s < a->nslots; s++) slot_src[s] = PETSC_MIN_INT;
-  PetscInt qbase = 0;
+  std::vector<PetscInt> count(a->nslots, 0), first(a->nslots, 0); /* per slot: sources, and where its (0, 0) value lists them */
+  PetscInt              qbase = 0;
   for (PetscInt r = 0; r < a->mbs; r++) {
     const PetscInt nr = a->row_nz[r];
     for (PetscInt k = 0; k < nr; k++) {
-      const PetscInt q00 = qbase + k * bs;
-      *why = "a value with no or several COO entries";
-      if (jmap[q00 + 1] - jmap[q00] != 1) return false;
-      const long base = perm[jmap[q00]];
-      *why            = "a block split between the two sources";
-      if ((base < n) != (base + bs2 - 1 < n)) return false; /* both ends in the same source */
-      *why = "a value with no or several COO entries";
-      bool plain = true, transposed = true;
-      for (PetscInt i = 0; i < bs; i++)
-        for (PetscInt j = 0; j < bs; j++) {
-          const PetscInt q = qbase + i * nr * bs + k * bs + j;
-          if (jmap[q + 1] - jmap[q] != 1) return false;
-          const long p = perm[jmap[q]];
-          plain      = plain && p == base + i * bs + j;
-          transposed = transposed && p == base + j * bs + i;
-        }
-      *why = "a block whose entries are not one whole block of the list";
-      if (!plain && !transposed) return false;
-      slot_src[BinBCSRSlot(a, r, k)] = plain ? (PetscInt)base : (PetscInt)(-1 - base);
+      const PetscInt q00 = qbase + k * bs, cnt = jmap[q00 + 1] - jmap[q00];
+      *why = "a value with no COO entry";
+      if (cnt == 0) return false;
+      for (PetscInt t = 0; t < cnt; t++) {
+        const long base = perm[jmap[q00] + t];
+        *why            = "a block split between the two sources";
+        if ((base < n) != (base + bs2 - 1 < n)) return false;
+        bool plain = true, transposed = true;
+        for (PetscInt i = 0; i < bs; i++)
+          for (PetscInt j = 0; j < bs; j++) {
+            const PetscInt q = qbase + i * nr * bs + k * bs + j;
+            *why             = "values of one block with different numbers of COO entries";
+            if (jmap[q + 1] - jmap[q] != cnt) return false;
+            const long p = perm[jmap[q] + t];
+            plain        = plain && p == base + i * bs + j;
+            transposed   = transposed && p == base + j * bs + i;
+          }
+        *why = "a block whose entries are not whole blocks of the list";
+        if (!plain && !transposed) return false;
+      }
+      const PetscInt slot = BinBCSRSlot(a, r, k);
+      count[slot]         = cnt;
+      first[slot]         = q00;
     }
     qbase += nr * bs2;
   }
+  slot_ptr[0] = 0;
+  for (PetscInt s = 0; s < a->nslots; s++) slot_ptr[s + 1] = slot_ptr[s] + count[s];
+  slot_src.resize(slot_ptr[a->nslots]);
+  for (PetscInt s = 0; s < a->nslots; s++)
+    for (PetscInt t = 0; t < count[s]; t++) {
+      const long base = perm[jmap[first[s]] + t];
+      /* plain or transposed: the (0, 1) value tells (for bs 1 both are the same) */
+      const bool transposed = bs > 1 && perm[jmap[first[s] + 1] + t] != base + 1;
+      slot_src[slot_ptr[s] + t] = transposed ? (PetscInt)(-1 - base) : (PetscInt)base;
+    }
   return true;
 }
 
 /* The refill by blocks: slot by slot in storage order, so the values are written in sequence. */
 template <int BS, bool ADD, typename V>
-void coo_refill_blocks(const Mat_SeqBinBCSR *a, V *val, const PetscInt *slot_src, const PetscScalar *v, long n, const PetscScalar *recv)
+void coo_refill_blocks(const Mat_SeqBinBCSR *a, V *val, const PetscInt *slot_ptr, const PetscInt *slot_src, const PetscScalar *v, long n, const PetscScalar *recv)
 {
+  constexpr int  MAXB2 = BS ? BS * BS : 1;
   const PetscInt bs = BS ? BS : a->bs, bs2 = bs * bs, bw = a->bw;
   for (PetscInt s0 = 0; s0 < a->nslots; s0 += bw) /* one column of a bin: bw lanes */
     for (PetscInt l = 0; l < bw; l++) {
-      const PetscInt src = slot_src[s0 + l];
-      if (src == PETSC_MIN_INT) continue; /* padding stays zero */
-      const long         base = src >= 0 ? src : -1 - (long)src;
-      const PetscScalar *x    = base < n ? v + base : recv + (base - n);
-      V                 *dst  = val + (size_t)s0 * bs2 + l;
-      if (src >= 0) {
-        for (PetscInt e = 0; e < bs2; e++) dst[(size_t)e * bw] = (V)(ADD ? (double)dst[(size_t)e * bw] + x[e] : x[e]);
-      } else {
+      const PetscInt p0 = slot_ptr[s0 + l], p1 = slot_ptr[s0 + l + 1];
+      if (p0 == p1) continue; /* padding stays zero */
+      V *dst = val + (size_t)s0 * bs2 + l;
+      if (BS) {
+        double sum[MAXB2] = {};
+        for (PetscInt p = p0; p < p1; p++) {
+          const PetscInt     src  = slot_src[p];
+          const long         base = src >= 0 ? src : -1 - (long)src;
+          const PetscScalar *x    = base < n ? v + base : recv + (base - n);
+          if (src >= 0)
+            for (int e = 0; e < MAXB2; e++) sum[e] += x[e];
+          else
+            for (int i = 0; i < BS; i++)
+              for (int j = 0; j < BS; j++) sum[i * BS + j] += x[j * BS + i];
+        }
+        for (int e = 0; e < MAXB2; e++) dst[(size_t)e * bw] = (V)(ADD ? (double)dst[(size_t)e * bw] + sum[e] : sum[e]);
+      } else { /* any block size: value by value */
         for (PetscInt i = 0; i < bs; i++)
           for (PetscInt j = 0; j < bs; j++) {
+            double sum = 0;
+            for (PetscInt p = p0; p < p1; p++) {
+              const PetscInt     src  = slot_src[p];
+              const long         base = src >= 0 ? src : -1 - (long)src;
+              const PetscScalar *x    = base < n ? v + base : recv + (base - n);
+              sum += src >= 0 ? x[i * bs + j] : x[j * bs + i];
+            }
             V &d = dst[(size_t)(i * bs + j) * bw];
-            d    = (V)(ADD ? (double)d + x[j * bs + i] : x[j * bs + i]);
+            d    = (V)(ADD ? (double)d + sum : sum);
           }
       }
     }
@@ -240,8 +275,10 @@ void coo_refill_any(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const
 {
   if (a->coo_slot_state == 1) {
     const bool add = imode == ADD_VALUES;
-    if (a->bs == 3) add ? coo_refill_blocks<3, true, V>(a, val, a->coo_slot_src, v, n, recv) : coo_refill_blocks<3, false, V>(a, val, a->coo_slot_src, v, n, recv);
-    else add ? coo_refill_blocks<0, true, V>(a, val, a->coo_slot_src, v, n, recv) : coo_refill_blocks<0, false, V>(a, val, a->coo_slot_src, v, n, recv);
+    const PetscInt *ptr = a->coo_slot_ptr, *src = a->coo_slot_src;
+    if (a->bs == 3) add ? coo_refill_blocks<3, true, V>(a, val, ptr, src, v, n, recv) : coo_refill_blocks<3, false, V>(a, val, ptr, src, v, n, recv);
+    else if (a->bs == 1) add ? coo_refill_blocks<1, true, V>(a, val, ptr, src, v, n, recv) : coo_refill_blocks<1, false, V>(a, val, ptr, src, v, n, recv);
+    else add ? coo_refill_blocks<0, true, V>(a, val, ptr, src, v, n, recv) : coo_refill_blocks<0, false, V>(a, val, ptr, src, v, n, recv);
     return;
   }
   if (a->bs == 3) coo_refill_mode<3, V>(a, val, perm, v, n, recv, imode);
@@ -259,11 +296,17 @@ PetscErrorCode SetValuesCOO(Mat A, const PetscInt *perm, const PetscScalar v[], 
   PetscCheck(imode == INSERT_VALUES || imode == ADD_VALUES, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "MatSetValuesCOO supports INSERT_VALUES and ADD_VALUES only");
   PetscCall(PetscLogEventBegin(MAT_BinBCSR_SetValuesCOO, A, 0, 0, 0));
   if (v && (a->coo_slot_state == 0 || (a->coo_slot_state == 1 && a->coo_slot_n != n))) { /* first refill (or another split) */
-    if (!a->coo_slot_src) PetscCall(PetscMalloc1(PetscMax(a->nslots, 1), &a->coo_slot_src));
-    const char *why   = "";
-    a->coo_slot_state = build_slot_map(a, perm, n, a->coo_slot_src, &why) ? 1 : -1;
+    std::vector<PetscInt> src;
+    const char           *why = "";
+    PetscCall(PetscFree(a->coo_slot_ptr));
+    PetscCall(PetscFree(a->coo_slot_src));
+    PetscCall(PetscMalloc1(a->nslots + 1, &a->coo_slot_ptr));
+    a->coo_slot_state = build_slot_map(a, perm, n, a->coo_slot_ptr, src, &why) ? 1 : -1;
     a->coo_slot_n     = n;
-    if (a->coo_slot_state < 0) PetscCall(PetscFree(a->coo_slot_src));
+    if (a->coo_slot_state > 0) {
+      PetscCall(PetscMalloc1(PetscMax(src.size(), (size_t)1), &a->coo_slot_src));
+      std::copy(src.begin(), src.end(), a->coo_slot_src);
+    } else PetscCall(PetscFree(a->coo_slot_ptr));
     PetscCall(PetscInfo(A, "COO refill %s%s\n", a->coo_slot_state > 0 ? "by whole blocks" : "by values: ", a->coo_slot_state > 0 ? "" : why));
   }
   if (!v) { /* no values: zeros */
@@ -300,7 +343,8 @@ PetscErrorCode MatSeqBinBCSRComposeCOO(Mat A, const PetscCount from[], PetscCoun
   PetscCall(PetscMalloc1(nperm, &a->coo_perm_src));
   for (PetscInt t = 0; t < nperm; t++) a->coo_perm_src[t] = (PetscInt)from[a->coo_perm[t]];
   a->coo_composed = PETSC_TRUE; /* coo_perm_src is NULL when the part has no entries */
-  PetscCall(PetscFree(a->coo_slot_src)); /* the block map follows the sources */
+  PetscCall(PetscFree(a->coo_slot_ptr)); /* the block map follows the sources */
+  PetscCall(PetscFree(a->coo_slot_src));
   a->coo_slot_state = 0;
   PetscFunctionReturn(0);
 }

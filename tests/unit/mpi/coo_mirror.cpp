@@ -201,11 +201,12 @@ TEST_CASE("COO mirror: off by default, option, other types unaffected, non-squar
 
 namespace {
 
-// Whole 3x3 blocks, row-major, each (I, J) at most once over all ranks (rank p lists every size-th
-// block, anywhere in the matrix; a fifth of them on the diagonal); with `mirror` only I <= J.
+// Whole 3x3 blocks, row-major, anywhere in the matrix (a fifth of them on the diagonal); with `mirror`
+// only I <= J. Each (I, J) at most once over all ranks (rank p lists every size-th block), or with
+// `repeated` every rank lists all blocks and the first ten twice (values summed from several blocks).
 // `broken` spoils the whole-block structure (one entry moved to another block position), so the
 // refill must fall back to the value-by-value map.
-CooList whole_blocks(PetscInt nblocks, bool mirror, bool broken, unsigned seed, int rank, int size)
+CooList whole_blocks(PetscInt nblocks, bool mirror, bool broken, bool repeated, unsigned seed, int rank, int size)
 {
   std::mt19937                            gen(seed);
   std::uniform_int_distribution<PetscInt> block(0, nblocks - 1);
@@ -216,8 +217,11 @@ CooList whole_blocks(PetscInt nblocks, bool mirror, bool broken, unsigned seed, 
     if (mirror && I > J) std::swap(I, J);
     if (std::find(blocks.begin(), blocks.end(), std::make_pair(I, J)) == blocks.end()) blocks.emplace_back(I, J);
   }
+  std::vector<size_t> listed;
+  for (size_t k = repeated ? 0 : rank; k < blocks.size(); k += repeated ? 1 : size) listed.push_back(k);
+  for (size_t k = 0; repeated && k < 10; ++k) listed.push_back(k);
   CooList l;
-  for (size_t k = rank; k < blocks.size(); k += size)
+  for (size_t k : listed)
     for (PetscInt r = 0; r < 3; ++r)
       for (PetscInt c = 0; c < 3; ++c) {
         l.i.push_back(3 * blocks[k].first + r);
@@ -230,22 +234,23 @@ CooList whole_blocks(PetscInt nblocks, bool mirror, bool broken, unsigned seed, 
 
 } // namespace
 
-TEST_CASE("COO refill by whole blocks (plain and mirrored) equals aij; other lists fall back", "[mpi][coo_mirror]")
+TEST_CASE("COO refill by whole blocks (plain, mirrored, repeated) equals aij; other lists fall back", "[mpi][coo_mirror]")
 {
   for (MPI_Comm comm : {PETSC_COMM_WORLD, PETSC_COMM_SELF})
     for (bool mirror : {false, true})
       for (bool sym : {false, true})
         for (bool single : {false, true})
-          for (bool broken : {false, true}) {
+          for (int variant : {0, 1, 2}) { // whole blocks once, broken, repeated
+            const bool broken = variant == 1, repeated = variant == 2;
             PetscMPIInt rank, size;
             MPI_Comm_rank(comm, &rank);
             MPI_Comm_size(comm, &size);
             // symmetric storage keeps the blocks coupling two ranks in full: without the mirror the
             // caller lists both (the mpibinbcsr tests do); here every list is an upper triangle
             if (sym && !mirror && size > 1) continue;
-            INFO("ranks " << size << " mirror " << mirror << " sym " << sym << " single " << single << " broken " << broken);
+            INFO("ranks " << size << " mirror " << mirror << " sym " << sym << " single " << single << " broken " << broken << " repeated " << repeated);
             const PetscInt nblocks = 23;
-            CooList        l       = whole_blocks(nblocks, mirror || sym, broken, 99u, rank, size);
+            CooList        l       = whole_blocks(nblocks, mirror || sym, broken, repeated, 99u, rank, size);
             if (sym) // diagonal blocks symmetric, so that the stored upper triangle is the whole matrix
               for (size_t k = 0; k < l.i.size(); ++k)
                 if (l.i[k] / 3 == l.j[k] / 3) {
