@@ -18,7 +18,7 @@ PETSC_INTERN PetscErrorCode MatBinBCSRInsertRows_Private(Mat src, Mat dst);
 /* MATSEQBINBCSR parts of MATMPIBINBCSR: after MatSetPreallocationCOO, compose the part's COO map with
    from[] (part entry -> source index); the two-source refill then reads source p < n from v and
    p >= n from recv[p - n]. A plain MatSetValuesCOO on the part keeps its own map. */
-PETSC_INTERN PetscErrorCode MatSeqBinBCSRComposeCOO(Mat, const PetscCount from[], PetscCount nsrc);
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRComposeCOO(Mat, const PetscCount from[], PetscCount n, PetscCount nsrc); /* from[] < n: the caller's values, else received */
 PETSC_INTERN PetscErrorCode MatSetValuesCOOTwoSources_SeqBinBCSR(Mat, const PetscScalar v[], PetscCount n, const PetscScalar recv[], InsertMode);
 
 /* Registered once by PetscBinBCSRRegisterAll(). */

@@ -289,8 +289,8 @@ PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_MPIBinBCSR(Mat mat, PetscCoun
   PetscCall(PetscObjectTypeCompare((PetscObject)b->B, MATSEQBINBCSR, &bbin));
   coo->composed = abin && bbin ? PETSC_TRUE : PETSC_FALSE;
   if (coo->composed) {
-    PetscCall(MatSeqBinBCSRComposeCOO(b->A, coo->a_from.data(), ncoo + coo->nrecv));
-    PetscCall(MatSeqBinBCSRComposeCOO(b->B, coo->b_from.data(), ncoo + coo->nrecv));
+    PetscCall(MatSeqBinBCSRComposeCOO(b->A, coo->a_from.data(), ncoo, ncoo + coo->nrecv));
+    PetscCall(MatSeqBinBCSRComposeCOO(b->B, coo->b_from.data(), ncoo, ncoo + coo->nrecv));
     std::vector<PetscCount>().swap(coo->a_from);
     std::vector<PetscCount>().swap(coo->b_from);
   } else {

@@ -103,12 +103,13 @@ typedef struct {
   /* When every stored block is a sum of whole COO blocks of the list (bs2 consecutive entries, row-major,
      or transposed as the COO mirror makes them), the refill sums blocks: slot s sums the source blocks
      coo_slot_src[coo_slot_ptr[s] .. coo_slot_ptr[s+1]-1], each the source index of its entry (0, 0)
-     (transposed: -1 - index); padding has none. Built at the first refill, for the split n between
+     (transposed: -1 - index); padding has none. Built at preallocation (or the first refill), for the split n between
      the two sources it was called with (coo_slot_n); coo_slot_state 0: not tried, 1: built, -1: the
      list is not made of whole blocks (the refill goes value by value). */
-  PetscInt  *coo_slot_ptr;
-  PetscInt  *coo_slot_src;
-  PetscCount coo_slot_n;
+  PetscInt       *coo_slot_ptr;
+  PetscInt       *coo_slot_src;
+  const PetscInt *coo_slot_perm; /* the value map it was built from (coo_perm or coo_perm_src) */
+  PetscCount      coo_slot_n;
   PetscInt   coo_slot_state;
 
   /* scratch */

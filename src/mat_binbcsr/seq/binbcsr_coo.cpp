@@ -14,6 +14,11 @@
 #include <cstdint>
 #include <vector>
 
+namespace
+{
+PetscErrorCode BuildSlotMap(Mat A, const PetscInt *perm, long n);
+}
+
 static PetscErrorCode PreallocateCOO(Mat A, PetscCount n, const PetscInt ci[], const PetscInt cj[])
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
@@ -122,6 +127,7 @@ PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat A, PetscCount n, const Pets
   PetscFunctionBegin;
   if (!a->coo_mirror) {
     PetscCall(PreallocateCOO(A, n, ci, cj));
+    PetscCall(BuildSlotMap(A, a->coo_perm, (long)n));
     PetscFunctionReturn(0);
   }
   PetscCall(PetscLayoutSetUp(A->rmap));
@@ -142,6 +148,7 @@ PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat A, PetscCount n, const Pets
   for (PetscInt t = 0; t < nperm; t++)
     if (a->coo_perm[t] >= n) a->coo_perm[t] = mirror_of[a->coo_perm[t] - n];
   a->coo_n = n;
+  PetscCall(BuildSlotMap(A, a->coo_perm, (long)n));
   PetscFunctionReturn(0);
 }
 
@@ -286,6 +293,29 @@ void coo_refill_any(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const
   else coo_refill_mode<0, V>(a, val, perm, v, n, recv, imode);
 }
 
+/* The block map if the list allows it (else the refill goes value by value), for the split n between
+   the two sources; built once, at preallocation. */
+PetscErrorCode BuildSlotMap(Mat A, const PetscInt *perm, long n)
+{
+  Mat_SeqBinBCSR       *a = (Mat_SeqBinBCSR *)A->data;
+  std::vector<PetscInt> src;
+  const char           *why = "";
+
+  PetscFunctionBegin;
+  PetscCall(PetscFree(a->coo_slot_ptr));
+  PetscCall(PetscFree(a->coo_slot_src));
+  PetscCall(PetscMalloc1(a->nslots + 1, &a->coo_slot_ptr));
+  a->coo_slot_state = build_slot_map(a, perm, n, a->coo_slot_ptr, src, &why) ? 1 : -1;
+  a->coo_slot_n     = n;
+  a->coo_slot_perm  = perm;
+  if (a->coo_slot_state > 0) {
+    PetscCall(PetscMalloc1(PetscMax(src.size(), (size_t)1), &a->coo_slot_src));
+    std::copy(src.begin(), src.end(), a->coo_slot_src);
+  } else PetscCall(PetscFree(a->coo_slot_ptr));
+  PetscCall(PetscInfo(A, "COO refill %s%s\n", a->coo_slot_state > 0 ? "by whole blocks" : "by values: ", a->coo_slot_state > 0 ? "" : why));
+  PetscFunctionReturn(0);
+}
+
 /* The refill both entry points share; v == NULL means zeros. */
 PetscErrorCode SetValuesCOO(Mat A, const PetscInt *perm, const PetscScalar v[], long n, const PetscScalar recv[], InsertMode imode)
 {
@@ -295,20 +325,8 @@ PetscErrorCode SetValuesCOO(Mat A, const PetscInt *perm, const PetscScalar v[], 
   PetscFunctionBegin;
   PetscCheck(imode == INSERT_VALUES || imode == ADD_VALUES, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "MatSetValuesCOO supports INSERT_VALUES and ADD_VALUES only");
   PetscCall(PetscLogEventBegin(MAT_BinBCSR_SetValuesCOO, A, 0, 0, 0));
-  if (v && (a->coo_slot_state == 0 || (a->coo_slot_state == 1 && a->coo_slot_n != n))) { /* first refill (or another split) */
-    std::vector<PetscInt> src;
-    const char           *why = "";
-    PetscCall(PetscFree(a->coo_slot_ptr));
-    PetscCall(PetscFree(a->coo_slot_src));
-    PetscCall(PetscMalloc1(a->nslots + 1, &a->coo_slot_ptr));
-    a->coo_slot_state = build_slot_map(a, perm, n, a->coo_slot_ptr, src, &why) ? 1 : -1;
-    a->coo_slot_n     = n;
-    if (a->coo_slot_state > 0) {
-      PetscCall(PetscMalloc1(PetscMax(src.size(), (size_t)1), &a->coo_slot_src));
-      std::copy(src.begin(), src.end(), a->coo_slot_src);
-    } else PetscCall(PetscFree(a->coo_slot_ptr));
-    PetscCall(PetscInfo(A, "COO refill %s%s\n", a->coo_slot_state > 0 ? "by whole blocks" : "by values: ", a->coo_slot_state > 0 ? "" : why));
-  }
+  /* the map is built at preallocation; again if this refill reads another map or split (a copy, a part refilled on its own) */
+  if (v && (a->coo_slot_state == 0 || (a->coo_slot_state == 1 && (a->coo_slot_n != n || a->coo_slot_perm != perm)))) PetscCall(BuildSlotMap(A, perm, n));
   if (!v) { /* no values: zeros */
     if (imode == INSERT_VALUES) {
       if (a->val) PetscCall(PetscArrayzero(a->val, nv));
@@ -331,7 +349,7 @@ PetscErrorCode MatSetValuesCOO_SeqBinBCSR(Mat A, const PetscScalar v[], InsertMo
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode MatSeqBinBCSRComposeCOO(Mat A, const PetscCount from[], PetscCount nsrc)
+PetscErrorCode MatSeqBinBCSRComposeCOO(Mat A, const PetscCount from[], PetscCount n, PetscCount nsrc)
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
 
@@ -343,9 +361,7 @@ PetscErrorCode MatSeqBinBCSRComposeCOO(Mat A, const PetscCount from[], PetscCoun
   PetscCall(PetscMalloc1(nperm, &a->coo_perm_src));
   for (PetscInt t = 0; t < nperm; t++) a->coo_perm_src[t] = (PetscInt)from[a->coo_perm[t]];
   a->coo_composed = PETSC_TRUE; /* coo_perm_src is NULL when the part has no entries */
-  PetscCall(PetscFree(a->coo_slot_ptr)); /* the block map follows the sources */
-  PetscCall(PetscFree(a->coo_slot_src));
-  a->coo_slot_state = 0;
+  PetscCall(BuildSlotMap(A, a->coo_perm_src, (long)n)); /* the block map follows the sources */
   PetscFunctionReturn(0);
 }
 
