@@ -3,7 +3,7 @@
 //   (M + h D + h^2 K) dv = h (f - h K v),   v += dv,   x += h v,
 // then particles inside the sphere collider are projected to its surface and lose their inward normal
 // velocity. Pinned particles keep dv = 0: their rows and columns hold only M, so the matrix stays SPD.
-// The 3x3-block pattern (one diagonal block per particle, two blocks per spring) is built once; values
+// The 3x3-block pattern (one diagonal block per particle, one or two blocks per spring) is built once; values
 // are refilled in place every step.
 #pragma once
 #include "physics/block_solver.hpp"
