@@ -32,5 +32,10 @@ fem_test(fem_bad_option_error "-fix .*expected none" ${FEM} ${FEM_SMALL} -fix mi
 fem_test(fem_bad_material_error "Poisson" ${FEM} ${FEM_SMALL} -poisson 0.5)
 fem_test(fem_mpi2_aij "ranks=2 .*status=ok" ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_SMALL} -fem_order 2 -mat_type aij)
 set_tests_properties(fem_mpi2_aij PROPERTIES LABELS "fem;mpi")
+# The COO mirror on 2 ranks (upper blocks only, lower ones filled by the Mat, also across ranks) and
+# the matrix dump of such a system.
+fem_test(fem_mpi2_binbcsr_mirror "mat_type=mpibinbcsr .*ranks=2 .*status=ok" ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_SMALL} -fem_order 2
+         -mat_type binbcsr -mat_binbcsr_coo_mirror -ksp_type mcg -dump_matrix ${CMAKE_CURRENT_BINARY_DIR}/fem_mirror_dump.bin)
+set_tests_properties(fem_mpi2_binbcsr_mirror PROPERTIES LABELS "fem;mpi")
 add_test(NAME unit_fem_mpi2 COMMAND ${MPIEXEC_CMD} -n 2 $<TARGET_FILE:test_fem> "[mpi]")
 set_tests_properties(unit_fem_mpi2 PROPERTIES LABELS "fem;mpi;unit" TIMEOUT 60)

@@ -138,3 +138,33 @@ TEST_CASE("BlockSystem: matrix dump loads back as the same aij matrix", "[fem][s
   std::remove(path.c_str());
   std::remove((path + ".info").c_str());
 }
+
+TEST_CASE("BlockSystem with the binbcsr COO mirror: upper blocks give the whole matrix, lower ones are refused", "[fem][system]")
+{
+  const PetscInt n = 12;
+  const Chain    full = make_chain(n, 1.0);
+  Chain          upper;
+  for (size_t k = 0; k < full.rows.size(); ++k)
+    if (full.rows[k] <= full.cols[k]) {
+      upper.rows.push_back(full.rows[k]);
+      upper.cols.push_back(full.cols[k]);
+      upper.values.insert(upper.values.end(), full.values.begin() + 9 * k, full.values.begin() + 9 * k + 9);
+    }
+  PetscErrorCode err;
+  PetscBool      upper_only = PETSC_FALSE, offrank_full = PETSC_TRUE, mirrored = PETSC_FALSE;
+  REQUIRE(PetscOptionsSetValue(nullptr, "-mat_binbcsr_coo_mirror", "1") == 0);
+  REQUIRE(PetscOptionsSetValue(nullptr, "-mat_type", "binbcsr") == 0);
+  err = BlockSystemStoredTriangle(PETSC_COMM_SELF, &upper_only, &offrank_full, nullptr, &mirrored);
+  PetscOptionsClearValue(nullptr, "-mat_type");
+  REQUIRE(err == 0);
+  CHECK(!upper_only); // the whole matrix is stored ...
+  CHECK(!offrank_full);
+  CHECK(mirrored); // ... from the upper blocks
+  const std::vector<PetscScalar> x = solve_with("binbcsr", upper, n, &err);
+  REQUIRE(err == 0);
+  CHECK(residual(full, n, x) < 1e-9);
+  // a driver that lists both triangles would get its off-diagonal blocks twice: refused
+  solve_with("binbcsr", full, n, &err);
+  CHECK(err == PETSC_ERR_ARG_WRONG);
+  PetscOptionsClearValue(nullptr, "-mat_binbcsr_coo_mirror");
+}
