@@ -6,7 +6,7 @@
 # build/valgrind (made by the first case, valgrind_build; the others require it as a fixture).
 find_program(VALGRIND_EXECUTABLE valgrind)
 set(VALGRIND_AREAS)
-foreach(area mat_core mat_ops mat_sym)
+foreach(area mat_core mat_ops mat_sym mat_factor)
   if(IS_DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/unit/${area})
     list(APPEND VALGRIND_AREAS ${area})
   endif()

@@ -45,6 +45,14 @@ JointMatrixPattern build_joint_matrix_pattern(const ArticulatedScene &scene)
     p.group_start.push_back(static_cast<int>(p.group_joint.size()));
     p.pair_start.push_back(static_cast<int>(p.pair_block.size()));
   }
+  std::vector<char> reached(p.block_row.size(), 0);
+  p.pair_first.resize(p.pair_block.size());
+  for (size_t i = 0; i < p.pair_block.size(); ++i) {
+    p.pair_first[i]            = !reached[p.pair_block[i]];
+    reached[p.pair_block[i]] = 1;
+  }
+  for (size_t b = 0; b < reached.size(); ++b)
+    if (!reached[b]) p.unreached_blocks.push_back(static_cast<int>(b));
   return p;
 }
 
@@ -71,7 +79,11 @@ void fill_joint_matrix(const ArticulatedScene &scene, const JointMatrixPattern &
                        const std::vector<Eigen::Matrix3d> &inverse_inertia_world, const std::vector<Eigen::Vector3d> &arm_a,
                        const std::vector<Eigen::Vector3d> &arm_b, std::vector<double> &block_values)
 {
-  block_values.assign(9 * pattern.block_row.size(), 0.0);
+  // Each block is written by the first pair that reaches it and added to by the others (pair_first), so
+  // the values need no zeroing pass; a pattern without that map (built by hand) is zeroed first.
+  const bool write_first = pattern.pair_first.size() == pattern.pair_block.size();
+  if (!write_first || block_values.size() != 9 * pattern.block_row.size()) block_values.assign(9 * pattern.block_row.size(), 0.0);
+  for (int b : pattern.unreached_blocks) std::fill(&block_values[9 * b], &block_values[9 * b] + 9, 0.0);
   // Per joint end q of a body: I^-1 [r_q]x, so that block (p, q) = (1/m) I - [r_p]x (I^-1 [r_q]x) costs one
   // cross product per column. Most bodies carry 2 joints; the buffer is for the rare crowded one.
   constexpr int   kInline = 8;
@@ -93,11 +105,16 @@ void fill_joint_matrix(const ArticulatedScene &scene, const JointMatrixPattern &
       const int              jp = pattern.group_joint[first + p];
       const Eigen::Vector3d &rp = pattern.group_sign[first + p] > 0 ? arm_a[jp] : arm_b[jp];
       for (int q = 0; q < n; ++q) {
-        const double sign = pattern.group_sign[first + p] * pattern.group_sign[first + q];
-        double      *out  = &block_values[9 * pattern.pair_block[pattern.pair_start[g] + p * n + q]];
+        const double sign  = pattern.group_sign[first + p] * pattern.group_sign[first + q];
+        const int    pair  = pattern.pair_start[g] + p * n + q;
+        double      *out   = &block_values[9 * pattern.pair_block[pair]];
+        const bool   write = write_first && pattern.pair_first[pair];
         for (int c = 0; c < 3; ++c) {
           const Eigen::Vector3d col = -rp.cross(turn[q].col(c));
-          for (int r = 0; r < 3; ++r) out[3 * r + c] += sign * (col[r] + (r == c ? inv_m : 0.0));
+          for (int r = 0; r < 3; ++r) {
+            const double v = sign * (col[r] + (r == c ? inv_m : 0.0));
+            out[3 * r + c] = write ? v : out[3 * r + c] + v; // a select, not a product: stale NaNs do not survive
+          }
         }
       }
     }

@@ -17,6 +17,10 @@ struct JointMatrixPattern {
   std::vector<int> body_of_group, group_start; // group g covers joints group_start[g]..group_start[g+1]-1
   std::vector<int> group_joint, group_sign;
   std::vector<int> pair_start, pair_block;     // pair_block[pair_start[g] + p*n_g + q]
+  // 1 where a pair is the first (in group order) to reach its block: the fill writes there instead of
+  // adding, so the 9 values per block need no zeroing pass first. Blocks that no body reaches are listed.
+  std::vector<char> pair_first;
+  std::vector<int>  unreached_blocks;
 };
 
 JointMatrixPattern build_joint_matrix_pattern(const ArticulatedScene &scene);
