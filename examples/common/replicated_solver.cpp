@@ -175,6 +175,8 @@ static PetscErrorCode Solve(ReplicatedSolver *rs, const std::vector<double> &rhs
 physics::BlockLinearSolver ReplicatedSolverAdapter(ReplicatedSolver *rs)
 {
   physics::BlockLinearSolver s;
+  if (rs->size > 1) // SetMatrix passes on only this rank's rows
+    for (int i = rs->row_offsets[rs->rank]; i < rs->row_offsets[rs->rank + 1]; ++i) s.needed_rows.push_back(rs->old_of_new[i]);
   s.set_matrix = [rs](const std::vector<double> &values) {
     if (!rs->error) rs->error = SetMatrix(rs, values);
   };

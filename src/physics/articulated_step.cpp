@@ -122,8 +122,12 @@ ArticulatedStepReport articulated_step(ArticulatedScene &scene, ArticulatedSolve
   s.correction_sum.assign(3 * nj, 0.0);
   update_frames(scene, s, nullptr);
 
+  // With the physics replicated over processes, each fills only the block rows its solver part takes.
+  if (!linear_solver.needed_rows.empty() && s.fill_groups.size() != s.pattern.body_of_group.size())
+    s.fill_groups = joint_groups_of_rows(s.pattern, linear_solver.needed_rows);
   auto refill = [&]() {
-    fill_joint_matrix(scene, s.pattern, s.regularised ? params.regularisation : 0.0, s.inverse_inertia, s.arm_a, s.arm_b, s.block_values);
+    fill_joint_matrix(scene, s.pattern, s.regularised ? params.regularisation : 0.0, s.inverse_inertia, s.arm_a, s.arm_b, s.block_values,
+                      linear_solver.needed_rows.empty() ? nullptr : &s.fill_groups);
     linear_solver.set_matrix(s.block_values);
   };
   auto switch_to_regularised = [&]() {

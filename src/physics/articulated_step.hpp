@@ -55,6 +55,7 @@ struct ArticulatedSolver {
   // Scratch, sized at the first step and reused: no allocation per step after it.
   std::vector<double>             rhs, impulses, errors, correction_sum;
   std::vector<Eigen::Matrix3d>    rotation, inverse_inertia;       // per body, start-of-step (or predicted) frame
+  std::vector<char>               fill_groups;                     // bodies whose blocks the solver needs (empty: all)
   std::vector<Eigen::Matrix3d>    inverse_inertia_body;            // per body, body frame: inertias are fixed, so
                                                                    // inverted once (at the first step)
   std::vector<Eigen::Vector3d>    arm_a, arm_b;                    // per joint, world arms of its two ends

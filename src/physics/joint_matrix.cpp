@@ -77,7 +77,7 @@ void fill_joint_matrix(const ArticulatedScene &scene, const JointMatrixPattern &
 
 void fill_joint_matrix(const ArticulatedScene &scene, const JointMatrixPattern &pattern, double regularisation,
                        const std::vector<Eigen::Matrix3d> &inverse_inertia_world, const std::vector<Eigen::Vector3d> &arm_a,
-                       const std::vector<Eigen::Vector3d> &arm_b, std::vector<double> &block_values)
+                       const std::vector<Eigen::Vector3d> &arm_b, std::vector<double> &block_values, const std::vector<char> *group_mask)
 {
   // Each block is written by the first pair that reaches it and added to by the others (pair_first), so
   // the values need no zeroing pass; a pattern without that map (built by hand) is zeroed first.
@@ -90,6 +90,7 @@ void fill_joint_matrix(const ArticulatedScene &scene, const JointMatrixPattern &
   Eigen::Matrix3d inline_buffer[kInline];
   std::vector<Eigen::Matrix3d> overflow;
   for (size_t g = 0; g + 1 < pattern.group_start.size(); ++g) {
+    if (group_mask && !(*group_mask)[g]) continue;
     const int              body  = pattern.body_of_group[g];
     const double           inv_m = 1.0 / scene.bodies[body].mass;
     const Eigen::Matrix3d &inv_inertia = inverse_inertia_world[body];
@@ -125,6 +126,15 @@ void fill_joint_matrix(const ArticulatedScene &scene, const JointMatrixPattern &
       const double shift = regularisation * (d[0] + d[4] + d[8]) / 3.0;
       d[0] += shift, d[4] += shift, d[8] += shift;
     }
+}
+
+std::vector<char> joint_groups_of_rows(const JointMatrixPattern &pattern, const std::vector<int> &rows)
+{
+  std::vector<char> needed(pattern.n_joints, 0), mask(pattern.body_of_group.size(), 0);
+  for (int r : rows) needed[r] = 1;
+  for (size_t g = 0; g < mask.size(); ++g)
+    for (int k = pattern.group_start[g]; k < pattern.group_start[g + 1] && !mask[g]; ++k) mask[g] = needed[pattern.group_joint[k]];
+  return mask;
 }
 
 void joint_matrix_multiply(const JointMatrixPattern &pattern, const std::vector<double> &block_values, const std::vector<double> &x, std::vector<double> &y)

@@ -35,10 +35,16 @@ void fill_joint_matrix(const ArticulatedScene &scene, const JointMatrixPattern &
 
 // The same from what a time step has at hand already: every body's world inverse inertia and every joint's
 // world arms (arm_a of end a, arm_b of end b; ignored for the world). Allocates nothing once block_values
-// has its size.
+// has its size. group_mask (one entry per body group of the pattern), when given, skips the bodies whose
+// group is 0: the block rows of joints in marked groups are still complete (every body adding to block
+// (p, q) carries joint p), the others are left unset (see joint_groups_of_rows).
 void fill_joint_matrix(const ArticulatedScene &scene, const JointMatrixPattern &pattern, double regularisation,
                        const std::vector<Eigen::Matrix3d> &inverse_inertia_world, const std::vector<Eigen::Vector3d> &arm_a,
-                       const std::vector<Eigen::Vector3d> &arm_b, std::vector<double> &block_values);
+                       const std::vector<Eigen::Vector3d> &arm_b, std::vector<double> &block_values,
+                       const std::vector<char> *group_mask = nullptr);
+
+// The group mask that fills exactly the block rows `rows` (joints) completely: the bodies of those joints.
+std::vector<char> joint_groups_of_rows(const JointMatrixPattern &pattern, const std::vector<int> &rows);
 
 // y = A x with the block values (reference product for tests and diagnostics).
 void joint_matrix_multiply(const JointMatrixPattern &pattern, const std::vector<double> &block_values, const std::vector<double> &x,

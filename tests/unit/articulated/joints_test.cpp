@@ -229,3 +229,40 @@ TEST_CASE("bad articulated input is rejected with a clear message", "[articulate
   CHECK_THAT(validate_params(p), Catch::Contains("time step"));
   CHECK_THROWS_AS(make_chain(ChainOptions{0}), std::invalid_argument);
 }
+
+TEST_CASE("joint matrix refill: stale values are overwritten, a row subset is filled completely", "[articulated]")
+{
+  BridgeOptions opt;
+  opt.chains = 3, opt.links = 6, opt.tie_every = 2;
+  ArticulatedScene scene = make_bridge(opt);
+  for (size_t i = 0; i < scene.bodies.size(); ++i) scene.bodies[i].orientation = rotated(scene.bodies[i].orientation, Eigen::Vector3d(0.2, 0.5 - 0.1 * i, -0.3), 1.0);
+  const JointMatrixPattern p = build_joint_matrix_pattern(scene);
+  const size_t             nb = scene.bodies.size(), nj = scene.joints.size();
+  std::vector<Eigen::Matrix3d> inv_inertia(nb);
+  std::vector<Eigen::Vector3d> arm_a(nj), arm_b(nj);
+  for (size_t i = 0; i < nb; ++i) {
+    const Eigen::Matrix3d R = scene.bodies[i].orientation.toRotationMatrix();
+    inv_inertia[i]          = R * scene.bodies[i].inertia_body.inverse() * R.transpose();
+  }
+  for (size_t j = 0; j < nj; ++j) {
+    const BallJoint &jt = scene.joints[j];
+    arm_a[j] = jt.body_a == kWorld ? Eigen::Vector3d::Zero() : Eigen::Vector3d(scene.bodies[jt.body_a].orientation * jt.anchor_a);
+    arm_b[j] = jt.body_b == kWorld ? Eigen::Vector3d::Zero() : Eigen::Vector3d(scene.bodies[jt.body_b].orientation * jt.anchor_b);
+  }
+  std::vector<double> full;
+  fill_joint_matrix(scene, p, 0.0, inv_inertia, arm_a, arm_b, full);
+  // every value is written, none accumulated onto what was there (no zeroing pass any more)
+  std::vector<double> again(full.size(), std::nan(""));
+  fill_joint_matrix(scene, p, 0.0, inv_inertia, arm_a, arm_b, again);
+  CHECK(again == full);
+  // the first half of the rows only (as one rank of two would): those rows equal the full fill
+  std::vector<int> rows;
+  for (int j = 0; j < p.n_joints / 2; ++j) rows.push_back(j);
+  const std::vector<char> mask = joint_groups_of_rows(p, rows);
+  CHECK(std::count(mask.begin(), mask.end(), 1) < static_cast<long>(mask.size()));
+  std::vector<double> part(full.size(), std::nan(""));
+  fill_joint_matrix(scene, p, 0.0, inv_inertia, arm_a, arm_b, part, &mask);
+  for (size_t k = 0; k < p.block_row.size(); ++k)
+    if (p.block_row[k] < p.n_joints / 2)
+      for (int e = 0; e < 9; ++e) REQUIRE(part[9 * k + e] == full[9 * k + e]);
+}
