@@ -65,9 +65,9 @@ void assemble_cloth_system(const Cloth &cloth, const ClothParams &params, ClothS
     // The spring's block of M + h D + h^2 K: alpha I + beta d d^T (symmetric).
     const double           alpha = h2 * t.k_iso, beta = h2 * t.k_dir + h * t.damping;
     const Eigen::Vector3d &d     = t.direction;
-    double                 block[9];
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) block[3 * r + c] = beta * d[r] * d[c] + (r == c ? alpha : 0.0);
+    double                 block[9]; // computed once per pair and mirrored: exactly symmetric, so a
+    for (int r = 0; r < 3; ++r)      // type that keeps one triangle sees the same matrix as one keeping both
+      for (int c = r; c < 3; ++c) block[3 * r + c] = block[3 * c + r] = beta * d[r] * d[c] + (r == c ? alpha : 0.0);
     // The spring's K acts on dv_a - dv_b; a pinned end has dv = 0, so its row, column and rhs stay out.
     // An end whose row is assembled elsewhere (diagonal_block < 0) is skipped the same way here.
     const bool   fa = cloth.fixed[sp.a], fb = cloth.fixed[sp.b];
