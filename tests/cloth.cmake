@@ -34,7 +34,8 @@ add_test(NAME cloth_mpi_np2
          COMMAND ${SUMMARY_SAME} "energy_final max_stretch contacts" 1e-6
                  "${CLOTH_SAME}" "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME}" "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg"
                  "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg -mat_binbcsr_symmetric_storage"
-                 "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type sbaij")
+                 "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type sbaij"
+                 "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg -mat_binbcsr_coo_mirror")
 set_tests_properties(cloth_mpi_np2 PROPERTIES LABELS "cloth;mpi" TIMEOUT 60)
 
 add_test(NAME cloth_vtk_dump

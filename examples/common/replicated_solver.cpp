@@ -50,7 +50,11 @@ PetscErrorCode ReplicatedSolverNumber(MPI_Comm comm, PetscInt n_blocks, const st
   for (PetscInt i = 0; i < n_blocks && !rs->renumbered; ++i) rs->renumbered = rs->new_of_old[i] != i;
   rs->old_of_new.resize(n_blocks);
   for (PetscInt i = 0; i < n_blocks; ++i) rs->old_of_new[rs->new_of_old[i]] = (int)i;
-  PetscCall(BlockSystemStoredTriangle(comm, &rs->upper_only, &rs->offrank_full));
+  {
+    PetscBool mirrored;
+    PetscCall(BlockSystemStoredTriangle(comm, &rs->upper_only, &rs->offrank_full, nullptr, &mirrored));
+    if (mirrored) rs->upper_only = PETSC_TRUE, rs->offrank_full = PETSC_FALSE; // the Mat fills the lower triangle from the upper one, across ranks too
+  }
   PetscFunctionReturn(0);
 }
 
