@@ -268,11 +268,17 @@ static PetscErrorCode MCGTrueResidual(KSP ksp, Mat Amat, Vec X, Vec B, Vec R, Ve
   PetscFunctionReturn(0);
 }
 
-/* Accumulates the terms of the rounding-drift estimate from the reduced dots of one iteration. */
-static void MCGTrackDrift(const PetscScalar *dots, PetscReal *anorm, PetscReal *sum_x, PetscReal *sum_r, PetscReal *xnorm)
+/* ||A|| from below: the largest Rayleigh quotient u.Au / u.u seen. */
+static void MCGTrackNorm(const PetscScalar *dots, PetscReal *anorm)
 {
   const PetscReal uu = PetscAbsScalar(dots[MCG_DOT_UU]);
   if (uu > 0) *anorm = PetscMax(*anorm, PetscAbsScalar(dots[MCG_DOT_UW]) / uu);
+}
+
+/* Accumulates the terms of the rounding-drift estimate from the reduced dots of one iteration. */
+static void MCGTrackDrift(const PetscScalar *dots, PetscReal *anorm, PetscReal *sum_x, PetscReal *sum_r, PetscReal *xnorm)
+{
+  MCGTrackNorm(dots, anorm);
   if (dots[MCG_DOT_XX] != (PetscScalar)0.0) *xnorm = PetscSqrtReal(PetscAbsScalar(dots[MCG_DOT_XX]));
   *sum_x += *xnorm;
   *sum_r += PetscSqrtReal(PetscAbsScalar(dots[MCG_DOT_RR]));
@@ -295,6 +301,7 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
   PetscReal   anorm = 0, sum_x = 0, sum_r = 0, xnorm = 0; /* for the rounding-drift estimate */
   PetscBool   fresh = PETSC_TRUE; /* p and s start from zero: first iteration or after a restart */
   PetscInt    i, max_its;
+  PetscBool   defer_product; /* one process, convergence tested: the next w = A u after the test */
 
   PetscFunctionBegin;
   PetscCall(PCGetDiagonalScale(ksp->pc, &diagonalscale));
@@ -354,6 +361,11 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
     if (ksp->reason) PetscFunctionReturn(0);
   }
 
+  {
+    PetscMPIInt size;
+    PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)ksp), &size));
+    defer_product = (PetscBool)(size == 1 && mcg->fixed_its <= 0);
+  }
   i = 0;
   while (PETSC_TRUE) {
     if (i >= max_its) {
@@ -395,9 +407,11 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
     ksp->its = i + 1;
     PetscCall(MCGUpdate(ksp, alpha, beta, X, R, U, W, P, S, dots));
     /* w = A u only feeds the next iteration: none follows the last allowed one (fixed-iteration mode
-       saves a product per solve this way; a restart recomputes w itself) */
+       saves a product per solve this way; a restart recomputes w itself). On one process the
+       reduction costs nothing, so the product waits for the convergence test (defer_product) and a
+       converged solve makes no product that nothing uses, as KSPCG: one product per iteration. */
     dots[MCG_DOT_UW] = 0;
-    if (i + 1 < max_its) PetscCall(MCGMatMultDot(ksp, Amat, U, W, &dots[MCG_DOT_UW]));
+    if (i + 1 < max_its && !defer_product) PetscCall(MCGMatMultDot(ksp, Amat, U, W, &dots[MCG_DOT_UW]));
     PetscCall(MCGReduce(ksp, dots, MCG_NDOTS));
     MCGCheckDots(ksp, dots);
     gamma_old = gamma;
@@ -494,6 +508,12 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
       MCGTrackDrift(dots, &anorm, &sum_x, &sum_r, &xnorm);
     }
     if (ksp->reason) break;
+    if (defer_product && !fresh && i < max_its) {
+      PetscCall(MCGMatMultDot(ksp, Amat, U, W, &dots[MCG_DOT_UW]));
+      KSPCheckDot(ksp, dots[MCG_DOT_UW]);
+      delta = dots[MCG_DOT_UW];
+      MCGTrackNorm(dots, &anorm);
+    }
   }
   PetscFunctionReturn(0);
 }
