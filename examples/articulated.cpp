@@ -112,7 +112,7 @@ int main(int argc, char **argv)
   physics::ArticulatedParams params;
   DriverOutput               out;
   PetscInt                   max_corr = params.max_corrections, max_halvings = params.max_halvings;
-  PetscBool                  vel_stab = PETSC_TRUE, refresh = PETSC_FALSE, warm = PETSC_FALSE, vtk_points = PETSC_FALSE;
+  PetscBool                  vel_stab = PETSC_TRUE, refresh = PETSC_TRUE, warm = PETSC_FALSE, vtk_points = PETSC_FALSE;
   PetscCall(DriverOutputFromOptions(comm, &out));
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-dt", &params.dt, nullptr));
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-joint_tol", &params.joint_tol, nullptr));

@@ -25,7 +25,7 @@ struct ArticulatedParams {
   double regularisation         = 1e-6; // relative to the diagonal, used once A is found singular
   bool   velocity_stabilisation = true;
   bool   regularise_from_start  = false;
-  bool   refresh_matrix         = false; // refill A at the predicted orientations for every correction after the first
+  bool   refresh_matrix         = true;  // refill A at the predicted orientations for every correction after the first
   // Initial guesses from the previous step: its stabilisation impulses for the stabilisation solve, the sum
   // of its correction impulses for the first correction, zero for later corrections. Only used if the
   // linear solver takes the incoming solution as its initial guess (the PETSc drivers then set
