@@ -18,13 +18,13 @@ static PetscErrorCode MatSeqBinBCSRFreeLayout(Mat_SeqBinBCSR *a)
   PetscCall(PetscFree(a->bin_start));
   PetscCall(PetscFree(a->row_nz));
   PetscCall(PetscFree(a->diag_slot));
-  PetscCall(MatSeqBinBCSRStreamFree(&a->col));
+  PetscCall(PetscFree(a->col));
   PetscCall(PetscFree(a->row_off));
   PetscCall(PetscFree(a->real_slot));
   PetscCall(PetscFree(a->lower_off));
   PetscCall(PetscFree(a->lower_slot));
-  PetscCall(MatSeqBinBCSRStreamFree(&a->val));
-  PetscCall(MatSeqBinBCSRStreamFree(&a->valf));
+  PetscCall(PetscFree(a->val));
+  PetscCall(PetscFree(a->valf));
   PetscCall(PetscFree2(a->rowbuf_cols, a->rowbuf_vals));
   PetscCall(PetscFree(a->idiag));
   PetscCall(PetscFree(a->sor_idiag));
@@ -235,10 +235,10 @@ static PetscErrorCode MatSeqBinBCSRBuildLayoutSym(Mat A, const PetscInt bi[], co
     }
   }
   a->nslots = a->bin_start[nbins];
-  PetscCall(MatSeqBinBCSRStreamCalloc(a->nslots, &a->col));
+  PetscCall(PetscMalloc1(a->nslots, &a->col));
   std::copy(allcol.begin(), allcol.end(), a->col);
-  if (a->precision == MAT_BINBCSR_PRECISION_DOUBLE) PetscCall(MatSeqBinBCSRStreamCalloc((size_t)a->nslots * a->bs2, &a->val));
-  else PetscCall(MatSeqBinBCSRStreamCalloc((size_t)a->nslots * a->bs2, &a->valf));
+  if (a->precision == MAT_BINBCSR_PRECISION_DOUBLE) PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->val));
+  else PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->valf));
   PetscCall(PetscMalloc2((size_t)PetscMax(a->nbs, 1) * a->bs, &a->rowbuf_cols, (size_t)PetscMax(a->nbs, 1) * a->bs, &a->rowbuf_vals)); /* a full row, both triangles */
   a->built        = PETSC_TRUE;
   A->preallocated = PETSC_TRUE;
@@ -318,9 +318,9 @@ PetscErrorCode MatSeqBinBCSRBuildLayout(Mat A, const PetscInt bi[], const PetscI
     a->bin_start[b + 1] = a->bin_start[b] + len * bw;
   }
   a->nslots = a->bin_start[nbins];
-  PetscCall(MatSeqBinBCSRStreamCalloc(a->nslots, &a->col));
-  if (a->precision == MAT_BINBCSR_PRECISION_DOUBLE) PetscCall(MatSeqBinBCSRStreamCalloc((size_t)a->nslots * a->bs2, &a->val));
-  else PetscCall(MatSeqBinBCSRStreamCalloc((size_t)a->nslots * a->bs2, &a->valf));
+  PetscCall(PetscMalloc1(a->nslots, &a->col));
+  if (a->precision == MAT_BINBCSR_PRECISION_DOUBLE) PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->val));
+  else PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->valf));
   for (PetscInt b = 0; b < nbins; b++) {
     const PetscInt len = (a->bin_start[b + 1] - a->bin_start[b]) / bw;
     for (PetscInt l = 0; l < bw; l++) {
@@ -600,13 +600,13 @@ static PetscErrorCode MatBinBCSRSetPrecision_SeqBinBCSR(Mat A, MatBinBCSRPrecisi
   if (p == a->precision) PetscFunctionReturn(0);
   if (a->built) {
     if (p == MAT_BINBCSR_PRECISION_SINGLE) {
-      PetscCall(MatSeqBinBCSRStreamCalloc(nv, &a->valf));
+      PetscCall(PetscMalloc1(nv, &a->valf));
       for (size_t i = 0; i < nv; i++) a->valf[i] = (float)a->val[i];
-      PetscCall(MatSeqBinBCSRStreamFree(&a->val));
+      PetscCall(PetscFree(a->val));
     } else {
-      PetscCall(MatSeqBinBCSRStreamCalloc(nv, &a->val));
+      PetscCall(PetscMalloc1(nv, &a->val));
       for (size_t i = 0; i < nv; i++) a->val[i] = (MatScalar)a->valf[i];
-      PetscCall(MatSeqBinBCSRStreamFree(&a->valf));
+      PetscCall(PetscFree(a->valf));
     }
     PetscCall(PetscObjectStateIncrease((PetscObject)A));
   }

@@ -205,14 +205,5 @@ PETSC_INTERN PetscErrorCode MatConvert_SeqBinBCSR_SeqBAIJ(Mat, MatType, MatReuse
 PETSC_INTERN PetscErrorCode MatView_SeqBinBCSR(Mat, PetscViewer);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRDestroyCOO(Mat_SeqBinBCSR *);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRDuplicateStaging(Mat, Mat, PetscBool copyvalues);
-/* The streamed arrays (val, valf, col): zeroed, 2 MiB aligned and huge-page advised when large
-   (binbcsr_memory.cpp); free them only with MatSeqBinBCSRStreamFree(&ptr). */
-PETSC_INTERN PetscErrorCode MatSeqBinBCSRStreamMalloc(size_t bytes, void **p);
-PETSC_INTERN PetscErrorCode MatSeqBinBCSRStreamFree(void *pp);
-template <class T>
-static inline PetscErrorCode MatSeqBinBCSRStreamCalloc(size_t n, T **p)
-{
-  return MatSeqBinBCSRStreamMalloc(n * sizeof(T), (void **)p);
-}
 
 #endif

@@ -88,14 +88,14 @@ static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues
     PetscCall(PetscArraycpy(b->row_nz, a->row_nz, a->mbs));
     PetscCall(PetscMalloc1(a->mbs, &b->diag_slot));
     PetscCall(PetscArraycpy(b->diag_slot, a->diag_slot, a->mbs));
-    PetscCall(MatSeqBinBCSRStreamCalloc(a->nslots, &b->col));
+    PetscCall(PetscMalloc1(a->nslots, &b->col));
     PetscCall(PetscArraycpy(b->col, a->col, a->nslots));
     if (a->val) {
-      PetscCall(MatSeqBinBCSRStreamCalloc(nv, &b->val));
+      PetscCall(PetscMalloc1(nv, &b->val));
       if (copyvalues) PetscCall(PetscArraycpy(b->val, a->val, nv));
       else PetscCall(PetscArrayzero(b->val, nv));
     } else {
-      PetscCall(MatSeqBinBCSRStreamCalloc(nv, &b->valf));
+      PetscCall(PetscMalloc1(nv, &b->valf));
       if (copyvalues) PetscCall(PetscArraycpy(b->valf, a->valf, nv));
       else PetscCall(PetscArrayzero(b->valf, nv));
     }
