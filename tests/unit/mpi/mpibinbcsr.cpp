@@ -110,6 +110,26 @@ PetscErrorCode fill_test_vector(Vec v, int salt = 0)
   PetscFunctionReturn(0);
 }
 
+// Solves A x = b with the given KSP and PC to rtol 1e-10 (x is the initial guess and the result);
+// returns the iterations and, through reason, why it stopped.
+PetscErrorCode solve_to_tolerance(Mat A, Vec b, Vec x, KSPType kt, PCType pt, PetscInt *its, KSPConvergedReason *reason)
+{
+  KSP ksp;
+  PC  pc;
+  PetscFunctionBeginUser;
+  PetscCall(KSPCreate(PETSC_COMM_WORLD, &ksp));
+  PetscCall(KSPSetOperators(ksp, A, A));
+  PetscCall(KSPSetType(ksp, kt));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCSetType(pc, pt));
+  PetscCall(KSPSetTolerances(ksp, 1e-10, 1e-50, PETSC_DEFAULT, 1000));
+  PetscCall(KSPSolve(ksp, b, x));
+  PetscCall(KSPGetIterationNumber(ksp, its));
+  PetscCall(KSPGetConvergedReason(ksp, reason));
+  PetscCall(KSPDestroy(&ksp));
+  PetscFunctionReturn(0);
+}
+
 // max |y_par[i] - y_seq[i]| over the rows of this rank, relative to max |y_seq|.
 double local_rel_diff(Vec ypar, Vec yseq)
 {
@@ -350,25 +370,14 @@ TEST_CASE("mpibinbcsr: CG solves equal aij's (iterations and solution)", "[mpi]"
   Vec              sol[2];
   MatType          types[2] = {MATMPIAIJ, MATMPIBINBCSR};
   for (int t = 0; t < 2; ++t) {
-    Mat A;
-    KSP ksp;
-    Vec b;
+    Mat                A;
+    Vec                b;
+    KSPConvergedReason reason;
     PCHK(assemble(fem, types[t], t == 0 ? Fill::Blocked : Fill::Coo, true, &A));
     PCHK(MatCreateVecs(A, &sol[t], &b));
     PCHK(fill_test_vector(b));
-    PCHK(KSPCreate(PETSC_COMM_WORLD, &ksp));
-    PCHK(KSPSetOperators(ksp, A, A));
-    PCHK(KSPSetType(ksp, KSPCG));
-    PC pc;
-    PCHK(KSPGetPC(ksp, &pc));
-    PCHK(PCSetType(pc, PCJACOBI));
-    PCHK(KSPSetTolerances(ksp, 1e-10, 1e-50, PETSC_DEFAULT, 1000));
-    PCHK(KSPSolve(ksp, b, sol[t]));
-    KSPConvergedReason reason;
-    PCHK(KSPGetConvergedReason(ksp, &reason));
+    PCHK(solve_to_tolerance(A, b, sol[t], KSPCG, PCJACOBI, &its[t], &reason));
     CHECK(reason > 0);
-    PCHK(KSPGetIterationNumber(ksp, &its[t]));
-    PCHK(KSPDestroy(&ksp));
     PCHK(VecDestroy(&b));
     PCHK(MatDestroy(&A));
   }
@@ -497,24 +506,16 @@ TEST_CASE("mpibinbcsr with symmetric storage (upper diagonal part, full off-diag
   for (KSPType kt : {KSPCG, KSPMCG}) {
     PetscInt its[2];
     for (int t = 0; t < 2; ++t) {
-      Mat A;
-      KSP ksp;
-      PC  pc;
-      Vec b, x;
+      Mat                A;
+      Vec                b, x;
+      KSPConvergedReason reason;
       if (t == 0) PCHK(PetscOptionsClearValue(nullptr, "-mat_binbcsr_symmetric_storage"));
       else PCHK(PetscOptionsSetValue(nullptr, "-mat_binbcsr_symmetric_storage", "1"));
       PCHK(assemble(fem, t == 0 ? MATMPIAIJ : MATMPIBINBCSR, Fill::Coo, false, &A));
       PCHK(MatCreateVecs(A, &x, &b));
       PCHK(fill_test_vector(b));
-      PCHK(KSPCreate(PETSC_COMM_WORLD, &ksp));
-      PCHK(KSPSetOperators(ksp, A, A));
-      PCHK(KSPSetType(ksp, kt));
-      PCHK(KSPGetPC(ksp, &pc));
-      PCHK(PCSetType(pc, PCJACOBI));
-      PCHK(KSPSetTolerances(ksp, 1e-10, 1e-50, PETSC_DEFAULT, 1000));
-      PCHK(KSPSolve(ksp, b, x));
-      PCHK(KSPGetIterationNumber(ksp, &its[t]));
-      PCHK(KSPDestroy(&ksp));
+      PCHK(solve_to_tolerance(A, b, x, kt, PCJACOBI, &its[t], &reason));
+      CHECK(reason > 0);
       PCHK(VecDestroy(&b));
       PCHK(VecDestroy(&x));
       PCHK(MatDestroy(&A));
@@ -589,20 +590,9 @@ TEST_CASE("mpibinbcsr: MatSOR local sweeps and PCSOR in CG equal mpibaij's (whol
     Mat      mats[2] = {R, A};
     Vec      sol[2]  = {xr, x};
     for (int t = 0; t < 2; ++t) {
-      KSP ksp;
-      PC  pc;
-      PCHK(KSPCreate(PETSC_COMM_WORLD, &ksp));
-      PCHK(KSPSetOperators(ksp, mats[t], mats[t]));
-      PCHK(KSPSetType(ksp, KSPCG));
-      PCHK(KSPGetPC(ksp, &pc));
-      PCHK(PCSetType(pc, PCSOR));
-      PCHK(KSPSetTolerances(ksp, 1e-10, 1e-50, PETSC_DEFAULT, 1000));
-      PCHK(KSPSolve(ksp, b, sol[t]));
       KSPConvergedReason reason;
-      PCHK(KSPGetConvergedReason(ksp, &reason));
+      PCHK(solve_to_tolerance(mats[t], b, sol[t], KSPCG, PCSOR, &its[t], &reason));
       CHECK(reason > 0);
-      PCHK(KSPGetIterationNumber(ksp, &its[t]));
-      PCHK(KSPDestroy(&ksp));
     }
     CHECK(its[0] == its[1]);
     PetscReal diff, ref;
