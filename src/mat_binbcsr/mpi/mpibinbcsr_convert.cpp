@@ -124,6 +124,7 @@ PETSC_INTERN PetscErrorCode MatView_MPIBinBCSR(Mat mat, PetscViewer viewer)
     PetscCallMPI(MPI_Comm_rank(PetscObjectComm((PetscObject)mat), &rank));
     PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)mat), &size));
     PetscCall(PetscViewerASCIIPrintf(viewer, "MATMPIBINBCSR on %d ranks: diagonal and off-diagonal parts of type %s, block size %" PetscInt_FMT "\n", size, b->inner_type, mat->rmap->bs));
+    if (b->coo_mirror) PetscCall(PetscViewerASCIIPrintf(viewer, "COO mirror on: entries of off-diagonal blocks also fill the transposed place (routed to its owner)\n"));
     if (!b->A) PetscFunctionReturn(0);
     PetscCall(PetscViewerASCIIPushSynchronized(viewer));
     PetscCall(PetscViewerGetSubViewer(viewer, PETSC_COMM_SELF, &sv));

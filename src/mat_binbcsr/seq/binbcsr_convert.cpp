@@ -384,7 +384,12 @@ PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
       PetscFunctionReturn(0);
     }
     PetscCall(PetscViewerASCIIPrintf(viewer, "bins %" PetscInt_FMT ", stored blocks %" PetscInt_FMT ", slots %" PetscInt_FMT " (padding overhead %.2f%%), longest row %" PetscInt_FMT " blocks\n", a->nbins, a->nz, a->nslots, a->nz ? 100.0 * (double)(a->nslots - a->nz) / (double)a->nz : 0.0, a->max_row_nz));
-    PetscCall(PetscViewerASCIIPrintf(viewer, "bytes: values %zu, indices %zu (column per slot and bin offsets)%s\n", vbytes, ibytes, a->coo_jmap ? ", COO map present" : ""));
+    PetscCall(PetscViewerASCIIPrintf(viewer, "bytes: values %zu, indices %zu (column per slot and bin offsets)\n", vbytes, ibytes));
+    if (a->coo_jmap || a->coo_mirror) {
+      const char *refill = a->coo_slot_state == 1 ? "by whole blocks" : a->coo_slot_state == -1 ? "value by value (the list is not made of whole blocks)" : "path chosen at the first refill";
+      if (a->coo_jmap) PetscCall(PetscViewerASCIIPrintf(viewer, "COO: %" PetscCount_FMT " entries, refill %s%s\n", a->coo_n, refill, a->coo_mirror ? "; mirror on (entries of off-diagonal blocks also fill the transposed place)" : ""));
+      else PetscCall(PetscViewerASCIIPrintf(viewer, "COO mirror on (for MatSetPreallocationCOO)\n"));
+    }
     if (a->sym) PetscCall(PetscViewerASCIIPrintf(viewer, "symmetric storage: upper triangle, %" PetscInt_FMT " stored blocks (the lower %" PetscInt_FMT " implied), %" PetscInt_FMT " padding slots; slots ordered by edge colouring\n", a->nz, a->nz - CountDiagonalBlocks(a), a->nslots - a->nz));
     PetscFunctionReturn(0);
   }
