@@ -73,7 +73,7 @@ Vec rhs(Mat A, bool ramp, PetscScalar value)
   return b;
 }
 
-static std::vector<PetscScalar> gather(Vec x)
+std::vector<PetscScalar> gather(Vec x)
 {
   VecScatter         sc;
   Vec                all;

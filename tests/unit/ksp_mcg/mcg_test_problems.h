@@ -36,6 +36,8 @@ struct Result {
 };
 // Solves A x = b from x0 (zero when x0 is null) with the given settings.
 Result solve(Mat A, Vec b, const Solve &s, Vec x0 = nullptr);
+// All entries of a parallel vector, on every rank.
+std::vector<PetscScalar> gather(Vec x);
 // ||a - b|| / ||b|| of two gathered vectors.
 PetscReal rel_diff(const std::vector<PetscScalar> &a, const std::vector<PetscScalar> &b);
 

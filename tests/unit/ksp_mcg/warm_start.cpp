@@ -27,29 +27,11 @@ PetscReal a_norm_of_difference(Mat A, const std::vector<PetscScalar> &x, const s
   return std::sqrt(PetscRealPart(e2));
 }
 
-std::vector<PetscScalar> gathered(Vec x)
-{
-  VecScatter         sc;
-  Vec                all;
-  PetscInt           n;
-  const PetscScalar *a;
-  VecScatterCreateToAll(x, &sc, &all);
-  VecScatterBegin(sc, x, all, INSERT_VALUES, SCATTER_FORWARD);
-  VecScatterEnd(sc, x, all, INSERT_VALUES, SCATTER_FORWARD);
-  VecGetSize(all, &n);
-  VecGetArrayRead(all, &a);
-  std::vector<PetscScalar> out(a, a + n);
-  VecRestoreArrayRead(all, &a);
-  VecScatterDestroy(&sc);
-  VecDestroy(&all);
-  return out;
-}
-
 void check_warm_started_fixed_iterations(Mat A, Vec b, Vec x0)
 {
   const Result exact = solve(A, b, Solve{KSPCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-14, 5000});
   REQUIRE(exact.reason > 0);
-  const PetscReal e_guess = a_norm_of_difference(A, gathered(x0), exact.x);
+  const PetscReal e_guess = a_norm_of_difference(A, gather(x0), exact.x);
   REQUIRE(e_guess > 0);
   PetscReal previous = e_guess;
   for (PetscInt k : {1, 2, 5, 10, 20, 30}) {
