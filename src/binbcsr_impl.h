@@ -14,6 +14,8 @@ PETSC_INTERN PetscErrorCode MatGetFactor_SeqBinBCSR_Petsc(Mat, MatFactorType, Ma
 
 /* Inserts src's local rows into dst (INSERT_VALUES) and assembles dst: the generic conversion path. */
 PETSC_INTERN PetscErrorCode MatBinBCSRInsertRows_Private(Mat src, Mat dst);
+/* An empty matrix of the given type with src's sizes and block sizes: a conversion's target (seq and mpi). */
+PETSC_INTERN PetscErrorCode MatBinBCSRCreateLike_Private(Mat src, MatType type, Mat *M);
 
 /* MATSEQBINBCSR parts of MATMPIBINBCSR: after MatSetPreallocationCOO, compose the part's COO map with
    from[] (part entry -> source index); the two-source refill then reads source p < n from v and

@@ -41,16 +41,6 @@ static PetscErrorCode RefillByRows(Mat src, Mat dst)
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode CreateLike(Mat src, MatType type, Mat *M)
-{
-  PetscFunctionBegin;
-  PetscCall(MatCreate(PetscObjectComm((PetscObject)src), M));
-  PetscCall(MatSetSizes(*M, src->rmap->n, src->cmap->n, src->rmap->N, src->cmap->N));
-  PetscCall(MatSetBlockSizesFromMats(*M, src, src));
-  PetscCall(MatSetType(*M, type));
-  PetscFunctionReturn(0);
-}
-
 PETSC_INTERN PetscErrorCode MatConvert_MPIBinBCSR_MPIAIJ(Mat mat, MatType newtype, MatReuse reuse, Mat *newmat)
 {
   Mat M;
@@ -61,7 +51,7 @@ PETSC_INTERN PetscErrorCode MatConvert_MPIBinBCSR_MPIAIJ(Mat mat, MatType newtyp
     PetscCall(RefillByRows(mat, *newmat));
     PetscFunctionReturn(0);
   }
-  PetscCall(CreateLike(mat, MATMPIAIJ, &M));
+  PetscCall(MatBinBCSRCreateLike_Private(mat, MATMPIAIJ, &M));
   PetscCall(PreallocateAndFill(mat, M));
   if (reuse == MAT_INPLACE_MATRIX) PetscCall(MatHeaderReplace(mat, &M));
   else *newmat = M;
@@ -78,7 +68,7 @@ PETSC_INTERN PetscErrorCode MatConvertFrom_MPIBinBCSR(Mat src, MatType newtype, 
     PetscCall(RefillByRows(src, *newmat));
     PetscFunctionReturn(0);
   }
-  PetscCall(CreateLike(src, newtype, &M));
+  PetscCall(MatBinBCSRCreateLike_Private(src, newtype, &M));
   /* the -mat_binbcsr_* options apply to converted matrices too (MatSetFromOptions could change the type) */
   PetscObjectOptionsBegin((PetscObject)M);
   if (M->ops->setfromoptions) PetscCall((*M->ops->setfromoptions)(M, PetscOptionsObject));
@@ -157,7 +147,7 @@ PETSC_INTERN PetscErrorCode MatDuplicate_MPIBinBCSR(Mat mat, MatDuplicateOption 
   Mat             C;
 
   PetscFunctionBegin;
-  PetscCall(CreateLike(mat, ((PetscObject)mat)->type_name, &C));
+  PetscCall(MatBinBCSRCreateLike_Private(mat, ((PetscObject)mat)->type_name, &C));
   PetscCall(PetscLayoutSetUp(C->rmap));
   PetscCall(PetscLayoutSetUp(C->cmap));
   Mat_MPIBinBCSR *c = MPIBinBCSR(C);

@@ -49,9 +49,8 @@ PetscErrorCode MatRestoreRow_SeqBinBCSR(Mat A, PetscInt row, PetscInt *nz, Petsc
   PetscFunctionReturn(0);
 }
 
-/* B gets A's layout (and values if copyvalues), in A's precision. B is a fresh MATSEQBINBCSR. */
 /* An empty matrix of the given type with A's sizes and block sizes (a conversion's target). */
-static PetscErrorCode MatCreateLike_Private(Mat A, MatType type, Mat *B)
+PetscErrorCode MatBinBCSRCreateLike_Private(Mat A, MatType type, Mat *B)
 {
   PetscFunctionBegin;
   PetscCall(MatCreate(PetscObjectComm((PetscObject)A), B));
@@ -61,6 +60,7 @@ static PetscErrorCode MatCreateLike_Private(Mat A, MatType type, Mat *B)
   PetscFunctionReturn(0);
 }
 
+/* B gets A's layout (and values if copyvalues), in A's precision. B is a fresh MATSEQBINBCSR. */
 static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues)
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data, *b = (Mat_SeqBinBCSR *)B->data;
@@ -127,7 +127,7 @@ PetscErrorCode MatDuplicate_SeqBinBCSR(Mat A, MatDuplicateOption op, Mat *M)
   Mat B;
 
   PetscFunctionBegin;
-  PetscCall(MatCreateLike_Private(A, ((PetscObject)A)->type_name, &B));
+  PetscCall(MatBinBCSRCreateLike_Private(A, ((PetscObject)A)->type_name, &B));
   PetscCall(PetscLayoutSetUp(B->rmap));
   PetscCall(PetscLayoutSetUp(B->cmap));
   PetscCall(MatSeqBinBCSRCopyLayout(A, B, op == MAT_COPY_VALUES ? PETSC_TRUE : PETSC_FALSE));
@@ -286,7 +286,7 @@ static PetscErrorCode MatConvert_SeqBinBCSR_XAIJ(Mat A, MatType newtype, MatReus
       B = *newmat;
       PetscCall(MatZeroEntries(B));
     } else {
-      PetscCall(MatCreateLike_Private(A, newtype, &B));
+      PetscCall(MatBinBCSRCreateLike_Private(A, newtype, &B));
       PetscCall(MatSeqBinBCSRBuildLowerIndex(a));
       PetscCall(PetscMalloc1(A->rmap->n, &nnz));
       for (PetscInt r = 0; r < A->rmap->n; r++) nnz[r] = (a->row_nz[r / bs] + a->lower_off[r / bs + 1] - a->lower_off[r / bs]) * (blocked ? 1 : bs);
@@ -309,7 +309,7 @@ static PetscErrorCode MatConvert_SeqBinBCSR_XAIJ(Mat A, MatType newtype, MatReus
     B = *newmat;
     PetscCall(MatZeroEntries(B));
   } else {
-    PetscCall(MatCreateLike_Private(A, newtype, &B));
+    PetscCall(MatBinBCSRCreateLike_Private(A, newtype, &B));
     if (blocked) PetscCall(MatSeqBAIJSetPreallocation(B, bs, 0, a->row_nz));
     else {
       PetscCall(PetscMalloc1(A->rmap->n, &nnz));
