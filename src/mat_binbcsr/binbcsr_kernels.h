@@ -117,6 +117,21 @@ BINBCSR_HD void sym_lane_mult(const V *bin_val, const I *bin_col, int len, int b
   }
 }
 
+/* True when the BW lanes of a slot group read the consecutive block columns c[0], c[0] + 1, ...: a
+   structured grid numbered along its rows (cloth, stencils), away from the grid's edges. */
+template <typename I>
+BINBCSR_HD bool unit_stride(const I *c, int bw)
+{
+  bool unit = true;
+  for (int l = 1; l < bw; l++) unit &= c[l] == c[0] + l;
+  return unit;
+}
+template <int BW, typename I>
+BINBCSR_HD bool unit_stride(const I *c)
+{
+  return unit_stride(c, BW);
+}
+
 /* The same for a whole bin of BW lanes (BW, BS compile-time), lanes in lock step per slot: the lane
    loop is the SIMD loop. Gathers x_c, fused multiply-adds into BS accumulators per lane, and a masked
    scatter-add of block^T x_r into y_c (conflict-free by the colouring). Lanes whose row is >= mbs are
@@ -140,6 +155,40 @@ BINBCSR_HD void sym_bin_mult(const V *bin_val, const I *bin_col, int len, I r0, 
     const I *c = bin_col + (long)k * BW;
     const V *t = bin_val + (long)k * BW * BS2;
     prefetch_values(t, BW * BS2 * (int)sizeof(V));
+    if (unit_stride<BW>(c)) { /* contiguous x_c and y_c: plain loads and stores instead of gathers and scatters */
+      const I c0 = c[0];
+      const double *xs = x + (long)c0 * BS;
+      double       *ys = y + (long)c0 * BS;
+      if (c0 == r0) { /* the diagonal blocks or padding of every lane: nothing to scatter */
+#pragma omp simd
+        for (int l = 0; l < BW; l++) {
+          double v[BS2];
+          for (int e = 0; e < BS2; e++) v[e] = (double)t[e * BW + l];
+          for (int i = 0; i < BS; i++) {
+            double s = acc[i][l];
+            for (int j = 0; j < BS; j++) s += v[i * BS + j] * xs[l * BS + j];
+            acc[i][l] = s;
+          }
+        }
+      } else {
+#pragma omp simd
+        for (int l = 0; l < BW; l++) {
+          double v[BS2];
+          for (int e = 0; e < BS2; e++) v[e] = (double)t[e * BW + l];
+          for (int i = 0; i < BS; i++) {
+            double s = acc[i][l];
+            for (int j = 0; j < BS; j++) s += v[i * BS + j] * xs[l * BS + j];
+            acc[i][l] = s;
+          }
+          for (int j = 0; j < BS; j++) {
+            double s = 0.0;
+            for (int i = 0; i < BS; i++) s += v[i * BS + j] * xr[i][l];
+            ys[l * BS + j] += s;
+          }
+        }
+      }
+      continue;
+    }
 #pragma omp simd
     for (int l = 0; l < BW; l++) {
       const I   cl = c[l];

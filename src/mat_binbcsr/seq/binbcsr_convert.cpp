@@ -1,5 +1,6 @@
 /* MATSEQBINBCSR rows, copies, conversions and ASCII views. */
 #include "binbcsr.h"
+#include "../binbcsr_kernels.h"
 #include <petscviewer.h>
 #include <algorithm>
 #include <vector>
@@ -367,6 +368,15 @@ static PetscInt CountDiagonalBlocks(const Mat_SeqBinBCSR *a)
   return n;
 }
 
+/* slot groups whose lanes read consecutive block columns: the products load x there (and y with
+   symmetric storage) instead of gathering it */
+static PetscInt MatSeqBinBCSRCountUnitStrideGroups(const Mat_SeqBinBCSR *a)
+{
+  PetscInt n = 0;
+  for (PetscInt g = 0; g < a->nslots / a->bw; g++) n += binbcsr::unit_stride(a->col + g * a->bw, (int)a->bw);
+  return n;
+}
+
 PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
 {
   Mat_SeqBinBCSR   *a = (Mat_SeqBinBCSR *)A->data;
@@ -385,6 +395,10 @@ PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
     }
     PetscCall(PetscViewerASCIIPrintf(viewer, "bins %" PetscInt_FMT ", stored blocks %" PetscInt_FMT ", slots %" PetscInt_FMT " (padding overhead %.2f%%), longest row %" PetscInt_FMT " blocks\n", a->nbins, a->nz, a->nslots, a->nz ? 100.0 * (double)(a->nslots - a->nz) / (double)a->nz : 0.0, a->max_row_nz));
     PetscCall(PetscViewerASCIIPrintf(viewer, "bytes: values %zu, indices %zu (column per slot and bin offsets)\n", vbytes, ibytes));
+    if ((a->bs == 1 || a->bs == 3) && (a->bw == 4 || a->bw == 8 || a->bw == 16 || a->bw == 32)) { /* the shapes of the vectorised sweeps */
+      const PetscInt groups = a->nslots / a->bw, unit = MatSeqBinBCSRCountUnitStrideGroups(a);
+      PetscCall(PetscViewerASCIIPrintf(viewer, "slot groups over consecutive block columns (x%s read without gathers): %" PetscInt_FMT " of %" PetscInt_FMT " (%.1f%%)\n", a->sym ? " and y" : "", unit, groups, groups ? 100.0 * (double)unit / (double)groups : 0.0));
+    }
     if (a->coo_jmap || a->coo_mirror) {
       const char *refill = a->coo_slot_state == 1 ? "by whole blocks" : a->coo_slot_state == -1 ? "value by value (the list is not made of whole blocks)" : "path chosen at the first refill";
       if (a->coo_jmap) PetscCall(PetscViewerASCIIPrintf(viewer, "COO: %" PetscCount_FMT " entries, refill %s%s\n", a->coo_n, refill, a->coo_mirror ? "; mirror on (entries of off-diagonal blocks also fill the transposed place)" : ""));

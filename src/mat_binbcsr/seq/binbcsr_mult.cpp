@@ -46,6 +46,17 @@ void mult_bins_fixed(const BinSweep<V> &m, const double *x, const double *z, dou
       for (int l = 0; l < BW; l++) acc[i][l] = 0.0;
     for (PetscInt k = 0; k < len; k++, c += BW, t += BW * BS2) {
       binbcsr::prefetch_values(t, BW * BS2 * (int)sizeof(V));
+      if (binbcsr::unit_stride<BW>(c)) { /* consecutive columns: x_c by plain loads, no gathers */
+        const double *xs = x + (size_t)c[0] * BS;
+        BINBCSR_LANE_LOOP
+        for (int l = 0; l < BW; l++) {
+          double yl[BS];
+          for (int i = 0; i < BS; i++) yl[i] = acc[i][l];
+          binbcsr::slot_mult<BS, V>(t + l, BW, BS, xs + l * BS, yl);
+          for (int i = 0; i < BS; i++) acc[i][l] = yl[i];
+        }
+        continue;
+      }
       BINBCSR_LANE_LOOP
       for (int l = 0; l < BW; l++) {
         const int ci = (int)c[l] * BS; /* 32-bit offsets (PetscInt is 32-bit here): vgatherdpd */

@@ -94,6 +94,30 @@ TEST_CASE("products on a FEM-like 3x3 block stencil", "[mat_core][mult]")
   check_products(fem_pattern(5, 4, 3), bw, prec);
 }
 
+// Grids numbered along their rows give slot groups whose lanes read consecutive block columns; the
+// products load x there instead of gathering it. nx = 48: every bin inside a grid row; nx = 49: bins
+// straddle grid rows, so unit-stride and gathered groups alternate.
+TEST_CASE("products on structured grids (slot groups over consecutive columns), bs 1 and 3", "[mat_core][mult]")
+{
+  const PetscInt            bs   = GENERATE(1, 3);
+  const PetscInt            bw   = GENERATE(4, 8, 16);
+  const PetscInt            nx   = GENERATE(48, 49);
+  const MatBinBCSRPrecision prec = GENERATE(MAT_BINBCSR_PRECISION_DOUBLE, MAT_BINBCSR_PRECISION_SINGLE);
+  CAPTURE(bs, bw, nx, prec);
+  const Pattern p = fem_pattern(nx, 2, 1, bs);
+  check_products(p, bw, prec);
+  Mat               A    = build(p, MATSEQBINBCSR, bw, prec);
+  const std::string info = info_view(A);
+  const size_t      at   = info.find("slot groups over consecutive block columns (x read without gathers): ");
+  REQUIRE(at != std::string::npos);
+  long unit = -1, groups = -1;
+  REQUIRE(std::sscanf(info.c_str() + at, "slot groups over consecutive block columns (x read without gathers): %ld of %ld", &unit, &groups) == 2);
+  CHECK(groups > 0);
+  if (nx == 48) CHECK(unit >= groups / 4); // boundary bins of the grid are the exceptions
+  else CHECK(unit > 0);
+  MatDestroy(&A);
+}
+
 TEST_CASE("a matrix flagged symmetric multiplies its transpose through the vectorised product", "[mat_core][mult]")
 {
   const Pattern p = fem_pattern(4, 3, 3);

@@ -6,6 +6,8 @@
 #include <petscbinbcsr.h>
 #include <cfloat>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <random>
 #include <vector>
 
@@ -200,6 +202,25 @@ inline void check_dense(const std::vector<PetscScalar> &got, const std::vector<P
       bad++;
     }
   CHECK(bad == 0);
+}
+
+// MatView(A) in PETSC_VIEWER_ASCII_INFO format, as text.
+inline std::string info_view(Mat A)
+{
+  FILE       *f = tmpfile();
+  PetscViewer v;
+  REQUIRE(f != nullptr);
+  REQUIRE(PetscViewerASCIIOpenWithFILE(PETSC_COMM_SELF, f, &v) == 0);
+  REQUIRE(PetscViewerPushFormat(v, PETSC_VIEWER_ASCII_INFO) == 0);
+  REQUIRE(MatView(A, v) == 0);
+  REQUIRE(PetscViewerPopFormat(v) == 0);
+  REQUIRE(PetscViewerDestroy(&v) == 0);
+  rewind(f);
+  std::string text;
+  char        buf[4096];
+  for (size_t n; (n = fread(buf, 1, sizeof buf, f)) > 0;) text.append(buf, n);
+  fclose(f);
+  return text;
 }
 
 } // namespace mat_core
