@@ -96,6 +96,52 @@ static bool WriteFrame(const std::string &path, const physics::ArticulatedScene 
   return physics::write_vtu(path, vtk);
 }
 
+// With the work split over ranks (physics::ArticulatedWorkSplit) each rank's bodies outside its active set
+// are stale: gather the state of every body from the rank that counts it (a sum in which the others add
+// zeros), for output and the final summary.
+static PetscErrorCode SyncScene(MPI_Comm comm, const physics::ArticulatedWorkSplit &split, physics::ArticulatedScene &scene)
+{
+  PetscFunctionBegin;
+  if (split.body_counted.empty()) PetscFunctionReturn(0);
+  constexpr int       nv = 13;
+  std::vector<double> state(nv * scene.bodies.size(), 0.0);
+  for (size_t i = 0; i < scene.bodies.size(); ++i) {
+    if (!split.body_counted[i]) continue;
+    const physics::RigidBody &b = scene.bodies[i];
+    double                   *v = &state[nv * i];
+    for (int k = 0; k < 3; ++k) v[k] = b.position[k], v[7 + k] = b.velocity[k], v[10 + k] = b.angular_velocity[k];
+    for (int k = 0; k < 4; ++k) v[3 + k] = b.orientation.coeffs()[k];
+  }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, state.data(), (int)state.size(), MPI_DOUBLE, MPI_SUM, comm));
+  for (size_t i = 0; i < scene.bodies.size(); ++i) {
+    physics::RigidBody &b = scene.bodies[i];
+    const double       *v = &state[nv * i];
+    for (int k = 0; k < 3; ++k) b.position[k] = v[k], b.velocity[k] = v[7 + k], b.angular_velocity[k] = v[10 + k];
+    for (int k = 0; k < 4; ++k) b.orientation.coeffs()[k] = v[3 + k];
+  }
+  PetscFunctionReturn(0);
+}
+
+// Total energy and whether every body this rank moves is finite, over all ranks.
+static PetscErrorCode SceneState(MPI_Comm comm, const physics::ArticulatedWorkSplit &split, const physics::ArticulatedScene &scene, double *energy, bool *finite)
+{
+  PetscFunctionBegin;
+  double e = 0, bad = 0;
+  for (size_t i = 0; i < scene.bodies.size(); ++i) {
+    const physics::RigidBody &b = scene.bodies[i];
+    if (!split.body_active.empty() && !split.body_active[i]) continue;
+    bad += !(b.position.allFinite() && b.velocity.allFinite() && b.angular_velocity.allFinite());
+    if (split.body_counted.empty() || split.body_counted[i]) e += physics::mechanical_energy(b, scene.gravity);
+  }
+  if (!split.body_counted.empty()) {
+    double v[2] = {e, bad};
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, v, 2, MPI_DOUBLE, MPI_SUM, comm));
+    e = v[0], bad = v[1];
+  }
+  *energy = e, *finite = bad == 0;
+  PetscFunctionReturn(0);
+}
+
 int main(int argc, char **argv)
 {
   PetscCall(PetscInitialize(&argc, &argv, nullptr, nullptr));
@@ -139,6 +185,17 @@ int main(int argc, char **argv)
   PetscCall(ReplicatedSolverCreate(comm, solver.pattern.n_joints, solver.pattern.block_row, solver.pattern.block_col, &rs));
   const physics::BlockLinearSolver linear = ReplicatedSolverAdapter(&rs);
   if (params.warm_start) PetscCall(KSPSetInitialGuessNonzero(rs.sys.ksp, PETSC_TRUE)); // the physics supplies the guesses
+  if (size > 1) { // each rank moves the bodies of its own joints only; the error maxima are all-reduced
+    std::vector<int> joint_rank(scene.joints.size());
+    for (int p = 0; p < size; ++p)
+      for (int i = rs.row_offsets[p]; i < rs.row_offsets[p + 1]; ++i) joint_rank[rs.old_of_new[i]] = p;
+    solver.split                    = physics::split_articulated_work(scene, joint_rank, rank);
+    solver.split.max_over_processes = [&rs](double local) {
+      double global = local;
+      if (MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_MAX, rs.comm) != MPI_SUCCESS && !rs.error) rs.error = PETSC_ERR_MPI;
+      return global;
+    };
+  }
   PetscInt    nnz;
   const char *mat_type, *ksp_type;
   PetscCall(BlockSystemGetInfo(&rs.sys, &nnz, &mat_type, &ksp_type));
@@ -148,7 +205,9 @@ int main(int argc, char **argv)
   auto write_frame = [&](PetscInt n) { return DriverWriteFrame(comm, &out, n, n * params.dt, [&](const std::string &path) { return WriteFrame(path, scene, vtk_points); }); };
   PetscCall(write_frame(0));
 
-  const double e0 = physics::total_energy(scene);
+  double e0;
+  bool   finite0;
+  PetscCall(SceneState(comm, solver.split, scene, &e0, &finite0));
   double       e_max = e0, worst_error = 0, worst_velocity = 0, step_ms_total = 0;
   long long    corrections = 0, halvings = 0, max_corrections_seen = 0, unconverged = 0, stalled = 0, singular_steps = 0, nan_steps = 0;
   for (PetscInt n = 1; n <= out.steps; ++n) {
@@ -158,8 +217,9 @@ int main(int argc, char **argv)
     const double step_ms = 1e3 * (WallTime() - t0);
     PetscCall(rs.error);
     step_ms_total += step_ms;
-    bool finite = true;
-    for (const physics::RigidBody &b : scene.bodies) finite &= b.position.allFinite() && b.velocity.allFinite() && b.angular_velocity.allFinite();
+    double energy;
+    bool   finite;
+    PetscCall(SceneState(comm, solver.split, scene, &energy, &finite));
     nan_steps += !finite;
     corrections += r.corrections;
     halvings += r.halvings;
@@ -169,16 +229,17 @@ int main(int argc, char **argv)
     singular_steps += r.singular_detected;
     worst_error    = std::max(worst_error, r.joint_error);
     worst_velocity = std::max(worst_velocity, r.velocity_error);
-    const double energy = physics::total_energy(scene);
-    e_max               = std::max(e_max, energy);
+    e_max = std::max(e_max, energy);
     if (n % out.progress_every == 0 || n == out.steps)
       PetscCall(PetscPrintf(comm, "step %" PetscInt_FMT " t=%.4f corrections=%d solves=%lld cg_its=%lld joint_err=%.3e vel_err=%.3e energy=%.6e ms=%.2f solve_ms=%.2f%s%s\n",
                             n, n * params.dt, r.corrections, rs.solves - solves0, rs.iterations - its0, r.joint_error, r.velocity_error, energy, step_ms,
                             rs.solve_ms - solve0, r.converged ? "" : " UNCONVERGED", r.singular_detected ? " SINGULAR->regularised" : ""));
     if (n == 1 && out.dump) PetscCall(BlockSystemDumpMatrix(&rs.sys, out.dump_path));
+    if (out.vtk && n % out.vtk_every == 0) PetscCall(SyncScene(comm, solver.split, scene));
     PetscCall(write_frame(n));
     if (!finite) break;
   }
+  PetscCall(SyncScene(comm, solver.split, scene)); // every body's state on every rank for the summary
 
   SummaryLine s;
   s.add("program", std::string("articulated"));

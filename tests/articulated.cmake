@@ -82,6 +82,13 @@ add_test(NAME articulated_mpi_np2
                  "${ART_MPI}" "${MPIEXEC_LINE} -n 2 ${ART_MPI}" "${MPIEXEC_LINE} -n 2 ${ART_MPI} -mat_type baij"
                  "${MPIEXEC_LINE} -n 2 ${ART_MPI} -mat_type binbcsr -ksp_type mcg")
 set_tests_properties(articulated_mpi_np2 PROPERTIES LABELS "articulated;mpi" TIMEOUT 60)
+# A 10-link chain split over 2 ranks (each rank moves the bodies of its own joints, the two middle links on
+# both): the same motion as one rank; one run also writes frames, which gathers every body mid-run.
+add_test(NAME articulated_mpi_np2_chain
+         COMMAND ${SUMMARY_SAME} "energy_final joint_error_final corrections_per_step" 1e-6
+                 "${ART_SAME} -mat_type aij" "${MPIEXEC_LINE} -n 2 ${ART_SAME} -mat_type aij"
+                 "${MPIEXEC_LINE} -n 2 ${ART_SAME} -mat_type binbcsr -ksp_type mcg -vtk art_np2_chain -vtk_every 50 -vtk_points")
+set_tests_properties(articulated_mpi_np2_chain PROPERTIES LABELS "articulated;mpi" PROCESSORS 2 TIMEOUT 60)
 
 # -vtk writes one .vtu per frame and a .pvd collection; -dump_matrix writes a PETSc binary matrix.
 add_test(NAME articulated_vtk_dump

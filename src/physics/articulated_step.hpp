@@ -15,6 +15,8 @@
 #include "physics/block_solver.hpp"
 #include "physics/joint_matrix.hpp"
 
+#include <functional>
+
 namespace physics {
 
 struct ArticulatedParams {
@@ -46,8 +48,31 @@ struct ArticulatedStepReport {
   int    halvings          = 0;     // impulses halved back by the line search (each costs a prediction)
 };
 
+// How the work of a step is split over processes that each hold the whole scene (the PETSc drivers with
+// several ranks, examples/common/replicated_solver.h). A process advances only its active bodies (those of
+// its own joints) and evaluates joint errors only for its own joints; a joint's impulse (the solve returns
+// all of them) is applied to every active end, in joint order, so a body active on two processes gets the
+// same state on both, bit for bit. Bodies that are not active keep stale values. max_over_processes turns
+// the process's max |C| into the global one (an all-reduce), so that every process takes the same
+// decisions (another correction, a halving). Each body is counted (for energies and output) by exactly one
+// process. Empty lists and masks: one process does everything.
+struct ArticulatedWorkSplit {
+  std::vector<int>                    own_joints;      // increasing
+  std::vector<int>                    active_bodies;   // increasing
+  std::vector<int>                    impulse_joints;  // joints with an active end, increasing
+  std::vector<char>                   body_active, body_counted; // per body
+  std::function<double(double)>       max_over_processes;
+};
+
+// The split for process `process` when joint j belongs to process joint_process[j]: the active bodies are
+// those of its joints, a body is counted by the process of its lowest-numbered joint, and bodies without
+// joints are active and counted on process 0. Throws std::invalid_argument on a wrong-sized list.
+ArticulatedWorkSplit split_articulated_work(const ArticulatedScene &scene, const std::vector<int> &joint_process, int process);
+
 struct ArticulatedSolver {
   JointMatrixPattern  pattern;
+  ArticulatedWorkSplit split;       // empty: this process does the whole scene
+  ArticulatedWorkSplit whole_scene; // the lists for that case, built at the first step
   std::vector<double> block_values;
   bool                regularised = false;
   // Warm start: the previous step's stabilisation impulses and summed correction impulses (3 per joint).

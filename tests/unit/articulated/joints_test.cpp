@@ -4,6 +4,7 @@
 #include "physics/articulated_step.hpp"
 #include "physics/kinematic_loops.hpp"
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 
@@ -265,4 +266,42 @@ TEST_CASE("joint matrix refill: stale values are overwritten, a row subset is fi
   for (size_t k = 0; k < p.block_row.size(); ++k)
     if (p.block_row[k] < p.n_joints / 2)
       for (int e = 0; e < 9; ++e) REQUIRE(part[9 * k + e] == full[9 * k + e]);
+}
+
+TEST_CASE("work split over processes: own joints partition, every body counted once, active = bodies of own joints", "[articulated][mpi]")
+{
+  BridgeOptions opt;
+  opt.chains = 3, opt.links = 6, opt.tie_every = 2;
+  ArticulatedScene scene = make_bridge(opt);
+  RigidBody        free_body; // no joints: process 0 moves and counts it
+  scene.bodies.push_back(free_body);
+  scene.body_sizes.push_back(Eigen::Vector3d::Ones());
+  const int        nb = (int)scene.bodies.size(), nj = (int)scene.joints.size(), processes = 3;
+  std::vector<int> joint_process(nj);
+  for (int j = 0; j < nj; ++j) joint_process[j] = (j * processes) / nj;
+  std::vector<int> counted(nb, 0), owned(nj, 0);
+  for (int p = 0; p < processes; ++p) {
+    const ArticulatedWorkSplit w = split_articulated_work(scene, joint_process, p);
+    for (int j : w.own_joints) {
+      CHECK(joint_process[j] == p);
+      owned[j]++;
+      for (int b : {scene.joints[j].body_a, scene.joints[j].body_b})
+        if (b != kWorld) CHECK(w.body_active[b]);
+    }
+    for (int i = 0; i < nb; ++i) {
+      counted[i] += w.body_counted[i];
+      if (w.body_counted[i]) CHECK(w.body_active[i]);
+      CHECK(std::count(w.active_bodies.begin(), w.active_bodies.end(), i) == w.body_active[i]);
+    }
+    CHECK(std::is_sorted(w.active_bodies.begin(), w.active_bodies.end()));
+    for (int j = 0; j < nj; ++j) { // impulse joints: exactly those with an active end
+      const BallJoint &jt     = scene.joints[j];
+      const bool       active = (jt.body_a != kWorld && w.body_active[jt.body_a]) || (jt.body_b != kWorld && w.body_active[jt.body_b]);
+      CHECK(std::count(w.impulse_joints.begin(), w.impulse_joints.end(), j) == (active ? 1 : 0));
+    }
+    CHECK(w.body_active[nb - 1] == (p == 0));
+  }
+  for (int i = 0; i < nb; ++i) CHECK(counted[i] == 1);
+  for (int j = 0; j < nj; ++j) CHECK(owned[j] == 1);
+  CHECK_THROWS_AS(split_articulated_work(scene, std::vector<int>(nj - 1, 0), 0), std::invalid_argument);
 }
