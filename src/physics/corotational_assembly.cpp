@@ -69,6 +69,30 @@ void reset_block_values(const BlockPattern &pattern, std::vector<double> &values
 
 namespace {
 
+// Elements are processed in chunks: the rotations of a chunk first (batched, see
+// rotations_from_deformations), then the chunk's blocks and forces.
+constexpr size_t kRotationChunk = 64;
+
+// R[j] for elements[j], j < n (at most kRotationChunk): the rotation of the corner deformation
+// gradient F = Ds Dm^-1, or I for plain linear elasticity.
+void element_rotations(const FemModel &model, const int *elements, size_t n, const double *x, Eigen::Matrix3d *R)
+{
+  using Vec3 = Eigen::Vector3d;
+  if (!model.settings.corotational) {
+    for (size_t j = 0; j < n; ++j) R[j].setIdentity();
+    return;
+  }
+  Eigen::Matrix3d F[kRotationChunk];
+  const int       npe = model.npe;
+  for (size_t j = 0; j < n; ++j) {
+    const int      *nodes = &model.mesh.elements[static_cast<size_t>(elements[j]) * npe];
+    Eigen::Matrix3d Ds;
+    for (int k = 0; k < 3; ++k) Ds.col(k) = Vec3::Map(x + 3 * nodes[k + 1]) - Vec3::Map(x + 3 * nodes[0]);
+    F[j].noalias() = Ds * model.rest_shape_inverse[elements[j]];
+  }
+  rotations_from_deformations(F, R, n);
+}
+
 template <int N>
 void assemble_kernel(const FemModel &model, const std::vector<int> &elements, const double *x, const double *v,
                      const StepCoefficients &c, const BlockPattern *pattern, double *values, double *rhs,
@@ -82,16 +106,14 @@ void assemble_kernel(const FemModel &model, const std::vector<int> &elements, co
   const bool    corotational = model.settings.corotational;
   const bool    mass_damping = c.mass_rhs != 0;
   const Eigen::Matrix<double, N, N> Mref = model.reference_mass;
+  Mat3 chunk_rotations[kRotationChunk];
   for (size_t i = 0; i < elements.size(); ++i) {
+    if (i % kRotationChunk == 0)
+      element_rotations(model, &elements[i], std::min(kRotationChunk, elements.size() - i), x, chunk_rotations);
     const int     e     = elements[i];
     const int    *nodes = &model.mesh.elements[static_cast<size_t>(e) * N];
     const double *K0    = &model.stiffness[static_cast<size_t>(e) * NB * 9];
-    Mat3          R     = Mat3::Identity();
-    if (corotational) {
-      Mat3 Ds;
-      for (int k = 0; k < 3; ++k) Ds.col(k) = Vec3::Map(x + 3 * nodes[k + 1]) - Vec3::Map(x + 3 * nodes[0]);
-      R = rotation_from_deformation(Ds * model.rest_shape_inverse[e]);
-    }
+    const Mat3    R     = chunk_rotations[i % kRotationChunk];
     if (rotations) rotations[i] = R;
     // z = a_f (R^T x - X) + a_K R^T v, so that rhs_a = -R sum_b K0_ab z_b in one product with K0.
     Vec3 z[N], s[N];
@@ -146,20 +168,17 @@ void assemble_kernel_p1(const FemModel &model, const std::vector<int> &elements,
   using Mat3                 = Eigen::Matrix3d;
   using RowMat3              = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
   const double *X            = model.mesh.nodes.data();
-  const bool    corotational = model.settings.corotational;
   const double  lambda = model.lame.lambda, mu = model.lame.mu;
   const double  mass_per_node = 0.25; // lumped: reference_mass = I / 4
+  Mat3 chunk_rotations[kRotationChunk];
   for (size_t i = 0; i < elements.size(); ++i) {
+    if (i % kRotationChunk == 0)
+      element_rotations(model, &elements[i], std::min(kRotationChunk, elements.size() - i), x, chunk_rotations);
     const int     e     = elements[i];
     const int    *nodes = &model.mesh.elements[static_cast<size_t>(e) * 4];
     const double *grad  = &model.gradients[static_cast<size_t>(e) * 12];
     const double  vol   = model.volume[e];
-    Mat3          R     = Mat3::Identity();
-    if (corotational) {
-      Mat3 Ds;
-      for (int k = 0; k < 3; ++k) Ds.col(k) = Vec3::Map(x + 3 * nodes[k + 1]) - Vec3::Map(x + 3 * nodes[0]);
-      R = rotation_from_deformation(Ds * model.rest_shape_inverse[e]);
-    }
+    const Mat3    R     = chunk_rotations[i % kRotationChunk];
     if (rotations) rotations[i] = R;
     Vec3 g[4];
     for (int a = 0; a < 4; ++a) g[a] = Vec3::Map(grad + 3 * a);

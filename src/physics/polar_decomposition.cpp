@@ -3,7 +3,9 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace physics {
 
@@ -61,6 +63,88 @@ Eigen::Matrix3d rotation_from_deformation(const Eigen::Matrix3d &F)
   }
   const Mat3 R = rotation_by_svd(F / std::sqrt(scale2));
   return R.allFinite() ? R : Mat3::Identity();
+}
+
+void rotations_from_deformations(const Eigen::Matrix3d *F, Eigen::Matrix3d *R, std::size_t n)
+{
+  // The Newton iteration above, run on kLanes matrices side by side (structure of arrays, Eigen
+  // packets across the lanes). One call is a serial chain of latencies (division, square roots,
+  // reductions); lanes side by side overlap those chains. Each lane follows the scalar iteration step
+  // for step; it stops where the scalar one would (its result is kept and the lane is set to the
+  // identity, which stays put, until the other lanes are done). Lanes that start inverted or flat or
+  // fail the final check take the scalar path, which ends in the SVD.
+  constexpr int kLanes = 8;
+  using Lanes          = Eigen::Array<double, kLanes, 1>;
+  Lanes X[9], C[9], det;
+  auto  cofactor = [&] { // X column-major (X[0..2] its first column); cof(X) = (x1 x x2, x2 x x0, x0 x x1)
+    C[0] = X[4] * X[8] - X[5] * X[7];
+    C[1] = X[5] * X[6] - X[3] * X[8];
+    C[2] = X[3] * X[7] - X[4] * X[6];
+    C[3] = X[7] * X[2] - X[8] * X[1];
+    C[4] = X[8] * X[0] - X[6] * X[2];
+    C[5] = X[6] * X[1] - X[7] * X[0];
+    C[6] = X[1] * X[5] - X[2] * X[4];
+    C[7] = X[2] * X[3] - X[0] * X[5];
+    C[8] = X[0] * X[4] - X[1] * X[3];
+    det  = X[0] * C[0] + X[1] * C[1] + X[2] * C[2];
+  };
+  auto set_identity = [&](int l) {
+    for (int j = 0; j < 9; ++j) X[j][l] = j % 4 == 0 ? 1.0 : 0.0;
+  };
+  for (std::size_t start = 0; start < n; start += kLanes) {
+    const int m = static_cast<int>(std::min<std::size_t>(kLanes, n - start));
+    Lanes     scale2 = Lanes::Zero();
+    for (int l = 0; l < kLanes; ++l) { // lanes past the end hold the identity
+      if (l < m)
+        for (int j = 0; j < 9; ++j) X[j][l] = F[start + l].data()[j];
+      else set_identity(l);
+    }
+    for (int j = 0; j < 9; ++j) scale2 += X[j].square();
+    unsigned pending = 0, newton = 0; // lanes still iterating; lanes whose Newton result is in R
+    for (int l = 0; l < kLanes; ++l) {
+      if (l < m && scale2[l] > 0 && std::isfinite(scale2[l])) pending |= 1u << l;
+      else scale2[l] = 3.0, set_identity(l);
+    }
+    // Scaled to Frobenius norm sqrt 3, as in the scalar path.
+    const Lanes k = (3.0 / scale2).sqrt();
+    for (int j = 0; j < 9; ++j) X[j] *= k;
+    cofactor();
+    for (int l = 0; l < kLanes; ++l)
+      if ((pending >> l & 1) && !(det[l] > 5.2e-6)) pending &= ~(1u << l), set_identity(l);
+    cofactor();
+    // The first step with Higham's scaling g = (|cof X| / (sqrt 3 det))^(1/2), then plain steps.
+    Lanes c2 = Lanes::Zero();
+    for (int j = 0; j < 9; ++j) c2 += C[j].square();
+    const Lanes g = (c2 / (det * det * 3.0)).sqrt().sqrt();
+    Lanes       a = 0.5 * g, b = 0.5 / (g * det);
+    for (int it = 0; it < 30 && pending; ++it) {
+      Lanes change = Lanes::Zero();
+      for (int j = 0; j < 9; ++j) {
+        const Lanes next = a * X[j] + b * C[j];
+        change += (next - X[j]).square();
+        X[j] = next;
+      }
+      cofactor();
+      // The scalar path stops once a step changed X by < 1e-7, or when det is no longer positive,
+      // or after 30 steps, and then checks det(X) = 1 and X finite. The mask is built without
+      // branches: which lanes stop in which step is unpredictable.
+      unsigned stopping = 0;
+      for (int l = 0; l < kLanes; ++l) stopping |= static_cast<unsigned>((change[l] < 1e-14) | !(det[l] > 0)) << l;
+      stopping = it == 29 ? pending : stopping & pending;
+      pending &= ~stopping;
+      for (; stopping; stopping &= stopping - 1) {
+        const int l   = __builtin_ctz(stopping);
+        double    sum = 0;
+        for (int j = 0; j < 9; ++j) sum += (R[start + l].data()[j] = X[j][l]);
+        if (std::isfinite(sum) && std::fabs(det[l] - 1.0) < 1e-8) newton |= 1u << l;
+        set_identity(l);
+      }
+      a = 0.5;
+      b = 0.5 / det;
+    }
+    for (int l = 0; l < m; ++l)
+      if (!(newton >> l & 1)) R[start + l] = rotation_from_deformation(F[start + l]);
+  }
 }
 
 } // namespace physics

@@ -8,7 +8,9 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <random>
 
@@ -107,6 +109,67 @@ TEST_CASE("polar decomposition agrees with the SVD polar factor on random F, nea
     if (k > -10) CHECK((R - previous).norm() < 1e-9);
     previous = R;
   }
+}
+
+TEST_CASE("batched polar decomposition: the scalar path's rotations, special lanes mixed into batches", "[fem][polar]")
+{
+  std::mt19937                           rng(5);
+  std::normal_distribution<double>       normal(0, 1);
+  std::uniform_real_distribution<double> uniform(0, 1);
+  auto random_rotation = [&] {
+    Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
+    return q.normalized().toRotationMatrix();
+  };
+  std::vector<Eigen::Matrix3d> F, polar; // polar: U V^T where known (zero: no reference)
+  for (int k = 0; k < 2000; ++k) {
+    const double    spread = std::pow(10.0, -6 + 6 * uniform(rng));
+    Eigen::Vector3d s;
+    for (int d = 0; d < 3; ++d) s[d] = std::max(0.05, 1 + spread * normal(rng));
+    const Eigen::Matrix3d U = random_rotation(), V = random_rotation();
+    F.push_back(std::pow(10.0, -3 + 6 * uniform(rng)) * U * s.asDiagonal() * V.transpose());
+    polar.push_back(U * V.transpose());
+  }
+  // Through inversion (the smallest singular value from +1e-3 to -1e-3): sign-corrected SVD.
+  const Eigen::Matrix3d U = random_rotation(), V = random_rotation();
+  for (int k = -10; k <= 10; ++k) {
+    F.push_back(U * Eigen::Vector3d(1.2, 0.9, 1e-4 * k).asDiagonal() * V.transpose());
+    polar.push_back(U * V.transpose());
+  }
+  // Strongly inverted, flat, collapsed, zero, non-finite: compared with the scalar path only.
+  const Eigen::Matrix3d Q = some_rotation();
+  Eigen::Matrix3d       nan = Eigen::Matrix3d::Identity(), inf = Eigen::Matrix3d::Identity();
+  nan(1, 2)               = std::nan("");
+  inf(0, 1)               = std::numeric_limits<double>::infinity();
+  for (const Eigen::Matrix3d &special :
+       {Eigen::Matrix3d(-Q), Eigen::Matrix3d(Q * Eigen::DiagonalMatrix<double, 3>(1.0, 1.0, -0.2)),
+        Eigen::Matrix3d(Q * Eigen::DiagonalMatrix<double, 3>(1.0, 2.0, 0.0)),
+        Eigen::Matrix3d(Q * Eigen::DiagonalMatrix<double, 3>(1.0, 0.0, 0.0)), Eigen::Matrix3d(Eigen::Matrix3d::Zero()), nan, inf}) {
+    F.push_back(special);
+    polar.push_back(Eigen::Matrix3d::Zero());
+  }
+  // Mix the special matrices into batches of regular ones; 2028 is not a multiple of the lane count.
+  std::vector<size_t> order(F.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::shuffle(order.begin(), order.end(), rng);
+  std::vector<Eigen::Matrix3d> F_mixed, polar_mixed;
+  for (size_t i : order) F_mixed.push_back(F[i]), polar_mixed.push_back(polar[i]);
+  for (size_t n : {F_mixed.size(), size_t(13), size_t(1)}) {
+    std::vector<Eigen::Matrix3d> R(n);
+    rotations_from_deformations(F_mixed.data(), R.data(), n);
+    double worst_scalar = 0, worst_polar = 0;
+    for (size_t i = 0; i < n; ++i) {
+      REQUIRE(is_rotation(R[i]));
+      worst_scalar = std::max(worst_scalar, (R[i] - rotation_from_deformation(F_mixed[i])).norm());
+      if (polar_mixed[i].squaredNorm() > 0) worst_polar = std::max(worst_polar, (R[i] - polar_mixed[i]).norm());
+    }
+    CHECK(worst_scalar < 1e-14);
+    CHECK(worst_polar < 1e-9); // the inversion sweep's tolerance; regular F below
+  }
+  std::vector<Eigen::Matrix3d> R(2000);
+  rotations_from_deformations(F.data(), R.data(), 2000);
+  double worst = 0;
+  for (int i = 0; i < 2000; ++i) worst = std::max(worst, (R[i] - polar[i]).norm());
+  CHECK(worst < 1e-12);
 }
 
 TEST_CASE("P2 shape functions integrate to -V/20 (corners) and V/5 (edges); masses positive", "[fem][mass]")
