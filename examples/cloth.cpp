@@ -145,16 +145,20 @@ int main(int argc, char **argv)
     nan_steps += !finite;
     unconverged += !r.converged;
     contacts += r.contacts;
-    max_stretch = std::max(max_stretch, r.max_stretch);
-    if (step % out.progress_every == 0 || step == out.steps)
+    max_stretch = std::max(max_stretch, r.max_stretch); // this rank's springs: reduced where printed
+    if (step % out.progress_every == 0 || step == out.steps) {
+      double stretch = r.max_stretch;
+      PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &stretch, 1, MPI_DOUBLE, MPI_MAX, comm));
       PetscCall(PetscPrintf(comm, "step %" PetscInt_FMT " t=%.4f cg_its=%lld stretch=%.5f contacts=%d energy=%.6e ms=%.2f solve_ms=%.2f%s\n", step, step * params.dt,
-                            rs.iterations - its0, r.max_stretch, r.contacts, physics::cloth_energy(cloth), step_ms, rs.solve_ms - solve0,
+                            rs.iterations - its0, stretch, r.contacts, physics::cloth_energy(cloth), step_ms, rs.solve_ms - solve0,
                             r.converged ? "" : " UNCONVERGED"));
+    }
     if (step == 1 && out.dump) PetscCall(BlockSystemDumpMatrix(&rs.sys, out.dump_path));
     PetscCall(write_frame(step));
     if (!finite) break;
   }
 
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &max_stretch, 1, MPI_DOUBLE, MPI_MAX, comm));
   double ke = 0;
   for (int p = 0; p < cloth.particle_count(); ++p) ke += 0.5 * cloth.mass[p] * cloth.velocity[p].squaredNorm();
   SummaryLine s;

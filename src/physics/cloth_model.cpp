@@ -86,4 +86,14 @@ double max_stretch_ratio(const Cloth &c)
   return worst;
 }
 
+double max_stretch_ratio(const Cloth &c, const std::vector<int> &springs)
+{
+  double worst = 0;
+  for (int k : springs) {
+    const Spring &s = c.springs[k];
+    worst           = std::max(worst, (c.position[s.b] - c.position[s.a]).norm() / s.rest_length);
+  }
+  return worst;
+}
+
 } // namespace physics

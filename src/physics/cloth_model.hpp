@@ -59,5 +59,7 @@ double cloth_energy(const Cloth &cloth);
 
 // Largest length / rest length over the stretch springs (1 = unstretched).
 double max_stretch_ratio(const Cloth &cloth);
+// The same over the listed springs (indices into cloth.springs), e.g. the stretch springs one process assembles.
+double max_stretch_ratio(const Cloth &cloth, const std::vector<int> &springs);
 
 } // namespace physics

@@ -2,6 +2,7 @@
 
 #include "physics/cloth_springs.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -32,6 +33,7 @@ ClothSystem make_cloth_system(const Cloth &cloth, const std::vector<char> &own, 
     const Spring &sp = cloth.springs[k];
     if (!own[sp.a] && !own[sp.b]) continue;
     s.springs.push_back((int)k);
+    if (sp.kind == SpringKind::Stretch) s.stretch_springs.push_back((int)k);
     s.block_ab.push_back(list(sp.a, sp.b));
     s.block_ba.push_back(list(sp.b, sp.a));
   }
@@ -47,9 +49,47 @@ std::string validate_params(const ClothParams &p)
   return "";
 }
 
+namespace {
+
+// One spring's share of the system: its block alpha I + beta d d^T on both diagonal blocks and (negated)
+// on its off-diagonal blocks that are listed (ab, ba: COO block indices or -1), and h f - h^2 K dv to the
+// right-hand side of its assembled ends.
+inline void add_spring(const Cloth &cloth, ClothSystem &sys, const Spring &sp, const SpringTerms &t, double h, int block_ab, int block_ba)
+{
+  const double h2 = h * h;
+  // The spring's block of M + h D + h^2 K: alpha I + beta d d^T (symmetric).
+  const double           alpha = h2 * t.k_iso, beta = h2 * t.k_dir + h * t.damping;
+  const Eigen::Vector3d &d     = t.direction;
+  double                 block[9]; // computed once per pair and mirrored: exactly symmetric, so a
+  for (int r = 0; r < 3; ++r)      // type that keeps one triangle sees the same matrix as one keeping both
+    for (int c = r; c < 3; ++c) block[3 * r + c] = block[3 * c + r] = beta * d[r] * d[c] + (r == c ? alpha : 0.0);
+  // The spring's K acts on dv_a - dv_b; a pinned end has dv = 0, so its row, column and rhs stay out.
+  // An end whose row is assembled elsewhere (diagonal_block < 0) is skipped the same way here.
+  const bool   fa = cloth.fixed[sp.a], fb = cloth.fixed[sp.b];
+  const int    ia = fa ? -1 : sys.diagonal_block[sp.a], ib = fb ? -1 : sys.diagonal_block[sp.b];
+  const double coupling = !fa && !fb ? -1.0 : 0.0;
+  double      *ab = block_ab < 0 ? nullptr : &sys.block_values[9 * block_ab];
+  double      *ba = block_ba < 0 ? nullptr : &sys.block_values[9 * block_ba];
+  for (int k = 0; k < 9; ++k) {
+    if (ia >= 0) sys.block_values[9 * ia + k] += block[k];
+    if (ib >= 0) sys.block_values[9 * ib + k] += block[k];
+    if (ab) ab[k] = coupling * block[k];
+    if (ba) ba[k] = coupling * block[k];
+  }
+  // h f_a - h^2 K (v_a - v_b), K = k_iso I + k_dir d d^T
+  const Eigen::Vector3d dvel    = cloth.velocity[sp.a] - cloth.velocity[sp.b];
+  const Eigen::Vector3d fa_term = h * t.force_on_a - h2 * (t.k_iso * dvel + t.k_dir * d.dot(dvel) * d);
+  for (int k = 0; k < 3; ++k) {
+    if (ia >= 0) sys.rhs[3 * sp.a + k] += fa_term[k];
+    if (ib >= 0) sys.rhs[3 * sp.b + k] -= fa_term[k];
+  }
+}
+
+} // namespace
+
 void assemble_cloth_system(const Cloth &cloth, const ClothParams &params, ClothSystem &sys)
 {
-  const double h = params.dt, h2 = h * h;
+  const double h = params.dt;
   // rhs = h (f - h K v), built as h m g first, then spring by spring. Diagonal blocks start at M and
   // accumulate; every off-diagonal block belongs to one spring and is written once (no clearing pass).
   for (int p = 0; p < sys.n_particles; ++p) {
@@ -59,35 +99,19 @@ void assemble_cloth_system(const Cloth &cloth, const ClothParams &params, ClothS
     d[0] = d[4] = d[8] = cloth.mass[p];
     for (int k = 0; k < 3; ++k) sys.rhs[3 * p + k] = h * cloth.mass[p] * cloth.gravity[k];
   }
-  for (size_t s = 0; s < sys.springs.size(); ++s) {
-    const Spring     &sp = cloth.springs[sys.springs[s]];
-    const SpringTerms t  = spring_terms(sp, cloth.position[sp.a], cloth.position[sp.b], cloth.velocity[sp.a], cloth.velocity[sp.b], cloth.damping, params.choi_ko);
-    // The spring's block of M + h D + h^2 K: alpha I + beta d d^T (symmetric).
-    const double           alpha = h2 * t.k_iso, beta = h2 * t.k_dir + h * t.damping;
-    const Eigen::Vector3d &d     = t.direction;
-    double                 block[9]; // computed once per pair and mirrored: exactly symmetric, so a
-    for (int r = 0; r < 3; ++r)      // type that keeps one triangle sees the same matrix as one keeping both
-      for (int c = r; c < 3; ++c) block[3 * r + c] = block[3 * c + r] = beta * d[r] * d[c] + (r == c ? alpha : 0.0);
-    // The spring's K acts on dv_a - dv_b; a pinned end has dv = 0, so its row, column and rhs stay out.
-    // An end whose row is assembled elsewhere (diagonal_block < 0) is skipped the same way here.
-    const bool   fa = cloth.fixed[sp.a], fb = cloth.fixed[sp.b];
-    const int    ia = fa ? -1 : sys.diagonal_block[sp.a], ib = fb ? -1 : sys.diagonal_block[sp.b];
-    const double coupling = !fa && !fb ? -1.0 : 0.0;
-    double      *ab = sys.block_ab[s] < 0 ? nullptr : &sys.block_values[9 * sys.block_ab[s]];
-    double      *ba = sys.block_ba[s] < 0 ? nullptr : &sys.block_values[9 * sys.block_ba[s]];
-    for (int k = 0; k < 9; ++k) {
-      if (ia >= 0) sys.block_values[9 * ia + k] += block[k];
-      if (ib >= 0) sys.block_values[9 * ib + k] += block[k];
-      if (ab) ab[k] = coupling * block[k];
-      if (ba) ba[k] = coupling * block[k];
+  // Springs go in chunks: first every spring's terms (square root and divisions, independent from spring to
+  // spring, so they overlap), then the sums into blocks and right-hand side. In one pass the stores of one
+  // spring stood between the loads of the next and the loop ran at the latency of the square root (10% slower).
+  constexpr size_t chunk = 64;
+  SpringTerms      terms[chunk];
+  for (size_t s0 = 0; s0 < sys.springs.size(); s0 += chunk) {
+    const size_t s1 = std::min(sys.springs.size(), s0 + chunk);
+    for (size_t s = s0; s < s1; ++s) {
+      const Spring &sp = cloth.springs[sys.springs[s]];
+      terms[s - s0]    = spring_terms(sp, cloth.position[sp.a], cloth.position[sp.b], cloth.velocity[sp.a], cloth.velocity[sp.b], cloth.damping, params.choi_ko);
     }
-    // h f_a - h^2 K (v_a - v_b), K = k_iso I + k_dir d d^T
-    const Eigen::Vector3d dvel    = cloth.velocity[sp.a] - cloth.velocity[sp.b];
-    const Eigen::Vector3d fa_term = h * t.force_on_a - h2 * (t.k_iso * dvel + t.k_dir * d.dot(dvel) * d);
-    for (int k = 0; k < 3; ++k) {
-      if (ia >= 0) sys.rhs[3 * sp.a + k] += fa_term[k];
-      if (ib >= 0) sys.rhs[3 * sp.b + k] -= fa_term[k];
-    }
+    for (size_t s = s0; s < s1; ++s)
+      add_spring(cloth, sys, cloth.springs[sys.springs[s]], terms[s - s0], h, sys.block_ab[s], sys.block_ba[s]);
   }
   for (int p = 0; p < sys.n_particles; ++p)
     if (cloth.fixed[p])
@@ -133,7 +157,7 @@ ClothStepReport cloth_step(Cloth &cloth, ClothSystem &sys, const ClothParams &pa
       }
     }
   }
-  report.max_stretch = max_stretch_ratio(cloth);
+  report.max_stretch = max_stretch_ratio(cloth, sys.stretch_springs);
   return report;
 }
 

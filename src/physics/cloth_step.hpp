@@ -28,6 +28,7 @@ struct ClothSystem {
   std::vector<int>    block_row, block_col;   // the COO list: own particles' diagonal blocks, then the kept spring blocks
   std::vector<int>    diagonal_block;         // per particle: its diagonal block, -1 when its row is not assembled here
   std::vector<int>    springs;                // springs with at least one end in an assembled row
+  std::vector<int>    stretch_springs;        // those of them along grid edges (for the stretch check)
   std::vector<int>    block_ab, block_ba;     // per listed spring: block of (a, b) and of (b, a), -1 when not listed
   std::vector<double> block_values, rhs, dv;  // rhs: 3 per particle, meaningful in assembled rows only
 };
@@ -36,7 +37,7 @@ struct ClothStepReport {
   bool   converged  = true;
   bool   breakdown  = false;
   int    contacts   = 0; // particles projected out of the sphere
-  double max_stretch = 0;
+  double max_stretch = 0; // over the stretch springs this process assembles (all of them on one process)
 };
 
 // Every row, both triangles.
