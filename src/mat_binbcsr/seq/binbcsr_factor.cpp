@@ -153,27 +153,31 @@ void WrapNumeric(Mat F, FactorShadow *f)
   }
 }
 
-PetscErrorCode CholeskyNumeric(Mat F, Mat A, const MatFactorInfo *info)
+/* Both numeric factorisations: refill the shadow, run PETSc's kernel on it, keep the routing. */
+template <class Numeric>
+PetscErrorCode ShadowNumeric(Mat F, Mat A, Numeric &&numeric)
 {
   FactorShadow *f;
 
   PetscFunctionBegin;
   PetscCall(GetShadow(F, &f));
   PetscCall(RefillShadow(A, f));
-  PetscCall((*f->choleskynumeric)(F, f->S, info));
+  PetscCall(numeric(f));
   WrapNumeric(F, f);
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode CholeskyNumeric(Mat F, Mat A, const MatFactorInfo *info)
+{
+  PetscFunctionBegin;
+  PetscCall(ShadowNumeric(F, A, [&](FactorShadow *f) { return (*f->choleskynumeric)(F, f->S, info); }));
   PetscFunctionReturn(0);
 }
 
 PetscErrorCode LUNumeric(Mat F, Mat A, const MatFactorInfo *info)
 {
-  FactorShadow *f;
-
   PetscFunctionBegin;
-  PetscCall(GetShadow(F, &f));
-  PetscCall(RefillShadow(A, f));
-  PetscCall((*f->lunumeric)(F, f->S, info));
-  WrapNumeric(F, f);
+  PetscCall(ShadowNumeric(F, A, [&](FactorShadow *f) { return (*f->lunumeric)(F, f->S, info); }));
   PetscFunctionReturn(0);
 }
 
@@ -191,7 +195,10 @@ PetscErrorCode ShadowOrdering(FactorShadow *f, IS row, IS col, IS *rperm, IS *cp
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode ICCSymbolic(Mat F, Mat A, IS perm, const MatFactorInfo *info)
+/* The four symbolic factorisations: refill the shadow, translate the ordering to it, run PETSc's
+   routine on it, and route the numeric kernel that routine chose back through the shadow. */
+template <class Symbolic>
+PetscErrorCode ShadowSymbolic(Mat F, Mat A, IS row, IS col, Symbolic &&symbolic)
 {
   FactorShadow *f;
   IS            r, c;
@@ -199,59 +206,39 @@ PetscErrorCode ICCSymbolic(Mat F, Mat A, IS perm, const MatFactorInfo *info)
   PetscFunctionBegin;
   PetscCall(GetShadow(F, &f));
   PetscCall(RefillShadow(A, f));
-  PetscCall(ShadowOrdering(f, perm, nullptr, &r, &c));
-  PetscCall((*f->iccsymbolic)(F, f->S, r, info));
+  PetscCall(ShadowOrdering(f, row, col, &r, &c));
+  PetscCall(symbolic(f, r, c));
   PetscCall(ISDestroy(&r));
   PetscCall(ISDestroy(&c));
   WrapNumeric(F, f);
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ICCSymbolic(Mat F, Mat A, IS perm, const MatFactorInfo *info)
+{
+  PetscFunctionBegin;
+  PetscCall(ShadowSymbolic(F, A, perm, nullptr, [&](FactorShadow *f, IS r, IS) { return (*f->iccsymbolic)(F, f->S, r, info); }));
   PetscFunctionReturn(0);
 }
 
 PetscErrorCode CholeskySymbolic(Mat F, Mat A, IS perm, const MatFactorInfo *info)
 {
-  FactorShadow *f;
-  IS            r, c;
-
   PetscFunctionBegin;
-  PetscCall(GetShadow(F, &f));
-  PetscCall(RefillShadow(A, f));
-  PetscCall(ShadowOrdering(f, perm, nullptr, &r, &c));
-  PetscCall((*f->choleskysymbolic)(F, f->S, r, info));
-  PetscCall(ISDestroy(&r));
-  PetscCall(ISDestroy(&c));
-  WrapNumeric(F, f);
+  PetscCall(ShadowSymbolic(F, A, perm, nullptr, [&](FactorShadow *f, IS r, IS) { return (*f->choleskysymbolic)(F, f->S, r, info); }));
   PetscFunctionReturn(0);
 }
 
 PetscErrorCode ILUSymbolic(Mat F, Mat A, IS row, IS col, const MatFactorInfo *info)
 {
-  FactorShadow *f;
-  IS            r, c;
-
   PetscFunctionBegin;
-  PetscCall(GetShadow(F, &f));
-  PetscCall(RefillShadow(A, f));
-  PetscCall(ShadowOrdering(f, row, col, &r, &c));
-  PetscCall((*f->ilusymbolic)(F, f->S, r, c, info));
-  PetscCall(ISDestroy(&r));
-  PetscCall(ISDestroy(&c));
-  WrapNumeric(F, f);
+  PetscCall(ShadowSymbolic(F, A, row, col, [&](FactorShadow *f, IS r, IS c) { return (*f->ilusymbolic)(F, f->S, r, c, info); }));
   PetscFunctionReturn(0);
 }
 
 PetscErrorCode LUSymbolic(Mat F, Mat A, IS row, IS col, const MatFactorInfo *info)
 {
-  FactorShadow *f;
-  IS            r, c;
-
   PetscFunctionBegin;
-  PetscCall(GetShadow(F, &f));
-  PetscCall(RefillShadow(A, f));
-  PetscCall(ShadowOrdering(f, row, col, &r, &c));
-  PetscCall((*f->lusymbolic)(F, f->S, r, c, info));
-  PetscCall(ISDestroy(&r));
-  PetscCall(ISDestroy(&c));
-  WrapNumeric(F, f);
+  PetscCall(ShadowSymbolic(F, A, row, col, [&](FactorShadow *f, IS r, IS c) { return (*f->lusymbolic)(F, f->S, r, c, info); }));
   PetscFunctionReturn(0);
 }
 } // namespace
