@@ -132,6 +132,31 @@ BINBCSR_HD bool unit_stride(const I *c)
   return unit_stride(c, BW);
 }
 
+/* One slot group of sym_bin_mult whose lanes read the consecutive block columns xs, xs + BS, ...:
+   acc += block x_c and, with SCATTER, y_c += block^T x_r, by unit-stride loads and stores. The
+   branch is a template argument: a run-time test inside the lane loop stops GCC from vectorising it. */
+template <int BS, int BW, typename V, bool SCATTER>
+BINBCSR_HD void sym_unit_group_mult(const V *t, const double *xs, const double (*xr)[BW], double *ys, double (*acc)[BW])
+{
+  constexpr int BS2 = BS * BS;
+#pragma omp simd
+  for (int l = 0; l < BW; l++) {
+    double v[BS2];
+    for (int e = 0; e < BS2; e++) v[e] = (double)t[e * BW + l];
+    for (int i = 0; i < BS; i++) {
+      double s = acc[i][l];
+      for (int j = 0; j < BS; j++) s += v[i * BS + j] * xs[l * BS + j];
+      acc[i][l] = s;
+    }
+    if constexpr (SCATTER)
+      for (int j = 0; j < BS; j++) {
+        double s = 0.0;
+        for (int i = 0; i < BS; i++) s += v[i * BS + j] * xr[i][l];
+        ys[l * BS + j] += s;
+      }
+  }
+}
+
 /* The same for a whole bin of BW lanes (BW, BS compile-time), lanes in lock step per slot: the lane
    loop is the SIMD loop. Gathers x_c, fused multiply-adds into BS accumulators per lane, and a masked
    scatter-add of block^T x_r into y_c (conflict-free by the colouring). Lanes whose row is >= mbs are
@@ -157,36 +182,9 @@ BINBCSR_HD void sym_bin_mult(const V *bin_val, const I *bin_col, int len, I r0, 
     prefetch_values(t, BW * BS2 * (int)sizeof(V));
     if (unit_stride<BW>(c)) { /* contiguous x_c and y_c: plain loads and stores instead of gathers and scatters */
       const I c0 = c[0];
-      const double *xs = x + (long)c0 * BS;
-      double       *ys = y + (long)c0 * BS;
-      if (c0 == r0) { /* the diagonal blocks or padding of every lane: nothing to scatter */
-#pragma omp simd
-        for (int l = 0; l < BW; l++) {
-          double v[BS2];
-          for (int e = 0; e < BS2; e++) v[e] = (double)t[e * BW + l];
-          for (int i = 0; i < BS; i++) {
-            double s = acc[i][l];
-            for (int j = 0; j < BS; j++) s += v[i * BS + j] * xs[l * BS + j];
-            acc[i][l] = s;
-          }
-        }
-      } else {
-#pragma omp simd
-        for (int l = 0; l < BW; l++) {
-          double v[BS2];
-          for (int e = 0; e < BS2; e++) v[e] = (double)t[e * BW + l];
-          for (int i = 0; i < BS; i++) {
-            double s = acc[i][l];
-            for (int j = 0; j < BS; j++) s += v[i * BS + j] * xs[l * BS + j];
-            acc[i][l] = s;
-          }
-          for (int j = 0; j < BS; j++) {
-            double s = 0.0;
-            for (int i = 0; i < BS; i++) s += v[i * BS + j] * xr[i][l];
-            ys[l * BS + j] += s;
-          }
-        }
-      }
+      /* c0 == r0: the diagonal blocks or padding of every lane, nothing to scatter */
+      if (c0 == r0) sym_unit_group_mult<BS, BW, V, false>(t, x + (long)c0 * BS, xr, nullptr, acc);
+      else sym_unit_group_mult<BS, BW, V, true>(t, x + (long)c0 * BS, xr, y + (long)c0 * BS, acc);
       continue;
     }
 #pragma omp simd
