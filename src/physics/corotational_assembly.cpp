@@ -52,6 +52,17 @@ BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &e
     }
     p.element_slots[kv.second] = static_cast<int>(p.rows.size()) - 1;
   }
+  // Mark the kernels' first write to each COO block (their loop order: elements, then a <= b, (a,b)
+  // before (b,a)).
+  std::vector<char> written(p.rows.size(), 0);
+  for (size_t i = 0; i < elements.size(); ++i)
+    for (int a = 0; a < npe; ++a)
+      for (int b = a; b < npe; ++b)
+        for (int *s : {&p.element_slots[(i * npe + a) * npe + b], &p.element_slots[(i * npe + b) * npe + a]}) {
+          if (*s < 0 || written[*s & kSlotIndexMask]) continue; // (a == b: the same entry twice)
+          written[*s] = 1;
+          *s |= kFirstContribution;
+        }
   for (int v = owned_begin; v < owned_end; ++v)
     if (fixed[v]) {
       p.identity_slots.push_back(static_cast<int>(p.rows.size()));
@@ -63,11 +74,22 @@ BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &e
 
 void reset_block_values(const BlockPattern &pattern, std::vector<double> &values)
 {
-  values.assign(9 * pattern.rows.size(), 0.0);
-  for (int s : pattern.identity_slots) values[9 * s] = values[9 * s + 4] = values[9 * s + 8] = 1.0;
+  values.resize(9 * pattern.rows.size());
+  for (int s : pattern.identity_slots)
+    for (int k = 0; k < 9; ++k) values[9 * static_cast<size_t>(s) + k] = k % 4 == 0 ? 1.0 : 0.0;
 }
 
 namespace {
+
+// Adds B (a 3x3 expression) into the row-major block of element slot s, or stores it where s is the
+// first write to that block.
+template <typename Block>
+inline void write_block(double *values, int s, const Block &B)
+{
+  Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> out(values + 9 * static_cast<size_t>(s & kSlotIndexMask));
+  if (s & kFirstContribution) out = B;
+  else out += B;
+}
 
 // Elements are processed in chunks: the rotations of a chunk first (batched, see
 // rotations_from_deformations), then the chunk's blocks and forces.
@@ -100,7 +122,6 @@ void assemble_kernel(const FemModel &model, const std::vector<int> &elements, co
 {
   using Vec3                 = Eigen::Vector3d;
   using Mat3                 = Eigen::Matrix3d;
-  using RowMat3              = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
   constexpr int NB           = packed_block_count(N);
   const double *X            = model.mesh.nodes.data();
   const bool    corotational = model.settings.corotational;
@@ -143,8 +164,8 @@ void assemble_kernel(const FemModel &model, const std::vector<int> &elements, co
         B.diagonal().array() += c.mass_matrix * mass * Mref(a, b);
         // Stored row-major: the Map of a row-major matrix over the slot takes B as is. One of the
         // pair may be a lower block the matrix does not store (-1).
-        if (sab >= 0) Eigen::Map<RowMat3>(values + 9 * static_cast<size_t>(sab)) += B;
-        if (b != a && sba >= 0) Eigen::Map<RowMat3>(values + 9 * static_cast<size_t>(sba)) += B.transpose();
+        if (sab >= 0) write_block(values, sab, B);
+        if (b != a && sba >= 0) write_block(values, sba, B.transpose());
       }
     for (int a = 0; a < N; ++a) {
       Vec3 r = -(R * s[a]);
@@ -166,7 +187,6 @@ void assemble_kernel_p1(const FemModel &model, const std::vector<int> &elements,
 {
   using Vec3                 = Eigen::Vector3d;
   using Mat3                 = Eigen::Matrix3d;
-  using RowMat3              = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
   const double *X            = model.mesh.nodes.data();
   const double  lambda = model.lame.lambda, mu = model.lame.mu;
   const double  mass_per_node = 0.25; // lumped: reference_mass = I / 4
@@ -208,8 +228,8 @@ void assemble_kernel_p1(const FemModel &model, const std::vector<int> &elements,
         if (sab < 0 && sba < 0) continue;
         Mat3 B = (kv * lambda) * rg[a] * rg[b].transpose() + (kv * mu) * rg[b] * rg[a].transpose();
         B.diagonal().array() += kv * mu * g[a].dot(g[b]) + (a == b ? c.mass_matrix * m : 0.0);
-        if (sab >= 0) Eigen::Map<RowMat3>(values + 9 * static_cast<size_t>(sab)) += B;
-        if (b != a && sba >= 0) Eigen::Map<RowMat3>(values + 9 * static_cast<size_t>(sba)) += B.transpose();
+        if (sab >= 0) write_block(values, sab, B);
+        if (b != a && sba >= 0) write_block(values, sba, B.transpose());
       }
   }
 }

@@ -43,10 +43,18 @@ StepCoefficients implicit_euler_coefficients(double dt, double rayleigh_alpha = 
 struct BlockPattern {
   std::vector<int> rows, cols;     // global block indices, one entry per COO block
   std::vector<int> element_slots;  // per listed element npe*npe: COO block of (a,b), -1 if dropped
-                                   // (fixed node, or a lower block the matrix does not store)
+                                   // (fixed node, or a lower block the matrix does not store), with
+                                   // kFirstContribution set on the kernels' first write to the block
   std::vector<int> identity_slots; // COO blocks that hold the identity (fixed nodes)
   bool             merged = false; // element blocks summed into unique COO blocks by the caller
 };
+// Set in an element_slots entry (index = entry & kSlotIndexMask) where the element loop writes that
+// COO block first (elements in list order; per element the pairs a <= b in order, (a,b) before
+// (b,a)): the kernel stores instead of adding there, so the block values need no zeroing each step
+// (the reset pass, and the loads of the first write to each block, cost ~1 ms per rank of linear_38k).
+constexpr int kFirstContribution = 1 << 30;
+constexpr int kSlotIndexMask     = kFirstContribution - 1;
+
 // Blocks below the block diagonal (row > column) that the matrix does not store: sbaij keeps only the
 // upper triangle; binbcsr with symmetric storage keeps the upper triangle of each rank's diagonal part
 // and its off-rank part in full. Dropped blocks get no COO entry and the element loop skips them.
@@ -60,12 +68,14 @@ struct LowerTriangle {
 BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &elements, const std::vector<char> &fixed,
                                 int owned_begin, int owned_end, bool merge_duplicates, const LowerTriangle &lower = {});
 
-// Sets the identity blocks and zeroes all others: call before assemble_elements each step.
+// Sizes block_values for the pattern and sets the identity blocks (fixed nodes), which the element
+// loop does not write. Call before assemble_elements (once is enough while the array is kept).
 void reset_block_values(const BlockPattern &pattern, std::vector<double> &block_values);
 
 // The element loop. x, v: 3 per node (all nodes). rhs: 3 per node, accumulated (+=). block_values:
-// 9 per COO block of `pattern`, accumulated (+=) row-major; may be null (forces only; pattern may
-// then be null too). rotations (optional): one per listed element.
+// 9 per COO block of `pattern`, row-major: every element block is overwritten with the sum of its
+// element contributions (the identity blocks are left as they are); may be null (forces only;
+// pattern may then be null too). rotations (optional): one per listed element.
 void assemble_elements(const FemModel &model, const std::vector<int> &elements, const double *x, const double *v,
                        const StepCoefficients &c, const BlockPattern *pattern, double *block_values, double *rhs,
                        Eigen::Matrix3d *rotations = nullptr);

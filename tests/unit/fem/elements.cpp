@@ -299,6 +299,63 @@ TEST_CASE("P1 fast kernel (rotated gradients) equals the generic K0 kernel", "[f
   CHECK(sr > 0);
 }
 
+TEST_CASE("element loop overwrites the block values: one first write per block, no reset needed", "[fem][kernel]")
+{
+  for (int order : {1, 2})
+    for (bool merge : {true, false})
+      for (bool drop : {false, true}) {
+        INFO("order " << order << " merge " << merge << " drop lower " << drop);
+        const TetMesh  mesh     = jittered_box(order);
+        const FemModel m        = make_fem_model(mesh, FemSettings{});
+        const auto     elements = fem_test::all_elements(m);
+        std::vector<char> fixed(mesh.node_count(), 0);
+        fixed[0] = fixed[5] = 1;
+        LowerTriangle lower;
+        lower.drop           = drop;
+        const BlockPattern p = make_block_pattern(m, elements, fixed, 0, mesh.node_count(), merge, lower);
+        // Every element block has exactly one entry marked as its first write, the earliest one.
+        std::vector<int> firsts(p.rows.size(), 0);
+        for (int s : p.element_slots)
+          if (s >= 0 && (s & kFirstContribution)) ++firsts[s & kSlotIndexMask];
+        for (int s : p.identity_slots) {
+          CHECK(firsts[s] == 0);
+          firsts[s] = 1;
+        }
+        CHECK(std::count(firsts.begin(), firsts.end(), 1) == static_cast<long>(p.rows.size()));
+        std::vector<double> x(mesh.nodes), v(x.size());
+        for (size_t k = 0; k < x.size(); ++k) x[k] *= 1.02, v[k] = std::sin(0.37 * k);
+        const StepCoefficients c = implicit_euler_coefficients(0.02, 0.3, 0.001);
+        std::vector<double>    fresh, rhs(x.size(), 0.0);
+        reset_block_values(p, fresh);
+        assemble_elements(m, elements, x.data(), v.data(), c, &p, fresh.data(), rhs.data());
+        // Garbage in the element blocks, then two assemblies without a reset: the same bits.
+        std::vector<double> reused(fresh.size(), std::nan(""));
+        reset_block_values(p, reused);
+        for (int pass = 0; pass < 2; ++pass) assemble_elements(m, elements, x.data(), v.data(), c, &p, reused.data(), rhs.data());
+        CHECK(reused == fresh);
+        // Against the unmerged assembly (one COO block per element block, nothing shared) summed here.
+        if (merge) {
+          const BlockPattern  u = make_block_pattern(m, elements, fixed, 0, mesh.node_count(), false, lower);
+          std::vector<double> uv, urhs(x.size(), 0.0);
+          reset_block_values(u, uv);
+          assemble_elements(m, elements, x.data(), v.data(), c, &u, uv.data(), urhs.data());
+          std::map<std::pair<int, int>, Eigen::Matrix<double, 9, 1>> sum;
+          for (size_t k = 0; k < u.rows.size(); ++k) {
+            auto it = sum.try_emplace({u.rows[k], u.cols[k]}, Eigen::Matrix<double, 9, 1>::Zero()).first;
+            it->second += Eigen::Matrix<double, 9, 1>::Map(&uv[9 * k]);
+          }
+          REQUIRE(sum.size() == p.rows.size());
+          double diff = 0, scale = 0;
+          for (size_t k = 0; k < p.rows.size(); ++k) {
+            const Eigen::Matrix<double, 9, 1> &ref = sum.at({p.rows[k], p.cols[k]});
+            diff  = std::max(diff, (Eigen::Matrix<double, 9, 1>::Map(&fresh[9 * k]) - ref).cwiseAbs().maxCoeff());
+            scale = std::max(scale, ref.cwiseAbs().maxCoeff());
+          }
+          CHECK(diff <= 1e-13 * scale);
+        }
+      }
+}
+
 TEST_CASE("upper-triangle patterns: kept blocks equal the full assembly's, lower ones dropped", "[fem][kernel]")
 {
   for (int order : {1, 2}) {
