@@ -169,6 +169,7 @@ TEST_CASE("rows assembled in parts, upper triangle only, add up to the whole sys
   Eigen::MatrixXd upper_sum = Eigen::MatrixXd::Zero(3 * n, 3 * n);
   Eigen::VectorXd rhs_sum   = Eigen::VectorXd::Zero(3 * n);
   size_t          springs_visited = 0, blocks = 0;
+  double          stretch_max     = 0;
   for (int part = 0; part < 3; ++part) {
     std::vector<char> own(n);
     for (int p = 0; p < n; ++p) own[p] = (p * 7) % 3 == part; // interleaved rows: many springs cross parts
@@ -180,7 +181,11 @@ TEST_CASE("rows assembled in parts, upper triangle only, add up to the whole sys
     for (size_t k = 0; k < sys.block_row.size(); ++k) CHECK((own[sys.block_row[k]] && sys.block_row[k] <= sys.block_col[k]));
     springs_visited += sys.springs.size();
     blocks += sys.block_row.size();
+    for (int k : sys.stretch_springs) CHECK(cloth.springs[k].kind == SpringKind::Stretch);
+    stretch_max = std::max(stretch_max, max_stretch_ratio(cloth, sys.stretch_springs)); // the driver's all-reduce
   }
+  CHECK(stretch_max == max_stretch_ratio(cloth)); // the parts' stretch checks cover every stretch spring
+  CHECK(stretch_max > 1.0);
   Eigen::MatrixXd upper = A; // the block upper triangle
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < i; ++j) upper.block<3, 3>(3 * i, 3 * j).setZero();
