@@ -384,3 +384,50 @@ TEST_CASE("bad input gives PETSc errors", "[mat_core][errors]")
     MatDestroy(&A);
   }
 }
+
+TEST_CASE("the info view reports the COO refill path and the mirror", "[mat_core][coo][view]")
+{
+  const PetscInt        mbs = 10, bs = 3, m = mbs * bs;
+  std::vector<PetscInt> bi, bj, si, sj; // whole 3x3 blocks (block row r: blocks r and r + 1), and scalars
+  for (PetscInt r = 0; r < mbs; r++)
+    for (PetscInt c : {r, (r + 1) % mbs})
+      for (PetscInt e = 0; e < 9; e++) {
+        bi.push_back(r * bs + e / 3);
+        bj.push_back(c * bs + e % 3);
+      }
+  for (PetscInt r = 0; r < m; r++) {
+    si.push_back(r);
+    sj.push_back(r);
+  }
+  SECTION("whole blocks")
+  {
+    Mat A = create(m, m, bs, 8);
+    REQUIRE(MatSetPreallocationCOO(A, (PetscCount)bi.size(), bi.data(), bj.data()) == 0);
+    std::vector<PetscScalar> v(bi.size(), 1.0);
+    REQUIRE(MatSetValuesCOO(A, v.data(), INSERT_VALUES) == 0);
+    const std::string info = info_view(A);
+    CHECK(info.find("COO: 180 entries, refill by whole blocks\n") != std::string::npos);
+    MatDestroy(&A);
+  }
+  SECTION("scalar entries")
+  {
+    Mat A = create(m, m, bs, 8);
+    REQUIRE(MatSetPreallocationCOO(A, (PetscCount)si.size(), si.data(), sj.data()) == 0);
+    std::vector<PetscScalar> v(si.size(), 2.0);
+    REQUIRE(MatSetValuesCOO(A, v.data(), INSERT_VALUES) == 0);
+    const std::string info = info_view(A);
+    CHECK(info.find("COO: 30 entries, refill value by value (the list is not made of whole blocks)") != std::string::npos);
+    MatDestroy(&A);
+  }
+  SECTION("mirror")
+  {
+    Mat A = create(m, m, bs, 8);
+    REQUIRE(MatBinBCSRSetCOOMirror(A, PETSC_TRUE) == 0);
+    REQUIRE(MatSetPreallocationCOO(A, (PetscCount)bi.size(), bi.data(), bj.data()) == 0);
+    std::vector<PetscScalar> v(bi.size(), 1.0);
+    REQUIRE(MatSetValuesCOO(A, v.data(), INSERT_VALUES) == 0);
+    const std::string info = info_view(A);
+    CHECK(info.find("COO: 180 entries, refill by whole blocks; mirror on") != std::string::npos);
+    MatDestroy(&A);
+  }
+}
