@@ -24,6 +24,11 @@
   #define BINBCSR_HD inline
 #endif
 
+#if !defined(__CUDACC__) && defined(__AVX512F__)
+  #define BINBCSR_AVX512 1
+  #include "binbcsr_kernels_avx512.h"
+#endif
+
 namespace binbcsr
 {
 
@@ -139,6 +144,12 @@ template <int BS, int BW, typename V, bool SCATTER>
 BINBCSR_HD void sym_unit_group_mult(const V *t, const double *xs, const double (*xr)[BW], double *ys, double (*acc)[BW])
 {
   constexpr int BS2 = BS * BS;
+#if defined(BINBCSR_AVX512)
+  if constexpr (BS == 3 && BW == 8) {
+    avx512::sym_unit_group_3x8<SCATTER, V>(t, xs, xr, ys, acc);
+    return;
+  }
+#endif
 #pragma omp simd
   for (int l = 0; l < BW; l++) {
     double v[BS2];
