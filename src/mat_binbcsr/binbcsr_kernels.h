@@ -25,8 +25,7 @@
 #endif
 
 #if !defined(__CUDACC__) && defined(__AVX512F__)
-  #define BINBCSR_AVX512 1
-  #include "binbcsr_kernels_avx512.h"
+  #define BINBCSR_AVX512 1 /* hand-written bodies for the common shape, binbcsr_kernels_avx512.h */
 #endif
 
 namespace binbcsr
@@ -137,6 +136,15 @@ BINBCSR_HD bool unit_stride(const I *c)
 {
   return unit_stride(c, BW);
 }
+
+} // namespace binbcsr
+
+#if defined(BINBCSR_AVX512)
+  #include "binbcsr_kernels_avx512.h" /* uses prefetch_values and unit_stride above */
+#endif
+
+namespace binbcsr
+{
 
 /* One slot group of sym_bin_mult whose lanes read the consecutive block columns xs, xs + BS, ...:
    acc += block x_c and, with SCATTER, y_c += block^T x_r, by unit-stride loads and stores. The

@@ -24,16 +24,51 @@ namespace avx512
 inline __m512d load8(const double *p) { return _mm512_loadu_pd(p); }
 inline __m512d load8(const float *p) { return _mm512_cvtps_pd(_mm256_loadu_ps(p)); }
 
+/* x, y and z of 8 consecutive nodes (24 interleaved doubles) as one register per component */
+inline void split_xyz(const double *xs, __m512d &x0, __m512d &x1, __m512d &x2)
+{
+  const __m512d a = _mm512_loadu_pd(xs), b = _mm512_loadu_pd(xs + 8), c = _mm512_loadu_pd(xs + 16);
+  x0 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, _mm512_setr_epi64(0, 3, 6, 9, 12, 15, 0, 0), b), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 10, 13), c);
+  x1 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, _mm512_setr_epi64(1, 4, 7, 10, 13, 0, 0, 0), b), _mm512_setr_epi64(0, 1, 2, 3, 4, 8, 11, 14), c);
+  x2 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, _mm512_setr_epi64(2, 5, 8, 11, 14, 0, 0, 0), b), _mm512_setr_epi64(0, 1, 2, 3, 4, 9, 12, 15), c);
+}
+
+/* The whole-storage product of one bin (3x3 blocks, 8 lanes): acc[i] (lane l in element l) +=
+   sum over the bin's len slot groups of block(i, j) x_c(j), the accumulators in registers for the
+   whole bin. Consecutive-column groups load x (split_xyz); the others gather it with 32-bit offsets. */
+template <typename V, typename I>
+inline void bin_mult_3x8(const V *t, const I *c, int len, const double *x, double (*acc)[8])
+{
+  static_assert(sizeof(I) == 4, "32-bit column indices");
+  __m512d       a0 = _mm512_loadu_pd(acc[0]), a1 = _mm512_loadu_pd(acc[1]), a2 = _mm512_loadu_pd(acc[2]);
+  const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  for (int k = 0; k < len; k++, c += 8, t += 72) {
+    prefetch_values(t, 72 * (int)sizeof(V));
+    const __m256i ci = _mm256_loadu_si256((const __m256i *)c);
+    __m512d       x0, x1, x2;
+    if (_mm256_cmpeq_epi32_mask(ci, _mm256_add_epi32(_mm256_set1_epi32((int)c[0]), iota)) == 0xFF) split_xyz(x + (long)c[0] * 3, x0, x1, x2);
+    else {
+      const __m256i off = _mm256_add_epi32(ci, _mm256_add_epi32(ci, ci)); /* 3 c */
+      x0                = _mm512_i32gather_pd(off, x, 8);
+      x1                = _mm512_i32gather_pd(off, x + 1, 8);
+      x2                = _mm512_i32gather_pd(off, x + 2, 8);
+    }
+    a0 = _mm512_fmadd_pd(load8(t + 16), x2, _mm512_fmadd_pd(load8(t + 8), x1, _mm512_fmadd_pd(load8(t), x0, a0)));
+    a1 = _mm512_fmadd_pd(load8(t + 40), x2, _mm512_fmadd_pd(load8(t + 32), x1, _mm512_fmadd_pd(load8(t + 24), x0, a1)));
+    a2 = _mm512_fmadd_pd(load8(t + 64), x2, _mm512_fmadd_pd(load8(t + 56), x1, _mm512_fmadd_pd(load8(t + 48), x0, a2)));
+  }
+  _mm512_storeu_pd(acc[0], a0);
+  _mm512_storeu_pd(acc[1], a1);
+  _mm512_storeu_pd(acc[2], a2);
+}
+
 /* acc[i][l] += sum_j block_l(i,j) x[(c0 + l) * 3 + j]; with SCATTER also
    y[(c0 + l) * 3 + j] += sum_i block_l(i,j) xr[i][l]. t: the group's tile (entry e of lane l at t[e * 8 + l]). */
 template <bool SCATTER, typename V>
 inline void sym_unit_group_3x8(const V *t, const double *xs, const double (*xr)[8], double *ys, double (*acc)[8])
 {
-  /* x components of the 8 lanes from 24 interleaved doubles (lane l, component j at 3l + j) */
-  const __m512d a = _mm512_loadu_pd(xs), b = _mm512_loadu_pd(xs + 8), c = _mm512_loadu_pd(xs + 16);
-  const __m512d x0 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, _mm512_setr_epi64(0, 3, 6, 9, 12, 15, 0, 0), b), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 10, 13), c);
-  const __m512d x1 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, _mm512_setr_epi64(1, 4, 7, 10, 13, 0, 0, 0), b), _mm512_setr_epi64(0, 1, 2, 3, 4, 8, 11, 14), c);
-  const __m512d x2 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, _mm512_setr_epi64(2, 5, 8, 11, 14, 0, 0, 0), b), _mm512_setr_epi64(0, 1, 2, 3, 4, 9, 12, 15), c);
+  __m512d x0, x1, x2;
+  split_xyz(xs, x0, x1, x2);
   __m512d v[9];
   for (int e = 0; e < 9; e++) v[e] = load8(t + e * 8);
   for (int i = 0; i < 3; i++) {

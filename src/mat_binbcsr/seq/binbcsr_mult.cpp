@@ -44,6 +44,10 @@ void mult_bins_fixed(const BinSweep<V> &m, const double *x, const double *z, dou
     double          acc[BS][BW];
     for (int i = 0; i < BS; i++)
       for (int l = 0; l < BW; l++) acc[i][l] = 0.0;
+#if defined(BINBCSR_AVX512)
+    if constexpr (BS == 3 && BW == 8) binbcsr::avx512::bin_mult_3x8(t, c, (int)len, x, acc);
+    else
+#endif
     for (PetscInt k = 0; k < len; k++, c += BW, t += BW * BS2) {
       binbcsr::prefetch_values(t, BW * BS2 * (int)sizeof(V));
       if (binbcsr::unit_stride<BW>(c)) { /* consecutive columns: x_c by plain loads, no gathers */
