@@ -29,6 +29,13 @@ Eigen::Matrix3d some_rotation()
 }
 
 // Irregular mesh: box with its interior nodes jittered.
+// A uniformly random rotation (normalised Gaussian quaternion), drawn with the caller's generator.
+Eigen::Matrix3d random_rotation(std::mt19937 &rng, std::normal_distribution<double> &normal)
+{
+  Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
+  return q.normalized().toRotationMatrix();
+}
+
 TetMesh jittered_box(int order)
 {
   TetMesh      m = make_box_mesh(1.0, 0.8, 0.6, 3, 3, 3);
@@ -80,17 +87,13 @@ TEST_CASE("polar decomposition agrees with the SVD polar factor on random F, nea
   std::mt19937                           rng(11);
   std::normal_distribution<double>       normal(0, 1);
   std::uniform_real_distribution<double> uniform(0, 1);
-  auto random_rotation = [&] {
-    Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
-    return q.normalized().toRotationMatrix();
-  };
   double worst = 0;
   for (int k = 0; k < 2000; ++k) {
     // F = U diag(s) V^T with singular values between 0.05 and 3 (strains of 1e-6 to 200%).
     const double    spread = std::pow(10.0, -6 + 6 * uniform(rng));
     Eigen::Vector3d s;
     for (int d = 0; d < 3; ++d) s[d] = std::max(0.05, 1 + spread * normal(rng));
-    const Eigen::Matrix3d U = random_rotation(), V = random_rotation();
+    const Eigen::Matrix3d U = random_rotation(rng, normal), V = random_rotation(rng, normal);
     const Eigen::Matrix3d F = U * s.asDiagonal() * V.transpose();
     const Eigen::Matrix3d R = rotation_from_deformation(F);
     REQUIRE(is_rotation(R));
@@ -99,7 +102,7 @@ TEST_CASE("polar decomposition agrees with the SVD polar factor on random F, nea
   CHECK(worst < 1e-12);
   // Across inversion: smallest singular value from +1e-3 through 0 to -1e-3 (one axis reflected).
   // The rotation is the one of the sign-corrected SVD, a proper rotation, and continuous.
-  const Eigen::Matrix3d U = random_rotation(), V = random_rotation();
+  const Eigen::Matrix3d U = random_rotation(rng, normal), V = random_rotation(rng, normal);
   Eigen::Matrix3d       previous = Eigen::Matrix3d::Zero();
   for (int k = -10; k <= 10; ++k) {
     const Eigen::Matrix3d F = U * Eigen::Vector3d(1.2, 0.9, 1e-4 * k).asDiagonal() * V.transpose();
@@ -116,21 +119,17 @@ TEST_CASE("batched polar decomposition: the scalar path's rotations, special lan
   std::mt19937                           rng(5);
   std::normal_distribution<double>       normal(0, 1);
   std::uniform_real_distribution<double> uniform(0, 1);
-  auto random_rotation = [&] {
-    Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
-    return q.normalized().toRotationMatrix();
-  };
   std::vector<Eigen::Matrix3d> F, polar; // polar: U V^T where known (zero: no reference)
   for (int k = 0; k < 2000; ++k) {
     const double    spread = std::pow(10.0, -6 + 6 * uniform(rng));
     Eigen::Vector3d s;
     for (int d = 0; d < 3; ++d) s[d] = std::max(0.05, 1 + spread * normal(rng));
-    const Eigen::Matrix3d U = random_rotation(), V = random_rotation();
+    const Eigen::Matrix3d U = random_rotation(rng, normal), V = random_rotation(rng, normal);
     F.push_back(std::pow(10.0, -3 + 6 * uniform(rng)) * U * s.asDiagonal() * V.transpose());
     polar.push_back(U * V.transpose());
   }
   // Through inversion (the smallest singular value from +1e-3 to -1e-3): sign-corrected SVD.
-  const Eigen::Matrix3d U = random_rotation(), V = random_rotation();
+  const Eigen::Matrix3d U = random_rotation(rng, normal), V = random_rotation(rng, normal);
   for (int k = -10; k <= 10; ++k) {
     F.push_back(U * Eigen::Vector3d(1.2, 0.9, 1e-4 * k).asDiagonal() * V.transpose());
     polar.push_back(U * V.transpose());

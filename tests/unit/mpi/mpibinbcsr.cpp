@@ -111,19 +111,27 @@ PetscErrorCode fill_test_vector(Vec v, int salt = 0)
   PetscFunctionReturn(0);
 }
 
+// A KSP of the given type and PC on A, to rtol 1e-10.
+PetscErrorCode create_solver(Mat A, KSPType kt, PCType pt, KSP *ksp)
+{
+  PC pc;
+  PetscFunctionBeginUser;
+  PetscCall(KSPCreate(PETSC_COMM_WORLD, ksp));
+  PetscCall(KSPSetOperators(*ksp, A, A));
+  PetscCall(KSPSetType(*ksp, kt));
+  PetscCall(KSPGetPC(*ksp, &pc));
+  PetscCall(PCSetType(pc, pt));
+  PetscCall(KSPSetTolerances(*ksp, 1e-10, 1e-50, PETSC_DEFAULT, 1000));
+  PetscFunctionReturn(0);
+}
+
 // Solves A x = b with the given KSP and PC to rtol 1e-10 (x is the initial guess and the result);
 // returns the iterations and, through reason, why it stopped.
 PetscErrorCode solve_to_tolerance(Mat A, Vec b, Vec x, KSPType kt, PCType pt, PetscInt *its, KSPConvergedReason *reason)
 {
   KSP ksp;
-  PC  pc;
   PetscFunctionBeginUser;
-  PetscCall(KSPCreate(PETSC_COMM_WORLD, &ksp));
-  PetscCall(KSPSetOperators(ksp, A, A));
-  PetscCall(KSPSetType(ksp, kt));
-  PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(PCSetType(pc, pt));
-  PetscCall(KSPSetTolerances(ksp, 1e-10, 1e-50, PETSC_DEFAULT, 1000));
+  PetscCall(create_solver(A, kt, pt, &ksp));
   PetscCall(KSPSolve(ksp, b, x));
   PetscCall(KSPGetIterationNumber(ksp, its));
   PetscCall(KSPGetConvergedReason(ksp, reason));
@@ -632,7 +640,6 @@ TEST_CASE("mpibinbcsr: a COO refill with values reaches a PC set up before it (b
       Mat      A, F; // A: refilled under a set-up KSP; F: fresh, filled with the new values before any set-up
       Vec      b, x, xf;
       KSP      ksp;
-      PC       pc;
       PetscInt its_first, its, its_fresh;
       PCHK(assemble(fem, MATMPIBINBCSR, Fill::Coo, false, &A, parts));
       PCHK(assemble(fem, MATMPIBINBCSR, Fill::Coo, false, &F, parts));
@@ -640,12 +647,7 @@ TEST_CASE("mpibinbcsr: a COO refill with values reaches a PC set up before it (b
       PCHK(MatCreateVecs(A, &x, &b));
       PCHK(VecDuplicate(x, &xf));
       PCHK(fill_test_vector(b));
-      PCHK(KSPCreate(PETSC_COMM_WORLD, &ksp));
-      PCHK(KSPSetOperators(ksp, A, A));
-      PCHK(KSPSetType(ksp, KSPCG));
-      PCHK(KSPGetPC(ksp, &pc));
-      PCHK(PCSetType(pc, pt));
-      PCHK(KSPSetTolerances(ksp, 1e-10, 1e-50, PETSC_DEFAULT, 1000));
+      PCHK(create_solver(A, KSPCG, pt, &ksp));
       PCHK(KSPSolve(ksp, b, x));
       PCHK(KSPGetIterationNumber(ksp, &its_first));
 
