@@ -5,11 +5,18 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 namespace physics {
 
 namespace {
+
+// The Newton iteration's limits, shared by the scalar and the batched path (the batched one must stop
+// where the scalar one does). For X scaled to Frobenius norm sqrt 3, det X is at most 1; below
+// 3^1.5 1e-6 Newton's inverse is unreliable.
+constexpr double kMinStartDet      = 5.2e-6;
+constexpr int    kMaxNewtonSteps   = 30;
+constexpr double kConvergedChange2 = 1e-14; // squared Frobenius change of a step: d < 1e-7
+constexpr double kDetTolerance     = 1e-8;  // |det X - 1| accepted as a rotation
 
 Eigen::Matrix3d rotation_by_svd(const Eigen::Matrix3d &F)
 {
@@ -39,9 +46,8 @@ Eigen::Matrix3d rotation_from_deformation(const Eigen::Matrix3d &F)
   C.col(1) = X.col(2).cross(X.col(0));
   C.col(2) = X.col(0).cross(X.col(1));
   double det = X.col(0).dot(C.col(0));
-  // det of a matrix of norm sqrt 3 is at most 1; below 3^1.5 1e-6 Newton's inverse is unreliable.
-  if (det > 5.2e-6) {
-    for (int it = 0; it < 30; ++it) {
+  if (det > kMinStartDet) {
+    for (int it = 0; it < kMaxNewtonSteps; ++it) {
       // Newton X <- (X + X^-T) / 2 converges quadratically to the polar factor; Higham's Frobenius
       // scaling only pays far away, so only the first step is scaled. Once a step changes X by d,
       // the new iterate is within O(d^2) of the limit: d < 1e-7 ends it (error ~1e-14). The count
@@ -52,14 +58,14 @@ Eigen::Matrix3d rotation_from_deformation(const Eigen::Matrix3d &F)
       const Mat3   next   = (0.5 * g) * X + (0.5 / (g * det)) * C;
       const double change = (next - X).squaredNorm();
       X                   = next;
-      if (change < 1e-14) break;
+      if (change < kConvergedChange2) break;
       C.col(0) = X.col(1).cross(X.col(2));
       C.col(1) = X.col(2).cross(X.col(0));
       C.col(2) = X.col(0).cross(X.col(1));
       det      = X.col(0).dot(C.col(0));
       if (!(det > 0)) break;
     }
-    if (X.allFinite() && std::fabs(X.determinant() - 1.0) < 1e-8) return X;
+    if (X.allFinite() && std::fabs(X.determinant() - 1.0) < kDetTolerance) return X;
   }
   const Mat3 R = rotation_by_svd(F / std::sqrt(scale2));
   return R.allFinite() ? R : Mat3::Identity();
@@ -110,14 +116,14 @@ void rotations_from_deformations(const Eigen::Matrix3d *F, Eigen::Matrix3d *R, s
     for (int j = 0; j < 9; ++j) X[j] *= k;
     cofactor();
     for (int l = 0; l < kLanes; ++l)
-      if ((pending >> l & 1) && !(det[l] > 5.2e-6)) pending &= ~(1u << l), set_identity(l);
+      if ((pending >> l & 1) && !(det[l] > kMinStartDet)) pending &= ~(1u << l), set_identity(l);
     cofactor();
     // The first step with Higham's scaling g = (|cof X| / (sqrt 3 det))^(1/2), then plain steps.
     Lanes c2 = Lanes::Zero();
     for (int j = 0; j < 9; ++j) c2 += C[j].square();
     const Lanes g = (c2 / (det * det * 3.0)).sqrt().sqrt();
     Lanes       a = 0.5 * g, b = 0.5 / (g * det);
-    for (int it = 0; it < 30 && pending; ++it) {
+    for (int it = 0; it < kMaxNewtonSteps && pending; ++it) {
       Lanes change = Lanes::Zero();
       for (int j = 0; j < 9; ++j) {
         const Lanes next = a * X[j] + b * C[j];
@@ -129,14 +135,14 @@ void rotations_from_deformations(const Eigen::Matrix3d *F, Eigen::Matrix3d *R, s
       // or after 30 steps, and then checks det(X) = 1 and X finite. The mask is built without
       // branches: which lanes stop in which step is unpredictable.
       unsigned stopping = 0;
-      for (int l = 0; l < kLanes; ++l) stopping |= static_cast<unsigned>((change[l] < 1e-14) | !(det[l] > 0)) << l;
-      stopping = it == 29 ? pending : stopping & pending;
+      for (int l = 0; l < kLanes; ++l) stopping |= static_cast<unsigned>((change[l] < kConvergedChange2) | !(det[l] > 0)) << l;
+      stopping = it == kMaxNewtonSteps - 1 ? pending : stopping & pending;
       pending &= ~stopping;
       for (; stopping; stopping &= stopping - 1) {
         const int l   = __builtin_ctz(stopping);
         double    sum = 0;
         for (int j = 0; j < 9; ++j) sum += (R[start + l].data()[j] = X[j][l]);
-        if (std::isfinite(sum) && std::fabs(det[l] - 1.0) < 1e-8) newton |= 1u << l;
+        if (std::isfinite(sum) && std::fabs(det[l] - 1.0) < kDetTolerance) newton |= 1u << l;
         set_identity(l);
       }
       a = 0.5;
