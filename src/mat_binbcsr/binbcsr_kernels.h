@@ -140,7 +140,7 @@ BINBCSR_HD bool unit_stride(const I *c)
 } // namespace binbcsr
 
 #if defined(BINBCSR_AVX512)
-  #include "binbcsr_kernels_avx512.h" /* uses prefetch_values and unit_stride above */
+  #include "binbcsr_kernels_avx512.h" /* uses prefetch_values above */
 #endif
 
 namespace binbcsr

@@ -46,6 +46,7 @@ inline void bin_mult_3x8(const V *t, const I *c, int len, const double *x, doubl
     prefetch_values(t, 72 * (int)sizeof(V));
     const __m256i ci = _mm256_loadu_si256((const __m256i *)c);
     __m512d       x0, x1, x2;
+    /* unit_stride<8>(c) as one vector compare: the indices are in a register already */
     if (_mm256_cmpeq_epi32_mask(ci, _mm256_add_epi32(_mm256_set1_epi32((int)c[0]), iota)) == 0xFF) split_xyz(x + (long)c[0] * 3, x0, x1, x2);
     else {
       const __m256i off = _mm256_add_epi32(ci, _mm256_add_epi32(ci, ci)); /* 3 c */
