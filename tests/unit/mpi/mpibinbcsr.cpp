@@ -83,6 +83,23 @@ PetscErrorCode assemble(const FemProblem &fem, MatType type, Fill fill, bool emp
   PetscFunctionReturn(0);
 }
 
+// This rank's COO values in assemble()'s order (elements dealt round-robin), element e scaled by
+// weight(e), and a value for the ignored entry assemble() appends.
+template <class Weight>
+std::vector<PetscScalar> rank_coo_values(const FemProblem &fem, Weight weight)
+{
+  PetscMPIInt rank, size;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  MPI_Comm_size(PETSC_COMM_WORLD, &size);
+  std::vector<PetscScalar> cv;
+  for (int e = rank; e < fem.element_count(); e += size) {
+    const double w = weight(e);
+    for (PetscScalar k : fem.element_matrix(e)) cv.push_back(w * k);
+  }
+  cv.push_back(0);
+  return cv;
+}
+
 PetscErrorCode serial_reference(const FemProblem &fem, Mat *S)
 {
   PetscFunctionBeginUser;
@@ -249,12 +266,7 @@ TEST_CASE("mpibinbcsr: refill in place (COO and MatSetValues) keeps the pattern 
   PetscMPIInt rank, size;
   MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
   MPI_Comm_size(PETSC_COMM_WORLD, &size);
-  std::vector<PetscScalar> cv;
-  for (int e = rank; e < fem.element_count(); e += size) {
-    const auto K = fem.element_matrix(e);
-    cv.insert(cv.end(), K.begin(), K.end());
-  }
-  cv.push_back(0);
+  const std::vector<PetscScalar> cv = rank_coo_values(fem, [](int) { return 1.0; });
   PCHK(MatSetValuesCOO(A, cv.data(), ADD_VALUES));
   PCHK(MatScale(S, 2.0));
   check_products(A, S);
@@ -624,16 +636,8 @@ TEST_CASE("mpibinbcsr: MatSOR local sweeps and PCSOR in CG equal mpibaij's (whol
 TEST_CASE("mpibinbcsr: a COO refill with values reaches a PC set up before it (bjacobi, sor)", "[mpi][coo_state]")
 {
   const FemProblem fem(5, 4, 4, true);
-  PetscMPIInt      rank, size;
-  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
-  MPI_Comm_size(PETSC_COMM_WORLD, &size);
   // the same elements, weighted unevenly so that a stale factor or diagonal is a different operator
-  std::vector<PetscScalar> cv;
-  for (int e = rank; e < fem.element_count(); e += size) {
-    const auto K = fem.element_matrix(e);
-    for (PetscScalar k : K) cv.push_back((1.0 + 3.0 * (e % 4)) * k);
-  }
-  cv.push_back(0); // the ignored entry assemble() appends
+  const std::vector<PetscScalar> cv = rank_coo_values(fem, [](int e) { return 1.0 + 3.0 * (e % 4); });
   for (const char *parts : {(const char *)nullptr, "seqaij"})
     for (PCType pt : {PCBJACOBI, PCSOR}) {
       INFO("parts " << (parts ? parts : "seqbinbcsr") << " pc " << pt);
