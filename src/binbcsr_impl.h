@@ -14,8 +14,17 @@ PETSC_INTERN PetscErrorCode MatGetFactor_SeqBinBCSR_Petsc(Mat, MatFactorType, Ma
 
 /* Inserts src's local rows into dst (INSERT_VALUES) and assembles dst: the generic conversion path. */
 PETSC_INTERN PetscErrorCode MatBinBCSRInsertRows_Private(Mat src, Mat dst);
+/* Preallocates dst (sized and typed, answering the AIJ preallocations) exactly from src's local rows, then fills it. */
+PETSC_INTERN PetscErrorCode MatBinBCSRPreallocateAndFill_Private(Mat src, Mat dst);
 /* An empty matrix of the given type with src's sizes and block sizes: a conversion's target (seq and mpi). */
 PETSC_INTERN PetscErrorCode MatBinBCSRCreateLike_Private(Mat src, MatType type, Mat *M);
+
+/* Submatrices (PCASM, PCGASM, PCREDUNDANT, PCFIELDSPLIT) of seq and mpi binbcsr through an AIJ shadow: binbcsr_submat.cpp */
+PETSC_INTERN PetscErrorCode MatIncreaseOverlap_BinBCSR(Mat, PetscInt, IS[], PetscInt);
+PETSC_INTERN PetscErrorCode MatCreateSubMatrices_BinBCSR(Mat, PetscInt, const IS[], const IS[], MatReuse, Mat *[]);
+PETSC_INTERN PetscErrorCode MatCreateSubMatricesMPI_BinBCSR(Mat, PetscInt, const IS[], const IS[], MatReuse, Mat *[]);
+PETSC_INTERN PetscErrorCode MatCreateSubMatrix_BinBCSR(Mat, IS, IS, MatReuse, Mat *);
+PETSC_INTERN PetscErrorCode MatCreateMPIMatConcatenateSeqMat_BinBCSR(MPI_Comm, Mat, PetscInt, MatReuse, Mat *);
 
 /* MATSEQBINBCSR parts of MATMPIBINBCSR: after MatSetPreallocationCOO, compose the part's COO map with
    from[] (part entry -> source index); the two-source refill then reads source p < n from v and

@@ -231,6 +231,9 @@ static PetscErrorCode MatSetOption_MPIBinBCSR(Mat mat, MatOption op, PetscBool f
   case MAT_IGNORE_OFF_PROC_ENTRIES:
     b->donotstash = flg;
     break;
+  case MAT_SUBMAT_SINGLEIS: /* PCASM: one index set on every rank (passed on to the AIJ shadow) */
+    mat->submat_singleis = flg;
+    break;
   case MAT_SYMMETRIC:
   case MAT_SPD:
   case MAT_HERMITIAN:
@@ -400,6 +403,10 @@ PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
   mat->ops->convertfrom         = MatConvertFrom_MPIBinBCSR;
   mat->ops->duplicate           = MatDuplicate_MPIBinBCSR;
   mat->ops->copy                = MatCopy_MPIBinBCSR;
+  mat->ops->increaseoverlap     = MatIncreaseOverlap_BinBCSR;
+  mat->ops->createsubmatrices   = MatCreateSubMatrices_BinBCSR;
+  mat->ops->createsubmatricesmpi = MatCreateSubMatricesMPI_BinBCSR;
+  mat->ops->createsubmatrix     = MatCreateSubMatrix_BinBCSR;
   mat->assembled                = PETSC_FALSE;
   mat->insertmode               = NOT_SET_VALUES;
 

@@ -4,34 +4,6 @@
 
 #include <algorithm>
 
-/* Preallocates dst (any AIJ-answering type, already sized and typed) exactly from src's rows and
-   copies them. */
-static PetscErrorCode PreallocateAndFill(Mat src, Mat dst)
-{
-  PetscInt rstart, rend;
-  PetscBool issbaij;
-
-  PetscFunctionBegin;
-  PetscCall(PetscObjectTypeCompareAny((PetscObject)src, &issbaij, MATSEQSBAIJ, MATMPISBAIJ, ""));
-  PetscCheck(!issbaij, PetscObjectComm((PetscObject)src), PETSC_ERR_SUP, "Cannot convert from SBAIJ: its rows hold only the upper triangle");
-  PetscCall(PetscLayoutSetUp(dst->rmap));
-  PetscCall(PetscLayoutSetUp(dst->cmap));
-  PetscCall(MatGetOwnershipRange(src, &rstart, &rend));
-  const PetscInt        cstart = dst->cmap->rstart, cend = dst->cmap->rend;
-  std::vector<PetscInt> dnnz(rend - rstart, 0), onnz(rend - rstart, 0);
-  for (PetscInt r = rstart; r < rend; r++) {
-    PetscInt        nz;
-    const PetscInt *cols;
-    PetscCall(MatGetRow(src, r, &nz, &cols, nullptr));
-    for (PetscInt k = 0; k < nz; k++) (cols[k] >= cstart && cols[k] < cend ? dnnz : onnz)[r - rstart]++;
-    PetscCall(MatRestoreRow(src, r, &nz, &cols, nullptr));
-  }
-  PetscCall(MatSeqAIJSetPreallocation(dst, 0, dnnz.data()));
-  PetscCall(MatMPIAIJSetPreallocation(dst, 0, dnnz.data(), 0, onnz.data()));
-  PetscCall(MatBinBCSRInsertRows_Private(src, dst));
-  PetscFunctionReturn(0);
-}
-
 /* Refills an existing matrix with src's values (its pattern must hold src's). */
 static PetscErrorCode RefillByRows(Mat src, Mat dst)
 {
@@ -52,7 +24,7 @@ PETSC_INTERN PetscErrorCode MatConvert_MPIBinBCSR_MPIAIJ(Mat mat, MatType newtyp
     PetscFunctionReturn(0);
   }
   PetscCall(MatBinBCSRCreateLike_Private(mat, MATMPIAIJ, &M));
-  PetscCall(PreallocateAndFill(mat, M));
+  PetscCall(MatBinBCSRPreallocateAndFill_Private(mat, M));
   if (reuse == MAT_INPLACE_MATRIX) PetscCall(MatHeaderReplace(mat, &M));
   else *newmat = M;
   PetscFunctionReturn(0);
@@ -73,7 +45,7 @@ PETSC_INTERN PetscErrorCode MatConvertFrom_MPIBinBCSR(Mat src, MatType newtype, 
   PetscObjectOptionsBegin((PetscObject)M);
   if (M->ops->setfromoptions) PetscCall((*M->ops->setfromoptions)(M, PetscOptionsObject));
   PetscOptionsEnd();
-  PetscCall(PreallocateAndFill(src, M));
+  PetscCall(MatBinBCSRPreallocateAndFill_Private(src, M));
   if (reuse == MAT_INPLACE_MATRIX) PetscCall(MatHeaderReplace(src, &M));
   else *newmat = M;
   PetscFunctionReturn(0);
@@ -94,7 +66,7 @@ PETSC_INTERN PetscErrorCode MatLoad_MPIBinBCSR(Mat mat, PetscViewer viewer)
   PetscCall(MatLoad(T, viewer));
   PetscCall(MatSetSizes(mat, T->rmap->n, T->cmap->n, T->rmap->N, T->cmap->N));
   PetscCall(MatSetBlockSizesFromMats(mat, T, T));
-  PetscCall(PreallocateAndFill(T, mat));
+  PetscCall(MatBinBCSRPreallocateAndFill_Private(T, mat));
   PetscCall(MatDestroy(&T));
   PetscFunctionReturn(0);
 }

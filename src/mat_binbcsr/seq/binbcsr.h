@@ -203,6 +203,8 @@ PETSC_INTERN PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat, MatType, MatReuse, Ma
 PETSC_INTERN PetscErrorCode MatConvert_SeqBinBCSR_SeqAIJ(Mat, MatType, MatReuse, Mat *);
 PETSC_INTERN PetscErrorCode MatConvert_SeqBinBCSR_SeqBAIJ(Mat, MatType, MatReuse, Mat *);
 PETSC_INTERN PetscErrorCode MatView_SeqBinBCSR(Mat, PetscViewer);
+PETSC_INTERN PetscErrorCode MatGetRowIJ_SeqBinBCSR(Mat, PetscInt, PetscBool, PetscBool, PetscInt *, const PetscInt *[], const PetscInt *[], PetscBool *);
+PETSC_INTERN PetscErrorCode MatRestoreRowIJ_SeqBinBCSR(Mat, PetscInt, PetscBool, PetscBool, PetscInt *, const PetscInt *[], const PetscInt *[], PetscBool *);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRDestroyCOO(Mat_SeqBinBCSR *);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRDuplicateStaging(Mat, Mat, PetscBool copyvalues);
 

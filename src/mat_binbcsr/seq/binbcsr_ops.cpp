@@ -553,6 +553,12 @@ PetscErrorCode MatSeqBinBCSRSetOps_Ops(Mat A)
   A->ops->getinfo           = MatGetInfo_SeqBinBCSR;
   A->ops->transpose         = MatTranspose_SeqBinBCSR;
   A->ops->load              = MatLoad_SeqBinBCSR;
+  /* submatrices through an AIJ shadow (binbcsr_submat.cpp); MatCreateSubMatrix uses createsubmatrices on one rank */
+  A->ops->increaseoverlap               = MatIncreaseOverlap_BinBCSR;
+  A->ops->createsubmatrices             = MatCreateSubMatrices_BinBCSR;
+  A->ops->creatempimatconcatenateseqmat = MatCreateMPIMatConcatenateSeqMat_BinBCSR;
+  A->ops->getrowij                      = MatGetRowIJ_SeqBinBCSR; /* binbcsr_rowij.cpp */
+  A->ops->restorerowij                  = MatRestoreRowIJ_SeqBinBCSR;
   a->view_other             = MatView_SeqBinBCSR_Other;
   PetscFunctionReturn(0);
 }

@@ -1,0 +1,222 @@
+/* Submatrices of MATSEQBINBCSR and MATMPIBINBCSR: what PCASM, PCGASM, PCREDUNDANT and PCFIELDSPLIT
+   ask a matrix for (MatIncreaseOverlap, MatCreateSubMatrices, MatCreateSubMatricesMPI,
+   MatCreateSubMatrix, MatCreateMPIMatConcatenateSeqMat).
+
+   The index-set exchange of a parallel extraction is PETSc's own (src/mat/impls/aij/mpi/mpiov.c):
+   the matrix keeps an AIJ shadow of itself (seqaij or mpiaij, composed on the matrix, so it goes with
+   MatDestroy) and asks it. The shadow is refreshed only when the matrix changed: rebuilt when its
+   nonzero state moved, refilled in place when only its values did (PetscObjectStateGet; the decision
+   is reduced over the communicator, so that every rank refreshes or none does). The AIJ submatrices
+   it returns are turned into binbcsr ones with the parent's block size, bin width, precision and,
+   for a symmetric extraction (same rows and columns), symmetric storage; then they are freed.
+
+   MAT_REUSE_MATRIX: the AIJ submatrices are extracted afresh (MAT_INITIAL_MATRIX on the shadow) and
+   their values written into the caller's binbcsr submatrices in place, which keep their layout and
+   nonzero state, so a PC on them redoes only its numeric set-up. Nothing is kept between calls but
+   the shadow: no PETSc-internal reuse data whose life would have to follow the caller's arrays. */
+#include "binbcsr_impl.h"
+#include <petsc/private/matimpl.h>
+
+namespace
+{
+struct AIJShadow {
+  Mat              S       = nullptr;
+  PetscObjectState state   = 0; /* of the binbcsr matrix when S got its values */
+  PetscObjectState nzstate = 0; /* its nonzero state when S was built */
+};
+
+const char shadow_key[] = "MatBinBCSR_AIJShadow";
+
+PetscErrorCode DestroyShadow(void *ctx)
+{
+  AIJShadow *sh = static_cast<AIJShadow *>(ctx);
+
+  PetscFunctionBegin;
+  PetscCall(MatDestroy(&sh->S));
+  delete sh;
+  PetscFunctionReturn(0);
+}
+
+/* The AIJ shadow of A holding A's current values. Collective on A. */
+PetscErrorCode GetAIJShadow(Mat A, Mat *S)
+{
+  PetscContainer   c;
+  AIJShadow       *sh;
+  PetscObjectState state;
+  PetscBool        mpi;
+  PetscMPIInt      todo[2];
+
+  PetscFunctionBegin;
+  PetscCheck(A->assembled, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_WRONGSTATE, "Submatrices of an unassembled binbcsr matrix");
+  PetscCall(PetscObjectQuery((PetscObject)A, shadow_key, (PetscObject *)&c));
+  if (!c) {
+    sh = new AIJShadow;
+    PetscCall(PetscContainerCreate(PETSC_COMM_SELF, &c));
+    PetscCall(PetscContainerSetPointer(c, sh));
+    PetscCall(PetscContainerSetUserDestroy(c, DestroyShadow));
+    PetscCall(PetscObjectCompose((PetscObject)A, shadow_key, (PetscObject)c));
+    PetscCall(PetscContainerDestroy(&c));
+  } else PetscCall(PetscContainerGetPointer(c, (void **)&sh));
+  PetscCall(PetscObjectStateGet((PetscObject)A, &state));
+  todo[0] = (!sh->S || sh->nzstate != A->nonzerostate) ? 1 : 0; /* rebuild */
+  todo[1] = (todo[0] || sh->state != state) ? 1 : 0;            /* refill */
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, todo, 2, MPI_INT, MPI_MAX, PetscObjectComm((PetscObject)A)));
+  PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIBINBCSR, &mpi));
+  if (todo[0]) {
+    PetscCall(MatDestroy(&sh->S));
+    PetscCall(MatConvert(A, mpi ? MATMPIAIJ : MATSEQAIJ, MAT_INITIAL_MATRIX, &sh->S));
+  } else if (todo[1]) PetscCall(MatConvert(A, mpi ? MATMPIAIJ : MATSEQAIJ, MAT_REUSE_MATRIX, &sh->S));
+  sh->state   = state;
+  sh->nzstate = A->nonzerostate;
+  *S          = sh->S;
+  PetscFunctionReturn(0);
+}
+
+/* A new binbcsr matrix (seq or mpi by T's communicator) with T's sizes and values and the storage
+   settings of parent. symmetric: T is a symmetric extraction (same rows and columns) of parent. */
+PetscErrorCode NewFromAIJ(Mat parent, Mat T, PetscBool symmetric, Mat *B)
+{
+  PetscMPIInt         size;
+  PetscInt            bs = T->rmap->bs, pbs = parent->rmap->bs, bw;
+  MatBinBCSRPrecision prec;
+  PetscBool           sym;
+
+  PetscFunctionBegin;
+  PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)T), &size));
+  if (bs < 1 || bs != T->cmap->bs) bs = 1; /* binbcsr needs equal row and column block sizes */
+  PetscCall(MatCreate(PetscObjectComm((PetscObject)T), B));
+  PetscCall(MatSetSizes(*B, T->rmap->n, T->cmap->n, T->rmap->N, T->cmap->N));
+  PetscCall(MatSetBlockSize(*B, bs));
+  PetscCall(MatSetType(*B, size > 1 ? MATMPIBINBCSR : MATSEQBINBCSR));
+  PetscCall(MatBinBCSRGetBinWidth(parent, &bw));
+  if (bw > 0 && bs == pbs) PetscCall(MatBinBCSRSetBinWidth(*B, bw)); /* a different block size keeps its own default */
+  PetscCall(MatBinBCSRGetPrecision(parent, &prec));
+  PetscCall(MatBinBCSRSetPrecision(*B, prec));
+  PetscCall(MatBinBCSRGetSymmetricStorage(parent, &sym));
+  if (sym && symmetric && T->rmap->N == T->cmap->N) PetscCall(MatBinBCSRSetSymmetricStorage(*B, PETSC_TRUE));
+  PetscCall(MatBinBCSRPreallocateAndFill_Private(T, *B));
+  PetscFunctionReturn(0);
+}
+
+/* MAT_REUSE_MATRIX: T's values into B, which must have T's sizes and hold its pattern. */
+PetscErrorCode RefillFromAIJ(Mat T, Mat B)
+{
+  PetscBool isbin;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)B, &isbin, MATSEQBINBCSR, MATMPIBINBCSR, ""));
+  PetscCheck(isbin, PetscObjectComm((PetscObject)B), PETSC_ERR_ARG_WRONG, "MAT_REUSE_MATRIX: the submatrix to refill is of type %s, not one this binbcsr matrix made", ((PetscObject)B)->type_name);
+  PetscCheck(B->rmap->N == T->rmap->N && B->cmap->N == T->cmap->N && B->rmap->n == T->rmap->n && B->cmap->n == T->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+             "MAT_REUSE_MATRIX: the submatrix to refill is %" PetscInt_FMT " x %" PetscInt_FMT " (local %" PetscInt_FMT " x %" PetscInt_FMT "), the index sets select %" PetscInt_FMT " x %" PetscInt_FMT " (local %" PetscInt_FMT " x %" PetscInt_FMT ")",
+             B->rmap->N, B->cmap->N, B->rmap->n, B->cmap->n, T->rmap->N, T->cmap->N, T->rmap->n, T->cmap->n);
+  PetscCall(MatZeroEntries(B));
+  PetscCall(MatBinBCSRInsertRows_Private(T, B));
+  PetscFunctionReturn(0);
+}
+
+/* MAT_REUSE_MATRIX of sequential submatrices: checked before anything is extracted, so that a wrong
+   call fails clean. */
+PetscErrorCode CheckReuse(PetscInt n, const IS irow[], const IS icol[], Mat B[])
+{
+  PetscFunctionBegin;
+  for (PetscInt i = 0; i < n; i++) {
+    PetscInt  m, k;
+    PetscBool isbin;
+    PetscCall(ISGetLocalSize(irow[i], &m));
+    PetscCall(ISGetLocalSize(icol[i], &k));
+    PetscCall(PetscObjectTypeCompare((PetscObject)B[i], MATSEQBINBCSR, &isbin));
+    PetscCheck(isbin, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "MAT_REUSE_MATRIX: submatrix %" PetscInt_FMT " is of type %s, not one this binbcsr matrix made", i, ((PetscObject)B[i])->type_name);
+    PetscCheck(B[i]->rmap->n == m && B[i]->cmap->n == k, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "MAT_REUSE_MATRIX: submatrix %" PetscInt_FMT " is %" PetscInt_FMT " x %" PetscInt_FMT ", its index sets select %" PetscInt_FMT " x %" PetscInt_FMT, i, B[i]->rmap->n, B[i]->cmap->n, m, k);
+  }
+  PetscFunctionReturn(0);
+}
+
+/* The binbcsr counterparts of the AIJ matrices T[0..n): created (MAT_INITIAL_MATRIX) or refilled. */
+PetscErrorCode FromAIJ(Mat parent, PetscInt n, const IS irow[], const IS icol[], Mat T[], MatReuse scall, Mat B[])
+{
+  PetscFunctionBegin;
+  for (PetscInt i = 0; i < n; i++) {
+    if (scall == MAT_INITIAL_MATRIX) {
+      PetscBool symmetric;
+      PetscCall(ISEqualUnsorted(irow[i], icol[i], &symmetric));
+      PetscCall(NewFromAIJ(parent, T[i], symmetric, &B[i]));
+    } else PetscCall(RefillFromAIJ(T[i], B[i]));
+  }
+  PetscFunctionReturn(0);
+}
+} // namespace
+
+PetscErrorCode MatIncreaseOverlap_BinBCSR(Mat A, PetscInt n, IS is[], PetscInt ov)
+{
+  Mat S;
+
+  PetscFunctionBegin;
+  PetscCall(GetAIJShadow(A, &S));
+  PetscCall(MatIncreaseOverlap(S, n, is, ov));
+  PetscFunctionReturn(0);
+}
+
+/* Sequential submatrices (PCASM's blocks, PCREDUNDANT's copy): MATSEQBINBCSR. The array has n+1
+   entries like PETSc's own (the last one unused), freed by MatDestroySubMatrices or MatDestroyMatrices. */
+PetscErrorCode MatCreateSubMatrices_BinBCSR(Mat A, PetscInt n, const IS irow[], const IS icol[], MatReuse scall, Mat *submat[])
+{
+  Mat S, *T;
+
+  PetscFunctionBegin;
+  PetscCheck(scall == MAT_INITIAL_MATRIX || scall == MAT_REUSE_MATRIX, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_WRONG, "MatCreateSubMatrices takes MAT_INITIAL_MATRIX or MAT_REUSE_MATRIX");
+  if (scall == MAT_REUSE_MATRIX) PetscCall(CheckReuse(n, irow, icol, *submat));
+  PetscCall(GetAIJShadow(A, &S));
+  S->submat_singleis = A->submat_singleis; /* PCASM's hint: one index set on every rank; used once, as MPIAIJ does */
+  A->submat_singleis = PETSC_FALSE;
+  PetscCall(MatCreateSubMatrices(S, n, irow, icol, MAT_INITIAL_MATRIX, &T));
+  if (scall == MAT_INITIAL_MATRIX) PetscCall(PetscCalloc1(n + 1, submat));
+  PetscCall(FromAIJ(A, n, irow, icol, T, scall, *submat));
+  PetscCall(MatDestroySubMatrices(n, &T));
+  PetscFunctionReturn(0);
+}
+
+/* Parallel submatrices on the index sets' subcommunicators (PCGASM): binbcsr of the kind each
+   subcommunicator's size calls for. */
+PetscErrorCode MatCreateSubMatricesMPI_BinBCSR(Mat A, PetscInt n, const IS irow[], const IS icol[], MatReuse scall, Mat *submat[])
+{
+  Mat S, *T;
+
+  PetscFunctionBegin;
+  PetscCheck(scall == MAT_INITIAL_MATRIX || scall == MAT_REUSE_MATRIX, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_WRONG, "MatCreateSubMatricesMPI takes MAT_INITIAL_MATRIX or MAT_REUSE_MATRIX");
+  PetscCall(GetAIJShadow(A, &S));
+  PetscCall(MatCreateSubMatricesMPI(S, n, irow, icol, MAT_INITIAL_MATRIX, &T));
+  if (scall == MAT_INITIAL_MATRIX) PetscCall(PetscCalloc1(n + 1, submat));
+  PetscCall(FromAIJ(A, n, irow, icol, T, scall, *submat));
+  PetscCall(MatDestroyMatrices(n, &T)); /* not MatDestroySubMatrices: these are parallel (as in PCGASM) */
+  PetscFunctionReturn(0);
+}
+
+/* One parallel submatrix (PCFIELDSPLIT's fields): MATMPIBINBCSR on A's communicator. */
+PetscErrorCode MatCreateSubMatrix_BinBCSR(Mat A, IS isrow, IS iscol, MatReuse cll, Mat *newmat)
+{
+  Mat S, T;
+
+  PetscFunctionBegin;
+  PetscCall(GetAIJShadow(A, &S));
+  PetscCall(MatCreateSubMatrix(S, isrow, iscol, MAT_INITIAL_MATRIX, &T));
+  PetscCall(FromAIJ(A, 1, &isrow, &iscol, &T, cll, newmat));
+  PetscCall(MatDestroy(&T));
+  PetscFunctionReturn(0);
+}
+
+/* PCREDUNDANT with fewer subcommunicators than ranks: the sequential copies of the rows joined into
+   one matrix on each subcommunicator, through MPIAIJ's own concatenation. */
+PetscErrorCode MatCreateMPIMatConcatenateSeqMat_BinBCSR(MPI_Comm comm, Mat seqmat, PetscInt n, MatReuse reuse, Mat *mpimat)
+{
+  Mat Taij, T;
+
+  PetscFunctionBegin;
+  PetscCall(MatConvert(seqmat, MATSEQAIJ, MAT_INITIAL_MATRIX, &Taij));
+  PetscCall(MatCreateMPIMatConcatenateSeqMat(comm, Taij, n, MAT_INITIAL_MATRIX, &T));
+  PetscCall(MatDestroy(&Taij));
+  /* seqmat is a strip of rows, never symmetric itself: the copy gets full storage */
+  if (reuse == MAT_REUSE_MATRIX) PetscCall(RefillFromAIJ(T, *mpimat));
+  else PetscCall(NewFromAIJ(seqmat, T, PETSC_FALSE, mpimat));
+  PetscCall(MatDestroy(&T));
+  PetscFunctionReturn(0);
+}
