@@ -304,41 +304,26 @@ PetscErrorCode MatSeqBinBCSRBuildLayout(Mat A, const PetscInt bi[], const PetscI
     PetscCall(PetscLogEventEnd(MAT_BinBCSR_BuildLayout, A, 0, 0, 0));
     PetscFunctionReturn(0);
   }
-  for (PetscInt b = 0; b < nbins; b++) {
-    PetscInt len = 0;
-    for (PetscInt r = b * bw; r < PetscMin(mbs, (b + 1) * bw); r++) {
-      const PetscInt n = bi[r + 1] - bi[r];
-      PetscCheck(n >= 0 && n <= a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_CORRUPT, "Block row %" PetscInt_FMT " has %" PetscInt_FMT " blocks", r, n);
-      a->row_nz[r] = n;
-      a->nz += n;
-      len = PetscMax(len, n);
+  for (PetscInt r = 0; r < mbs; r++) {
+    const PetscInt n = bi[r + 1] - bi[r];
+    PetscCheck(n >= 0 && n <= a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_CORRUPT, "Block row %" PetscInt_FMT " has %" PetscInt_FMT " blocks", r, n);
+    for (PetscInt p = bi[r]; p < bi[r + 1]; p++) {
+      PetscCheck(bj[p] >= 0 && bj[p] < a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Block column %" PetscInt_FMT " of block row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", bj[p], r, a->nbs);
+      PetscCheck(p == bi[r] || bj[p] > bj[p - 1], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Block columns of block row %" PetscInt_FMT " are not sorted and unique", r);
     }
-    a->max_row_nz = PetscMax(a->max_row_nz, len);
-    PetscCheck((PetscInt64)a->bin_start[b] + (PetscInt64)len * bw <= PETSC_MAX_INT / PetscMax(a->bs2, 1), PETSC_COMM_SELF, PETSC_ERR_SUP, "Matrix too large for 32-bit slot indices");
-    a->bin_start[b + 1] = a->bin_start[b] + len * bw;
+    a->row_nz[r]  = n;
+    a->nz        += n;
+    a->max_row_nz = PetscMax(a->max_row_nz, n);
   }
-  a->nslots = a->bin_start[nbins];
+  {
+    const long nslots = binbcsr::bin_starts<PetscInt>(bi, mbs, bw, a->bin_start);
+    PetscCheck(nslots <= PETSC_MAX_INT / PetscMax(a->bs2, 1), PETSC_COMM_SELF, PETSC_ERR_SUP, "Matrix too large for 32-bit slot indices");
+    a->nslots = (PetscInt)nslots;
+  }
   PetscCall(PetscMalloc1(a->nslots, &a->col));
   if (a->precision == MAT_BINBCSR_PRECISION_DOUBLE) PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->val));
   else PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->valf));
-  for (PetscInt b = 0; b < nbins; b++) {
-    const PetscInt len = (a->bin_start[b + 1] - a->bin_start[b]) / bw;
-    for (PetscInt l = 0; l < bw; l++) {
-      const PetscInt r = b * bw + l;
-      const PetscInt n = r < mbs ? a->row_nz[r] : 0;
-      PetscInt       last = 0; /* padding column: the lane's last real column (0 for an empty lane) */
-      if (r < mbs) a->diag_slot[r] = -1;
-      for (PetscInt k = 0; k < n; k++) {
-        const PetscInt c = bj[bi[r] + k], s = a->bin_start[b] + k * bw + l;
-        PetscCheck(c >= 0 && c < a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Block column %" PetscInt_FMT " of block row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", c, r, a->nbs);
-        PetscCheck(k == 0 || c > last, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Block columns of block row %" PetscInt_FMT " are not sorted and unique", r);
-        a->col[s] = c;
-        if (c == r) a->diag_slot[r] = s;
-        last = c;
-      }
-      for (PetscInt k = n; k < len; k++) a->col[a->bin_start[b] + k * bw + l] = last;
-    }
-  }
+  binbcsr::bin_columns<PetscInt>(bi, bj, mbs, bw, a->bin_start, a->col, a->diag_slot);
   PetscCall(PetscMalloc2((size_t)a->max_row_nz * a->bs, &a->rowbuf_cols, (size_t)a->max_row_nz * a->bs, &a->rowbuf_vals));
   a->built = PETSC_TRUE;
   A->preallocated = PETSC_TRUE; /* a layout is an allocation, however it was built (convert, load, ...) */

@@ -44,6 +44,7 @@
 #define BINBCSR_SEQ_H
 
 #include "binbcsr_impl.h"
+#include "../binbcsr_layout.h"
 #include <petsc/private/matimpl.h>
 #include <vector>
 
@@ -132,17 +133,13 @@ static inline PetscInt BinBCSRDefaultBinWidth(PetscInt bs) { return bs == 1 ? 16
 
 /* Lane of slot s, and the index into val/valf of entry e of slot s. */
 static inline PetscInt BinBCSRLane(PetscInt s, PetscInt bw) { return s % bw; }
-static inline PetscInt BinBCSRValueIndex(PetscInt s, PetscInt e, PetscInt bw, PetscInt bs2)
-{
-  const PetscInt l = s % bw;
-  return (s - l) * bs2 + e * bw + l;
-}
+static inline PetscInt BinBCSRValueIndex(PetscInt s, PetscInt e, PetscInt bw, PetscInt bs2) { return (PetscInt)binbcsr::value_index(s, (int)e, (int)bw, (int)bs2); }
 /* Slot of the k-th real block (ascending column) of block row r, k < row_nz[r]. With full storage
    it is entry k of the lane; with symmetric storage the colouring decides. */
 static inline PetscInt BinBCSRSlot(const Mat_SeqBinBCSR *a, PetscInt r, PetscInt k)
 {
   if (a->real_slot) return a->real_slot[a->row_off[r] + k];
-  return a->bin_start[r / a->bw] + k * a->bw + r % a->bw;
+  return (PetscInt)binbcsr::row_slot<PetscInt>(a->bin_start, a->bw, r, k);
 }
 /* Value at value index v, whatever the storage precision. */
 static inline PetscScalar BinBCSRGetValue(const Mat_SeqBinBCSR *a, PetscInt v) { return a->val ? a->val[v] : (PetscScalar)a->valf[v]; }

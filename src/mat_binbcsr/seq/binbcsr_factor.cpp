@@ -64,7 +64,7 @@ PetscErrorCode BuildShadowPattern(Mat A, PetscBool upper, FactorShadow *f, std::
   const PetscInt  bw = a->bw, bs2 = a->bs2;
 
   PetscFunctionBegin;
-  auto base = [&](PetscInt s) { return (s - s % bw) * bs2 + s % bw; };
+  auto base = [&](PetscInt s) { return BinBCSRValueIndex(s, 0, bw, bs2); };
   if (a->sym && !upper) PetscCall(MatSeqBinBCSRBuildLowerIndex(a));
   bi.assign(1, 0);
   bj.clear();

@@ -1,0 +1,75 @@
+/*
+   The whole-storage BIN-(B)CSR layout rule (src/mat_binbcsr/seq/binbcsr.h has the picture) as plain
+   functions over a block CSR pattern: no PETSc, no STL, no allocation. MATSEQBINBCSR builds its bins
+   with them after checking the pattern, and the CUDA benchmark (examples/gpu/) builds the same bins on a
+   machine without PETSc, so both run the one layout the kernels are written for.
+
+   Input: mbs block rows, row_ptr[mbs + 1], cols[row_ptr[mbs]] sorted and unique in each row (the caller
+   checks). I is the index type (32-bit in this build).
+*/
+#ifndef BINBCSR_LAYOUT_H
+#define BINBCSR_LAYOUT_H
+
+namespace binbcsr
+{
+
+/* bin_start[0 .. nbins] for bins of bw rows, each padded to its longest row (a multiple of bw slots per
+   bin); returns the number of slots. The caller checks that the total fits its index type. */
+template <typename I>
+inline long bin_starts(const I *row_ptr, I mbs, I bw, I *bin_start)
+{
+  const I nbins = (mbs + bw - 1) / bw;
+  long    s     = 0;
+  bin_start[0]  = 0;
+  for (I b = 0; b < nbins; b++) {
+    I len = 0;
+    for (I r = b * bw; r < mbs && r < (b + 1) * bw; r++) len = row_ptr[r + 1] - row_ptr[r] > len ? row_ptr[r + 1] - row_ptr[r] : len;
+    s += (long)len * bw;
+    bin_start[b + 1] = (I)s;
+  }
+  return s;
+}
+
+/* col[slot] for every slot: entry k of lane l of bin b at bin_start[b] + k * bw + l; padding repeats the
+   lane's last real column (0 for an empty or phantom lane) so kernels run without branches and read no x
+   entry the row does not already read. diag_slot[r] (if non-null): the slot of block (r, r), or -1. */
+template <typename I>
+inline void bin_columns(const I *row_ptr, const I *cols, I mbs, I bw, const I *bin_start, I *col, I *diag_slot)
+{
+  const I nbins = (mbs + bw - 1) / bw;
+  for (I b = 0; b < nbins; b++) {
+    const I len = (bin_start[b + 1] - bin_start[b]) / bw;
+    for (I l = 0; l < bw; l++) {
+      const I r    = b * bw + l;
+      const I n    = r < mbs ? row_ptr[r + 1] - row_ptr[r] : 0;
+      I       last = 0;
+      if (r < mbs && diag_slot) diag_slot[r] = -1;
+      for (I k = 0; k < n; k++) {
+        const I c = cols[row_ptr[r] + k], s = bin_start[b] + k * bw + l;
+        col[s] = c;
+        if (c == r && diag_slot) diag_slot[r] = s;
+        last = c;
+      }
+      for (I k = n; k < len; k++) col[bin_start[b] + k * bw + l] = last;
+    }
+  }
+}
+
+/* Index into the value array of entry e (row-major in the block) of slot s: the bs2 values of a group of
+   bw slots are stored entry plane by entry plane, so for fixed e the bw lanes' values are contiguous. */
+inline long value_index(long s, int e, int bw, int bs2)
+{
+  const long l = s % bw;
+  return (s - l) * bs2 + (long)e * bw + l;
+}
+
+/* Slot of entry k (k-th stored block of the row, ascending column) of block row r. */
+template <typename I>
+inline long row_slot(const I *bin_start, I bw, I r, I k)
+{
+  return bin_start[r / bw] + (long)k * bw + r % bw;
+}
+
+} // namespace binbcsr
+
+#endif
