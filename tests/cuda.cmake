@@ -10,3 +10,13 @@ if(BINBCSR_NVCC)
 else()
   message(STATUS "nvcc not found: CTest case cuda_kernels_compile (CUDA compile check of the kernels) not added")
 endif()
+if(BINBCSR_NVCC)
+  # The GPU benchmark (examples/gpu/, run by scripts/gpu_bench on a machine with a GPU) and the CUDA
+  # kernels it drives (src/mat_binbcsr/cuda/): built and linked against cuSPARSE and cuBLAS with warnings
+  # as errors, so the CUDA code cannot rot where no GPU runs it. Running it needs a GPU (docs/gpu.md).
+  add_test(NAME cuda_gpu_bench_build
+           COMMAND ${BINBCSR_NVCC} -std=c++17 -O1 -arch=sm_90 -I${PROJECT_SOURCE_DIR}/src
+                   -Xcompiler -Wall,-Wextra,-Wno-unknown-pragmas -Werror all-warnings
+                   ${PROJECT_SOURCE_DIR}/examples/gpu/binbcsr_gpu_bench.cu -o ${CMAKE_CURRENT_BINARY_DIR}/binbcsr_gpu_bench -lcusparse -lcublas)
+  set_tests_properties(cuda_gpu_bench_build PROPERTIES LABELS "cuda;mat_core" TIMEOUT 300)
+endif()

@@ -80,10 +80,34 @@ BINBCSR_HD void lane_mult(const V *bin_val, const I *bin_col, int len, int bw, i
 {
   const int bs  = BS ? BS : bs_rt;
   const int bs2 = bs * bs;
+#if defined(__CUDACC__)
+  #pragma unroll 4 /* a thread's slots are a chain of dependent loads (column, then x): unrolled, the
+                      column loads of 4 slots are in flight together, which the long bins need */
+#endif
   for (int k = 0; k < len; k++) {
     const long s = (long)k * bw + lane;
     slot_mult<BS, V>(bin_val + (long)k * bw * bs2 + lane, bw, bs, x + (long)bin_col[s] * bs, acc);
   }
+}
+
+/* Point row i (0 <= i < bs) of the lane's block row times x over the bin's len slots: what lane_mult
+   computes for acc[i] alone. A GPU runs bs threads per lane with it (a warp per bin and point row,
+   still coalesced), which triples the threads of small matrices that would otherwise not fill it. */
+template <int BS, typename V, typename I>
+BINBCSR_HD double lane_row_mult(const V *bin_val, const I *bin_col, int len, int bw, int bs_rt, int lane, int i, const double *x, int k0 = 0, int kstep = 1)
+{
+  const int bs  = BS ? BS : bs_rt;
+  const int bs2 = bs * bs;
+  double    s   = 0.0;
+#if defined(__CUDACC__)
+  #pragma unroll 4
+#endif
+  for (int k = k0; k < len; k += kstep) { /* k0, kstep: a share of the slots, for threads that split a bin */
+    const V      *t  = bin_val + (long)k * bw * bs2 + (long)i * bs * bw + lane;
+    const long    c0 = (long)bin_col[(long)k * bw + lane] * bs;
+    for (int j = 0; j < bs; j++) s += (double)t[j * bw] * x[c0 + j];
+  }
+  return s;
 }
 
 /* y(cols) += (row at `lane`)^T * xr over the lane's nz real slots (padding skipped: its column may

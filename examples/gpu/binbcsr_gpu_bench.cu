@@ -1,0 +1,780 @@
+// BIN-(B)CSR and the merged CG on a GPU, against cuSPARSE and a stock CG (cuSPARSE + cuBLAS): the
+// seed's Fig. 2.42 (SpMV GFlop/s per format and matrix) and Fig. 2.43 (CG speed-up over matrix size)
+// with this project's matrices. Standalone (no PETSc: Debian's PETSc has no CUDA): it builds the bins
+// with src/mat_binbcsr/binbcsr_layout.h and runs the lane kernels of binbcsr_kernels.h through
+// src/mat_binbcsr/cuda/binbcsr_cuda.cuh. Every product is checked against a double-precision product
+// on the host, every CG against the stock CG's residual history; a failed check exits non-zero.
+//
+//   binbcsr_gpu_bench [-stencil 16,32,64] [-f A.bin [-f B.bin ...]] [-bs 3] [-cg_its 1000] [-no_cg]
+//
+// -f reads a PETSc binary matrix (what the drivers write with -dump_matrix), grouped into bs x bs
+// blocks. Stencil matrices are 27-point block stencils on n^3 nodes, symmetric and diagonally dominant.
+// Build: scripts/gpu_bench (nvcc; links cuSPARSE and cuBLAS).
+#include "mat_binbcsr/binbcsr_layout.h"
+#include "mat_binbcsr/cuda/binbcsr_cuda.cuh"
+
+#include <cublas_v2.h>
+#include <cuda_runtime.h>
+#include <cusparse.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace
+{
+
+void fail(const char *what, const char *file, int line)
+{
+  std::fprintf(stderr, "%s:%d: %s\n", file, line, what);
+  std::exit(2);
+}
+#define CK(call) \
+  do { \
+    cudaError_t e_ = (call); \
+    if (e_ != cudaSuccess) fail(cudaGetErrorString(e_), __FILE__, __LINE__); \
+  } while (0)
+#define CKS(call) \
+  do { \
+    cusparseStatus_t e_ = (call); \
+    if (e_ != CUSPARSE_STATUS_SUCCESS) fail(cusparseGetErrorString(e_), __FILE__, __LINE__); \
+  } while (0)
+#define CKB(call) \
+  do { \
+    if ((call) != CUBLAS_STATUS_SUCCESS) fail(#call, __FILE__, __LINE__); \
+  } while (0)
+#define CKL() CK(cudaGetLastError())
+
+int failures = 0;
+
+// A square matrix of bs x bs blocks in block CSR (row-major blocks), host side.
+struct BlockMatrix {
+  std::string         name;
+  int                 bs = 3, mbs = 0;
+  std::vector<int>    ptr, col;
+  std::vector<double> val;
+  long   nblocks() const { return (long)col.size(); }
+  int    n() const { return mbs * bs; }
+  bool   spd = true;
+};
+
+uint64_t mix(uint64_t h)
+{
+  h ^= h >> 33;
+  h *= 0xff51afd7ed558ccdULL;
+  h ^= h >> 33;
+  h *= 0xc4ceb9fe1a85ec53ULL;
+  return h ^ (h >> 33);
+}
+double unit_random(uint64_t key) { return (double)(mix(key) >> 11) * (2.0 / 9007199254740992.0) - 1.0; }
+
+// 27-point block stencil on n^3 nodes: block (i, j) = -(1 + 0.5 u) I - 0.2 S for neighbours, with u and the
+// symmetric S drawn from the unordered pair {i, j} (so A is symmetric), the diagonal block a multiple of I
+// larger than the row's off-diagonal absolute sum (so A is SPD).
+BlockMatrix stencil_matrix(int n)
+{
+  BlockMatrix A;
+  A.name = "stencil" + std::to_string(n);
+  A.bs   = 3;
+  A.mbs  = n * n * n;
+  A.ptr.assign(1, 0);
+  for (int z = 0; z < n; z++)
+    for (int y = 0; y < n; y++)
+      for (int x = 0; x < n; x++) {
+        const long i = ((long)z * n + y) * n + x;
+        long       diag_pos = -1;
+        for (int dz = -1; dz <= 1; dz++)
+          for (int dy = -1; dy <= 1; dy++)
+            for (int dx = -1; dx <= 1; dx++) {
+              if (z + dz < 0 || z + dz >= n || y + dy < 0 || y + dy >= n || x + dx < 0 || x + dx >= n) continue;
+              const long j = ((long)(z + dz) * n + y + dy) * n + x + dx;
+              A.col.push_back((int)j);
+              const size_t at = A.val.size();
+              A.val.resize(at + 9, 0.0);
+              if (j == i) {
+                diag_pos = (long)at;
+                continue;
+              }
+              const uint64_t key = (uint64_t)std::min(i, j) * 0x9E3779B97F4A7C15ULL + (uint64_t)std::max(i, j);
+              const double   u   = unit_random(key * 7 + 1);
+              double         s[6];
+              for (int k = 0; k < 6; k++) s[k] = unit_random(key * 7 + 2 + k);
+              const double S[9] = {s[0], s[1], s[2], s[1], s[3], s[4], s[2], s[4], s[5]};
+              for (int e = 0; e < 9; e++) A.val[at + e] = (e % 4 == 0 ? -(1.0 + 0.5 * u) : 0.0) - 0.2 * S[e];
+            }
+        A.ptr.push_back((int)A.col.size());
+        // Dominance row by row: the largest row sum of |off-diagonal entries| over the block row, plus 1.
+        double rowmax = 0.0;
+        for (int r = 0; r < 3; r++) {
+          double rs = 0.0;
+          for (long p = A.ptr[A.ptr.size() - 2]; p < A.ptr.back(); p++)
+            if (A.col[p] != i)
+              for (int c = 0; c < 3; c++) rs += std::fabs(A.val[(size_t)p * 9 + 3 * r + c]);
+          rowmax = std::max(rowmax, rs);
+        }
+        for (int d = 0; d < 3; d++) A.val[diag_pos + 4 * d] = rowmax + 1.0;
+      }
+  return A;
+}
+
+uint32_t big_endian32(const unsigned char *p) { return (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3]; }
+
+// A PETSc binary matrix (big-endian: class id 1211216, M, N, nz, row lengths, columns, values), grouped
+// into bs x bs blocks (entries the blocks hold but the file does not are zeros).
+BlockMatrix read_petsc_binary(const std::string &path, int bs)
+{
+  std::ifstream f(path, std::ios::binary);
+  if (!f) {
+    std::fprintf(stderr, "cannot open %s\n", path.c_str());
+    std::exit(2);
+  }
+  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  auto                       need = [&](size_t n) {
+    if (bytes.size() < n) {
+      std::fprintf(stderr, "%s: truncated PETSc binary matrix\n", path.c_str());
+      std::exit(2);
+    }
+  };
+  need(16);
+  const uint32_t id = big_endian32(&bytes[0]);
+  const long     M = big_endian32(&bytes[4]), N = big_endian32(&bytes[8]), nz = big_endian32(&bytes[12]);
+  if (id != 1211216 || M != N || M % bs || M <= 0 || nz < 0) {
+    std::fprintf(stderr, "%s: not a square PETSc binary matrix with block size %d (class id %u, %ld x %ld)\n", path.c_str(), bs, id, M, N);
+    std::exit(2);
+  }
+  need(16 + 4 * (size_t)M + 12 * (size_t)nz);
+  std::vector<long> rowptr(M + 1, 0);
+  for (long r = 0; r < M; r++) rowptr[r + 1] = rowptr[r] + big_endian32(&bytes[16 + 4 * r]);
+  if (rowptr[M] != nz) {
+    std::fprintf(stderr, "%s: row lengths do not add up to nz\n", path.c_str());
+    std::exit(2);
+  }
+  const unsigned char *cols = &bytes[16 + 4 * M], *vals = cols + 4 * nz;
+  BlockMatrix          A;
+  A.name = path.substr(path.find_last_of('/') + 1);
+  A.bs   = bs;
+  A.mbs  = (int)(M / bs);
+  A.ptr.assign(1, 0);
+  std::vector<long> slot_of(A.mbs, -1);
+  for (int br = 0; br < A.mbs; br++) {
+    std::vector<int> bcols;
+    for (long r = (long)br * bs; r < (long)(br + 1) * bs; r++)
+      for (long p = rowptr[r]; p < rowptr[r + 1]; p++) bcols.push_back((int)(big_endian32(cols + 4 * p) / bs));
+    std::sort(bcols.begin(), bcols.end());
+    bcols.erase(std::unique(bcols.begin(), bcols.end()), bcols.end());
+    const size_t first = A.col.size();
+    for (size_t k = 0; k < bcols.size(); k++) {
+      if (bcols[k] < 0 || bcols[k] >= A.mbs) {
+        std::fprintf(stderr, "%s: column out of range\n", path.c_str());
+        std::exit(2);
+      }
+      slot_of[bcols[k]] = (long)(first + k);
+    }
+    A.col.insert(A.col.end(), bcols.begin(), bcols.end());
+    A.val.resize(A.col.size() * bs * bs, 0.0);
+    for (long r = (long)br * bs; r < (long)(br + 1) * bs; r++)
+      for (long p = rowptr[r]; p < rowptr[r + 1]; p++) {
+        const uint32_t c = big_endian32(cols + 4 * p);
+        uint64_t       u = 0;
+        for (int k = 0; k < 8; k++) u = u << 8 | vals[8 * p + k];
+        double v;
+        std::memcpy(&v, &u, 8);
+        A.val[(size_t)slot_of[c / bs] * bs * bs + (r % bs) * bs + c % bs] = v;
+      }
+    A.ptr.push_back((int)A.col.size());
+  }
+  return A;
+}
+
+// Scalar CSR of the block matrix (every entry of every block, zeros included: all formats store the same).
+struct ScalarCSR {
+  std::vector<int>    ptr, col;
+  std::vector<double> val;
+};
+ScalarCSR scalar_csr(const BlockMatrix &A)
+{
+  const int bs = A.bs;
+  ScalarCSR S;
+  S.ptr.assign(1, 0);
+  for (int br = 0; br < A.mbs; br++)
+    for (int i = 0; i < bs; i++) {
+      for (int p = A.ptr[br]; p < A.ptr[br + 1]; p++)
+        for (int j = 0; j < bs; j++) {
+          S.col.push_back(A.col[p] * bs + j);
+          S.val.push_back(A.val[(size_t)p * bs * bs + i * bs + j]);
+        }
+      S.ptr.push_back((int)S.col.size());
+    }
+  return S;
+}
+
+// The bins of a block CSR pattern (bs 1 for BIN-CSR), values in the tile layout, in V.
+template <typename V>
+struct Bins {
+  int               bs, bw, mbs;
+  std::vector<int>  start, col;
+  std::vector<V>    val;
+  long              nslots() const { return (long)col.size(); }
+};
+template <typename V>
+Bins<V> make_bins(const std::vector<int> &ptr, const std::vector<int> &col, const std::vector<double> &val, int bs, int mbs, int bw)
+{
+  Bins<V> B;
+  B.bs  = bs;
+  B.bw  = bw;
+  B.mbs = mbs;
+  B.start.resize((mbs + bw - 1) / bw + 1);
+  const long nslots = binbcsr::bin_starts<int>(ptr.data(), mbs, bw, B.start.data());
+  B.col.resize(nslots);
+  binbcsr::bin_columns<int>(ptr.data(), col.data(), mbs, bw, B.start.data(), B.col.data(), nullptr);
+  B.val.assign((size_t)nslots * bs * bs, (V)0);
+  for (int r = 0; r < mbs; r++)
+    for (int k = 0; k < ptr[r + 1] - ptr[r]; k++) {
+      const long s = binbcsr::row_slot<int>(B.start.data(), bw, r, k);
+      for (int e = 0; e < bs * bs; e++) B.val[binbcsr::value_index(s, e, bw, bs * bs)] = (V)val[(size_t)(ptr[r] + k) * bs * bs + e];
+    }
+  return B;
+}
+
+template <typename T>
+T *to_device(const std::vector<T> &h)
+{
+  T *d = nullptr;
+  CK(cudaMalloc(&d, std::max<size_t>(h.size(), 1) * sizeof(T)));
+  if (!h.empty()) CK(cudaMemcpy(d, h.data(), h.size() * sizeof(T), cudaMemcpyHostToDevice));
+  return d;
+}
+template <typename T>
+std::vector<T> to_host(const T *d, size_t n)
+{
+  std::vector<T> h(n);
+  CK(cudaMemcpy(h.data(), d, n * sizeof(T), cudaMemcpyDeviceToHost));
+  return h;
+}
+
+// Seconds per call of f: the median over 7 batches of events around `per_batch` calls, after a warm-up.
+template <class F>
+double time_per_call(F &&f, int per_batch)
+{
+  cudaEvent_t a, b;
+  CK(cudaEventCreate(&a));
+  CK(cudaEventCreate(&b));
+  for (int i = 0; i < 3; i++) f();
+  CK(cudaDeviceSynchronize());
+  std::vector<double> t;
+  for (int rep = 0; rep < 7; rep++) {
+    CK(cudaEventRecord(a));
+    for (int i = 0; i < per_batch; i++) f();
+    CK(cudaEventRecord(b));
+    CK(cudaEventSynchronize(b));
+    float ms = 0;
+    CK(cudaEventElapsedTime(&ms, a, b));
+    t.push_back(ms * 1e-3 / per_batch);
+  }
+  CK(cudaEventDestroy(a));
+  CK(cudaEventDestroy(b));
+  std::sort(t.begin(), t.end());
+  return t[t.size() / 2];
+}
+
+// Calls per batch so that a batch takes about 20 ms (one timed call first).
+template <class F>
+int batch_size(F &&f)
+{
+  const double one = time_per_call(f, 1);
+  return (int)std::min(2000.0, std::max(5.0, 0.02 / std::max(one, 1e-7)));
+}
+
+__global__ void triad(long n, const double *__restrict__ a, const double *__restrict__ b, double *__restrict__ c)
+{
+  for (long i = blockIdx.x * (long)blockDim.x + threadIdx.x; i < n; i += (long)gridDim.x * blockDim.x) c[i] = a[i] + 1.5 * b[i];
+}
+
+// STREAM triad over 3 arrays of 2^26 doubles (1.6 GB, far beyond L2): bytes read + written per second.
+double triad_bandwidth()
+{
+  const long n = 1L << 26;
+  double    *a, *b, *c;
+  CK(cudaMalloc(&a, n * 8));
+  CK(cudaMalloc(&b, n * 8));
+  CK(cudaMalloc(&c, n * 8));
+  CK(cudaMemset(a, 0, n * 8));
+  CK(cudaMemset(b, 0, n * 8));
+  const double t = time_per_call([&] { triad<<<132 * 16, 256>>>(n, a, b, c); }, 20);
+  CKL();
+  CK(cudaFree(a));
+  CK(cudaFree(b));
+  CK(cudaFree(c));
+  return 3.0 * n * 8 / t;
+}
+
+// Host reference y = A x in double, and per row the scale sum_j |a_ij x_j| the errors are measured against.
+void host_product(const ScalarCSR &S, const std::vector<double> &x, std::vector<double> &y, std::vector<double> &scale)
+{
+  const size_t n = S.ptr.size() - 1;
+  y.assign(n, 0.0);
+  scale.assign(n, 0.0);
+  for (size_t i = 0; i < n; i++)
+    for (int p = S.ptr[i]; p < S.ptr[i + 1]; p++) {
+      y[i] += S.val[p] * x[S.col[p]];
+      scale[i] += std::fabs(S.val[p] * x[S.col[p]]);
+    }
+}
+
+struct Row {
+  std::string format;
+  double      seconds, bytes, flops, error, bound;
+};
+
+// Checks y against the reference: max_i |y_i - ref_i| / scale_i <= bound (NaN fails: y was poisoned).
+template <typename T>
+double product_error(const T *dy, const std::vector<double> &ref, const std::vector<double> &scale)
+{
+  const std::vector<T> y = to_host(dy, ref.size());
+  double               e = 0.0;
+  for (size_t i = 0; i < ref.size(); i++) {
+    const double d = std::fabs((double)y[i] - ref[i]) / std::max(scale[i], 1e-300);
+    if (!(d <= e)) e = std::isnan(d) ? INFINITY : std::max(e, d);
+  }
+  return e;
+}
+
+void print_rows(const std::vector<Row> &rows, double bw_triad)
+{
+  const double csr = rows[0].seconds;
+  std::printf("%-26s %9s %9s %8s %7s %7s %9s %9s %s\n", "format", "us", "GFlop/s", "GB/s", "%triad", "x csr", "error", "bound", "check");
+  for (const Row &r : rows) {
+    const bool ok = r.error <= r.bound;
+    failures += !ok;
+    std::printf("%-26s %9.2f %9.1f %8.1f %7.1f %7.2f %9.1e %9.1e %s\n", r.format.c_str(), r.seconds * 1e6, r.flops / r.seconds * 1e-9, r.bytes / r.seconds * 1e-9, 100.0 * r.bytes / r.seconds / bw_triad, csr / r.seconds, r.error, r.bound, ok ? "ok" : "FAIL");
+  }
+}
+
+// cuSPARSE SpMV through the generic API, in T (x, y and values all T).
+template <typename T>
+Row cusparse_row(cusparseHandle_t h, cusparseSpMatDescr_t mat, const char *name, double matrix_bytes, double flops, long n, const std::vector<double> &x, const std::vector<double> &ref, const std::vector<double> &scale, double bound, cusparseSpMVAlg_t alg)
+{
+  const cudaDataType dt = sizeof(T) == 8 ? CUDA_R_64F : CUDA_R_32F;
+  std::vector<T>     xt(x.begin(), x.end());
+  T                 *dx = to_device(xt), *dy;
+  CK(cudaMalloc(&dy, n * sizeof(T)));
+  cusparseDnVecDescr_t vx, vy;
+  CKS(cusparseCreateDnVec(&vx, n, dx, dt));
+  CKS(cusparseCreateDnVec(&vy, n, dy, dt));
+  const T one = 1, zero = 0;
+  size_t  buf_size = 0;
+  void   *buf      = nullptr;
+  CKS(cusparseSpMV_bufferSize(h, CUSPARSE_OPERATION_NON_TRANSPOSE, &one, mat, vx, &zero, vy, dt, alg, &buf_size));
+  CK(cudaMalloc(&buf, std::max<size_t>(buf_size, 8)));
+  auto run = [&] { CKS(cusparseSpMV(h, CUSPARSE_OPERATION_NON_TRANSPOSE, &one, mat, vx, &zero, vy, dt, alg, buf)); };
+  CK(cudaMemset(dy, 0xFF, n * sizeof(T))); /* NaN: an entry the product does not write fails the check */
+  run();
+  CK(cudaDeviceSynchronize());
+  Row r{name, time_per_call(run, batch_size(run)), matrix_bytes + 2.0 * n * sizeof(T), flops, product_error(dy, ref, scale), bound};
+  CKS(cusparseDestroyDnVec(vx));
+  CKS(cusparseDestroyDnVec(vy));
+  CK(cudaFree(buf));
+  CK(cudaFree(dx));
+  CK(cudaFree(dy));
+  return r;
+}
+
+// Our product: bins in V, x and y in double.
+template <int BS, typename V>
+Row bin_row(const Bins<V> &B, bool per_row, const char *name, double flops, const std::vector<double> &x, const std::vector<double> &ref, const std::vector<double> &scale, double bound)
+{
+  const long n  = (long)B.mbs * BS;
+  V         *dv = to_device(B.val);
+  int       *dc = to_device(B.col), *ds = to_device(B.start);
+  double    *dx = to_device(x), *dy;
+  CK(cudaMalloc(&dy, n * 8));
+  const int bt = binbcsr::cuda::block_threads, lanes_blocks = (B.mbs + bt - 1) / bt, rows_blocks = (int)((binbcsr::cuda::rows_threads(B.mbs, B.bw, BS) + bt - 1) / bt);
+  const int split_blocks = (int)((binbcsr::cuda::split_threads(B.mbs, BS) + bt - 1) / bt);
+  auto      run = [&] {
+    if (per_row && B.bw == 8) binbcsr::cuda::bin_mult_split8<BS, V><<<split_blocks, bt>>>(dv, dc, ds, B.mbs, dx, dy);
+    else if (per_row) binbcsr::cuda::bin_mult_rows<BS, V><<<rows_blocks, bt>>>(dv, dc, ds, B.mbs, B.bw, dx, dy);
+    else binbcsr::cuda::bin_mult<BS, V><<<lanes_blocks, bt>>>(dv, dc, ds, B.mbs, B.bw, dx, dy);
+  };
+  CK(cudaMemset(dy, 0xFF, n * 8));
+  run();
+  CKL();
+  CK(cudaDeviceSynchronize());
+  const double bytes = (double)B.val.size() * sizeof(V) + 4.0 * (B.col.size() + B.start.size()) + 16.0 * n;
+  Row          r{name, time_per_call(run, batch_size(run)), bytes, flops, product_error(dy, ref, scale), bound};
+  CK(cudaFree(dv));
+  CK(cudaFree(dc));
+  CK(cudaFree(ds));
+  CK(cudaFree(dx));
+  CK(cudaFree(dy));
+  return r;
+}
+
+void spmv_table(const BlockMatrix &A, const ScalarCSR &S, cusparseHandle_t h, double bw_triad)
+{
+  const long   n = A.n(), nnz = (long)S.col.size();
+  const double flops = 2.0 * nnz, eps32 = std::ldexp(1.0, -24);
+  int          maxrow = 0, minrow = 1 << 30;
+  for (int r = 0; r < A.mbs; r++) {
+    maxrow = std::max(maxrow, A.ptr[r + 1] - A.ptr[r]);
+    minrow = std::min(minrow, A.ptr[r + 1] - A.ptr[r]);
+  }
+  std::vector<double> x(n), ref, scale;
+  for (long i = 0; i < n; i++) x[i] = unit_random(0xABCDEFULL + i);
+  host_product(S, x, ref, scale);
+  const double b64 = 1e-12, b32 = (double)(maxrow * A.bs + 2) * eps32, bstore32 = 2 * eps32;
+
+  std::vector<Row> rows;
+  // cuSPARSE CSR
+  int   *dptr = to_device(S.ptr), *dcol = to_device(S.col);
+  double *dval = to_device(S.val);
+  std::vector<float> sval32(S.val.begin(), S.val.end());
+  float *dval32 = to_device(sval32);
+  cusparseSpMatDescr_t m;
+  const double csr_bytes64 = 12.0 * nnz + 4.0 * (n + 1), csr_bytes32 = 8.0 * nnz + 4.0 * (n + 1);
+  CKS(cusparseCreateCsr(&m, n, n, nnz, dptr, dcol, dval, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO, CUDA_R_64F));
+  rows.push_back(cusparse_row<double>(h, m, "cusparse csr double", csr_bytes64, flops, n, x, ref, scale, b64, CUSPARSE_SPMV_CSR_ALG1));
+  CKS(cusparseDestroySpMat(m));
+  CKS(cusparseCreateCsr(&m, n, n, nnz, dptr, dcol, dval32, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO, CUDA_R_32F));
+  rows.push_back(cusparse_row<float>(h, m, "cusparse csr single", csr_bytes32, flops, n, x, ref, scale, b32, CUSPARSE_SPMV_CSR_ALG1));
+  CKS(cusparseDestroySpMat(m));
+  CK(cudaFree(dval));
+  CK(cudaFree(dval32));
+  CK(cudaFree(dptr));
+  CK(cudaFree(dcol));
+  // cuSPARSE BSR (block rows as A, row-major blocks)
+  if (A.bs > 1) {
+    int   *bptr = to_device(A.ptr), *bcol = to_device(A.col);
+    double *bval = to_device(A.val);
+    std::vector<float> bv32(A.val.begin(), A.val.end());
+    float *bval32 = to_device(bv32);
+    const double bsr_bytes64 = 8.0 * A.val.size() + 4.0 * (A.col.size() + A.ptr.size()), bsr_bytes32 = 4.0 * A.val.size() + 4.0 * (A.col.size() + A.ptr.size());
+    CKS(cusparseCreateBsr(&m, A.mbs, A.mbs, A.nblocks(), A.bs, A.bs, bptr, bcol, bval, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO, CUDA_R_64F, CUSPARSE_ORDER_ROW));
+    rows.push_back(cusparse_row<double>(h, m, "cusparse bsr double", bsr_bytes64, flops, n, x, ref, scale, b64, CUSPARSE_SPMV_BSR_ALG1));
+    CKS(cusparseDestroySpMat(m));
+    CKS(cusparseCreateBsr(&m, A.mbs, A.mbs, A.nblocks(), A.bs, A.bs, bptr, bcol, bval32, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO, CUDA_R_32F, CUSPARSE_ORDER_ROW));
+    rows.push_back(cusparse_row<float>(h, m, "cusparse bsr single", bsr_bytes32, flops, n, x, ref, scale, b32, CUSPARSE_SPMV_BSR_ALG1));
+    CKS(cusparseDestroySpMat(m));
+    CK(cudaFree(bptr));
+    CK(cudaFree(bcol));
+    CK(cudaFree(bval));
+    CK(cudaFree(bval32));
+  }
+  // cuSPARSE sliced ELL, slice 32 (padding column -1): the nearest cuSPARSE format to BIN-CSR
+  {
+    const int          slice = 32, nslices = (int)((n + slice - 1) / slice);
+    std::vector<int>    off(nslices + 1, 0), scol;
+    std::vector<double> sval;
+    for (int sl = 0; sl < nslices; sl++) {
+      int len = 0;
+      for (long r = (long)sl * slice; r < std::min(n, (long)(sl + 1) * slice); r++) len = std::max(len, S.ptr[r + 1] - S.ptr[r]);
+      off[sl + 1] = off[sl] + len * slice;
+    }
+    scol.assign(off[nslices], -1);
+    sval.assign(off[nslices], 0.0);
+    for (long r = 0; r < n; r++)
+      for (int k = 0; k < S.ptr[r + 1] - S.ptr[r]; k++) {
+        const long at = off[r / slice] + (long)k * slice + r % slice;
+        scol[at]      = S.col[S.ptr[r] + k];
+        sval[at]      = S.val[S.ptr[r] + k];
+      }
+    std::vector<float> sv32(sval.begin(), sval.end());
+    int   *doff = to_device(off), *dsc = to_device(scol);
+    double *dsv = to_device(sval);
+    float *dsv32 = to_device(sv32);
+    const double sell_bytes64 = 12.0 * scol.size() + 4.0 * off.size(), sell_bytes32 = 8.0 * scol.size() + 4.0 * off.size();
+    CKS(cusparseCreateSlicedEll(&m, n, n, nnz, (int64_t)scol.size(), slice, doff, dsc, dsv, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO, CUDA_R_64F));
+    rows.push_back(cusparse_row<double>(h, m, "cusparse sell32 double", sell_bytes64, flops, n, x, ref, scale, b64, CUSPARSE_SPMV_SELL_ALG1));
+    CKS(cusparseDestroySpMat(m));
+    CKS(cusparseCreateSlicedEll(&m, n, n, nnz, (int64_t)scol.size(), slice, doff, dsc, dsv32, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO, CUDA_R_32F));
+    rows.push_back(cusparse_row<float>(h, m, "cusparse sell32 single", sell_bytes32, flops, n, x, ref, scale, b32, CUSPARSE_SPMV_SELL_ALG1));
+    CKS(cusparseDestroySpMat(m));
+    CK(cudaFree(doff));
+    CK(cudaFree(dsc));
+    CK(cudaFree(dsv));
+    CK(cudaFree(dsv32));
+  }
+  // Ours: BIN-CSR (scalars, bin width 32) and BIN-BCSR (3x3 blocks, bin widths 32, 16, 8)
+  double pad_csr = 0, pad_bcsr32 = 0;
+  {
+    const auto B = make_bins<double>(S.ptr, S.col, S.val, 1, (int)n, 32);
+    pad_csr      = 100.0 * ((double)B.nslots() / nnz - 1.0);
+    rows.push_back(bin_row<1, double>(B, false, "bin-csr double (bw 32)", flops, x, ref, scale, b64));
+    const auto F = make_bins<float>(S.ptr, S.col, S.val, 1, (int)n, 32);
+    rows.push_back(bin_row<1, float>(F, false, "bin-csr single (bw 32)", flops, x, ref, scale, bstore32));
+  }
+  if (A.bs == 3)
+    for (int bw : {32, 16, 8}) {
+      const auto   B    = make_bins<double>(A.ptr, A.col, A.val, 3, A.mbs, bw);
+      const auto   F    = make_bins<float>(A.ptr, A.col, A.val, 3, A.mbs, bw);
+      const std::string tail = bw == 8 ? ", split 4)" : ")", d = "bin-bcsr double (bw " + std::to_string(bw) + tail, s = "bin-bcsr single (bw " + std::to_string(bw) + tail;
+      if (bw == 32) pad_bcsr32 = 100.0 * ((double)B.nslots() / A.nblocks() - 1.0);
+      rows.push_back(bin_row<3, double>(B, true, d.c_str(), flops, x, ref, scale, b64));
+      rows.push_back(bin_row<3, float>(F, true, s.c_str(), flops, x, ref, scale, bstore32));
+      if (bw == 32) { /* one thread per lane for all 3 point rows: a third of the threads */
+        rows.push_back(bin_row<3, double>(B, false, "bin-bcsr double, lane/thread", flops, x, ref, scale, b64));
+        rows.push_back(bin_row<3, float>(F, false, "bin-bcsr single, lane/thread", flops, x, ref, scale, bstore32));
+      }
+    }
+  std::printf("\n== %s: %ld rows, %ld nonzeros (%ld blocks of %dx%d), block row length %d..%d (avg %.1f), padding bin-csr %.1f%%, bin-bcsr (bw 32) %.1f%%\n", A.name.c_str(), n, nnz, A.nblocks(), A.bs, A.bs, minrow, maxrow, (double)A.nblocks() / A.mbs, pad_csr, pad_bcsr32);
+  print_rows(rows, bw_triad);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// CG, Jacobi-preconditioned, from x = 0, a fixed number of iterations.
+
+__global__ void pointwise_mult(int n, const double *__restrict__ a, const double *__restrict__ b, double *__restrict__ c)
+{
+  for (int i = blockIdx.x * blockDim.x + threadIdx.x; i < n; i += gridDim.x * blockDim.x) c[i] = a[i] * b[i];
+}
+
+struct CGResult {
+  double              seconds_per_it;
+  std::vector<double> rz; /* r.z after each iteration (index 0: the start) */
+};
+
+// Stock CG as a PETSc user gets it on a GPU (KSPCG + PCJACOBI on aijcusparse): cuSPARSE CSR SpMV (or
+// the BIN-BCSR kernel with bins != nullptr), cuBLAS dots that return to the host, axpys, a Jacobi
+// kernel: 8 launches and 2 host synchronisations per iteration.
+template <typename V>
+CGResult stock_cg(cusparseHandle_t sh, cublasHandle_t bh, const ScalarCSR &S, const Bins<V> *bins, const std::vector<double> &dinv_h, const std::vector<double> &b_h, int its)
+{
+  const int n = (int)dinv_h.size();
+  double   *dinv = to_device(dinv_h), *b = to_device(b_h), *x, *r, *z, *p, *q;
+  for (double **v : {&x, &r, &z, &p, &q}) CK(cudaMalloc(v, n * 8));
+  int    *dptr = nullptr, *dcol = nullptr, *bc = nullptr, *bst = nullptr;
+  double *dval = nullptr;
+  V      *bv   = nullptr;
+  cusparseSpMatDescr_t m  = nullptr;
+  cusparseDnVecDescr_t vp = nullptr, vq = nullptr;
+  void                *buf = nullptr;
+  const double         one = 1.0, zero = 0.0;
+  if (!bins) {
+    dptr = to_device(S.ptr);
+    dcol = to_device(S.col);
+    dval = to_device(S.val);
+    CKS(cusparseCreateCsr(&m, n, n, (int64_t)S.col.size(), dptr, dcol, dval, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO, CUDA_R_64F));
+    CKS(cusparseCreateDnVec(&vp, n, p, CUDA_R_64F));
+    CKS(cusparseCreateDnVec(&vq, n, q, CUDA_R_64F));
+    size_t sz = 0;
+    CKS(cusparseSpMV_bufferSize(sh, CUSPARSE_OPERATION_NON_TRANSPOSE, &one, m, vp, &zero, vq, CUDA_R_64F, CUSPARSE_SPMV_CSR_ALG1, &sz));
+    CK(cudaMalloc(&buf, std::max<size_t>(sz, 8)));
+  } else {
+    bv  = to_device(bins->val);
+    bc  = to_device(bins->col);
+    bst = to_device(bins->start);
+  }
+  const int vb = std::min((n + 255) / 256, 132 * 8);
+  auto      spmv = [&] {
+    if (!bins) CKS(cusparseSpMV(sh, CUSPARSE_OPERATION_NON_TRANSPOSE, &one, m, vp, &zero, vq, CUDA_R_64F, CUSPARSE_SPMV_CSR_ALG1, buf));
+    else binbcsr::cuda::bin_mult_rows<3, V><<<(int)((binbcsr::cuda::rows_threads(bins->mbs, bins->bw, 3) + 255) / 256), 256>>>(bv, bc, bst, bins->mbs, bins->bw, p, q);
+  };
+  CGResult res;
+  auto     solve = [&](bool record) {
+    double rz, pq;
+    CK(cudaMemcpy(r, b, n * 8, cudaMemcpyDeviceToDevice));
+    CK(cudaMemset(x, 0, n * 8));
+    pointwise_mult<<<vb, 256>>>(n, dinv, r, z);
+    CK(cudaMemcpy(p, z, n * 8, cudaMemcpyDeviceToDevice));
+    CKB(cublasDdot(bh, n, r, 1, z, 1, &rz));
+    if (record) res.rz.assign(1, rz);
+    for (int it = 0; it < its; it++) {
+      spmv();
+      CKB(cublasDdot(bh, n, p, 1, q, 1, &pq));
+      const double a = pq > 0.0 ? rz / pq : 0.0, ma = -a; /* the merged CG's guards: p = 0 once converged exactly */
+      CKB(cublasDaxpy(bh, n, &a, p, 1, x, 1));
+      CKB(cublasDaxpy(bh, n, &ma, q, 1, r, 1));
+      pointwise_mult<<<vb, 256>>>(n, dinv, r, z);
+      double rz_new;
+      CKB(cublasDdot(bh, n, r, 1, z, 1, &rz_new));
+      const double beta = rz > 0.0 ? rz_new / rz : 0.0;
+      CKB(cublasDscal(bh, n, &beta, p, 1));
+      CKB(cublasDaxpy(bh, n, &one, z, 1, p, 1));
+      rz = rz_new;
+      if (record) res.rz.push_back(rz);
+    }
+  };
+  solve(true);
+  CKL();
+  res.seconds_per_it = time_per_call([&] { solve(false); }, 3) / its;
+  if (m) {
+    CKS(cusparseDestroySpMat(m));
+    CKS(cusparseDestroyDnVec(vp));
+    CKS(cusparseDestroyDnVec(vq));
+  }
+  for (void *v : {(void *)dinv, (void *)b, (void *)x, (void *)r, (void *)z, (void *)p, (void *)q, (void *)dptr, (void *)dcol, (void *)dval, (void *)bv, (void *)bc, (void *)bst, buf}) CK(cudaFree(v));
+  return res;
+}
+
+// The merged CG with BIN-BCSR: 3 launches per iteration, no host synchronisation until the end; with
+// graph, the whole fixed-iteration solve is captured once and replayed as one launch.
+template <typename V>
+CGResult merged_cg(const Bins<V> &B, const std::vector<double> &dinv_h, const std::vector<double> &b_h, int its, bool graph)
+{
+  namespace bc = binbcsr::cuda;
+  const int n = (int)dinv_h.size();
+  double   *dinv = to_device(dinv_h), *b = to_device(b_h), *x, *r, *z, *p, *q, *partials, *hist;
+  for (double **v : {&x, &r, &z, &p, &q}) CK(cudaMalloc(v, n * 8));
+  V  *dv = to_device(B.val);
+  int *dc = to_device(B.col), *ds = to_device(B.start);
+  const int sb = (int)(((B.bw == 8 ? bc::split_threads(B.mbs, 3) : bc::rows_threads(B.mbs, B.bw, 3)) + bc::block_threads - 1) / bc::block_threads), vb = std::min((n + bc::block_threads - 1) / bc::block_threads, 132 * 8);
+  CK(cudaMalloc(&partials, std::max(sb, vb) * 8));
+  CK(cudaMalloc(&hist, (its + 1) * 8));
+  bc::MCGScalars *s;
+  CK(cudaMalloc(&s, sizeof(bc::MCGScalars)));
+  CK(cudaMemset(s, 0, sizeof(bc::MCGScalars)));
+  cudaStream_t st;
+  CK(cudaStreamCreate(&st));
+  auto enqueue = [&] {
+    bc::mcg_start<<<vb, bc::block_threads, 0, st>>>(n, dinv, b, x, r, z, p, partials, s, hist);
+    for (int it = 0; it < its; it++) {
+      const int cur = it % 2;
+      if (B.bw == 8) bc::mcg_spmv_dot_split8<3, V><<<sb, bc::block_threads, 0, st>>>(dv, dc, ds, B.mbs, p, q, partials, s);
+      else bc::mcg_spmv_dot<3, V><<<sb, bc::block_threads, 0, st>>>(dv, dc, ds, B.mbs, B.bw, p, q, partials, s);
+      bc::mcg_update<<<vb, bc::block_threads, 0, st>>>(n, cur, dinv, p, q, x, r, z, partials, s, hist + it + 1);
+      bc::mcg_direction<<<vb, bc::block_threads, 0, st>>>(n, cur, z, p, s);
+    }
+  };
+  cudaGraphExec_t exec = nullptr;
+  if (graph) {
+    cudaGraph_t g;
+    CK(cudaStreamBeginCapture(st, cudaStreamCaptureModeGlobal));
+    enqueue();
+    CK(cudaStreamEndCapture(st, &g));
+    CK(cudaGraphInstantiate(&exec, g, 0));
+    CK(cudaGraphDestroy(g));
+  }
+  auto solve = [&] {
+    if (graph) CK(cudaGraphLaunch(exec, st));
+    else enqueue();
+  };
+  CK(cudaMemset(hist, 0xFF, (its + 1) * 8));
+  solve();
+  CK(cudaStreamSynchronize(st));
+  CKL();
+  CGResult res;
+  res.rz = to_host(hist, its + 1);
+  // time_per_call records on the default stream, which waits for st (legacy default stream semantics)
+  res.seconds_per_it = time_per_call(solve, 3) / its;
+  if (exec) CK(cudaGraphExecDestroy(exec));
+  CK(cudaStreamDestroy(st));
+  for (void *v : {(void *)dinv, (void *)b, (void *)x, (void *)r, (void *)z, (void *)p, (void *)q, (void *)partials, (void *)hist, (void *)s, (void *)dv, (void *)dc, (void *)ds}) CK(cudaFree(v));
+  return res;
+}
+
+// Largest relative difference of sqrt(r.z) between two histories over the first `upto` iterations.
+double history_difference(const std::vector<double> &a, const std::vector<double> &b, size_t upto)
+{
+  double d = 0.0;
+  for (size_t i = 0; i < std::min({a.size(), b.size(), upto + 1}); i++) {
+    const double e = std::fabs(std::sqrt(std::fabs(a[i])) - std::sqrt(std::fabs(b[i]))) / std::sqrt(std::fabs(b[i]));
+    if (!(e <= d)) d = std::isnan(e) ? INFINITY : e;
+  }
+  return d;
+}
+
+void cg_table(const BlockMatrix &A, const ScalarCSR &S, cusparseHandle_t sh, cublasHandle_t bh, int its)
+{
+  const int           n = A.n();
+  std::vector<double> dinv(n), b(n);
+  for (int br = 0; br < A.mbs; br++)
+    for (int p = A.ptr[br]; p < A.ptr[br + 1]; p++)
+      if (A.col[p] == br)
+        for (int i = 0; i < A.bs; i++) dinv[br * A.bs + i] = 1.0 / A.val[(size_t)p * A.bs * A.bs + i * A.bs + i];
+  for (int i = 0; i < n; i++) b[i] = unit_random(0x5EEDULL + i);
+  const auto     B32 = make_bins<double>(A.ptr, A.col, A.val, 3, A.mbs, 32);
+  const auto     F32 = make_bins<float>(A.ptr, A.col, A.val, 3, A.mbs, 32);
+  const auto     B8  = make_bins<double>(A.ptr, A.col, A.val, 3, A.mbs, 8);
+  const auto     F8  = make_bins<float>(A.ptr, A.col, A.val, 3, A.mbs, 8);
+  const CGResult stock = stock_cg<double>(sh, bh, S, nullptr, dinv, b, its);
+  const CGResult stock_bins = stock_cg<double>(sh, bh, S, &B32, dinv, b, its);
+  const CGResult mcg = merged_cg<double>(B32, dinv, b, its, false);
+  const CGResult mcg_graph = merged_cg<double>(B32, dinv, b, its, true);
+  const CGResult mcg_single = merged_cg<float>(F32, dinv, b, its, true);
+  const CGResult mcg8 = merged_cg<double>(B8, dinv, b, its, true);
+  const CGResult mcg8_single = merged_cg<float>(F8, dinv, b, its, true);
+
+  const size_t   upto = 30; /* residual histories of different summation orders drift apart slowly; compare the simulation's 30 */
+  struct Line {
+    const char     *name;
+    const CGResult *r;
+    double          bound;
+  } lines[] = {{"stock cg, cusparse csr", &stock, 0},
+               {"stock cg, bin-bcsr spmv", &stock_bins, 1e-8},
+               {"merged cg, bin-bcsr", &mcg, 1e-8},
+               {"merged cg, bin-bcsr, graph", &mcg_graph, 1e-8},
+               {"merged cg, single, graph", &mcg_single, 1e-3},
+               {"merged cg, bw 8 split, graph", &mcg8, 1e-8},
+               {"merged cg, bw 8 split, single", &mcg8_single, 1e-3}};
+  std::printf("\n-- CG (Jacobi, from zero, %d iterations) on %s: sqrt(r.z) %.3e -> %.3e\n", its, A.name.c_str(), std::sqrt(stock.rz.front()), std::sqrt(std::fabs(stock.rz.back())));
+  std::printf("%-30s %12s %10s %22s %s\n", "solver", "us/iteration", "speed-up", "history diff (30 its)", "check");
+  for (const Line &l : lines) {
+    const double d  = history_difference(l.r->rz, stock.rz, upto);
+    const bool   ok = l.r == &stock || d <= l.bound;
+    failures += !ok;
+    std::printf("%-30s %12.2f %10.2f %22.1e %s\n", l.name, l.r->seconds_per_it * 1e6, stock.seconds_per_it / l.r->seconds_per_it, d, ok ? "ok" : "FAIL");
+  }
+}
+
+} // namespace
+
+int main(int argc, char **argv)
+{
+  std::vector<int>         sizes;
+  std::vector<std::string> files;
+  int                      bs = 3, its = 1000;
+  bool                     cg = true;
+  for (int i = 1; i < argc; i++) {
+    const std::string a = argv[i];
+    auto              next = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "%s needs a value\n", a.c_str());
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "-stencil") {
+      std::string v = next();
+      for (size_t p = 0; p < v.size();) {
+        size_t q = v.find(',', p);
+        sizes.push_back(std::atoi(v.substr(p, q - p).c_str()));
+        p = q == std::string::npos ? v.size() : q + 1;
+      }
+    } else if (a == "-f") files.push_back(next());
+    else if (a == "-bs") bs = std::atoi(next().c_str());
+    else if (a == "-cg_its") its = std::atoi(next().c_str());
+    else if (a == "-no_cg") cg = false;
+    else {
+      std::fprintf(stderr, "unknown option %s\nusage: %s [-stencil 16,32] [-f A.bin]... [-bs 3] [-cg_its 1000] [-no_cg]\n", a.c_str(), argv[0]);
+      return 2;
+    }
+  }
+  if (sizes.empty() && files.empty()) sizes = {16, 32, 64};
+  cudaDeviceProp prop;
+  CK(cudaGetDeviceProperties(&prop, 0));
+  const double bw_triad = triad_bandwidth();
+  std::printf("device: %s, %d SMs, L2 %.0f MB; STREAM triad %.0f GB/s (3 x 512 MB arrays)\n", prop.name, prop.multiProcessorCount, prop.l2CacheSize / 1e6, bw_triad * 1e-9);
+  std::printf("bytes model: values + column indices + row/bin offsets + x read once + y written once; GFlop/s = 2 nnz / t\n");
+  cusparseHandle_t sh;
+  cublasHandle_t   bh;
+  CKS(cusparseCreate(&sh));
+  CKB(cublasCreate(&bh));
+  std::vector<BlockMatrix> mats;
+  for (int s : sizes) mats.push_back(stencil_matrix(s));
+  for (const std::string &f : files) mats.push_back(read_petsc_binary(f, bs));
+  for (const BlockMatrix &A : mats) {
+    const ScalarCSR S = scalar_csr(A);
+    spmv_table(A, S, sh, bw_triad);
+    if (cg && A.bs == 3) cg_table(A, S, sh, bh, its);
+    std::fflush(stdout);
+  }
+  CKS(cusparseDestroy(sh));
+  CKB(cublasDestroy(bh));
+  std::printf("\n%s: %d check(s) failed\n", failures ? "FAIL" : "ok", failures);
+  return failures ? 1 : 0;
+}
