@@ -25,6 +25,10 @@ PETSC_INTERN PetscErrorCode MatCreateSubMatrices_BinBCSR(Mat, PetscInt, const IS
 PETSC_INTERN PetscErrorCode MatCreateSubMatricesMPI_BinBCSR(Mat, PetscInt, const IS[], const IS[], MatReuse, Mat *[]);
 PETSC_INTERN PetscErrorCode MatCreateSubMatrix_BinBCSR(Mat, IS, IS, MatReuse, Mat *);
 PETSC_INTERN PetscErrorCode MatCreateMPIMatConcatenateSeqMat_BinBCSR(MPI_Comm, Mat, PetscInt, MatReuse, Mat *);
+/* The seqaij/mpiaij copy of a binbcsr matrix, composed on it, refreshed when the matrix changed (collective) */
+PETSC_INTERN PetscErrorCode MatBinBCSRGetAIJShadow_Private(Mat, Mat *);
+/* MUMPS / SuperLU_DIST LU and Cholesky for seq and mpi binbcsr through that shadow: binbcsr_factor_external.cpp */
+PETSC_INTERN PetscErrorCode MatBinBCSRRegisterExternalFactors(void);
 
 /* MATSEQBINBCSR parts of MATMPIBINBCSR: after MatSetPreallocationCOO, compose the part's COO map with
    from[] (part entry -> source index); the two-source refill then reads source p < n from v and

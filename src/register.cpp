@@ -20,6 +20,7 @@ PetscErrorCode PetscBinBCSRRegisterAll(void)
   PetscCall(MatRegisterRootName(MATBINBCSR, MATSEQBINBCSR, MATMPIBINBCSR));
   PetscCall(KSPRegister(KSPMCG, KSPCreate_MCG));
   for (MatFactorType ft : {MAT_FACTOR_ICC, MAT_FACTOR_CHOLESKY, MAT_FACTOR_ILU, MAT_FACTOR_LU}) PetscCall(MatSolverTypeRegister(MATSOLVERPETSC, MATSEQBINBCSR, ft, MatGetFactor_SeqBinBCSR_Petsc));
+  PetscCall(MatBinBCSRRegisterExternalFactors());
   PetscCall(PetscLogEventRegister("BinBCSRBuildLay", MAT_CLASSID, &MAT_BinBCSR_BuildLayout));
   PetscCall(PetscLogEventRegister("BinBCSRSetCOO", MAT_CLASSID, &MAT_BinBCSR_SetValuesCOO));
   PetscCall(PetscLogEventRegister("BinBCSRMultDot", MAT_CLASSID, &MAT_BinBCSR_MultDot));

@@ -37,8 +37,10 @@ PetscErrorCode DestroyShadow(void *ctx)
   PetscFunctionReturn(0);
 }
 
+} // namespace
+
 /* The AIJ shadow of A holding A's current values. Collective on A. */
-PetscErrorCode GetAIJShadow(Mat A, Mat *S)
+PetscErrorCode MatBinBCSRGetAIJShadow_Private(Mat A, Mat *S)
 {
   PetscContainer   c;
   AIJShadow       *sh;
@@ -72,6 +74,8 @@ PetscErrorCode GetAIJShadow(Mat A, Mat *S)
   PetscFunctionReturn(0);
 }
 
+namespace
+{
 /* A new binbcsr matrix (seq or mpi by T's communicator) with T's sizes and values and the storage
    settings of parent. symmetric: T is a symmetric extraction (same rows and columns) of parent. */
 PetscErrorCode NewFromAIJ(Mat parent, Mat T, PetscBool symmetric, Mat *B)
@@ -151,7 +155,7 @@ PetscErrorCode MatIncreaseOverlap_BinBCSR(Mat A, PetscInt n, IS is[], PetscInt o
   Mat S;
 
   PetscFunctionBegin;
-  PetscCall(GetAIJShadow(A, &S));
+  PetscCall(MatBinBCSRGetAIJShadow_Private(A, &S));
   PetscCall(MatIncreaseOverlap(S, n, is, ov));
   PetscFunctionReturn(0);
 }
@@ -165,7 +169,7 @@ PetscErrorCode MatCreateSubMatrices_BinBCSR(Mat A, PetscInt n, const IS irow[], 
   PetscFunctionBegin;
   PetscCheck(scall == MAT_INITIAL_MATRIX || scall == MAT_REUSE_MATRIX, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_WRONG, "MatCreateSubMatrices takes MAT_INITIAL_MATRIX or MAT_REUSE_MATRIX");
   if (scall == MAT_REUSE_MATRIX) PetscCall(CheckReuse(n, irow, icol, *submat));
-  PetscCall(GetAIJShadow(A, &S));
+  PetscCall(MatBinBCSRGetAIJShadow_Private(A, &S));
   S->submat_singleis = A->submat_singleis; /* PCASM's hint: one index set on every rank; used once, as MPIAIJ does */
   A->submat_singleis = PETSC_FALSE;
   PetscCall(MatCreateSubMatrices(S, n, irow, icol, MAT_INITIAL_MATRIX, &T));
@@ -183,7 +187,7 @@ PetscErrorCode MatCreateSubMatricesMPI_BinBCSR(Mat A, PetscInt n, const IS irow[
 
   PetscFunctionBegin;
   PetscCheck(scall == MAT_INITIAL_MATRIX || scall == MAT_REUSE_MATRIX, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_WRONG, "MatCreateSubMatricesMPI takes MAT_INITIAL_MATRIX or MAT_REUSE_MATRIX");
-  PetscCall(GetAIJShadow(A, &S));
+  PetscCall(MatBinBCSRGetAIJShadow_Private(A, &S));
   PetscCall(MatCreateSubMatricesMPI(S, n, irow, icol, MAT_INITIAL_MATRIX, &T));
   if (scall == MAT_INITIAL_MATRIX) PetscCall(PetscCalloc1(n + 1, submat));
   PetscCall(FromAIJ(A, n, irow, icol, T, scall, *submat));
@@ -197,7 +201,7 @@ PetscErrorCode MatCreateSubMatrix_BinBCSR(Mat A, IS isrow, IS iscol, MatReuse cl
   Mat S, T;
 
   PetscFunctionBegin;
-  PetscCall(GetAIJShadow(A, &S));
+  PetscCall(MatBinBCSRGetAIJShadow_Private(A, &S));
   PetscCall(MatCreateSubMatrix(S, isrow, iscol, MAT_INITIAL_MATRIX, &T));
   PetscCall(FromAIJ(A, 1, &isrow, &iscol, &T, cll, newmat));
   PetscCall(MatDestroy(&T));
