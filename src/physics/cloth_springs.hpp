@@ -2,6 +2,8 @@
 #pragma once
 #include "physics/cloth_model.hpp"
 
+#include <cmath>
+
 namespace physics {
 
 struct SpringLinearisation {
@@ -18,28 +20,34 @@ struct SpringTerms {
   double          k_iso = 0, k_dir = 0, damping = 0;
 };
 
-// Inline: the assembly calls it once per spring, and returning the struct through memory from another
-// translation unit cost a store-forwarding stall per call (a third of the assembly time).
+// The terms of one spring from plain numbers: the separation xb - xa = (dx, dy, dz) and the relative velocity
+// vb - va = (wx, wy, wz) of its ends. What spring_terms computes, written so that a loop over springs vectorises
+// (the assembly runs it over a chunk of springs at a time); branch-free: a coincident pair gets direction and
+// force zero, k_iso = stiffness, k_dir = 0.
+inline void spring_terms_lane(double rest_length, double stiffness, double dx, double dy, double dz, double wx, double wy, double wz, double damping,
+                              bool choi_ko, double &d0, double &d1, double &d2, double &f0, double &f1, double &f2, double &k_iso, double &k_dir)
+{
+  const double length     = std::sqrt(dx * dx + dy * dy + dz * dz);
+  const bool   coincident = length < 1e-12 * rest_length; // no direction, no force
+  const double l          = coincident ? 1.0 : length;
+  const double e0 = coincident ? 0.0 : dx / l, e1 = coincident ? 0.0 : dy / l, e2 = coincident ? 0.0 : dz / l;
+  const double exact      = 1.0 - rest_length / l;
+  const double transverse = choi_ko && exact < 0 ? 0.0 : exact;
+  const double f          = coincident ? 0.0 : stiffness * (length - rest_length) + damping * (e0 * wx + e1 * wy + e2 * wz);
+  d0 = e0, d1 = e1, d2 = e2;
+  f0 = f * e0, f1 = f * e1, f2 = f * e2;
+  k_iso = coincident ? stiffness : stiffness * transverse;
+  k_dir = coincident ? 0.0 : stiffness * (1.0 - transverse);
+}
+
 inline SpringTerms spring_terms(const Spring &s, const Eigen::Vector3d &xa, const Eigen::Vector3d &xb, const Eigen::Vector3d &va,
                                 const Eigen::Vector3d &vb, double damping, bool choi_ko = true)
 {
   SpringTerms           out;
-  const Eigen::Vector3d delta  = xb - xa;
-  const double          length = delta.norm();
-  if (length < 1e-12 * s.rest_length) { // coincident particles: no direction, no force
-    out.direction.setZero();
-    out.force_on_a.setZero();
-    out.k_iso = s.stiffness;
-    return out;
-  }
-  const Eigen::Vector3d d = delta / length;
-  double transverse = 1.0 - s.rest_length / length;
-  if (choi_ko && transverse < 0) transverse = 0;
-  out.direction  = d;
-  out.force_on_a = (s.stiffness * (length - s.rest_length) + damping * d.dot(vb - va)) * d;
-  out.k_iso      = s.stiffness * transverse;
-  out.k_dir      = s.stiffness * (1.0 - transverse);
-  out.damping    = damping;
+  const Eigen::Vector3d delta = xb - xa, w = vb - va;
+  spring_terms_lane(s.rest_length, s.stiffness, delta[0], delta[1], delta[2], w[0], w[1], w[2], damping, choi_ko, out.direction[0], out.direction[1],
+                    out.direction[2], out.force_on_a[0], out.force_on_a[1], out.force_on_a[2], out.k_iso, out.k_dir);
+  out.damping = damping;
   return out;
 }
 
