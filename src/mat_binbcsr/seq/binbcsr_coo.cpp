@@ -235,7 +235,18 @@ void coo_refill_blocks(const Mat_SeqBinBCSR *a, V *val, const PetscInt *slot_ptr
 {
   constexpr int  MAXB2 = BS ? BS * BS : 1;
   const PetscInt bs = BS ? BS : a->bs, bs2 = bs * bs, bw = a->bw;
-  for (PetscInt s0 = 0; s0 < a->nslots; s0 += bw) /* one column of a bin: bw lanes */
+  for (PetscInt s0 = 0; s0 < a->nslots; s0 += bw) { /* one column of a bin: bw lanes */
+    /* the sources of the slot column four ahead: the caller's blocks are read in its order, not in
+       storage order, and each read waited for memory */
+    if (s0 + 4 * bw < a->nslots)
+      for (PetscInt l = 0; l < bw; l++) {
+        const PetscInt p = slot_ptr[s0 + 4 * bw + l];
+        if (p == slot_ptr[s0 + 4 * bw + l + 1]) continue;
+        const long         base = slot_src[p] >= 0 ? slot_src[p] : -1 - (long)slot_src[p];
+        const PetscScalar *x    = base < n ? v + base : recv + (base - n);
+        __builtin_prefetch(x);
+        __builtin_prefetch(x + bs2 - 1);
+      }
     for (PetscInt l = 0; l < bw; l++) {
       const PetscInt p0 = slot_ptr[s0 + l], p1 = slot_ptr[s0 + l + 1];
       if (p0 == p1) continue; /* padding stays zero */
@@ -268,6 +279,7 @@ void coo_refill_blocks(const Mat_SeqBinBCSR *a, V *val, const PetscInt *slot_ptr
           }
       }
     }
+  }
 }
 
 template <int BS, typename V>
