@@ -81,8 +81,9 @@ BINBCSR_HD void lane_mult(const V *bin_val, const I *bin_col, int len, int bw, i
   const int bs  = BS ? BS : bs_rt;
   const int bs2 = bs * bs;
 #if defined(__CUDACC__)
-  #pragma unroll 4 /* a thread's slots are a chain of dependent loads (column, then x): unrolled, the
-                      column loads of 4 slots are in flight together, which the long bins need */
+  #pragma unroll 4 /* a thread's slots are chains of dependent loads (column, then x): unrolled, the
+                      column loads of 4 slots can be in flight together (on the H100 the gain was
+                      within the spread between runs, docs/gpu.md) */
 #endif
   for (int k = 0; k < len; k++) {
     const long s = (long)k * bw + lane;
