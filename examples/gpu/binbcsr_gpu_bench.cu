@@ -5,7 +5,7 @@
 // src/mat_binbcsr/cuda/binbcsr_cuda.cuh. Every product is checked against a double-precision product
 // on the host, every CG against the stock CG's residual history; a failed check exits non-zero.
 //
-//   binbcsr_gpu_bench [-stencil 16,32,64] [-f A.bin [-f B.bin ...]] [-bs 3] [-cg_its 1000] [-no_cg]
+//   binbcsr_gpu_bench [-stencil 16,32,64] [-f A.bin [-f B.bin ...]] [-bs 3] [-cg_its 1000] [-no_cg] [-no_triad]
 //
 // -f reads a PETSc binary matrix (what the drivers write with -dump_matrix), grouped into bs x bs
 // blocks. Stencil matrices are 27-point block stencils on n^3 nodes, symmetric and diagonally dominant.
@@ -540,7 +540,7 @@ int main(int argc, char **argv)
   std::vector<int>         sizes;
   std::vector<std::string> files;
   int                      bs = 3, its = 1000;
-  bool                     cg = true;
+  bool                     cg = true, triad_run = true;
   for (int i = 1; i < argc; i++) {
     const std::string a = argv[i];
     auto              next = [&]() -> std::string {
@@ -561,15 +561,16 @@ int main(int argc, char **argv)
     else if (a == "-bs") bs = std::atoi(next().c_str());
     else if (a == "-cg_its") its = std::atoi(next().c_str());
     else if (a == "-no_cg") cg = false;
+    else if (a == "-no_triad") triad_run = false; /* e.g. under compute-sanitizer, where 1.5 GB of triad takes minutes */
     else {
-      std::fprintf(stderr, "unknown option %s\nusage: %s [-stencil 16,32] [-f A.bin]... [-bs 3] [-cg_its 1000] [-no_cg]\n", a.c_str(), argv[0]);
+      std::fprintf(stderr, "unknown option %s\nusage: %s [-stencil 16,32] [-f A.bin]... [-bs 3] [-cg_its 1000] [-no_cg] [-no_triad]\n", a.c_str(), argv[0]);
       return 2;
     }
   }
   if (sizes.empty() && files.empty()) sizes = {16, 32, 64};
   cudaDeviceProp prop;
   CK(cudaGetDeviceProperties(&prop, 0));
-  const double bw_triad = triad_bandwidth();
+  const double bw_triad = triad_run ? triad_bandwidth() : NAN;
   std::printf("device: %s, %d SMs, L2 %.0f MB; STREAM triad %.0f GB/s (3 x 512 MB arrays)\n", prop.name, prop.multiProcessorCount, prop.l2CacheSize / 1e6, bw_triad * 1e-9);
   std::printf("bytes model: values + column indices + row/bin offsets + x read once + y written once; GFlop/s = 2 nnz / t\n");
   cusparseHandle_t sh;
