@@ -171,6 +171,19 @@ void print_rows(const std::vector<Row> &rows, double bw_triad)
   }
 }
 
+// One product row of the table: y poisoned with NaN (an entry the product does not write fails the
+// check), one checked run, then the timing.
+template <typename T, class F>
+Row measure_product(const char *name, F &&run, T *dy, long n, double bytes, double flops, const std::vector<double> &ref, const std::vector<double> &scale, double bound)
+{
+  CK(cudaMemset(dy, 0xFF, n * sizeof(T)));
+  run();
+  CKL();
+  CK(cudaDeviceSynchronize());
+  const double error = product_error(dy, ref, scale);
+  return Row{name, time_per_call(run, batch_size(run)), bytes, flops, error, bound};
+}
+
 // cuSPARSE SpMV through the generic API, in T (x, y and values all T).
 template <typename T>
 Row cusparse_row(cusparseHandle_t h, cusparseSpMatDescr_t mat, const char *name, double matrix_bytes, double flops, long n, const std::vector<double> &x, const std::vector<double> &ref, const std::vector<double> &scale, double bound, cusparseSpMVAlg_t alg)
@@ -188,10 +201,7 @@ Row cusparse_row(cusparseHandle_t h, cusparseSpMatDescr_t mat, const char *name,
   CKS(cusparseSpMV_bufferSize(h, CUSPARSE_OPERATION_NON_TRANSPOSE, &one, mat, vx, &zero, vy, dt, alg, &buf_size));
   CK(cudaMalloc(&buf, std::max<size_t>(buf_size, 8)));
   auto run = [&] { CKS(cusparseSpMV(h, CUSPARSE_OPERATION_NON_TRANSPOSE, &one, mat, vx, &zero, vy, dt, alg, buf)); };
-  CK(cudaMemset(dy, 0xFF, n * sizeof(T))); /* NaN: an entry the product does not write fails the check */
-  run();
-  CK(cudaDeviceSynchronize());
-  Row r{name, time_per_call(run, batch_size(run)), matrix_bytes + 2.0 * n * sizeof(T), flops, product_error(dy, ref, scale), bound};
+  Row  r   = measure_product(name, run, dy, n, matrix_bytes + 2.0 * n * sizeof(T), flops, ref, scale, bound);
   CKS(cusparseDestroyDnVec(vx));
   CKS(cusparseDestroyDnVec(vy));
   CK(cudaFree(buf));
@@ -216,12 +226,8 @@ Row bin_row(const Bins<V> &B, bool per_row, const char *name, double flops, cons
     else if (per_row) binbcsr::cuda::bin_mult_rows<BS, V><<<rows_blocks, bt>>>(dv, dc, ds, B.mbs, B.bw, dx, dy);
     else binbcsr::cuda::bin_mult<BS, V><<<lanes_blocks, bt>>>(dv, dc, ds, B.mbs, B.bw, dx, dy);
   };
-  CK(cudaMemset(dy, 0xFF, n * 8));
-  run();
-  CKL();
-  CK(cudaDeviceSynchronize());
   const double bytes = (double)B.val.size() * sizeof(V) + 4.0 * (B.col.size() + B.start.size()) + 16.0 * n;
-  Row          r{name, time_per_call(run, batch_size(run)), bytes, flops, product_error(dy, ref, scale), bound};
+  Row          r     = measure_product(name, run, dy, n, bytes, flops, ref, scale, bound);
   CK(cudaFree(dv));
   CK(cudaFree(dc));
   CK(cudaFree(ds));
