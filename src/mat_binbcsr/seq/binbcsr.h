@@ -27,18 +27,20 @@
 
         [ a . b . . ]        rows 0,1 -> bin 0, longest row 2 -> 4 slots
         [ . c . . . ]        rows 2,3 -> bin 1, longest row 3 -> 6 slots
-        [ d . e f g ]        row  4   -> bin 2 (lane 1 phantom), longest 1 -> 2 slots
+        [ d . e f . ]        row  4   -> bin 2 (lane 1 phantom), longest 1 -> 2 slots
         [ . . . h . ]
         [ . . . . i ]
 
      bin_start = [0, 4, 10, 12]
      slot:  0  1  2  3 |  4  5  6  7  8  9 | 10 11
-     col:   0  1  2  1 |  0  3  2  3  3  3 |  4  4
+     col:   0  1  2  1 |  0  3  2  3  3  3 |  4  0
      val:   a  c  b  0 |  d  h  e  0  f  0 |  i  0
             k=0   k=1    k=0   k=1   k=2     k=0
 
-   (row 1's slot k=1 and row 3's slots k=1,2 are padding: zero values, repeated last column).
-   The padding overhead is nslots / nz - 1 (here 12/9 - 1 = 33%; FEM matrices give a few %).
+   (row 1's slot k=1 and row 3's slots k=1,2 are padding: zero values, repeated last column; the
+   phantom lane of bin 2 has no column, its padding reads column 0). The padding overhead is
+   nslots / nz - 1 (here 12/8 - 1 = 50%; FEM matrices give a few %). tests/unit/mat_core/layout.cpp
+   checks this example.
 */
 #ifndef BINBCSR_SEQ_H
 #define BINBCSR_SEQ_H
