@@ -25,6 +25,7 @@ PETSC_INTERN PetscErrorCode MatCreateSubMatrices_BinBCSR(Mat, PetscInt, const IS
 PETSC_INTERN PetscErrorCode MatCreateSubMatricesMPI_BinBCSR(Mat, PetscInt, const IS[], const IS[], MatReuse, Mat *[]);
 PETSC_INTERN PetscErrorCode MatCreateSubMatrix_BinBCSR(Mat, IS, IS, MatReuse, Mat *);
 PETSC_INTERN PetscErrorCode MatCreateMPIMatConcatenateSeqMat_BinBCSR(MPI_Comm, Mat, PetscInt, MatReuse, Mat *);
+PETSC_INTERN PetscErrorCode MatConvert_BinBCSR_HYPRE(Mat, MatType, MatReuse, Mat *); /* composed as MatConvert_<type>_hypre_C */
 /* The seqaij/mpiaij copy of a binbcsr matrix, composed on it, refreshed when the matrix changed (collective) */
 PETSC_INTERN PetscErrorCode MatBinBCSRGetAIJShadow_Private(Mat, Mat *);
 /* MUMPS / SuperLU_DIST LU and Cholesky for seq and mpi binbcsr through that shadow: binbcsr_factor_external.cpp */

@@ -1,6 +1,6 @@
 /* Submatrices of MATSEQBINBCSR and MATMPIBINBCSR: what PCASM, PCGASM, PCREDUNDANT and PCFIELDSPLIT
    ask a matrix for (MatIncreaseOverlap, MatCreateSubMatrices, MatCreateSubMatricesMPI,
-   MatCreateSubMatrix, MatCreateMPIMatConcatenateSeqMat).
+   MatCreateSubMatrix, MatCreateMPIMatConcatenateSeqMat), and PCHYPRE's MatConvert to MATHYPRE.
 
    The index-set exchange of a parallel extraction is PETSc's own (src/mat/impls/aij/mpi/mpiov.c):
    the matrix keeps an AIJ shadow of itself (seqaij or mpiaij, composed on the matrix, so it goes with
@@ -157,6 +157,19 @@ PetscErrorCode MatIncreaseOverlap_BinBCSR(Mat A, PetscInt n, IS is[], PetscInt o
   PetscFunctionBegin;
   PetscCall(MatBinBCSRGetAIJShadow_Private(A, &S));
   PetscCall(MatIncreaseOverlap(S, n, is, ov));
+  PetscFunctionReturn(0);
+}
+
+/* MatConvert to MATHYPRE (PCHYPRE): the shadow's own conversion, which copies its CSR arrays; a
+   refilled matrix reaches hypre through MAT_REUSE_MATRIX like aij. */
+PetscErrorCode MatConvert_BinBCSR_HYPRE(Mat A, MatType type, MatReuse reuse, Mat *newmat)
+{
+  Mat S;
+
+  PetscFunctionBegin;
+  PetscCheck(reuse != MAT_INPLACE_MATRIX, PetscObjectComm((PetscObject)A), PETSC_ERR_SUP, "In-place conversion of binbcsr to %s is not supported", type);
+  PetscCall(MatBinBCSRGetAIJShadow_Private(A, &S));
+  PetscCall(MatConvert(S, type, reuse, newmat));
   PetscFunctionReturn(0);
 }
 

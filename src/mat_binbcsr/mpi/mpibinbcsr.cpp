@@ -12,7 +12,7 @@ static PetscErrorCode MatDestroy_MPIBinBCSR(Mat mat)
   delete MPIBinBCSR(mat);
   mat->data = nullptr;
   PetscCall(PetscObjectChangeTypeName((PetscObject)mat, nullptr));
-  const char *names[] = {"MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatBinBCSRSetCOOMirror_C", "MatBinBCSRGetCOOMirror_C", "MatMPIAIJSetPreallocation_C", "MatMPIBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatGetDiagonalBlock_C", "MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatConvert_mpibinbcsr_mpiaij_C"};
+  const char *names[] = {"MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatBinBCSRSetCOOMirror_C", "MatBinBCSRGetCOOMirror_C", "MatMPIAIJSetPreallocation_C", "MatMPIBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatGetDiagonalBlock_C", "MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatConvert_mpibinbcsr_mpiaij_C", "MatConvert_mpibinbcsr_hypre_C"};
   for (const char *name : names) PetscCall(PetscObjectComposeFunction((PetscObject)mat, name, (void (*)(void)) nullptr));
   PetscFunctionReturn(0);
 }
@@ -425,6 +425,9 @@ PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetPrecision_C", MatBinBCSRSetPrecision_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetPrecision_C", MatBinBCSRGetPrecision_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatConvert_mpibinbcsr_mpiaij_C", MatConvert_MPIBinBCSR_MPIAIJ));
+#if defined(PETSC_HAVE_HYPRE)
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatConvert_mpibinbcsr_hypre_C", MatConvert_BinBCSR_HYPRE));
+#endif
   PetscCall(PetscObjectChangeTypeName((PetscObject)mat, MATMPIBINBCSR));
   PetscFunctionReturn(0);
 }

@@ -559,6 +559,9 @@ PetscErrorCode MatSeqBinBCSRSetOps_Ops(Mat A)
   A->ops->creatempimatconcatenateseqmat = MatCreateMPIMatConcatenateSeqMat_BinBCSR;
   A->ops->getrowij                      = MatGetRowIJ_SeqBinBCSR; /* binbcsr_rowij.cpp */
   A->ops->restorerowij                  = MatRestoreRowIJ_SeqBinBCSR;
+#if defined(PETSC_HAVE_HYPRE)
+  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatConvert_seqbinbcsr_hypre_C", MatConvert_BinBCSR_HYPRE));
+#endif
   a->view_other             = MatView_SeqBinBCSR_Other;
   PetscFunctionReturn(0);
 }
