@@ -13,6 +13,68 @@ static PetscErrorCode RefillByRows(Mat src, Mat dst)
   PetscFunctionReturn(0);
 }
 
+/* B's local columns as global point columns (garray holds block columns). */
+static std::vector<PetscInt> PointGarray(Mat mat)
+{
+  const Mat_MPIBinBCSR *b  = MPIBinBCSR(mat);
+  const PetscInt        bs = mat->cmap->bs;
+  std::vector<PetscInt> cols(b->garray.size() * bs);
+  for (size_t k = 0; k < b->garray.size(); k++)
+    for (PetscInt c = 0; c < bs; c++) cols[k * bs + c] = b->garray[k] * bs + c;
+  return cols;
+}
+
+/* An assembled matrix as MPIAIJ without communicating its entries: each part converted to seqaij (the
+   diagonal one with both triangles under symmetric storage) and joined by MatCreateMPIAIJWithSeqAIJ,
+   the off-diagonal part's compressed columns mapped through garray. */
+static PetscErrorCode ConvertByParts(Mat mat, Mat *M)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+  Mat             Ad, Ao;
+
+  PetscFunctionBegin;
+  const std::vector<PetscInt> cols = PointGarray(mat);
+  PetscCall(MatConvert(b->A, MATSEQAIJ, MAT_INITIAL_MATRIX, &Ad));
+  if (b->B) PetscCall(MatConvert(b->B, MATSEQAIJ, MAT_INITIAL_MATRIX, &Ao));
+  else {
+    PetscCall(MatCreateSeqAIJ(PETSC_COMM_SELF, mat->rmap->n, 0, 0, nullptr, &Ao));
+    PetscCall(MatAssemblyBegin(Ao, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(Ao, MAT_FINAL_ASSEMBLY));
+  }
+  PetscCheck(Ao->cmap->n == static_cast<PetscInt>(cols.size()), PETSC_COMM_SELF, PETSC_ERR_PLIB, "Off-diagonal part has %" PetscInt_FMT " columns, garray %zu", Ao->cmap->n, cols.size());
+  PetscCall(MatCreateMPIAIJWithSeqAIJ(PetscObjectComm((PetscObject)mat), Ad, Ao, cols.data(), M));
+  PetscCall(MatSetOption(*M, MAT_NEW_NONZERO_LOCATION_ERR, PETSC_FALSE)); /* as any other conversion's result */
+  PetscCall(MatPropagateSymmetryOptions(mat, *M));
+  PetscFunctionReturn(0);
+}
+
+/* MAT_REUSE_MATRIX into an MPIAIJ made by ConvertByParts (same rows, same off-diagonal columns): each
+   part's values into the MPIAIJ's part, no communication. Collective: every rank takes this path or
+   none does (*done). */
+static PetscErrorCode RefillByParts(Mat mat, Mat M, PetscBool *done)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+  PetscBool       ok;
+  Mat             Ad = nullptr, Ao = nullptr;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectTypeCompare((PetscObject)M, MATMPIAIJ, &ok));
+  if (ok) ok = (b->compressed && mat->assembled && M->rmap->n == mat->rmap->n && M->cmap->n == mat->cmap->n && M->rmap->N == mat->rmap->N && M->cmap->N == mat->cmap->N) ? PETSC_TRUE : PETSC_FALSE;
+  if (ok) {
+    const PetscInt *colmap;
+    PetscCall(MatMPIAIJGetSeqAIJ(M, &Ad, &Ao, &colmap));
+    const std::vector<PetscInt> cols = PointGarray(mat);
+    ok = (Ao->cmap->n == static_cast<PetscInt>(cols.size()) && std::equal(cols.begin(), cols.end(), colmap) && (b->B || cols.empty())) ? PETSC_TRUE : PETSC_FALSE;
+  }
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &ok, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)mat)));
+  *done = ok;
+  if (!ok) PetscFunctionReturn(0);
+  PetscCall(MatConvert(b->A, MATSEQAIJ, MAT_REUSE_MATRIX, &Ad));
+  if (b->B) PetscCall(MatConvert(b->B, MATSEQAIJ, MAT_REUSE_MATRIX, &Ao));
+  PetscCall(PetscObjectStateIncrease((PetscObject)M));
+  PetscFunctionReturn(0);
+}
+
 PETSC_INTERN PetscErrorCode MatConvert_MPIBinBCSR_MPIAIJ(Mat mat, MatType newtype, MatReuse reuse, Mat *newmat)
 {
   Mat M;
@@ -20,11 +82,16 @@ PETSC_INTERN PetscErrorCode MatConvert_MPIBinBCSR_MPIAIJ(Mat mat, MatType newtyp
   PetscFunctionBegin;
   (void)newtype;
   if (reuse == MAT_REUSE_MATRIX) {
-    PetscCall(RefillByRows(mat, *newmat));
+    PetscBool done;
+    PetscCall(RefillByParts(mat, *newmat, &done));
+    if (!done) PetscCall(RefillByRows(mat, *newmat));
     PetscFunctionReturn(0);
   }
-  PetscCall(MatBinBCSRCreateLike_Private(mat, MATMPIAIJ, &M));
-  PetscCall(MatBinBCSRPreallocateAndFill_Private(mat, M));
+  if (MPIBinBCSR(mat)->compressed && mat->assembled) PetscCall(ConvertByParts(mat, &M));
+  else {
+    PetscCall(MatBinBCSRCreateLike_Private(mat, MATMPIAIJ, &M));
+    PetscCall(MatBinBCSRPreallocateAndFill_Private(mat, M));
+  }
   if (reuse == MAT_INPLACE_MATRIX) PetscCall(MatHeaderReplace(mat, &M));
   else *newmat = M;
   PetscFunctionReturn(0);
