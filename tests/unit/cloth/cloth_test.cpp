@@ -110,6 +110,45 @@ TEST_CASE("system matrix is symmetric positive definite, also with compressed sp
   CHECK(eig_exact.eigenvalues().minCoeff() < 0);
 }
 
+TEST_CASE("one spring's force and Jacobians match finite differences; coincident ends have none", "[cloth]")
+{
+  // The spring kernel (spring_terms_lane, through linearise_spring) against central differences of
+  // f_a = k (l - L) d + c (d.(v_b - v_a)) d: K = -df_a/dx_a of the elastic part (the damping force's
+  // change of direction is left out, as in Baraff & Witkin), D = -df_a/dv_a.
+  Spring s;
+  s.a = 0, s.b = 1, s.rest_length = 0.1, s.stiffness = 300;
+  const double c     = 0.7;
+  auto         force = [&](const Eigen::Vector3d &xa, const Eigen::Vector3d &xb, const Eigen::Vector3d &va, const Eigen::Vector3d &vb, double damping) {
+    const Eigen::Vector3d d = (xb - xa).normalized();
+    return Eigen::Vector3d((s.stiffness * ((xb - xa).norm() - s.rest_length) + damping * d.dot(vb - va)) * d);
+  };
+  const Eigen::Vector3d xa(0.01, -0.02, 0.03), va(0.3, -0.1, 0.2), vb(-0.2, 0.4, 0.1);
+  for (const double length : {0.13, 0.07}) { // stretched, compressed
+    const Eigen::Vector3d xb = xa + length * Eigen::Vector3d(2, -1, 2) / 3.0;
+    Eigen::Matrix3d       K, D;
+    const double          e = 1e-6;
+    for (int j = 0; j < 3; ++j) {
+      const Eigen::Vector3d dx = e * Eigen::Vector3d::Unit(j);
+      K.col(j) = -(force(xa + dx, xb, va, vb, 0) - force(xa - dx, xb, va, vb, 0)) / (2 * e);
+      D.col(j) = -(force(xa, xb, va + dx, vb, c) - force(xa, xb, va - dx, vb, c)) / (2 * e);
+    }
+    const SpringLinearisation exact = linearise_spring(s, xa, xb, va, vb, c, false);
+    CHECK((exact.force_on_a - force(xa, xb, va, vb, c)).norm() < 1e-12 * force(xa, xb, va, vb, c).norm());
+    CHECK((exact.stiffness - K).norm() < 1e-6 * K.norm());
+    CHECK((exact.damping - D).norm() < 1e-6 * D.norm());
+    // Choi-Ko: a compressed spring keeps only k d d^T
+    const SpringLinearisation ck = linearise_spring(s, xa, xb, va, vb, c, true);
+    const Eigen::Vector3d     d  = (xb - xa).normalized();
+    if (length < s.rest_length) CHECK((ck.stiffness - s.stiffness * d * d.transpose()).norm() < 1e-12 * s.stiffness);
+    else CHECK((ck.stiffness - exact.stiffness).norm() == 0);
+  }
+  const SpringTerms none = spring_terms(s, xa, xa, va, vb, c);
+  CHECK(none.direction.norm() == 0);
+  CHECK(none.force_on_a.norm() == 0);
+  CHECK(none.k_iso == s.stiffness);
+  CHECK(none.k_dir == 0);
+}
+
 TEST_CASE("assembled system equals M + h D + h^2 K and h (f - h K v) built from each spring's Jacobians", "[cloth]")
 {
   ClothOptions opt;
