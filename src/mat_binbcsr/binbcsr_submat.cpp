@@ -14,16 +14,86 @@
    their values written into the caller's binbcsr submatrices in place, which keep their layout and
    nonzero state, so a PC on them redoes only its numeric set-up. Nothing is kept between calls but
    the shadow: no PETSc-internal reuse data whose life would have to follow the caller's arrays. */
-#include "binbcsr_impl.h"
-#include <petsc/private/matimpl.h>
+#include "mpi/mpibinbcsr.h"
+#include "seq/binbcsr.h"
 
 namespace
 {
-struct AIJShadow {
-  Mat              S       = nullptr;
-  PetscObjectState state   = 0; /* of the binbcsr matrix when S got its values */
-  PetscObjectState nzstate = 0; /* its nonzero state when S was built */
+/* A MATSEQBINBCSR matrix (the matrix itself, or a part of the parallel one) and the seqaij matrix of
+   the shadow that holds its values, with the value map between them. */
+struct PartMap {
+  Mat                   bin = nullptr, aij = nullptr; /* referenced */
+  std::vector<PetscInt> map;
 };
+
+struct AIJShadow {
+  Mat                  S       = nullptr;
+  PetscObjectState     state   = 0; /* of the binbcsr matrix when S got its values */
+  PetscObjectState     nzstate = 0; /* its nonzero state when S was built */
+  std::vector<PartMap> parts;       /* the refill by value maps; empty: by MatConvert */
+};
+
+PetscErrorCode ClearParts(AIJShadow *sh)
+{
+  PetscFunctionBegin;
+  for (PartMap &p : sh->parts) {
+    PetscCall(MatDestroy(&p.bin));
+    PetscCall(MatDestroy(&p.aij));
+  }
+  sh->parts.clear();
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode AddPart(AIJShadow *sh, Mat bin, Mat aij)
+{
+  PetscFunctionBegin;
+  sh->parts.emplace_back();
+  PartMap &p = sh->parts.back();
+  PetscCall(MatSeqBinBCSRAIJValueMap(bin, aij, p.map));
+  PetscCall(PetscObjectReference((PetscObject)bin));
+  PetscCall(PetscObjectReference((PetscObject)aij));
+  p.bin = bin;
+  p.aij = aij;
+  PetscFunctionReturn(0);
+}
+
+/* The parts of A whose values the shadow S holds, each with its value map; none (refill by
+   MatConvert) when a part is not MATSEQBINBCSR (-mat_mpibinbcsr_inner_type). */
+PetscErrorCode BuildParts(Mat A, AIJShadow *sh)
+{
+  PetscBool mpi, binA, binB = PETSC_TRUE;
+
+  PetscFunctionBegin;
+  PetscCall(ClearParts(sh));
+  PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIBINBCSR, &mpi));
+  if (!mpi) {
+    PetscCall(AddPart(sh, A, sh->S));
+    PetscFunctionReturn(0);
+  }
+  Mat_MPIBinBCSR *b = MPIBinBCSR(A);
+  Mat             Ad, Ao;
+  const PetscInt *colmap;
+  PetscCall(MatMPIAIJGetSeqAIJ(sh->S, &Ad, &Ao, &colmap));
+  PetscCall(PetscObjectTypeCompare((PetscObject)b->A, MATSEQBINBCSR, &binA));
+  if (b->B) PetscCall(PetscObjectTypeCompare((PetscObject)b->B, MATSEQBINBCSR, &binB));
+  /* the shadow's off-diagonal columns are B's (it was made from the parts: mpibinbcsr_convert.cpp) */
+  const PetscBool same_cols = (b->B ? Ao->cmap->n == b->B->cmap->n : Ao->cmap->n == 0) ? PETSC_TRUE : PETSC_FALSE;
+  if (!binA || !binB || !same_cols) PetscFunctionReturn(0);
+  PetscCall(AddPart(sh, b->A, Ad));
+  if (b->B) PetscCall(AddPart(sh, b->B, Ao));
+  PetscFunctionReturn(0);
+}
+
+/* The parts still those of A (a new preallocation replaces them). */
+PetscBool PartsCurrent(Mat A, const AIJShadow *sh)
+{
+  PetscBool mpi;
+  PetscObjectTypeCompare((PetscObject)A, MATMPIBINBCSR, &mpi);
+  if (!mpi) return sh->parts.size() == 1 && sh->parts[0].bin == A ? PETSC_TRUE : PETSC_FALSE;
+  const Mat_MPIBinBCSR *b = MPIBinBCSR(A);
+  const size_t          n = b->B ? 2 : 1;
+  return sh->parts.size() == n && sh->parts[0].bin == b->A && (n == 1 || sh->parts[1].bin == b->B) ? PETSC_TRUE : PETSC_FALSE;
+}
 
 const char shadow_key[] = "MatBinBCSR_AIJShadow";
 
@@ -32,6 +102,7 @@ PetscErrorCode DestroyShadow(void *ctx)
   AIJShadow *sh = static_cast<AIJShadow *>(ctx);
 
   PetscFunctionBegin;
+  PetscCall(ClearParts(sh));
   PetscCall(MatDestroy(&sh->S));
   delete sh;
   PetscFunctionReturn(0);
@@ -60,14 +131,20 @@ PetscErrorCode MatBinBCSRGetAIJShadow_Private(Mat A, Mat *S)
     PetscCall(PetscContainerDestroy(&c));
   } else PetscCall(PetscContainerGetPointer(c, (void **)&sh));
   PetscCall(PetscObjectStateGet((PetscObject)A, &state));
-  todo[0] = (!sh->S || sh->nzstate != A->nonzerostate) ? 1 : 0; /* rebuild */
+  todo[0] = (!sh->S || sh->nzstate != A->nonzerostate || (!sh->parts.empty() && !PartsCurrent(A, sh))) ? 1 : 0; /* rebuild */
   todo[1] = (todo[0] || sh->state != state) ? 1 : 0;            /* refill */
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, todo, 2, MPI_INT, MPI_MAX, PetscObjectComm((PetscObject)A)));
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIBINBCSR, &mpi));
   if (todo[0]) {
+    PetscCall(ClearParts(sh));
     PetscCall(MatDestroy(&sh->S));
     PetscCall(MatConvert(A, mpi ? MATMPIAIJ : MATSEQAIJ, MAT_INITIAL_MATRIX, &sh->S));
+    PetscCall(BuildParts(A, sh));
+  } else if (todo[1] && !sh->parts.empty()) { /* values only: one gather per part */
+    for (const PartMap &p : sh->parts) PetscCall(MatSeqBinBCSRAIJGather(p.bin, p.map, p.aij));
+    PetscCall(PetscObjectStateIncrease((PetscObject)sh->S));
   } else if (todo[1]) PetscCall(MatConvert(A, mpi ? MATMPIAIJ : MATSEQAIJ, MAT_REUSE_MATRIX, &sh->S));
+  if (todo[1]) PetscCall(MatPropagateSymmetryOptions(A, sh->S)); /* external factors read them (MUMPS: SPD) */
   sh->state   = state;
   sh->nzstate = A->nonzerostate;
   *S          = sh->S;
@@ -102,10 +179,47 @@ PetscErrorCode NewFromAIJ(Mat parent, Mat T, PetscBool symmetric, Mat *B)
   PetscFunctionReturn(0);
 }
 
+const char submap_key[] = "MatBinBCSR_SubmatrixValueMap";
+
+PetscErrorCode DestroyValueMap(void *ctx)
+{
+  PetscFunctionBegin;
+  delete static_cast<std::vector<PetscInt> *>(ctx);
+  PetscFunctionReturn(0);
+}
+
+/* A sequential submatrix B refilled from T (seqaij, the same extraction as the one B was made from) by
+   the value map composed on B, made at the first refill and remade if T's entry count differs. */
+PetscErrorCode RefillSeqByMap(Mat T, Mat B)
+{
+  PetscContainer         c;
+  std::vector<PetscInt> *map;
+  const PetscInt        *ia, *ja;
+  PetscInt               n;
+  PetscBool              done;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectQuery((PetscObject)B, submap_key, (PetscObject *)&c));
+  if (!c) {
+    map = new std::vector<PetscInt>;
+    PetscCall(PetscContainerCreate(PETSC_COMM_SELF, &c));
+    PetscCall(PetscContainerSetPointer(c, map));
+    PetscCall(PetscContainerSetUserDestroy(c, DestroyValueMap));
+    PetscCall(PetscObjectCompose((PetscObject)B, submap_key, (PetscObject)c));
+    PetscCall(PetscContainerDestroy(&c));
+  } else PetscCall(PetscContainerGetPointer(c, (void **)&map));
+  PetscCall(MatGetRowIJ(T, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
+  const size_t nz = done ? (size_t)ia[n] : 0;
+  PetscCall(MatRestoreRowIJ(T, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
+  if (map->size() != nz || map->empty()) PetscCall(MatSeqBinBCSRAIJValueMap(B, T, *map));
+  PetscCall(MatSeqBinBCSRAIJScatter(T, *map, B));
+  PetscFunctionReturn(0);
+}
+
 /* MAT_REUSE_MATRIX: T's values into B, which must have T's sizes and hold its pattern. */
 PetscErrorCode RefillFromAIJ(Mat T, Mat B)
 {
-  PetscBool isbin;
+  PetscBool isbin, seq;
 
   PetscFunctionBegin;
   PetscCall(PetscObjectTypeCompareAny((PetscObject)B, &isbin, MATSEQBINBCSR, MATMPIBINBCSR, ""));
@@ -113,8 +227,13 @@ PetscErrorCode RefillFromAIJ(Mat T, Mat B)
   PetscCheck(B->rmap->N == T->rmap->N && B->cmap->N == T->cmap->N && B->rmap->n == T->rmap->n && B->cmap->n == T->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
              "MAT_REUSE_MATRIX: the submatrix to refill is %" PetscInt_FMT " x %" PetscInt_FMT " (local %" PetscInt_FMT " x %" PetscInt_FMT "), the index sets select %" PetscInt_FMT " x %" PetscInt_FMT " (local %" PetscInt_FMT " x %" PetscInt_FMT ")",
              B->rmap->N, B->cmap->N, B->rmap->n, B->cmap->n, T->rmap->N, T->cmap->N, T->rmap->n, T->cmap->n);
-  PetscCall(MatZeroEntries(B));
-  PetscCall(MatBinBCSRInsertRows_Private(T, B));
+  PetscCall(PetscObjectTypeCompare((PetscObject)B, MATSEQBINBCSR, &seq));
+  if (seq) PetscCall(PetscObjectTypeCompare((PetscObject)T, MATSEQAIJ, &seq));
+  if (seq) PetscCall(RefillSeqByMap(T, B));
+  else {
+    PetscCall(MatZeroEntries(B));
+    PetscCall(MatBinBCSRInsertRows_Private(T, B));
+  }
   PetscFunctionReturn(0);
 }
 

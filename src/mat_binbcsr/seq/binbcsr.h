@@ -202,6 +202,10 @@ PETSC_INTERN PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat, MatType, MatReuse, Ma
 PETSC_INTERN PetscErrorCode MatConvert_SeqBinBCSR_SeqAIJ(Mat, MatType, MatReuse, Mat *);
 PETSC_INTERN PetscErrorCode MatConvert_SeqBinBCSR_SeqBAIJ(Mat, MatType, MatReuse, Mat *);
 PETSC_INTERN PetscErrorCode MatView_SeqBinBCSR(Mat, PetscViewer);
+/* Value maps to and from a seqaij matrix over the same point pattern (binbcsr_aijmap.cpp) */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRAIJValueMap(Mat B, Mat T, std::vector<PetscInt> &map);
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRAIJGather(Mat B, const std::vector<PetscInt> &map, Mat T);
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRAIJScatter(Mat T, const std::vector<PetscInt> &map, Mat B);
 PETSC_INTERN PetscErrorCode MatGetRowIJ_SeqBinBCSR(Mat, PetscInt, PetscBool, PetscBool, PetscInt *, const PetscInt *[], const PetscInt *[], PetscBool *);
 PETSC_INTERN PetscErrorCode MatRestoreRowIJ_SeqBinBCSR(Mat, PetscInt, PetscBool, PetscBool, PetscInt *, const PetscInt *[], const PetscInt *[], PetscBool *);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRDestroyCOO(Mat_SeqBinBCSR *);
