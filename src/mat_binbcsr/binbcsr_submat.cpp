@@ -216,6 +216,38 @@ PetscErrorCode RefillSeqByMap(Mat T, Mat B)
   PetscFunctionReturn(0);
 }
 
+/* A parallel submatrix B (mpibinbcsr) refilled from T (mpiaij) part by part through value maps, when
+   every rank's parts line up (the off-diagonal columns the same); *done says whether it was. */
+PetscErrorCode RefillMPIByParts(Mat T, Mat B, PetscBool *done)
+{
+  PetscBool ok;
+  Mat       Td = nullptr, To = nullptr;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectTypeCompare((PetscObject)T, MATMPIAIJ, &ok));
+  Mat_MPIBinBCSR *b = MPIBinBCSR(B);
+  if (ok) {
+    PetscBool binA, binB = PETSC_TRUE;
+    PetscCall(PetscObjectTypeCompare((PetscObject)b->A, MATSEQBINBCSR, &binA));
+    if (b->B) PetscCall(PetscObjectTypeCompare((PetscObject)b->B, MATSEQBINBCSR, &binB));
+    ok = (binA && binB && b->compressed) ? PETSC_TRUE : PETSC_FALSE;
+  }
+  if (ok) {
+    const PetscInt *colmap;
+    const PetscInt  bs = B->cmap->bs;
+    PetscCall(MatMPIAIJGetSeqAIJ(T, &Td, &To, &colmap));
+    ok = (To->cmap->n == static_cast<PetscInt>(b->garray.size()) * bs && (b->B || To->cmap->n == 0)) ? PETSC_TRUE : PETSC_FALSE;
+    for (PetscInt k = 0; ok && k < To->cmap->n; k++) ok = colmap[k] == b->garray[k / bs] * bs + k % bs ? PETSC_TRUE : PETSC_FALSE;
+  }
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &ok, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)B)));
+  *done = ok;
+  if (!ok) PetscFunctionReturn(0);
+  PetscCall(RefillSeqByMap(Td, b->A));
+  if (b->B) PetscCall(RefillSeqByMap(To, b->B));
+  PetscCall(PetscObjectStateIncrease((PetscObject)B));
+  PetscFunctionReturn(0);
+}
+
 /* MAT_REUSE_MATRIX: T's values into B, which must have T's sizes and hold its pattern. */
 PetscErrorCode RefillFromAIJ(Mat T, Mat B)
 {
@@ -231,8 +263,13 @@ PetscErrorCode RefillFromAIJ(Mat T, Mat B)
   if (seq) PetscCall(PetscObjectTypeCompare((PetscObject)T, MATSEQAIJ, &seq));
   if (seq) PetscCall(RefillSeqByMap(T, B));
   else {
-    PetscCall(MatZeroEntries(B));
-    PetscCall(MatBinBCSRInsertRows_Private(T, B));
+    PetscBool done = PETSC_FALSE;
+    PetscCall(PetscObjectTypeCompare((PetscObject)B, MATMPIBINBCSR, &isbin));
+    if (isbin) PetscCall(RefillMPIByParts(T, B, &done));
+    if (!done) {
+      PetscCall(MatZeroEntries(B));
+      PetscCall(MatBinBCSRInsertRows_Private(T, B));
+    }
   }
   PetscFunctionReturn(0);
 }
