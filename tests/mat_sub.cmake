@@ -27,3 +27,11 @@ foreach(entry ${MAT_SUB_PCS})
                    -- -mat_type binbcsr)
   set_tests_properties(mat_sub_stock_ex4_${name}_np2 PROPERTIES LABELS "mat_sub;mpi;stock" PROCESSORS 2 TIMEOUT 60)
 endforeach()
+
+# No PETSc object left behind (the AIJ shadow, value maps and submatrices go with their matrices; a
+# reference from the shadow back to its own matrix once kept every matrix alive): PETSc's own
+# allocation dump at PetscFinalize must be empty.
+add_test(NAME unit_mat_sub_malloc_dump COMMAND test_mat_sub)
+set_tests_properties(unit_mat_sub_malloc_dump PROPERTIES LABELS "mat_sub" TIMEOUT 120
+                     ENVIRONMENT "PETSC_OPTIONS=-malloc_debug -malloc_dump"
+                     FAIL_REGULAR_EXPRESSION "[0-9]+ bytes [A-Za-z_0-9]+\\(\\) at")

@@ -22,7 +22,8 @@ namespace
 /* A MATSEQBINBCSR matrix (the matrix itself, or a part of the parallel one) and the seqaij matrix of
    the shadow that holds its values, with the value map between them. */
 struct PartMap {
-  Mat                   bin = nullptr, aij = nullptr; /* referenced */
+  Mat                   bin = nullptr, aij = nullptr; /* referenced, but bin not when it is the matrix itself (which owns the shadow) */
+  PetscBool             bin_referenced = PETSC_FALSE;
   std::vector<PetscInt> map;
 };
 
@@ -37,23 +38,24 @@ PetscErrorCode ClearParts(AIJShadow *sh)
 {
   PetscFunctionBegin;
   for (PartMap &p : sh->parts) {
-    PetscCall(MatDestroy(&p.bin));
+    if (p.bin_referenced) PetscCall(MatDestroy(&p.bin));
     PetscCall(MatDestroy(&p.aij));
   }
   sh->parts.clear();
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode AddPart(AIJShadow *sh, Mat bin, Mat aij)
+PetscErrorCode AddPart(AIJShadow *sh, Mat bin, Mat aij, PetscBool reference_bin)
 {
   PetscFunctionBegin;
   sh->parts.emplace_back();
   PartMap &p = sh->parts.back();
   PetscCall(MatSeqBinBCSRAIJValueMap(bin, aij, p.map));
-  PetscCall(PetscObjectReference((PetscObject)bin));
+  if (reference_bin) PetscCall(PetscObjectReference((PetscObject)bin)); /* a reference to the matrix itself would be a cycle */
   PetscCall(PetscObjectReference((PetscObject)aij));
-  p.bin = bin;
-  p.aij = aij;
+  p.bin            = bin;
+  p.bin_referenced = reference_bin;
+  p.aij            = aij;
   PetscFunctionReturn(0);
 }
 
@@ -67,7 +69,7 @@ PetscErrorCode BuildParts(Mat A, AIJShadow *sh)
   PetscCall(ClearParts(sh));
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIBINBCSR, &mpi));
   if (!mpi) {
-    PetscCall(AddPart(sh, A, sh->S));
+    PetscCall(AddPart(sh, A, sh->S, PETSC_FALSE));
     PetscFunctionReturn(0);
   }
   Mat_MPIBinBCSR *b = MPIBinBCSR(A);
@@ -79,8 +81,8 @@ PetscErrorCode BuildParts(Mat A, AIJShadow *sh)
   /* the shadow's off-diagonal columns are B's (it was made from the parts: mpibinbcsr_convert.cpp) */
   const PetscBool same_cols = (b->B ? Ao->cmap->n == b->B->cmap->n : Ao->cmap->n == 0) ? PETSC_TRUE : PETSC_FALSE;
   if (!binA || !binB || !same_cols) PetscFunctionReturn(0);
-  PetscCall(AddPart(sh, b->A, Ad));
-  if (b->B) PetscCall(AddPart(sh, b->B, Ao));
+  PetscCall(AddPart(sh, b->A, Ad, PETSC_TRUE));
+  if (b->B) PetscCall(AddPart(sh, b->B, Ao, PETSC_TRUE));
   PetscFunctionReturn(0);
 }
 
