@@ -9,9 +9,9 @@
    own routine with the shadow in place of the binbcsr matrix. Solves are the factor's own.
 
    The shadow and the map live as long as the factor Mat (a PC keeps it between solves, so a refilled
-   matrix costs one value copy plus the numeric factorisation). Orderings: the factor's preferred
-   ordering is natural for every type (PETSc's sbaij supports nothing else; LU would otherwise ask for
-   nested dissection, which needs MatGetRowIJ). */
+   matrix costs one value copy plus the numeric factorisation). Orderings are BAIJ's: LU defaults to
+   nested dissection and ILU to natural, and both take any of PETSc's orderings (computed on the
+   binbcsr matrix through MatGetRowIJ); ICC and Cholesky are natural only, as PETSc's sbaij. */
 #include "binbcsr.h"
 #include <vector>
 
@@ -181,17 +181,32 @@ PetscErrorCode LUNumeric(Mat F, Mat A, const MatFactorInfo *info)
   PetscFunctionReturn(0);
 }
 
-/* The permutation PETSc would have computed for S: PCFactor computes its ordering on the binbcsr
-   matrix, which gives point-sized identity index sets; BAIJ and SBAIJ expect block-sized ones. */
+/* The permutation for S from the one PCFactor computed on the binbcsr matrix. PETSc's orderings read
+   the block-compressed structure (MatGetRowIJ), so for bs > 1 they come out block-sized: what BAIJ's
+   LU and ILU take, so they pass through. The identity (natural) may come point-sized; it becomes S's
+   own natural ordering. SBAIJ (ICC, Cholesky) factors in natural order only. */
 PetscErrorCode ShadowOrdering(FactorShadow *f, IS row, IS col, IS *rperm, IS *cperm)
 {
-  PetscBool rid = PETSC_TRUE, cid = PETSC_TRUE;
+  PetscBool      rid = PETSC_TRUE, cid = PETSC_TRUE, sbaij;
+  const PetscInt mbs = f->S->rmap->n / f->bs;
+  PetscInt       nr = -1, nc = -1;
 
   PetscFunctionBegin;
   if (row) PetscCall(ISIdentity(row, &rid));
   if (col) PetscCall(ISIdentity(col, &cid));
-  PetscCheck(rid && cid, PETSC_COMM_SELF, PETSC_ERR_SUP, "Factorisations of MATSEQBINBCSR support only the natural ordering (-pc_factor_mat_ordering_type natural)");
-  PetscCall(MatGetOrdering(f->S, MATORDERINGNATURAL, rperm, cperm));
+  if (rid && cid) {
+    PetscCall(MatGetOrdering(f->S, MATORDERINGNATURAL, rperm, cperm));
+    PetscFunctionReturn(0);
+  }
+  PetscCall(PetscObjectTypeCompare((PetscObject)f->S, MATSEQSBAIJ, &sbaij));
+  PetscCheck(!sbaij, PETSC_COMM_SELF, PETSC_ERR_SUP, "ICC and Cholesky of MATSEQBINBCSR (PETSc's seqsbaij factor) support only the natural ordering (-pc_factor_mat_ordering_type natural), or use -pc_factor_mat_solver_type mumps");
+  if (row) PetscCall(ISGetLocalSize(row, &nr));
+  if (col) PetscCall(ISGetLocalSize(col, &nc));
+  PetscCheck(nr == mbs && nc == mbs, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "LU and ILU of MATSEQBINBCSR take block orderings of its %" PetscInt_FMT " block rows (as MatGetOrdering gives), not index sets of %" PetscInt_FMT " and %" PetscInt_FMT " entries", mbs, nr, nc);
+  PetscCall(PetscObjectReference((PetscObject)row));
+  PetscCall(PetscObjectReference((PetscObject)col));
+  *rperm = row;
+  *cperm = col;
   PetscFunctionReturn(0);
 }
 
@@ -283,7 +298,9 @@ PetscErrorCode MatGetFactor_SeqBinBCSR_Petsc(Mat A, MatFactorType ftype, Mat *F)
   if (f->choleskysymbolic) B->ops->choleskyfactorsymbolic = CholeskySymbolic;
   if (f->ilusymbolic) B->ops->ilufactorsymbolic = ILUSymbolic;
   if (f->lusymbolic) B->ops->lufactorsymbolic = LUSymbolic;
-  PetscCall(PetscFree(B->preferredordering[ftype]));
-  PetscCall(PetscStrallocpy(MATORDERINGNATURAL, (char **)&B->preferredordering[ftype]));
+  if (upper) { /* LU and ILU keep BAIJ's preferences: nested dissection for LU, natural for ILU */
+    PetscCall(PetscFree(B->preferredordering[ftype]));
+    PetscCall(PetscStrallocpy(MATORDERINGNATURAL, (char **)&B->preferredordering[ftype]));
+  }
   PetscFunctionReturn(0);
 }

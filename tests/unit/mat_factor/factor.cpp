@@ -6,6 +6,7 @@
 // program on 1 and 2 ranks).
 #include "mat_core/support.h"
 #include <petscksp.h>
+#include <cstring>
 
 using namespace mat_core;
 
@@ -145,6 +146,57 @@ TEST_CASE("ICC, Cholesky, ILU and LU on binbcsr equal PETSc's on seqsbaij/seqbai
     }
 }
 
+namespace
+{
+// LU or ILU through PCFactor with an ordering (nullptr: the factor's preferred one); returns the solution
+// and the factor's stored nonzeros, which show which ordering was applied.
+Solution factor_solve(Mat A, PCType pc, const char *ordering, Vec b, double *factor_nz)
+{
+  KSP k = make_ksp(PETSC_COMM_SELF, strcmp(pc, PCLU) ? KSPGMRES : KSPPREONLY, pc, 1e-10);
+  PC  p;
+  REQUIRE(KSPGetPC(k, &p) == 0);
+  if (ordering) REQUIRE(PCFactorSetMatOrderingType(p, ordering) == 0);
+  Solution s = solve_with(k, A, b);
+  Mat      F;
+  MatInfo  info;
+  REQUIRE(PCFactorGetMatrix(p, &F) == 0);
+  REQUIRE(MatGetInfo(F, MAT_LOCAL, &info) == 0);
+  *factor_nz = info.nz_used;
+  REQUIRE(KSPDestroy(&k) == 0);
+  return s;
+}
+} // namespace
+
+TEST_CASE("LU and ILU take PETSc's orderings as seqbaij does; LU defaults to nested dissection", "[mat_factor]")
+{
+  for (PetscInt bs : {1, 3})
+    for (bool sym : {false, true}) {
+      const Pattern p    = fem_pattern(6, 5, 4, bs);
+      Mat           A    = build_bin(p, sym);
+      Mat           Aref = build(p, MATSEQBAIJ);
+      Vec           b    = make_vec(p.m, 11);
+      for (const char *ordering : {(const char *)nullptr, MATORDERINGNATURAL, MATORDERINGND, MATORDERINGRCM, MATORDERINGQMD, MATORDERING1WD}) {
+        CAPTURE(bs, sym, ordering ? ordering : "default");
+        double         nz = 0, nzref = 0;
+        const Solution lu = factor_solve(A, PCLU, ordering, b, &nz), luref = factor_solve(Aref, PCLU, ordering, b, &nzref);
+        CHECK(lu.relres < 1e-13);
+        CHECK(nz == nzref); // the same ordering gives the same fill
+        check_same(lu, luref, 1e-13);
+        const Solution ilu = factor_solve(A, PCILU, ordering, b, &nz), iluref = factor_solve(Aref, PCILU, ordering, b, &nzref);
+        CHECK(nz == nzref);
+        check_same(ilu, iluref, 1e-10);
+      }
+      // nested dissection by default: less fill than the natural order on this 3-D mesh
+      double nz_default = 0, nz_natural = 0;
+      factor_solve(A, PCLU, nullptr, b, &nz_default);
+      factor_solve(A, PCLU, MATORDERINGNATURAL, b, &nz_natural);
+      CHECK(nz_default < 0.9 * nz_natural);
+      REQUIRE(VecDestroy(&b) == 0);
+      REQUIRE(MatDestroy(&A) == 0);
+      REQUIRE(MatDestroy(&Aref) == 0);
+    }
+}
+
 TEST_CASE("single-precision binbcsr factors its rounded values", "[mat_factor]")
 {
   const Pattern p = fem_pattern(4, 4, 3, 3);
@@ -205,7 +257,7 @@ TEST_CASE("unsupported factorisations are errors, not crashes", "[mat_factor][er
   CHECK(MatGetFactor(A, MATSOLVERPETSC, MAT_FACTOR_QR, &F) != 0);
   CHECK(MatGetFactor(A, MATSOLVERPETSC, MAT_FACTOR_ILUDT, &F) != 0);
   CHECK(F == nullptr);
-  // orderings other than natural
+  // orderings other than natural for ICC (PETSc's seqsbaij factors in natural order only)
   KSP k = make_ksp(PETSC_COMM_SELF, KSPCG, PCICC, 1e-8);
   PC  pc;
   REQUIRE(KSPGetPC(k, &pc) == 0);
