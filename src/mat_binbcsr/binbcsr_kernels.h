@@ -178,12 +178,6 @@ template <int BS, int BW, typename V, bool SCATTER>
 BINBCSR_HD void sym_unit_group_mult(const V *t, const double *xs, const double (*xr)[BW], double *ys, double (*acc)[BW])
 {
   constexpr int BS2 = BS * BS;
-#if defined(BINBCSR_AVX512)
-  if constexpr (BS == 3 && BW == 8) {
-    avx512::sym_unit_group_3x8<SCATTER, V>(t, xs, xr, ys, acc);
-    return;
-  }
-#endif
 #pragma omp simd
   for (int l = 0; l < BW; l++) {
     double v[BS2];
@@ -210,6 +204,12 @@ BINBCSR_HD void sym_unit_group_mult(const V *t, const double *xs, const double (
 template <int BS, int BW, typename V, typename I>
 BINBCSR_HD void sym_bin_mult(const V *bin_val, const I *bin_col, int len, I r0, I mbs, const double *x, double *y)
 {
+#if defined(BINBCSR_AVX512)
+  if constexpr (BS == 3 && BW == 8 && sizeof(I) == 4) {
+    avx512::sym_bin_mult_3x8(bin_val, bin_col, len, r0, mbs, x, y);
+    return;
+  }
+#endif
   constexpr int BS2 = BS * BS;
   double        acc[BS][BW], xr[BS][BW];
   I             own[BW];

@@ -1,15 +1,16 @@
 /*
-   AVX-512 body of one slot group of the symmetric product over consecutive block columns, for the
-   shape the cloth and the stencils use (3x3 blocks, bin width 8 = one zmm register of doubles). CPU
-   only: binbcsr_kernels.h includes it when the compiler targets AVX-512 and calls it from
-   sym_unit_group_mult, whose portable loop stays the definition (and the CUDA path).
+   AVX-512 bodies of the two products of 3x3 blocks at bin width 8 (one zmm register of doubles per
+   block entry), the shape of the cloth, the stencils and the FE scenes: a whole bin of the whole-storage
+   product (bin_mult_3x8) and of the symmetric one (sym_bin_mult_3x8). CPU only: binbcsr_kernels.h
+   includes this header when the compiler targets AVX-512; the portable per-lane kernels stay the
+   definition (and the CUDA path), and the unit tests compare both with seqaij.
 
-   Why by hand: x_c of the 8 lanes are 24 consecutive doubles (x, y, z of 8 nodes) and so are the y_c
-   updated by the transposed blocks. GCC vectorises the portable loop with 256-bit halves, spills the
-   accumulators and (de)interleaves through many shuffles, so the group stayed compute-bound (the
-   single-storage product took as long as the double one). Here: 3 loads and 6 two-source permutes
-   split x into its components, 9 FMAs for the lanes' rows, 9 for the transposed blocks, 6 permutes
-   interleave the result back for 3 loads, adds and stores of y.
+   Why by hand: where the 8 lanes read consecutive block columns, x_c is 24 consecutive doubles (x, y, z
+   of 8 nodes), and so is the y_c that the transposed blocks update. GCC vectorises the portable loop with
+   256-bit halves, spills the accumulators and (de)interleaves through many shuffles. Here 3 loads and
+   6 two-source permutes split x into its components (split_xyz), 9 FMAs serve the lanes' rows and 9 the
+   transposed blocks, and 6 permutes interleave the result back (add_xyz). The accumulators stay in
+   registers for the whole bin.
 */
 #ifndef BINBCSR_KERNELS_AVX512_H
 #define BINBCSR_KERNELS_AVX512_H
@@ -31,6 +32,17 @@ inline void split_xyz(const double *xs, __m512d &x0, __m512d &x1, __m512d &x2)
   x0 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, _mm512_setr_epi64(0, 3, 6, 9, 12, 15, 0, 0), b), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 10, 13), c);
   x1 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, _mm512_setr_epi64(1, 4, 7, 10, 13, 0, 0, 0), b), _mm512_setr_epi64(0, 1, 2, 3, 4, 8, 11, 14), c);
   x2 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, _mm512_setr_epi64(2, 5, 8, 11, 14, 0, 0, 0), b), _mm512_setr_epi64(0, 1, 2, 3, 4, 9, 12, 15), c);
+}
+
+/* ys[3l + j] += s_j[l]: one register per component back to 24 interleaved doubles (split_xyz inverted) */
+inline void add_xyz(double *ys, __m512d s0, __m512d s1, __m512d s2)
+{
+  const __m512d lo = _mm512_permutex2var_pd(_mm512_permutex2var_pd(s0, _mm512_setr_epi64(0, 8, 0, 1, 9, 0, 2, 10), s1), _mm512_setr_epi64(0, 1, 8, 3, 4, 9, 6, 7), s2);
+  const __m512d mi = _mm512_permutex2var_pd(_mm512_permutex2var_pd(s0, _mm512_setr_epi64(0, 3, 11, 0, 4, 12, 0, 5), s1), _mm512_setr_epi64(10, 1, 2, 11, 4, 5, 12, 7), s2);
+  const __m512d hi = _mm512_permutex2var_pd(_mm512_permutex2var_pd(s0, _mm512_setr_epi64(13, 0, 6, 14, 0, 7, 15, 0), s1), _mm512_setr_epi64(0, 13, 2, 3, 14, 5, 6, 15), s2);
+  _mm512_storeu_pd(ys, _mm512_add_pd(_mm512_loadu_pd(ys), lo));
+  _mm512_storeu_pd(ys + 8, _mm512_add_pd(_mm512_loadu_pd(ys + 8), mi));
+  _mm512_storeu_pd(ys + 16, _mm512_add_pd(_mm512_loadu_pd(ys + 16), hi));
 }
 
 /* The whole-storage product of one bin (3x3 blocks, 8 lanes): acc[i] (lane l in element l) +=
@@ -63,33 +75,58 @@ inline void bin_mult_3x8(const V *t, const I *c, int len, const double *x, doubl
   _mm512_storeu_pd(acc[2], a2);
 }
 
-/* acc[i][l] += sum_j block_l(i,j) x[(c0 + l) * 3 + j]; with SCATTER also
-   y[(c0 + l) * 3 + j] += sum_i block_l(i,j) xr[i][l]. t: the group's tile (entry e of lane l at t[e * 8 + l]). */
-template <bool SCATTER, typename V>
-inline void sym_unit_group_3x8(const V *t, const double *xs, const double (*xr)[8], double *ys, double (*acc)[8])
+/* sym_bin_mult (binbcsr_kernels.h) for 3x3 blocks and 8 lanes, the whole bin in registers: the lanes'
+   accumulators and x_r stay in zmm registers from the first slot group to the last (a per-group body
+   kept them in memory, a store and a reload per group on the critical path: the cloth's product took
+   1.02 ms instead of 0.84, docs/mat_binbcsr.md). Consecutive-column
+   groups load x and update y contiguously; the others gather x and gather-add-scatter y for the lanes
+   whose column is not their own row (conflict-free within a group: the colouring). Same semantics as
+   the portable sym_bin_mult: on exit y_r += acc for the real lanes. */
+template <typename V, typename I>
+inline void sym_bin_mult_3x8(const V *bin_val, const I *bin_col, int len, I r0, I mbs, const double *x, double *y)
 {
-  __m512d x0, x1, x2;
-  split_xyz(xs, x0, x1, x2);
-  __m512d v[9];
-  for (int e = 0; e < 9; e++) v[e] = load8(t + e * 8);
-  for (int i = 0; i < 3; i++) {
-    __m512d s = _mm512_loadu_pd(acc[i]);
-    s         = _mm512_fmadd_pd(v[3 * i + 0], x0, s);
-    s         = _mm512_fmadd_pd(v[3 * i + 1], x1, s);
-    s         = _mm512_fmadd_pd(v[3 * i + 2], x2, s);
-    _mm512_storeu_pd(acc[i], s);
+  static_assert(sizeof(I) == 4, "32-bit column indices");
+  const int     nreal = mbs - r0 < 8 ? (int)(mbs - r0) : 8;
+  const __m256i iota  = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256i own   = _mm256_mask_blend_epi32((__mmask8)((1u << nreal) - 1), _mm256_set1_epi32((int)mbs - 1), _mm256_add_epi32(_mm256_set1_epi32((int)r0), iota));
+  __m512d       r[3], a[3] = {_mm512_setzero_pd(), _mm512_setzero_pd(), _mm512_setzero_pd()};
+  if (nreal == 8) split_xyz(x + (long)r0 * 3, r[0], r[1], r[2]);
+  else {
+    alignas(64) double xr[3][8] = {};
+    for (int l = 0; l < nreal; l++)
+      for (int i = 0; i < 3; i++) xr[i][l] = x[(long)(r0 + l) * 3 + i];
+    for (int i = 0; i < 3; i++) r[i] = _mm512_load_pd(xr[i]);
   }
-  if (!SCATTER) return;
-  const __m512d r0 = _mm512_loadu_pd(xr[0]), r1 = _mm512_loadu_pd(xr[1]), r2 = _mm512_loadu_pd(xr[2]);
-  __m512d       s[3];
-  for (int j = 0; j < 3; j++) s[j] = _mm512_fmadd_pd(v[6 + j], r2, _mm512_fmadd_pd(v[3 + j], r1, _mm512_mul_pd(v[j], r0)));
-  /* back to 24 interleaved doubles: (s0[l], s1[l], s2[l]) at 3l .. 3l + 2 */
-  const __m512d lo = _mm512_permutex2var_pd(_mm512_permutex2var_pd(s[0], _mm512_setr_epi64(0, 8, 0, 1, 9, 0, 2, 10), s[1]), _mm512_setr_epi64(0, 1, 8, 3, 4, 9, 6, 7), s[2]);
-  const __m512d mi = _mm512_permutex2var_pd(_mm512_permutex2var_pd(s[0], _mm512_setr_epi64(0, 3, 11, 0, 4, 12, 0, 5), s[1]), _mm512_setr_epi64(10, 1, 2, 11, 4, 5, 12, 7), s[2]);
-  const __m512d hi = _mm512_permutex2var_pd(_mm512_permutex2var_pd(s[0], _mm512_setr_epi64(13, 0, 6, 14, 0, 7, 15, 0), s[1]), _mm512_setr_epi64(0, 13, 2, 3, 14, 5, 6, 15), s[2]);
-  _mm512_storeu_pd(ys, _mm512_add_pd(_mm512_loadu_pd(ys), lo));
-  _mm512_storeu_pd(ys + 8, _mm512_add_pd(_mm512_loadu_pd(ys + 8), mi));
-  _mm512_storeu_pd(ys + 16, _mm512_add_pd(_mm512_loadu_pd(ys + 16), hi));
+  const V *t = bin_val;
+  const I *c = bin_col;
+  for (int k = 0; k < len; k++, c += 8, t += 72) {
+    prefetch_values(t, 72 * (int)sizeof(V));
+    const __m256i ci = _mm256_loadu_si256((const __m256i *)c);
+    __m512d       v[9], xc[3], s[3];
+    for (int e = 0; e < 9; e++) v[e] = load8(t + e * 8);
+    const bool unit = _mm256_cmpeq_epi32_mask(ci, _mm256_add_epi32(_mm256_set1_epi32((int)c[0]), iota)) == 0xFF;
+    __m256i    off  = _mm256_add_epi32(ci, _mm256_add_epi32(ci, ci)); /* 3 c */
+    if (unit) split_xyz(x + (long)c[0] * 3, xc[0], xc[1], xc[2]);
+    else
+      for (int j = 0; j < 3; j++) xc[j] = _mm512_i32gather_pd(off, x + j, 8);
+    for (int i = 0; i < 3; i++) a[i] = _mm512_fmadd_pd(v[3 * i + 2], xc[2], _mm512_fmadd_pd(v[3 * i + 1], xc[1], _mm512_fmadd_pd(v[3 * i], xc[0], a[i])));
+    const __mmask8 scatter = _mm256_cmpneq_epi32_mask(ci, own); /* not the diagonal block, not padding */
+    if (!scatter) continue;
+    for (int j = 0; j < 3; j++) s[j] = _mm512_fmadd_pd(v[6 + j], r[2], _mm512_fmadd_pd(v[3 + j], r[1], _mm512_mul_pd(v[j], r[0])));
+    if (unit) add_xyz(y + (long)c[0] * 3, s[0], s[1], s[2]); /* all lanes scatter: c0 != r0 */
+    else
+      for (int j = 0; j < 3; j++) {
+        const __m512d yc = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), scatter, off, y + j, 8);
+        _mm512_mask_i32scatter_pd(y + j, scatter, off, _mm512_add_pd(yc, s[j]), 8);
+      }
+  }
+  if (nreal == 8) add_xyz(y + (long)r0 * 3, a[0], a[1], a[2]);
+  else {
+    alignas(64) double acc[3][8];
+    for (int i = 0; i < 3; i++) _mm512_store_pd(acc[i], a[i]);
+    for (int l = 0; l < nreal; l++)
+      for (int i = 0; i < 3; i++) y[(long)(r0 + l) * 3 + i] += acc[i][l];
+  }
 }
 
 } // namespace avx512
