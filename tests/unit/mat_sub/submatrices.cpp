@@ -30,33 +30,6 @@ const Storage storages[] = {{"full", false, false}, {"symmetric storage", true, 
 double weight0(int) { return 1.0; }
 double weight1(int e) { return 1.0 + 3.0 * (e % 4); } // a refill that changes the preconditioner a lot
 
-// This rank's COO entries: elements dealt round-robin (most entries belong to other ranks' rows).
-void coo_entries(const FemProblem &fem, std::vector<PetscInt> &ci, std::vector<PetscInt> &cj)
-{
-  PetscMPIInt rank, size;
-  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
-  MPI_Comm_size(PETSC_COMM_WORLD, &size);
-  for (int e = rank; e < fem.element_count(); e += size) {
-    const auto r = fem.element_rows(e);
-    for (int a = 0; a < 24; ++a)
-      for (int b = 0; b < 24; ++b) {
-        ci.push_back(r[a]);
-        cj.push_back(r[b]);
-      }
-  }
-}
-
-template <class Weight>
-std::vector<PetscScalar> coo_values(const FemProblem &fem, Weight weight)
-{
-  PetscMPIInt rank, size;
-  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
-  MPI_Comm_size(PETSC_COMM_WORLD, &size);
-  std::vector<PetscScalar> cv;
-  for (int e = rank; e < fem.element_count(); e += size)
-    for (PetscScalar k : fem.element_matrix(e)) cv.push_back(weight(e) * k);
-  return cv;
-}
 
 // A binbcsr (or aij) matrix filled through COO with element weights weight0.
 PetscErrorCode coo_matrix(const FemProblem &fem, MatType type, const Storage &st, Mat *A)
@@ -71,9 +44,9 @@ PetscErrorCode coo_matrix(const FemProblem &fem, MatType type, const Storage &st
   PetscCall(MatSetOption(*A, MAT_SYMMETRIC, PETSC_TRUE));
   if (st.sym) PetscCall(MatBinBCSRSetSymmetricStorage(*A, PETSC_TRUE));
   if (st.single) PetscCall(MatBinBCSRSetPrecision(*A, MAT_BINBCSR_PRECISION_SINGLE));
-  coo_entries(fem, ci, cj);
+  rank_coo_entries(fem, ci, cj);
   PetscCall(MatSetPreallocationCOO(*A, static_cast<PetscCount>(ci.size()), ci.data(), cj.data()));
-  PetscCall(MatSetValuesCOO(*A, coo_values(fem, weight0).data(), INSERT_VALUES));
+  PetscCall(MatSetValuesCOO(*A, rank_element_values(fem, weight0).data(), INSERT_VALUES));
   PetscFunctionReturn(0);
 }
 
@@ -92,7 +65,7 @@ PetscErrorCode matrix_pair(const FemProblem &fem, const Storage &st, Mat *A, Mat
 PetscErrorCode refill_pair(const FemProblem &fem, const Storage &st, Mat A, Mat R, bool copy_values = false)
 {
   PetscFunctionBeginUser;
-  const auto cv = coo_values(fem, weight1);
+  const auto cv = rank_element_values(fem, weight1);
   PetscCall(MatSetValuesCOO(A, cv.data(), INSERT_VALUES));
   if (st.single || copy_values) PetscCall(MatConvert(A, MATAIJ, MAT_REUSE_MATRIX, &R));
   else PetscCall(MatSetValuesCOO(R, cv.data(), INSERT_VALUES));

@@ -78,6 +78,38 @@ inline PetscInt local_rows(const FemProblem &fem, MPI_Comm comm, bool empty_rank
   return 3 * (n / parts + (me < n % parts ? 1 : 0));
 }
 
+// This rank's share of a COO list of the whole problem: elements dealt round-robin over PETSC_COMM_WORLD
+// (so most entries belong to other ranks' rows), each element's 24 x 24 entries row by row.
+inline void rank_coo_entries(const FemProblem &fem, std::vector<PetscInt> &ci, std::vector<PetscInt> &cj)
+{
+  PetscMPIInt rank, size;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  MPI_Comm_size(PETSC_COMM_WORLD, &size);
+  for (int e = rank; e < fem.element_count(); e += size) {
+    const auto r = fem.element_rows(e);
+    for (int a = 0; a < 24; ++a)
+      for (int b = 0; b < 24; ++b) {
+        ci.push_back(r[a]);
+        cj.push_back(r[b]);
+      }
+  }
+}
+
+// The values of rank_coo_entries' list, element e's matrix scaled by weight(e).
+template <class Weight>
+std::vector<PetscScalar> rank_element_values(const FemProblem &fem, Weight weight)
+{
+  PetscMPIInt rank, size;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  MPI_Comm_size(PETSC_COMM_WORLD, &size);
+  std::vector<PetscScalar> cv;
+  for (int e = rank; e < fem.element_count(); e += size) {
+    const double w = weight(e);
+    for (PetscScalar k : fem.element_matrix(e)) cv.push_back(w * k);
+  }
+  return cv;
+}
+
 // True on every rank iff ok on every rank (so that all ranks pass or fail a check together).
 inline bool all_ranks(bool ok, MPI_Comm comm = PETSC_COMM_WORLD)
 {

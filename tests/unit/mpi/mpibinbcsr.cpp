@@ -40,19 +40,9 @@ PetscErrorCode assemble(const FemProblem &fem, MatType type, Fill fill, bool emp
   PetscCall(MatSetFromOptions(*A));
   if (parts) PetscCall(PetscOptionsClearValue(nullptr, "-mat_mpibinbcsr_inner_type"));
   if (fill == Fill::Coo) {
-    // elements dealt round-robin: most entries belong to another rank's rows
     std::vector<PetscInt>    ci, cj;
-    std::vector<PetscScalar> cv;
-    for (int e = rank; e < fem.element_count(); e += size) {
-      const auto r = fem.element_rows(e);
-      const auto K = fem.element_matrix(e);
-      for (int a = 0; a < 24; ++a)
-        for (int b = 0; b < 24; ++b) {
-          ci.push_back(r[a]);
-          cj.push_back(r[b]);
-          cv.push_back(K[a * 24 + b]);
-        }
-    }
+    std::vector<PetscScalar> cv = rank_element_values(fem, [](int) { return 1.0; });
+    rank_coo_entries(fem, ci, cj);
     ci.push_back(-1); // ignored, by PETSc's convention
     cj.push_back(0);
     cv.push_back(1e30);
@@ -83,19 +73,12 @@ PetscErrorCode assemble(const FemProblem &fem, MatType type, Fill fill, bool emp
   PetscFunctionReturn(0);
 }
 
-// This rank's COO values in assemble()'s order (elements dealt round-robin), element e scaled by
-// weight(e), and a value for the ignored entry assemble() appends.
+// This rank's COO values in assemble()'s order, element e scaled by weight(e), and a value for the
+// ignored entry assemble() appends.
 template <class Weight>
 std::vector<PetscScalar> rank_coo_values(const FemProblem &fem, Weight weight)
 {
-  PetscMPIInt rank, size;
-  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
-  MPI_Comm_size(PETSC_COMM_WORLD, &size);
-  std::vector<PetscScalar> cv;
-  for (int e = rank; e < fem.element_count(); e += size) {
-    const double w = weight(e);
-    for (PetscScalar k : fem.element_matrix(e)) cv.push_back(w * k);
-  }
+  std::vector<PetscScalar> cv = rank_element_values(fem, weight);
   cv.push_back(0);
   return cv;
 }
