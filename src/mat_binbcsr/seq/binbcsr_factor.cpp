@@ -13,6 +13,7 @@
    nested dissection and ILU to natural, and both take any of PETSc's orderings (computed on the
    binbcsr matrix through MatGetRowIJ); ICC and Cholesky are natural only, as PETSc's sbaij. */
 #include "binbcsr.h"
+#include "../binbcsr_factor_routing.h"
 #include <vector>
 
 namespace
@@ -30,30 +31,20 @@ struct FactorShadow {
   PetscErrorCode (*lusymbolic)(Mat, Mat, IS, IS, const MatFactorInfo *)         = nullptr;
   PetscErrorCode (*choleskynumeric)(Mat, Mat, const MatFactorInfo *)            = nullptr;
   PetscErrorCode (*lunumeric)(Mat, Mat, const MatFactorInfo *)                  = nullptr;
+
+  /* the routing (binbcsr_factor_routing.h) */
+  static const char *key() { return "MatSeqBinBCSR_FactorShadow"; }
+  static PetscErrorCode Destroy(void *ctx)
+  {
+    FactorShadow *f = (FactorShadow *)ctx;
+
+    PetscFunctionBegin;
+    PetscCall(MatDestroy(&f->S));
+    delete f;
+    PetscFunctionReturn(0);
+  }
+  PetscErrorCode Shadow(Mat A, Mat *shadow); /* refills S from A (RefillShadow) */
 };
-
-const char shadow_key[] = "MatSeqBinBCSR_FactorShadow";
-
-PetscErrorCode DestroyShadow(void *ctx)
-{
-  FactorShadow *f = (FactorShadow *)ctx;
-
-  PetscFunctionBegin;
-  PetscCall(MatDestroy(&f->S));
-  delete f;
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode GetShadow(Mat F, FactorShadow **f)
-{
-  PetscContainer c;
-
-  PetscFunctionBegin;
-  PetscCall(PetscObjectQuery((PetscObject)F, shadow_key, (PetscObject *)&c));
-  PetscCheck(c, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Factor of a MATSEQBINBCSR matrix without its shadow");
-  PetscCall(PetscContainerGetPointer(c, (void **)f));
-  PetscFunctionReturn(0);
-}
 
 /* The block pattern of S from A's: upper = blocks with column >= row (for seqsbaij), else all blocks
    (with symmetric storage the lower ones are the stored upper ones transposed). Fills f->src and
@@ -138,46 +129,11 @@ PetscErrorCode RefillShadow(Mat A, FactorShadow *f)
   PetscFunctionReturn(0);
 }
 
-/* After PETSc's symbolic or numeric routine chose its numeric kernel, route it through the shadow. */
-PetscErrorCode CholeskyNumeric(Mat, Mat, const MatFactorInfo *);
-PetscErrorCode LUNumeric(Mat, Mat, const MatFactorInfo *);
-void WrapNumeric(Mat F, FactorShadow *f)
-{
-  if (F->ops->choleskyfactornumeric && F->ops->choleskyfactornumeric != CholeskyNumeric) {
-    f->choleskynumeric               = F->ops->choleskyfactornumeric;
-    F->ops->choleskyfactornumeric    = CholeskyNumeric;
-  }
-  if (F->ops->lufactornumeric && F->ops->lufactornumeric != LUNumeric) {
-    f->lunumeric            = F->ops->lufactornumeric;
-    F->ops->lufactornumeric = LUNumeric;
-  }
-}
-
-/* Both numeric factorisations: refill the shadow, run PETSc's kernel on it, keep the routing. */
-template <class Numeric>
-PetscErrorCode ShadowNumeric(Mat F, Mat A, Numeric &&numeric)
-{
-  FactorShadow *f;
-
-  PetscFunctionBegin;
-  PetscCall(GetShadow(F, &f));
-  PetscCall(RefillShadow(A, f));
-  PetscCall(numeric(f));
-  WrapNumeric(F, f);
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode CholeskyNumeric(Mat F, Mat A, const MatFactorInfo *info)
+PetscErrorCode FactorShadow::Shadow(Mat A, Mat *shadow)
 {
   PetscFunctionBegin;
-  PetscCall(ShadowNumeric(F, A, [&](FactorShadow *f) { return (*f->choleskynumeric)(F, f->S, info); }));
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode LUNumeric(Mat F, Mat A, const MatFactorInfo *info)
-{
-  PetscFunctionBegin;
-  PetscCall(ShadowNumeric(F, A, [&](FactorShadow *f) { return (*f->lunumeric)(F, f->S, info); }));
+  PetscCall(RefillShadow(A, this));
+  *shadow = S;
   PetscFunctionReturn(0);
 }
 
@@ -211,21 +167,21 @@ PetscErrorCode ShadowOrdering(FactorShadow *f, IS row, IS col, IS *rperm, IS *cp
 }
 
 /* The four symbolic factorisations: refill the shadow, translate the ordering to it, run PETSc's
-   routine on it, and route the numeric kernel that routine chose back through the shadow. */
+   routine on it (the routing keeps the numeric kernel that routine chose on the shadow). */
 template <class Symbolic>
 PetscErrorCode ShadowSymbolic(Mat F, Mat A, IS row, IS col, Symbolic &&symbolic)
 {
-  FactorShadow *f;
-  IS            r, c;
-
   PetscFunctionBegin;
-  PetscCall(GetShadow(F, &f));
-  PetscCall(RefillShadow(A, f));
-  PetscCall(ShadowOrdering(f, row, col, &r, &c));
-  PetscCall(symbolic(f, r, c));
-  PetscCall(ISDestroy(&r));
-  PetscCall(ISDestroy(&c));
-  WrapNumeric(F, f);
+  PetscCall(binbcsr_factor::OnShadow<FactorShadow>(F, A, [&](FactorShadow *f, Mat) {
+    IS r, c;
+
+    PetscFunctionBegin;
+    PetscCall(ShadowOrdering(f, row, col, &r, &c));
+    PetscCall(symbolic(f, r, c));
+    PetscCall(ISDestroy(&r));
+    PetscCall(ISDestroy(&c));
+    PetscFunctionReturn(0);
+  }));
   PetscFunctionReturn(0);
 }
 
@@ -264,7 +220,6 @@ PetscErrorCode MatGetFactor_SeqBinBCSR_Petsc(Mat A, MatFactorType ftype, Mat *F)
   const PetscBool       upper = (ftype == MAT_FACTOR_ICC || ftype == MAT_FACTOR_CHOLESKY) ? PETSC_TRUE : PETSC_FALSE;
   FactorShadow         *f;
   std::vector<PetscInt> bi, bj;
-  PetscContainer        c;
 
   PetscFunctionBegin;
   PetscCheck(ftype == MAT_FACTOR_ICC || ftype == MAT_FACTOR_CHOLESKY || ftype == MAT_FACTOR_ILU || ftype == MAT_FACTOR_LU, PETSC_COMM_SELF, PETSC_ERR_SUP, "MATSEQBINBCSR provides ICC, Cholesky, ILU and LU (MATSOLVERPETSC), not %s", MatFactorTypes[ftype]);
@@ -283,11 +238,7 @@ PetscErrorCode MatGetFactor_SeqBinBCSR_Petsc(Mat A, MatFactorType ftype, Mat *F)
   PetscCall(MatPropagateSymmetryOptions(A, f->S));
 
   PetscCall(MatGetFactor(f->S, MATSOLVERPETSC, ftype, F));
-  PetscCall(PetscContainerCreate(PETSC_COMM_SELF, &c));
-  PetscCall(PetscContainerSetPointer(c, f));
-  PetscCall(PetscContainerSetUserDestroy(c, DestroyShadow));
-  PetscCall(PetscObjectCompose((PetscObject)*F, shadow_key, (PetscObject)c));
-  PetscCall(PetscContainerDestroy(&c));
+  PetscCall(binbcsr_factor::Attach(*F, f));
 
   Mat B = *F;
   f->iccsymbolic      = B->ops->iccfactorsymbolic;
