@@ -28,6 +28,7 @@ struct ExternalFactor {
     PetscFunctionReturn(0);
   }
   PetscErrorCode Shadow(Mat A, Mat *S) { return MatBinBCSRGetAIJShadow_Private(A, S); }
+  PetscErrorCode Routed(Mat) { return 0; } /* the package's solves as they are */
 };
 
 PetscErrorCode LUSymbolic(Mat F, Mat A, IS r, IS c, const MatFactorInfo *info)

@@ -8,6 +8,7 @@
      static const char *key();                       the composition key
      static PetscErrorCode Destroy(void *);          frees a Ctx (and what it holds)
      PetscErrorCode Shadow(Mat A, Mat *S);           S holding A's current values
+     PetscErrorCode Routed(Mat F);                   after each symbolic/numeric: the factor's ops set
      lunumeric, choleskynumeric                      the package's numeric ops (filled here) */
 #ifndef BINBCSR_FACTOR_ROUTING_H
 #define BINBCSR_FACTOR_ROUTING_H
@@ -74,6 +75,7 @@ PetscErrorCode OnShadow(Mat F, Mat A, Routine &&routine)
   PetscCall(f->Shadow(A, &S));
   PetscCall(routine(f, S));
   RouteNumeric(F, f);
+  PetscCall(f->Routed(F));
   PetscFunctionReturn(0);
 }
 

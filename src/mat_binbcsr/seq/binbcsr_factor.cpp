@@ -14,6 +14,7 @@
    binbcsr matrix through MatGetRowIJ); ICC and Cholesky are natural only, as PETSc's sbaij. */
 #include "binbcsr.h"
 #include "../binbcsr_factor_routing.h"
+#include <algorithm>
 #include <vector>
 
 namespace
@@ -31,6 +32,13 @@ struct FactorShadow {
   PetscErrorCode (*lusymbolic)(Mat, Mat, IS, IS, const MatFactorInfo *)         = nullptr;
   PetscErrorCode (*choleskynumeric)(Mat, Mat, const MatFactorInfo *)            = nullptr;
   PetscErrorCode (*lunumeric)(Mat, Mat, const MatFactorInfo *)                  = nullptr;
+  /* ICC and Cholesky in an ordering: S holds the permuted matrix (seqsbaij factors in its natural
+     order only), and the factor's solves are wrapped to permute in and out */
+  std::vector<PetscInt> perm; /* new block row -> A's block row; empty: natural */
+  Vec                   bp = nullptr, xp = nullptr;
+  PetscErrorCode (*solve)(Mat, Vec, Vec)         = nullptr;
+  PetscErrorCode (*forwardsolve)(Mat, Vec, Vec)  = nullptr;
+  PetscErrorCode (*backwardsolve)(Mat, Vec, Vec) = nullptr;
 
   /* the routing (binbcsr_factor_routing.h) */
   static const char *key() { return "MatSeqBinBCSR_FactorShadow"; }
@@ -40,43 +48,61 @@ struct FactorShadow {
 
     PetscFunctionBegin;
     PetscCall(MatDestroy(&f->S));
+    PetscCall(VecDestroy(&f->bp));
+    PetscCall(VecDestroy(&f->xp));
     delete f;
     PetscFunctionReturn(0);
   }
   PetscErrorCode Shadow(Mat A, Mat *shadow); /* refills S from A (RefillShadow) */
+  PetscErrorCode Routed(Mat F);              /* the permuting solves, when perm is set */
 };
 
-/* The block pattern of S from A's: upper = blocks with column >= row (for seqsbaij), else all blocks
-   (with symmetric storage the lower ones are the stored upper ones transposed). Fills f->src and
+/* The block pattern of S from A's, in the numbering of f->perm (new block row i is A's block row
+   perm[i]; natural when empty): upper = blocks with new column >= new row (for seqsbaij), else all
+   blocks (with symmetric storage the lower ones are the stored upper ones transposed). Fills f->src and
    f->transpose in the order of S's blocks (CSR, ascending columns). */
 PetscErrorCode BuildShadowPattern(Mat A, PetscBool upper, FactorShadow *f, std::vector<PetscInt> &bi, std::vector<PetscInt> &bj)
 {
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-  const PetscInt  bw = a->bw, bs2 = a->bs2;
+  Mat_SeqBinBCSR *a        = (Mat_SeqBinBCSR *)A->data;
+  const PetscInt  bw       = a->bw, bs2 = a->bs2;
+  const bool      permuted = !f->perm.empty();
+  struct Block {
+    PetscInt col, src;
+    char     transpose;
+  };
+  std::vector<PetscInt> iperm;
+  std::vector<Block>    row;
 
   PetscFunctionBegin;
   auto base = [&](PetscInt s) { return BinBCSRValueIndex(s, 0, bw, bs2); };
-  if (a->sym && !upper) PetscCall(MatSeqBinBCSRBuildLowerIndex(a));
+  /* the lower part of a row is needed unless only the (unpermuted) upper triangle is */
+  if (a->sym && (!upper || permuted)) PetscCall(MatSeqBinBCSRBuildLowerIndex(a));
+  if (permuted) {
+    iperm.resize(a->mbs);
+    for (PetscInt i = 0; i < a->mbs; i++) iperm[f->perm[i]] = i;
+  }
   bi.assign(1, 0);
   bj.clear();
   f->src.clear();
   f->transpose.clear();
-  for (PetscInt r = 0; r < a->mbs; r++) {
-    if (!upper) {
-      if (a->sym) {
-        for (PetscInt p = a->lower_off[r]; p < a->lower_off[r + 1]; p++) {
-          bj.push_back(a->lower_slot[2 * p + 1]);
-          f->src.push_back(base(a->lower_slot[2 * p]));
-          f->transpose.push_back(1);
-        }
-      }
-    }
+  for (PetscInt i = 0; i < a->mbs; i++) {
+    const PetscInt r = permuted ? f->perm[i] : i;
+    auto           add = [&](PetscInt c, PetscInt s, char transpose) {
+      const PetscInt j = permuted ? iperm[c] : c;
+      if (!upper || j >= i) row.push_back({j, base(s), transpose});
+    };
+    row.clear();
+    if (a->sym && a->lower_off)
+      for (PetscInt p = a->lower_off[r]; p < a->lower_off[r + 1]; p++) add(a->lower_slot[2 * p + 1], a->lower_slot[2 * p], 1);
     for (PetscInt k = 0; k < a->row_nz[r]; k++) {
       const PetscInt s = BinBCSRSlot(a, r, k);
-      if (upper && a->col[s] < r) continue;
-      bj.push_back(a->col[s]);
-      f->src.push_back(base(s));
-      f->transpose.push_back(0);
+      add(a->col[s], s, 0);
+    }
+    if (permuted) std::sort(row.begin(), row.end(), [](const Block &x, const Block &y) { return x.col < y.col; });
+    for (const Block &b : row) {
+      bj.push_back(b.col);
+      f->src.push_back(b.src);
+      f->transpose.push_back(b.transpose);
     }
     bi.push_back((PetscInt)bj.size());
   }
@@ -137,32 +163,166 @@ PetscErrorCode FactorShadow::Shadow(Mat A, Mat *shadow)
   PetscFunctionReturn(0);
 }
 
+/* S (re)built from A's pattern in the numbering of f->perm: seqsbaij (upper) or seqbaij. */
+PetscErrorCode BuildShadow(Mat A, PetscBool upper, FactorShadow *f)
+{
+  std::vector<PetscInt> bi, bj;
+
+  PetscFunctionBegin;
+  PetscCall(BuildShadowPattern(A, upper, f, bi, bj));
+  PetscCall(MatDestroy(&f->S));
+  PetscCall(MatCreate(PETSC_COMM_SELF, &f->S));
+  PetscCall(MatSetSizes(f->S, A->rmap->n, A->cmap->n, A->rmap->n, A->cmap->n));
+  PetscCall(MatSetType(f->S, upper ? MATSEQSBAIJ : MATSEQBAIJ));
+  if (upper) PetscCall(MatSeqSBAIJSetPreallocationCSR(f->S, f->bs, bi.data(), bj.data(), nullptr));
+  else PetscCall(MatSeqBAIJSetPreallocationCSR(f->S, f->bs, bi.data(), bj.data(), nullptr));
+  PetscCall(MatPropagateSymmetryOptions(A, f->S));
+  PetscFunctionReturn(0);
+}
+
 /* The permutation for S from the one PCFactor computed on the binbcsr matrix. PETSc's orderings read
-   the block-compressed structure (MatGetRowIJ), so for bs > 1 they come out block-sized: what BAIJ's
-   LU and ILU take, so they pass through. The identity (natural) may come point-sized; it becomes S's
-   own natural ordering. SBAIJ (ICC, Cholesky) factors in natural order only. */
-PetscErrorCode ShadowOrdering(FactorShadow *f, IS row, IS col, IS *rperm, IS *cperm)
+   the block-compressed structure (MatGetRowIJ), so for bs > 1 they come out block-sized. LU and ILU:
+   BAIJ's factor takes them, so they pass through. ICC and Cholesky: seqsbaij factors in natural order
+   only (bs > 1), so S itself is rebuilt as the permuted matrix P^T A P and the solves permute in and
+   out (FactorShadow::Routed); S's factor then runs in its natural order. The identity (natural) may
+   come point-sized; it becomes S's own natural ordering. */
+PetscErrorCode ShadowOrdering(Mat A, FactorShadow *f, IS row, IS col, IS *rperm, IS *cperm)
 {
   PetscBool      rid = PETSC_TRUE, cid = PETSC_TRUE, sbaij;
-  const PetscInt mbs = f->S->rmap->n / f->bs;
+  const PetscInt mbs = A->rmap->n / f->bs;
   PetscInt       nr = -1, nc = -1;
 
   PetscFunctionBegin;
   if (row) PetscCall(ISIdentity(row, &rid));
   if (col) PetscCall(ISIdentity(col, &cid));
+  PetscCall(PetscObjectTypeCompare((PetscObject)f->S, MATSEQSBAIJ, &sbaij));
   if (rid && cid) {
+    if (!f->perm.empty()) {
+      f->perm.clear();
+      PetscCall(BuildShadow(A, sbaij, f));
+    }
     PetscCall(MatGetOrdering(f->S, MATORDERINGNATURAL, rperm, cperm));
     PetscFunctionReturn(0);
   }
-  PetscCall(PetscObjectTypeCompare((PetscObject)f->S, MATSEQSBAIJ, &sbaij));
-  PetscCheck(!sbaij, PETSC_COMM_SELF, PETSC_ERR_SUP, "ICC and Cholesky of MATSEQBINBCSR (PETSc's seqsbaij factor) support only the natural ordering (-pc_factor_mat_ordering_type natural), or use -pc_factor_mat_solver_type mumps");
   if (row) PetscCall(ISGetLocalSize(row, &nr));
   if (col) PetscCall(ISGetLocalSize(col, &nc));
-  PetscCheck(nr == mbs && nc == mbs, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "LU and ILU of MATSEQBINBCSR take block orderings of its %" PetscInt_FMT " block rows (as MatGetOrdering gives), not index sets of %" PetscInt_FMT " and %" PetscInt_FMT " entries", mbs, nr, nc);
-  PetscCall(PetscObjectReference((PetscObject)row));
-  PetscCall(PetscObjectReference((PetscObject)col));
-  *rperm = row;
-  *cperm = col;
+  PetscCheck(nr == mbs && (sbaij || nc == mbs), PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Factorisations of MATSEQBINBCSR take block orderings of its %" PetscInt_FMT " block rows (as MatGetOrdering gives), not index sets of %" PetscInt_FMT " and %" PetscInt_FMT " entries", mbs, nr, nc);
+  if (!sbaij) {
+    PetscCall(PetscObjectReference((PetscObject)row));
+    PetscCall(PetscObjectReference((PetscObject)col));
+    *rperm = row;
+    *cperm = col;
+    PetscFunctionReturn(0);
+  }
+  {
+    const PetscInt       *idx;
+    std::vector<PetscInt> perm(mbs);
+    std::vector<char>     seen(mbs, 0);
+
+    PetscCall(ISGetIndices(row, &idx));
+    for (PetscInt i = 0; i < mbs; i++) perm[i] = idx[i];
+    PetscCall(ISRestoreIndices(row, &idx));
+    for (PetscInt i = 0; i < mbs; i++) {
+      PetscCheck(perm[i] >= 0 && perm[i] < mbs && !seen[perm[i]], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "The ordering for the factorisation of MATSEQBINBCSR is not a permutation of its %" PetscInt_FMT " block rows (entry %" PetscInt_FMT " is %" PetscInt_FMT ")", mbs, i, perm[i]);
+      seen[perm[i]] = 1;
+    }
+    if (perm != f->perm) {
+      f->perm = std::move(perm);
+      PetscCall(BuildShadow(A, PETSC_TRUE, f));
+    }
+  }
+  PetscCall(MatGetOrdering(f->S, MATORDERINGNATURAL, rperm, cperm));
+  PetscFunctionReturn(0);
+}
+
+/* Between A's numbering and S's (f->perm) for the permuting solves: to = from, moved block by block. */
+PetscErrorCode Permute(const FactorShadow *f, Vec from, Vec to, PetscBool into_shadow)
+{
+  const PetscScalar *src;
+  PetscScalar       *dst;
+  const PetscInt     bs = f->bs, mbs = (PetscInt)f->perm.size();
+
+  PetscFunctionBegin;
+  PetscCall(VecGetArrayRead(from, &src));
+  PetscCall(VecGetArrayWrite(to, &dst));
+  for (PetscInt i = 0; i < mbs; i++) {
+    const PetscInt o = f->perm[i] * bs;
+    for (PetscInt d = 0; d < bs; d++) {
+      if (into_shadow) dst[i * bs + d] = src[o + d];
+      else dst[o + d] = src[i * bs + d];
+    }
+  }
+  PetscCall(VecRestoreArrayRead(from, &src));
+  PetscCall(VecRestoreArrayWrite(to, &dst));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode WorkVectors(FactorShadow *f)
+{
+  PetscFunctionBegin;
+  if (!f->bp) PetscCall(VecCreateSeq(PETSC_COMM_SELF, f->S->rmap->n, &f->bp));
+  if (!f->xp) PetscCall(VecCreateSeq(PETSC_COMM_SELF, f->S->rmap->n, &f->xp));
+  PetscFunctionReturn(0);
+}
+
+/* x = P (L D L^T)^-1 P^T b; the transpose solve is the same (the factor is symmetric) */
+PetscErrorCode PermutedSolve(Mat F, Vec b, Vec x)
+{
+  FactorShadow *f;
+
+  PetscFunctionBegin;
+  PetscCall(binbcsr_factor::Get(F, &f));
+  PetscCall(WorkVectors(f));
+  PetscCall(Permute(f, b, f->bp, PETSC_TRUE));
+  PetscCall((*f->solve)(F, f->bp, f->xp));
+  PetscCall(Permute(f, f->xp, x, PETSC_FALSE));
+  PetscFunctionReturn(0);
+}
+
+/* The split solves (PCApplySymmetricLeft/Right): the intermediate vector stays in S's numbering. */
+PetscErrorCode PermutedForwardSolve(Mat F, Vec b, Vec x)
+{
+  FactorShadow *f;
+
+  PetscFunctionBegin;
+  PetscCall(binbcsr_factor::Get(F, &f));
+  PetscCall(WorkVectors(f));
+  PetscCall(Permute(f, b, f->bp, PETSC_TRUE));
+  PetscCall((*f->forwardsolve)(F, f->bp, x));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode PermutedBackwardSolve(Mat F, Vec b, Vec x)
+{
+  FactorShadow *f;
+
+  PetscFunctionBegin;
+  PetscCall(binbcsr_factor::Get(F, &f));
+  PetscCall(WorkVectors(f));
+  PetscCall((*f->backwardsolve)(F, b, f->xp));
+  PetscCall(Permute(f, f->xp, x, PETSC_FALSE));
+  PetscFunctionReturn(0);
+}
+
+/* seqsbaij's symbolic and numeric routines set the factor's solves (per block size and ordering), so
+   the permuting wrappers go back on after each of them. */
+PetscErrorCode FactorShadow::Routed(Mat F)
+{
+  PetscFunctionBegin;
+  if (perm.empty()) PetscFunctionReturn(0);
+  auto route = [](PetscErrorCode (*&op)(Mat, Vec, Vec), PetscErrorCode (*&saved)(Mat, Vec, Vec), PetscErrorCode (*wrapper)(Mat, Vec, Vec)) {
+    if (op && op != wrapper) {
+      saved = op;
+      op    = wrapper;
+    }
+  };
+  route(F->ops->solve, solve, PermutedSolve);
+  route(F->ops->forwardsolve, forwardsolve, PermutedForwardSolve);
+  route(F->ops->backwardsolve, backwardsolve, PermutedBackwardSolve);
+  if (F->ops->solvetranspose) F->ops->solvetranspose = PermutedSolve;
+  /* MatMatSolve falls back to one MatSolve per column */
+  F->ops->matsolve          = nullptr;
+  F->ops->matsolvetranspose = nullptr;
   PetscFunctionReturn(0);
 }
 
@@ -176,7 +336,7 @@ PetscErrorCode ShadowSymbolic(Mat F, Mat A, IS row, IS col, Symbolic &&symbolic)
     IS r, c;
 
     PetscFunctionBegin;
-    PetscCall(ShadowOrdering(f, row, col, &r, &c));
+    PetscCall(ShadowOrdering(A, f, row, col, &r, &c));
     PetscCall(symbolic(f, r, c));
     PetscCall(ISDestroy(&r));
     PetscCall(ISDestroy(&c));
@@ -219,7 +379,6 @@ PetscErrorCode MatGetFactor_SeqBinBCSR_Petsc(Mat A, MatFactorType ftype, Mat *F)
   Mat_SeqBinBCSR       *a     = (Mat_SeqBinBCSR *)A->data;
   const PetscBool       upper = (ftype == MAT_FACTOR_ICC || ftype == MAT_FACTOR_CHOLESKY) ? PETSC_TRUE : PETSC_FALSE;
   FactorShadow         *f;
-  std::vector<PetscInt> bi, bj;
 
   PetscFunctionBegin;
   PetscCheck(ftype == MAT_FACTOR_ICC || ftype == MAT_FACTOR_CHOLESKY || ftype == MAT_FACTOR_ILU || ftype == MAT_FACTOR_LU, PETSC_COMM_SELF, PETSC_ERR_SUP, "MATSEQBINBCSR provides ICC, Cholesky, ILU and LU (MATSOLVERPETSC), not %s", MatFactorTypes[ftype]);
@@ -229,13 +388,7 @@ PetscErrorCode MatGetFactor_SeqBinBCSR_Petsc(Mat A, MatFactorType ftype, Mat *F)
   f->bs      = a->bs;
   f->bw      = a->bw;
   f->nzstate = A->nonzerostate;
-  PetscCall(BuildShadowPattern(A, upper, f, bi, bj));
-  PetscCall(MatCreate(PETSC_COMM_SELF, &f->S));
-  PetscCall(MatSetSizes(f->S, A->rmap->n, A->cmap->n, A->rmap->n, A->cmap->n));
-  PetscCall(MatSetType(f->S, upper ? MATSEQSBAIJ : MATSEQBAIJ));
-  if (upper) PetscCall(MatSeqSBAIJSetPreallocationCSR(f->S, a->bs, bi.data(), bj.data(), nullptr));
-  else PetscCall(MatSeqBAIJSetPreallocationCSR(f->S, a->bs, bi.data(), bj.data(), nullptr));
-  PetscCall(MatPropagateSymmetryOptions(A, f->S));
+  PetscCall(BuildShadow(A, upper, f));
 
   PetscCall(MatGetFactor(f->S, MATSOLVERPETSC, ftype, F));
   PetscCall(binbcsr_factor::Attach(*F, f));
@@ -249,9 +402,10 @@ PetscErrorCode MatGetFactor_SeqBinBCSR_Petsc(Mat A, MatFactorType ftype, Mat *F)
   if (f->choleskysymbolic) B->ops->choleskyfactorsymbolic = CholeskySymbolic;
   if (f->ilusymbolic) B->ops->ilufactorsymbolic = ILUSymbolic;
   if (f->lusymbolic) B->ops->lufactorsymbolic = LUSymbolic;
-  if (upper) { /* LU and ILU keep BAIJ's preferences: nested dissection for LU, natural for ILU */
+  if (upper) { /* LU and ILU keep BAIJ's preferences (nested dissection for LU, natural for ILU); ICC and
+                  Cholesky take AIJ's (natural for ICC, nested dissection for Cholesky) */
     PetscCall(PetscFree(B->preferredordering[ftype]));
-    PetscCall(PetscStrallocpy(MATORDERINGNATURAL, (char **)&B->preferredordering[ftype]));
+    PetscCall(PetscStrallocpy(ftype == MAT_FACTOR_CHOLESKY ? MATORDERINGND : MATORDERINGNATURAL, (char **)&B->preferredordering[ftype]));
   }
   PetscFunctionReturn(0);
 }
