@@ -388,6 +388,7 @@ PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
   mat->ops->diagonalset         = MatDiagonalSet_MPIBinBCSR;
   mat->ops->invertblockdiagonal = MatInvertBlockDiagonal_MPIBinBCSR;
   mat->ops->sor                 = MatSOR_MPIBinBCSR;
+  mat->ops->multdiagonalblock   = MatMultDiagonalBlock_MPIBinBCSR;
   mat->ops->scale               = MatScale_MPIBinBCSR;
   mat->ops->shift               = MatShift_MPIBinBCSR;
   mat->ops->zeroentries         = MatZeroEntries_MPIBinBCSR;

@@ -115,6 +115,7 @@ PETSC_INTERN PetscErrorCode MatGetDiagonal_MPIBinBCSR(Mat, Vec);
 PETSC_INTERN PetscErrorCode MatDiagonalSet_MPIBinBCSR(Mat, Vec, InsertMode);
 PETSC_INTERN PetscErrorCode MatInvertBlockDiagonal_MPIBinBCSR(Mat, const PetscScalar **);
 PETSC_INTERN PetscErrorCode MatSOR_MPIBinBCSR(Mat, Vec, PetscReal, MatSORType, PetscReal, PetscInt, PetscInt, Vec);
+PETSC_INTERN PetscErrorCode MatMultDiagonalBlock_MPIBinBCSR(Mat, Vec, Vec); /* mpibinbcsr_sor.cpp */
 PETSC_INTERN PetscErrorCode MatScale_MPIBinBCSR(Mat, PetscScalar);
 PETSC_INTERN PetscErrorCode MatShift_MPIBinBCSR(Mat, PetscScalar);
 PETSC_INTERN PetscErrorCode MatZeroEntries_MPIBinBCSR(Mat);

@@ -730,6 +730,7 @@ PetscErrorCode MatCreate_SeqBinBCSR(Mat A)
   A->ops->getdiagonal         = MatGetDiagonal_SeqBinBCSR;
   A->ops->invertblockdiagonal = MatInvertBlockDiagonal_SeqBinBCSR;
   A->ops->sor                 = MatSOR_SeqBinBCSR;
+  A->ops->multdiagonalblock   = MatMultDiagonalBlock_SeqBinBCSR;
   A->ops->assemblyend         = MatAssemblyEnd_SeqBinBCSR;
   A->ops->setoption           = MatSetOption_SeqBinBCSR;
   A->ops->setup               = MatSetUp_SeqBinBCSR;

@@ -192,6 +192,7 @@ PETSC_INTERN PetscErrorCode MatGetDiagonal_SeqBinBCSR(Mat, Vec);
 PETSC_INTERN PetscErrorCode MatInvertBlockDiagonal_SeqBinBCSR(Mat, const PetscScalar **);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRInvertDiagonalBlocks(Mat, PetscReal shift, MatScalar *out, PetscInt *zero_row);
 PETSC_INTERN PetscErrorCode MatSOR_SeqBinBCSR(Mat, Vec, PetscReal, MatSORType, PetscReal, PetscInt, PetscInt, Vec);
+PETSC_INTERN PetscErrorCode MatMultDiagonalBlock_SeqBinBCSR(Mat, Vec, Vec);
 PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat, PetscCount, const PetscInt[], const PetscInt[]);
 PETSC_INTERN PetscErrorCode MatSetValuesCOO_SeqBinBCSR(Mat, const PetscScalar[], InsertMode);
 PETSC_INTERN PetscErrorCode MatGetRow_SeqBinBCSR(Mat, PetscInt, PetscInt *, PetscInt **, PetscScalar **);

@@ -7,9 +7,17 @@
    newest x (SOR on A + shift I, as PETSc's AIJ defines the shift). The row products reuse the per-slot
    kernels of MatMult (slot_mult, and slot_mult_transpose for the lower triangle that symmetric
    storage keeps in other rows). Sweeps are sequential over rows by nature: they walk
-   the bin layout one lane at a time and do not get the SIMD speed of MatMult. */
+   the bin layout one lane at a time and do not get the SIMD speed of MatMult.
+
+   PCEISENSTAT's operations as well: SOR_EISENSTAT applies (L + E)^-1 A (U + E)^-1, E = (D + shift I) / omega,
+   with one backward and one forward sweep from zero (Eisenstat's trick, as PETSc's AIJ: about one matrix
+   pass instead of two for SSOR plus a product); SOR_APPLY_UPPER applies U + E; MatMultDiagonalBlock
+   applies D (PCEISENSTAT's diagonal scaling). D is the block diagonal, so for bs 3 this is the point-block
+   Eisenstat that AIJ's inodes give for 3-row nodes. */
 #include "binbcsr.h"
 #include "../binbcsr_kernels.h"
+
+#include <type_traits>
 
 namespace
 {
@@ -84,33 +92,71 @@ void sweep(const Mat_SeqBinBCSR *a, const V *val, const MatScalar *idiag, PetscR
   h.upper_ok = !forward;
 }
 
-template <typename V>
-void sweep_dispatch(const Mat_SeqBinBCSR *a, const V *val, const MatScalar *idiag, PetscReal omega, const double *b, double *x, bool forward, HalfSums &h, double *work)
+/* y_r += alpha (D_r + shift I) x_r for every block row r (D_r: the stored diagonal block, zero if none). */
+template <int BS, typename V>
+void diagonal_block_axpy(const Mat_SeqBinBCSR *a, const V *val, double alpha, double shift, const double *x, double *y, double *acc)
 {
-  if (a->bs == 3) sweep<3, V>(a, val, idiag, omega, b, x, forward, h, work);
-  else if (a->bs == 1) sweep<1, V>(a, val, idiag, omega, b, x, forward, h, work);
-  else sweep<0, V>(a, val, idiag, omega, b, x, forward, h, work);
+  const int bs = BS ? BS : (int)a->bs, bs2 = bs * bs, bw = (int)a->bw;
+  for (PetscInt r = 0; r < a->mbs; r++) {
+    const double *xr = x + (size_t)r * bs;
+    for (int i = 0; i < bs; i++) acc[i] = shift * xr[i];
+    if (a->diag_slot[r] >= 0) binbcsr::slot_mult<BS, V>(val + BinBCSRValueIndex(a->diag_slot[r], 0, bw, bs2), bw, bs, xr, acc);
+    for (int i = 0; i < bs; i++) y[(size_t)r * bs + i] += alpha * acc[i];
+  }
+}
+
+/* x_r = (D_r + shift I) b_r / omega + U_r b: SOR_APPLY_UPPER, (U + E) b. */
+template <int BS, typename V>
+void apply_upper(const Mat_SeqBinBCSR *a, const V *val, PetscReal omega, PetscReal shift, const double *b, double *x, double *work)
+{
+  const int bs = BS ? BS : (int)a->bs;
+  for (PetscInt r = 0; r < a->mbs; r++) row_half_product<BS, V>(a, val, r, false, b, x + (size_t)r * bs);
+  diagonal_block_axpy<BS, V>(a, val, 1.0 / omega, shift, b, x, work);
+}
+
+/* f(block size constant, values) for the storage and block size of a: the kernels are compiled for
+   bs 3 and 1 and a runtime block size (0), in double or single storage. */
+template <typename F>
+void dispatch(const Mat_SeqBinBCSR *a, F &&f)
+{
+  if (a->val) {
+    if (a->bs == 3) f(std::integral_constant<int, 3>(), (const MatScalar *)a->val);
+    else if (a->bs == 1) f(std::integral_constant<int, 1>(), (const MatScalar *)a->val);
+    else f(std::integral_constant<int, 0>(), (const MatScalar *)a->val);
+  } else {
+    if (a->bs == 3) f(std::integral_constant<int, 3>(), (const float *)a->valf);
+    else if (a->bs == 1) f(std::integral_constant<int, 1>(), (const float *)a->valf);
+    else f(std::integral_constant<int, 0>(), (const float *)a->valf);
+  }
+}
+
+template <typename P>
+using ValueType = std::remove_const_t<std::remove_pointer_t<P>>;
+
+/* One sweep of x (forward or backward) in the storage and block size of a. */
+void sweep_any(const Mat_SeqBinBCSR *a, PetscReal omega, const double *b, double *x, bool forward, HalfSums &h, double *work)
+{
+  dispatch(a, [&](auto BS, const auto *val) { sweep<decltype(BS)::value, ValueType<decltype(val)>>(a, val, a->sor_idiag, omega, b, x, forward, h, work); });
+}
+
+/* x = 0 and the half sums of x = 0: the first sweep in either direction needs neither. */
+void zero_start(PetscInt n, double *x, HalfSums &h)
+{
+  for (PetscInt i = 0; i < n; i++) x[i] = h.lower[i] = h.upper[i] = 0.0;
+  h.lower_ok = h.upper_ok = true;
 }
 
 } // namespace
 
-PetscErrorCode MatSOR_SeqBinBCSR(Mat A, Vec bb, PetscReal omega, MatSORType flag, PetscReal fshift, PetscInt its, PetscInt lits, Vec xx)
+namespace
 {
-  Mat_SeqBinBCSR    *a = (Mat_SeqBinBCSR *)A->data;
-  const PetscScalar *b;
-  PetscScalar       *x;
-  double            *work = nullptr;
-  PetscObjectState   state;
-  const PetscBool    forward  = (flag & (SOR_FORWARD_SWEEP | SOR_LOCAL_FORWARD_SWEEP)) ? PETSC_TRUE : PETSC_FALSE;
-  const PetscBool    backward = (flag & (SOR_BACKWARD_SWEEP | SOR_LOCAL_BACKWARD_SWEEP)) ? PETSC_TRUE : PETSC_FALSE;
+/* sor_idiag = (D + shift I)^-1, recomputed when the matrix or the shift changed. */
+PetscErrorCode SORInvertDiagonal(Mat A, PetscReal fshift)
+{
+  Mat_SeqBinBCSR  *a = (Mat_SeqBinBCSR *)A->data;
+  PetscObjectState state;
 
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
-  PetscCheck(a->mbs == a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "MatSOR needs a square matrix (%" PetscInt_FMT " x %" PetscInt_FMT " blocks)", a->mbs, a->nbs);
-  PetscCheck(!(flag & (SOR_EISENSTAT | SOR_APPLY_UPPER | SOR_APPLY_LOWER)), PETSC_COMM_SELF, PETSC_ERR_SUP, "MATSEQBINBCSR's MatSOR does forward, backward and symmetric sweeps only (no Eisenstat, no apply upper/lower)");
-  PetscCheck(forward || backward, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "MatSOR: the flag %d asks for no sweep", (int)flag);
-  PetscCheck(its > 0 && lits > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "MatSOR: its (%" PetscInt_FMT ") and lits (%" PetscInt_FMT ") must be positive", its, lits);
-  PetscCheck(!PetscIsInfOrNanReal(omega) && !PetscIsInfOrNanReal(fshift), PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "MatSOR: omega and the shift must be finite");
   PetscCall(PetscObjectStateGet((PetscObject)A, &state));
   if (!a->sor_idiag || a->sor_state != state || a->sor_shift != fshift) {
     PetscInt zero_row;
@@ -121,26 +167,106 @@ PetscErrorCode MatSOR_SeqBinBCSR(Mat A, Vec bb, PetscReal omega, MatSORType flag
     a->sor_state = state;
     a->sor_shift = fshift;
   }
+  PetscFunctionReturn(0);
+}
+
+/* Eisenstat's trick (SOR_EISENSTAT): x = (L + E)^-1 A (U + E)^-1 b with E = (D + shift I) / omega, from
+     y = (U + E)^-1 b                     a backward sweep from zero
+     t = b - (2 E - D - shift I) y       since A y = (L + E) y + (U + E) y - (2 E - D - shift I) y
+     x = y + (L + E)^-1 t                 a forward sweep from zero
+   The two sweeps cost one pass over the off-diagonal blocks together. */
+PetscErrorCode SOREisenstat(Mat A, PetscReal omega, PetscReal fshift, const double *b, double *x)
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  const PetscInt  n = a->mbs * a->bs;
+  double         *work, *t, *z;
+  HalfSums        h = {nullptr, nullptr, false, false};
+
+  PetscFunctionBegin;
+  PetscCall(PetscMalloc5(3 * a->bs, &work, n, &h.lower, n, &h.upper, n, &t, n, &z));
+  zero_start(n, x, h);
+  sweep_any(a, omega, b, x, false, h, work);
+  PetscCall(PetscArraycpy(t, b, n));
+  dispatch(a, [&](auto BS, const auto *val) { diagonal_block_axpy<decltype(BS)::value, ValueType<decltype(val)>>(a, val, 1.0 - 2.0 / omega, fshift, x, t, work); });
+  zero_start(n, z, h);
+  sweep_any(a, omega, t, z, true, h, work);
+  for (PetscInt i = 0; i < n; i++) x[i] += z[i];
+  PetscCall(PetscFree5(work, h.lower, h.upper, t, z));
+  PetscCall(PetscLogFlops((double)(a->sym ? 2 * (a->nz - a->mbs) : a->nz - a->mbs) * a->bs2 + 6.0 * a->mbs * a->bs2));
+  PetscFunctionReturn(0);
+}
+} // namespace
+
+/* y = D x (block diagonal): PCEISENSTAT's diagonal scaling, consistent with the block sweeps. */
+PetscErrorCode MatMultDiagonalBlock_SeqBinBCSR(Mat A, Vec xx, Vec yy)
+{
+  Mat_SeqBinBCSR    *a = (Mat_SeqBinBCSR *)A->data;
+  const PetscScalar *x;
+  PetscScalar       *y;
+  double            *work;
+
+  PetscFunctionBegin;
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
+  PetscCheck(a->mbs == a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "MatMultDiagonalBlock needs a square matrix (%" PetscInt_FMT " x %" PetscInt_FMT " blocks)", a->mbs, a->nbs);
+  PetscCall(PetscMalloc1(a->bs, &work));
+  PetscCall(VecGetArrayRead(xx, &x));
+  PetscCall(VecGetArrayWrite(yy, &y));
+  PetscCall(PetscArrayzero(y, A->rmap->n));
+  dispatch(a, [&](auto BS, const auto *val) { diagonal_block_axpy<decltype(BS)::value, ValueType<decltype(val)>>(a, val, 1.0, 0.0, x, y, work); });
+  PetscCall(VecRestoreArrayWrite(yy, &y));
+  PetscCall(VecRestoreArrayRead(xx, &x));
+  PetscCall(PetscFree(work));
+  PetscCall(PetscLogFlops(2.0 * a->mbs * a->bs2));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatSOR_SeqBinBCSR(Mat A, Vec bb, PetscReal omega, MatSORType flag, PetscReal fshift, PetscInt its, PetscInt lits, Vec xx)
+{
+  Mat_SeqBinBCSR    *a = (Mat_SeqBinBCSR *)A->data;
+  const PetscScalar *b;
+  PetscScalar       *x;
+  double            *work = nullptr;
+  const PetscBool    forward  = (flag & (SOR_FORWARD_SWEEP | SOR_LOCAL_FORWARD_SWEEP)) ? PETSC_TRUE : PETSC_FALSE;
+  const PetscBool    backward = (flag & (SOR_BACKWARD_SWEEP | SOR_LOCAL_BACKWARD_SWEEP)) ? PETSC_TRUE : PETSC_FALSE;
+
+  PetscFunctionBegin;
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
+  PetscCheck(a->mbs == a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "MatSOR needs a square matrix (%" PetscInt_FMT " x %" PetscInt_FMT " blocks)", a->mbs, a->nbs);
+  PetscCheck(!(flag & SOR_APPLY_LOWER), PETSC_COMM_SELF, PETSC_ERR_SUP, "MATSEQBINBCSR's MatSOR has no SOR_APPLY_LOWER (nor has PETSc's AIJ; PCEISENSTAT does not use it)");
+  PetscCheck(!PetscIsInfOrNanReal(omega) && !PetscIsInfOrNanReal(fshift) && omega != 0.0, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "MatSOR: omega (%g) must be finite and nonzero, the shift finite", (double)omega);
   if (a->sym) PetscCall(MatSeqBinBCSRBuildLowerIndex(a));
-  if (flag & SOR_ZERO_INITIAL_GUESS) PetscCall(VecSet(xx, 0.0));
+  if (flag == SOR_APPLY_UPPER) {
+    PetscCall(VecGetArrayRead(bb, &b));
+    PetscCall(VecGetArrayWrite(xx, &x));
+    PetscCall(PetscMalloc1(a->bs, &work));
+    dispatch(a, [&](auto BS, const auto *val) { apply_upper<decltype(BS)::value, ValueType<decltype(val)>>(a, val, omega, fshift, b, x, work); });
+    PetscCall(PetscFree(work));
+    PetscCall(VecRestoreArrayWrite(xx, &x));
+    PetscCall(VecRestoreArrayRead(bb, &b));
+    PetscCall(PetscLogFlops((double)(a->sym ? a->nz - a->mbs : (a->nz - a->mbs) / 2) * 2 * a->bs2 + 2.0 * a->mbs * a->bs2));
+    PetscFunctionReturn(0);
+  }
+  PetscCheck(!(flag & SOR_APPLY_UPPER), PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "MatSOR: SOR_APPLY_UPPER cannot be combined with other flags (%d)", (int)flag);
+  PetscCall(SORInvertDiagonal(A, fshift));
+  if (flag & SOR_EISENSTAT) {
+    PetscCall(VecGetArrayRead(bb, &b));
+    PetscCall(VecGetArrayWrite(xx, &x));
+    PetscCall(SOREisenstat(A, omega, fshift, b, x));
+    PetscCall(VecRestoreArrayWrite(xx, &x));
+    PetscCall(VecRestoreArrayRead(bb, &b));
+    PetscFunctionReturn(0);
+  }
+  PetscCheck(forward || backward, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "MatSOR: the flag %d asks for no sweep", (int)flag);
+  PetscCheck(its > 0 && lits > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "MatSOR: its (%" PetscInt_FMT ") and lits (%" PetscInt_FMT ") must be positive", its, lits);
   PetscCall(VecGetArrayRead(bb, &b));
   PetscCall(VecGetArray(xx, &x));
   const size_t n = (size_t)a->mbs * a->bs;
   HalfSums     h = {nullptr, nullptr, false, false};
   PetscCall(PetscMalloc3(3 * a->bs, &work, n, &h.lower, n, &h.upper));
-  if (flag & SOR_ZERO_INITIAL_GUESS) { /* x = 0: no row has anything right of its diagonal yet */
-    PetscCall(PetscArrayzero(h.upper, n));
-    h.upper_ok = true;
-  }
+  if (flag & SOR_ZERO_INITIAL_GUESS) zero_start((PetscInt)n, x, h);
   for (PetscInt it = 0; it < its * lits; it++) {
-    if (forward) {
-      if (a->val) sweep_dispatch<double>(a, a->val, a->sor_idiag, omega, b, x, true, h, work);
-      else sweep_dispatch<float>(a, a->valf, a->sor_idiag, omega, b, x, true, h, work);
-    }
-    if (backward) {
-      if (a->val) sweep_dispatch<double>(a, a->val, a->sor_idiag, omega, b, x, false, h, work);
-      else sweep_dispatch<float>(a, a->valf, a->sor_idiag, omega, b, x, false, h, work);
-    }
+    if (forward) sweep_any(a, omega, b, x, true, h, work);
+    if (backward) sweep_any(a, omega, b, x, false, h, work);
   }
   PetscCall(PetscFree3(work, h.lower, h.upper));
   PetscCall(VecRestoreArray(xx, &x));

@@ -188,14 +188,15 @@ TEST_CASE("PCSOR (SSOR) in CG: binbcsr takes the iterations of aij (bs 1) and of
   }
 }
 
-TEST_CASE("MatSOR errors: Eisenstat, a singular diagonal block, no sweep", "[mat_sym][sor]")
+TEST_CASE("MatSOR errors: apply lower, mixed apply upper, a singular diagonal block, no sweep", "[mat_sym][sor]")
 {
   Pattern p = fem_pattern(3, 3, 2, 3);
   Mat     A = build_sym(p, 4, MAT_BINBCSR_PRECISION_DOUBLE, true);
   Vec     b = make_vec(p.m, 1), x;
   REQUIRE(VecDuplicate(b, &x) == 0);
-  CHECK(MatSOR(A, b, 1.0, (MatSORType)(SOR_EISENSTAT | SOR_SYMMETRIC_SWEEP), 0.0, 1, 1, x) == PETSC_ERR_SUP);
-  CHECK(MatSOR(A, b, 1.0, SOR_APPLY_UPPER, 0.0, 1, 1, x) == PETSC_ERR_SUP);
+  // (Eisenstat and SOR_APPLY_UPPER work: tests/unit/pc/eisenstat_test.cpp)
+  CHECK(MatSOR(A, b, 1.0, SOR_APPLY_LOWER, 0.0, 1, 1, x) == PETSC_ERR_SUP);
+  CHECK(MatSOR(A, b, 1.0, (MatSORType)(SOR_APPLY_UPPER | SOR_FORWARD_SWEEP), 0.0, 1, 1, x) == PETSC_ERR_ARG_WRONG);
   CHECK(MatSOR(A, b, 1.0, SOR_ZERO_INITIAL_GUESS, 0.0, 1, 1, x) == PETSC_ERR_ARG_WRONG);
   // block row 4's diagonal block made singular: (60, .5/(1+i+j)) -> its first column zeroed
   for (PetscInt i = 0; i < 3; i++) REQUIRE(MatSetValue(A, 4 * 3 + i, 4 * 3 + 0, 0.0, INSERT_VALUES) == 0);
@@ -203,6 +204,7 @@ TEST_CASE("MatSOR errors: Eisenstat, a singular diagonal block, no sweep", "[mat
   REQUIRE(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY) == 0);
   REQUIRE(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY) == 0);
   CHECK(MatSOR(A, b, 1.0, SOR_SYMMETRIC_SWEEP, 0.0, 1, 1, x) == PETSC_ERR_MAT_LU_ZRPVT);
+  CHECK(MatSOR(A, b, 1.0, SOR_EISENSTAT, 0.0, 1, 1, x) == PETSC_ERR_MAT_LU_ZRPVT);
   // a shift that makes it regular again is accepted
   CHECK(MatSOR(A, b, 1.0, SOR_SYMMETRIC_SWEEP, 1.0, 1, 1, x) == 0);
   MatDestroy(&A);

@@ -1,0 +1,19 @@
+# PCs that binbcsr serves through its own kernels (PCEISENSTAT) or its AIJ shadow (PCGAMG): the unit
+# tests (collective, written for any communicator size) on 2 and 3 ranks; unit_pc runs them on one rank.
+foreach(np 2 3)
+  add_test(NAME unit_pc_np${np} COMMAND ${MPIEXEC_CMD} -n ${np} $<TARGET_FILE:test_pc>)
+  set_tests_properties(unit_pc_np${np} PROPERTIES LABELS "pc;mpi" PROCESSORS 2 TIMEOUT 120)
+endforeach()
+
+# PETSc's stock ksp ex4 loaded with -dll_append: -pc_type eisenstat takes as many GMRES iterations with
+# -mat_type binbcsr as with aij (one rank: PETSc 3.18's MPIAIJ fails Eisenstat on ex4's matrices, which
+# have no inodes; the unit tests compare on more ranks where aij works).
+binbcsr_stock_example(stock_ksp_ex4 ksp/ksp/tutorials/ex4.c)
+foreach(bs 1 3)
+  add_test(NAME pc_stock_ex4_eisenstat_bs${bs}
+           COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/mpi/compare_its.sh 0 env
+                   -- $<TARGET_FILE:stock_ksp_ex4> -bs ${bs} -m 20 -n 20 -pc_type eisenstat -dll_append ${PLUGIN}
+                   -- -mat_type aij
+                   -- -mat_type binbcsr)
+  set_tests_properties(pc_stock_ex4_eisenstat_bs${bs} PROPERTIES LABELS "pc;stock" TIMEOUT 60)
+endforeach()
