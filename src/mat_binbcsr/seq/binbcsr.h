@@ -170,6 +170,8 @@ PETSC_INTERN PetscInt MatSeqBinBCSRFindSlot(const Mat_SeqBinBCSR *, PetscInt bro
    each row. Values are zero, in the current precision. Drops staging and any COO map; increases the
    nonzero state. Used by assembly, COO preallocation, MatConvert and available to MatLoad. */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRBuildLayout(Mat, const PetscInt bi[], const PetscInt bj[]);
+/* Sizes checked, any layout and staging dropped (binbcsr.cpp): where a layout build starts. */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRResetLayout(Mat);
 
 /* Before the layout exists: zero the staged values, keeping the staged pattern (MatZeroEntries). */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRStagingZeroValues(Mat);

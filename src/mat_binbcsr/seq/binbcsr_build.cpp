@@ -1,0 +1,157 @@
+/* MATSEQBINBCSR: the bin layout built from a block pattern (at the first final assembly, and by
+   conversion, load, duplication), the lower-part index of symmetric storage, and the slot lookup. */
+#include "binbcsr.h"
+#include <algorithm>
+#include <vector>
+
+PetscInt MatSeqBinBCSRFindSlot(const Mat_SeqBinBCSR *a, PetscInt brow, PetscInt bcol)
+{
+  PetscInt lo = 0, hi = a->row_nz[brow];
+  if (a->sym && bcol < brow) return -1; /* not stored: the transposed block (bcol, brow) is */
+  while (lo < hi) {
+    const PetscInt mid = (lo + hi) / 2, s = BinBCSRSlot(a, brow, mid), c = a->col[s];
+    if (c == bcol) return s;
+    if (c < bcol) lo = mid + 1;
+    else hi = mid;
+  }
+  return -1;
+}
+
+/* The symmetric-storage part of MatSeqBinBCSRBuildLayout: bins ordered by the colouring. */
+static PetscErrorCode MatSeqBinBCSRBuildLayoutSym(Mat A, const PetscInt bi[], const PetscInt bj[])
+{
+  Mat_SeqBinBCSR       *a = (Mat_SeqBinBCSR *)A->data;
+  const PetscInt        bw = a->bw, mbs = a->mbs, nbins = a->nbins;
+  std::vector<PetscInt> slot_col, entry_k, colid(a->nbs, -1), allcol;
+
+  PetscFunctionBegin;
+  PetscCheck(A->rmap->n == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Symmetric storage needs a square matrix, this one is %" PetscInt_FMT " x %" PetscInt_FMT, A->rmap->n, A->cmap->n);
+  for (PetscInt r = 0; r < mbs; r++) {
+    PetscCheck(bi[r + 1] - bi[r] >= 0 && bi[r + 1] - bi[r] <= a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_CORRUPT, "Block row %" PetscInt_FMT " has %" PetscInt_FMT " blocks", r, bi[r + 1] - bi[r]);
+    for (PetscInt p = bi[r]; p < bi[r + 1]; p++) {
+      PetscCheck(bj[p] >= 0 && bj[p] < a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Block column %" PetscInt_FMT " of block row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", bj[p], r, a->nbs);
+      PetscCheck(p == bi[r] || bj[p] > bj[p - 1], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Block columns of block row %" PetscInt_FMT " are not sorted and unique", r);
+    }
+  }
+  PetscCall(PetscMalloc1(mbs + 1, &a->row_off));
+  a->row_off[0] = 0;
+  for (PetscInt r = 0; r < mbs; r++) {
+    PetscInt n = 0;
+    for (PetscInt p = bi[r]; p < bi[r + 1]; p++) n += bj[p] >= r;
+    a->row_nz[r]      = n;
+    a->row_off[r + 1] = a->row_off[r] + n;
+    a->max_row_nz     = PetscMax(a->max_row_nz, n);
+  }
+  a->nz = a->row_off[mbs];
+  PetscCall(PetscMalloc1(a->nz, &a->real_slot));
+  for (PetscInt b = 0; b < nbins; b++) {
+    const PetscInt r0 = b * bw;
+    entry_k.clear();
+    const PetscInt len = MatSeqBinBCSRColourBin(bw, r0, mbs, bi, bj, slot_col, entry_k, colid);
+    PetscCheck((PetscInt64)a->bin_start[b] + (PetscInt64)len * bw <= PETSC_MAX_INT / PetscMax(a->bs2, 1), PETSC_COMM_SELF, PETSC_ERR_SUP, "Matrix too large for 32-bit slot indices");
+    a->bin_start[b + 1] = a->bin_start[b] + len * bw;
+    allcol.insert(allcol.end(), slot_col.begin(), slot_col.end());
+    size_t e = 0;
+    for (PetscInt r = r0; r < PetscMin(mbs, r0 + bw); r++) {
+      a->diag_slot[r] = -1;
+      for (PetscInt k = 0; k < a->row_nz[r]; k++, e++) {
+        const PetscInt s                 = a->bin_start[b] + entry_k[e] * bw + (r - r0);
+        a->real_slot[a->row_off[r] + k] = s;
+        if (allcol[s] == r) a->diag_slot[r] = s;
+      }
+    }
+  }
+  a->nslots = a->bin_start[nbins];
+  PetscCall(PetscMalloc1(a->nslots, &a->col));
+  std::copy(allcol.begin(), allcol.end(), a->col);
+  if (a->precision == MAT_BINBCSR_PRECISION_DOUBLE) PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->val));
+  else PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->valf));
+  PetscCall(PetscMalloc2((size_t)PetscMax(a->nbs, 1) * a->bs, &a->rowbuf_cols, (size_t)PetscMax(a->nbs, 1) * a->bs, &a->rowbuf_vals)); /* a full row, both triangles */
+  a->built        = PETSC_TRUE;
+  A->preallocated = PETSC_TRUE;
+  A->nonzerostate++;
+  PetscCall(MatSetOption(A, MAT_SYMMETRIC, PETSC_TRUE));
+  PetscCall(MatSetOption(A, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatSeqBinBCSRBuildLowerIndex(Mat_SeqBinBCSR *a)
+{
+  PetscInt *fill;
+
+  PetscFunctionBegin;
+  if (a->lower_off) PetscFunctionReturn(0);
+  PetscCall(PetscCalloc1(a->mbs + 1, &a->lower_off));
+  for (PetscInt r = 0; r < a->mbs; r++)
+    for (PetscInt k = 0; k < a->row_nz[r]; k++) {
+      const PetscInt c = a->col[BinBCSRSlot(a, r, k)];
+      if (c != r) a->lower_off[c + 1]++;
+    }
+  for (PetscInt r = 0; r < a->mbs; r++) a->lower_off[r + 1] += a->lower_off[r];
+  PetscCall(PetscMalloc1(2 * PetscMax(a->lower_off[a->mbs], 1), &a->lower_slot));
+  PetscCall(PetscMalloc1(a->mbs, &fill));
+  for (PetscInt r = 0; r < a->mbs; r++) fill[r] = a->lower_off[r];
+  for (PetscInt r = 0; r < a->mbs; r++) /* rows ascending: each lower list comes out in ascending c */
+    for (PetscInt k = 0; k < a->row_nz[r]; k++) {
+      const PetscInt s = BinBCSRSlot(a, r, k), c = a->col[s];
+      if (c != r) {
+        a->lower_slot[2 * fill[c]]     = s;
+        a->lower_slot[2 * fill[c] + 1] = r;
+        fill[c]++;
+      }
+    }
+  PetscCall(PetscFree(fill));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatSeqBinBCSRBuildLayout(Mat A, const PetscInt bi[], const PetscInt bj[])
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  PetscInt        bw, mbs, nbins;
+
+  PetscFunctionBegin;
+  PetscCall(PetscLogEventBegin(MAT_BinBCSR_BuildLayout, A, 0, 0, 0));
+  PetscCall(MatSeqBinBCSRResetLayout(A));
+  if (!a->bw_set) a->bw = BinBCSRDefaultBinWidth(a->bs);
+  bw = a->bw;
+  mbs = a->mbs;
+  nbins = (mbs + bw - 1) / bw;
+  a->nbins = nbins;
+  PetscCall(PetscMalloc1(nbins + 1, &a->bin_start));
+  PetscCall(PetscMalloc1(mbs, &a->row_nz));
+  PetscCall(PetscMalloc1(mbs, &a->diag_slot));
+  a->bin_start[0] = 0;
+  a->nz = 0;
+  a->max_row_nz = 0;
+  if (a->sym) {
+    PetscCall(MatSeqBinBCSRBuildLayoutSym(A, bi, bj));
+    PetscCall(PetscLogEventEnd(MAT_BinBCSR_BuildLayout, A, 0, 0, 0));
+    PetscFunctionReturn(0);
+  }
+  for (PetscInt r = 0; r < mbs; r++) {
+    const PetscInt n = bi[r + 1] - bi[r];
+    PetscCheck(n >= 0 && n <= a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_CORRUPT, "Block row %" PetscInt_FMT " has %" PetscInt_FMT " blocks", r, n);
+    for (PetscInt p = bi[r]; p < bi[r + 1]; p++) {
+      PetscCheck(bj[p] >= 0 && bj[p] < a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Block column %" PetscInt_FMT " of block row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", bj[p], r, a->nbs);
+      PetscCheck(p == bi[r] || bj[p] > bj[p - 1], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Block columns of block row %" PetscInt_FMT " are not sorted and unique", r);
+    }
+    a->row_nz[r]  = n;
+    a->nz        += n;
+    a->max_row_nz = PetscMax(a->max_row_nz, n);
+  }
+  {
+    const long nslots = binbcsr::bin_starts<PetscInt>(bi, mbs, bw, a->bin_start);
+    PetscCheck(nslots <= PETSC_MAX_INT / PetscMax(a->bs2, 1), PETSC_COMM_SELF, PETSC_ERR_SUP, "Matrix too large for 32-bit slot indices");
+    a->nslots = (PetscInt)nslots;
+  }
+  PetscCall(PetscMalloc1(a->nslots, &a->col));
+  if (a->precision == MAT_BINBCSR_PRECISION_DOUBLE) PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->val));
+  else PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->valf));
+  binbcsr::bin_columns<PetscInt>(bi, bj, mbs, bw, a->bin_start, a->col, a->diag_slot);
+  PetscCall(PetscMalloc2((size_t)a->max_row_nz * a->bs, &a->rowbuf_cols, (size_t)a->max_row_nz * a->bs, &a->rowbuf_vals));
+  a->built = PETSC_TRUE;
+  A->preallocated = PETSC_TRUE; /* a layout is an allocation, however it was built (convert, load, ...) */
+  A->nonzerostate++;
+  PetscCall(PetscLogEventEnd(MAT_BinBCSR_BuildLayout, A, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
