@@ -265,43 +265,34 @@ PetscErrorCode WorkVectors(FactorShadow *f)
   PetscFunctionReturn(0);
 }
 
+/* One of the factor's solves between the two numberings: the right-hand side moved into S's (in), the
+   result moved back into A's (out). The split solves of PCApplySymmetricLeft/Right keep the
+   intermediate vector in S's numbering: forward moves in only, backward out only. */
+PetscErrorCode PermutedApply(Mat F, Vec b, Vec x, PetscErrorCode (*FactorShadow::*op)(Mat, Vec, Vec), bool in, bool out)
+{
+  FactorShadow *f;
+
+  PetscFunctionBegin;
+  PetscCall(binbcsr_factor::Get(F, &f));
+  PetscCall(WorkVectors(f));
+  if (in) PetscCall(Permute(f, b, f->bp, PETSC_TRUE));
+  PetscCall((*(f->*op))(F, in ? f->bp : b, out ? f->xp : x));
+  if (out) PetscCall(Permute(f, f->xp, x, PETSC_FALSE));
+  PetscFunctionReturn(0);
+}
+
 /* x = P (L D L^T)^-1 P^T b; the transpose solve is the same (the factor is symmetric) */
 PetscErrorCode PermutedSolve(Mat F, Vec b, Vec x)
 {
-  FactorShadow *f;
-
-  PetscFunctionBegin;
-  PetscCall(binbcsr_factor::Get(F, &f));
-  PetscCall(WorkVectors(f));
-  PetscCall(Permute(f, b, f->bp, PETSC_TRUE));
-  PetscCall((*f->solve)(F, f->bp, f->xp));
-  PetscCall(Permute(f, f->xp, x, PETSC_FALSE));
-  PetscFunctionReturn(0);
+  return PermutedApply(F, b, x, &FactorShadow::solve, true, true);
 }
-
-/* The split solves (PCApplySymmetricLeft/Right): the intermediate vector stays in S's numbering. */
 PetscErrorCode PermutedForwardSolve(Mat F, Vec b, Vec x)
 {
-  FactorShadow *f;
-
-  PetscFunctionBegin;
-  PetscCall(binbcsr_factor::Get(F, &f));
-  PetscCall(WorkVectors(f));
-  PetscCall(Permute(f, b, f->bp, PETSC_TRUE));
-  PetscCall((*f->forwardsolve)(F, f->bp, x));
-  PetscFunctionReturn(0);
+  return PermutedApply(F, b, x, &FactorShadow::forwardsolve, true, false);
 }
-
 PetscErrorCode PermutedBackwardSolve(Mat F, Vec b, Vec x)
 {
-  FactorShadow *f;
-
-  PetscFunctionBegin;
-  PetscCall(binbcsr_factor::Get(F, &f));
-  PetscCall(WorkVectors(f));
-  PetscCall((*f->backwardsolve)(F, b, f->xp));
-  PetscCall(Permute(f, f->xp, x, PETSC_FALSE));
-  PetscFunctionReturn(0);
+  return PermutedApply(F, b, x, &FactorShadow::backwardsolve, false, true);
 }
 
 /* seqsbaij's symbolic and numeric routines set the factor's solves (per block size and ordering), so

@@ -148,14 +148,18 @@ TEST_CASE("ICC, Cholesky, ILU and LU on binbcsr equal PETSc's on seqsbaij/seqbai
 
 namespace
 {
-// LU or ILU through PCFactor with an ordering (nullptr: the factor's preferred one); returns the solution
-// and the factor's stored nonzeros, which show which ordering was applied.
-Solution factor_solve(Mat A, PCType pc, const char *ordering, Vec b, double *factor_nz)
+// A factorisation through PCFactor with an ordering (nullptr: the factor's preferred one) and fill
+// levels (ILU/ICC; 0: PETSc's default); LU and Cholesky are direct solves (preonly), ILU and ICC
+// precondition GMRES. Returns the solution and the factor's stored nonzeros, which show which ordering
+// was applied.
+Solution factor_solve(Mat A, PCType pc, const char *ordering, Vec b, double *factor_nz, PetscInt levels = 0)
 {
-  KSP k = make_ksp(PETSC_COMM_SELF, strcmp(pc, PCLU) ? KSPGMRES : KSPPREONLY, pc, 1e-10);
-  PC  p;
+  const bool direct = !strcmp(pc, PCLU) || !strcmp(pc, PCCHOLESKY);
+  KSP        k      = make_ksp(PETSC_COMM_SELF, direct ? KSPPREONLY : KSPGMRES, pc, 1e-10);
+  PC         p;
   REQUIRE(KSPGetPC(k, &p) == 0);
   if (ordering) REQUIRE(PCFactorSetMatOrderingType(p, ordering) == 0);
+  if (levels) REQUIRE(PCFactorSetLevels(p, levels) == 0);
   Solution s = solve_with(k, A, b);
   Mat      F;
   MatInfo  info;
@@ -237,22 +241,6 @@ std::vector<PetscInt> block_ordering(Mat A, const char *ordering)
   return perm;
 }
 
-Solution factor_solve_levels(Mat A, KSPType type, PCType pc, const char *ordering, PetscInt levels, Vec b, double *factor_nz)
-{
-  KSP k = make_ksp(PETSC_COMM_SELF, type, pc, 1e-10);
-  PC  p;
-  REQUIRE(KSPGetPC(k, &p) == 0);
-  if (ordering) REQUIRE(PCFactorSetMatOrderingType(p, ordering) == 0);
-  if (levels) REQUIRE(PCFactorSetLevels(p, levels) == 0);
-  Solution s = solve_with(k, A, b);
-  Mat      F;
-  MatInfo  info;
-  REQUIRE(PCFactorGetMatrix(p, &F) == 0);
-  REQUIRE(MatGetInfo(F, MAT_LOCAL, &info) == 0);
-  *factor_nz = info.nz_used;
-  REQUIRE(KSPDestroy(&k) == 0);
-  return s;
-}
 } // namespace
 
 TEST_CASE("ICC and Cholesky take PETSc's orderings (the permuted matrix factored); Cholesky defaults to nested dissection", "[mat_factor]")
@@ -282,8 +270,8 @@ TEST_CASE("ICC and Cholesky take PETSc's orderings (the permuted matrix factored
           CAPTURE(pc);
           const bool     chol = !strcmp(pc, PCCHOLESKY);
           double         nz = 0, nzref = 0;
-          const Solution got = factor_solve_levels(A, chol ? KSPPREONLY : KSPCG, pc, ordering, 0, b, &nz);
-          const Solution ref = factor_solve_levels(Aperm, chol ? KSPPREONLY : KSPCG, pc, MATORDERINGNATURAL, 0, bperm, &nzref);
+          const Solution got = factor_solve(A, pc, ordering, b, &nz);
+          const Solution ref = factor_solve(Aperm, pc, MATORDERINGNATURAL, bperm, &nzref);
           CHECK(nz == nzref);
           CHECK(got.relres < (chol ? 1e-13 : 1e-9));
           Solution moved = got;
@@ -293,14 +281,35 @@ TEST_CASE("ICC and Cholesky take PETSc's orderings (the permuted matrix factored
         REQUIRE(VecDestroy(&bperm) == 0);
         REQUIRE(MatDestroy(&Aperm) == 0);
       }
-      // back to natural on the same KSP after an ordering: the shadow is renumbered back
+      // the split solves (symmetric preconditioning: forward then backward) compose to the whole one
+      {
+        KSP k = make_ksp(PETSC_COMM_SELF, KSPCG, PCICC, 1e-10);
+        PC  pc;
+        Vec t, split, whole;
+        REQUIRE(KSPGetPC(k, &pc) == 0);
+        REQUIRE(PCFactorSetMatOrderingType(pc, MATORDERINGRCM) == 0);
+        REQUIRE(KSPSetOperators(k, A, A) == 0);
+        REQUIRE(KSPSetUp(k) == 0);
+        for (Vec *v : {&t, &split, &whole}) REQUIRE(VecDuplicate(b, v) == 0);
+        REQUIRE(PCApplySymmetricLeft(pc, b, t) == 0);
+        REQUIRE(PCApplySymmetricRight(pc, t, split) == 0);
+        REQUIRE(PCApply(pc, b, whole) == 0);
+        PetscReal norm, diff;
+        REQUIRE(VecNorm(whole, NORM_INFINITY, &norm) == 0);
+        REQUIRE(VecAXPY(split, -1.0, whole) == 0);
+        REQUIRE(VecNorm(split, NORM_INFINITY, &diff) == 0);
+        CHECK(diff <= 1e-12 * norm);
+        for (Vec *v : {&t, &split, &whole}) REQUIRE(VecDestroy(v) == 0);
+        REQUIRE(KSPDestroy(&k) == 0);
+      }
+      // a refill in an ordering: the renumbered shadow refilled, the numeric factorisation redone
       {
         KSP k = make_ksp(PETSC_COMM_SELF, KSPPREONLY, PCCHOLESKY, 1e-10);
         PC  pc;
         REQUIRE(KSPGetPC(k, &pc) == 0);
         REQUIRE(PCFactorSetMatOrderingType(pc, MATORDERINGRCM) == 0);
         CHECK(solve_with(k, A, b).relres < 1e-13);
-        REQUIRE(MatScale(A, 2.0) == 0); // refactored, numeric only, in the same ordering
+        REQUIRE(MatScale(A, 2.0) == 0);
         CHECK(solve_with(k, A, b).relres < 1e-13);
         REQUIRE(KSPDestroy(&k) == 0);
       }
@@ -308,10 +317,10 @@ TEST_CASE("ICC and Cholesky take PETSc's orderings (the permuted matrix factored
       // with fill levels high enough is exact in any ordering
       double nz_default = 0, nz_natural = 0, nz_icc = 0;
       CAPTURE(bs, sym);
-      CHECK(factor_solve_levels(A, KSPPREONLY, PCCHOLESKY, nullptr, 0, b, &nz_default).relres < 1e-13);
-      CHECK(factor_solve_levels(A, KSPPREONLY, PCCHOLESKY, MATORDERINGNATURAL, 0, b, &nz_natural).relres < 1e-13);
+      CHECK(factor_solve(A, PCCHOLESKY, nullptr, b, &nz_default).relres < 1e-13);
+      CHECK(factor_solve(A, PCCHOLESKY, MATORDERINGNATURAL, b, &nz_natural).relres < 1e-13);
       CHECK(nz_default < 0.9 * nz_natural);
-      CHECK(factor_solve_levels(A, KSPPREONLY, PCICC, MATORDERINGRCM, 200, b, &nz_icc).relres < 1e-12);
+      CHECK(factor_solve(A, PCICC, MATORDERINGRCM, b, &nz_icc, 200).relres < 1e-12);
       REQUIRE(VecDestroy(&b) == 0);
       REQUIRE(MatDestroy(&A) == 0);
     }
