@@ -28,6 +28,9 @@ PETSC_INTERN PetscErrorCode MatCreateMPIMatConcatenateSeqMat_BinBCSR(MPI_Comm, M
 PETSC_INTERN PetscErrorCode MatConvert_BinBCSR_HYPRE(Mat, MatType, MatReuse, Mat *); /* composed as MatConvert_<type>_hypre_C */
 /* The seqaij/mpiaij copy of a binbcsr matrix, composed on it, refreshed when the matrix changed (collective) */
 PETSC_INTERN PetscErrorCode MatBinBCSRGetAIJShadow_Private(Mat, Mat *);
+/* PCGAMG's needs through that shadow (MatCreateGraph, matrix products with binbcsr operands): binbcsr_shadow_ops.cpp */
+PETSC_INTERN PetscErrorCode MatCreateGraph_BinBCSR(Mat, PetscBool, PetscBool, PetscReal, Mat *);
+PETSC_INTERN PetscErrorCode MatProductSetFromOptions_BinBCSR(Mat); /* also composed as MatProductSetFromOptions_anytype_C */
 /* MUMPS / SuperLU_DIST LU and Cholesky for seq and mpi binbcsr through that shadow: binbcsr_factor_external.cpp */
 PETSC_INTERN PetscErrorCode MatBinBCSRRegisterExternalFactors(void);
 

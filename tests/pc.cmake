@@ -17,3 +17,21 @@ foreach(bs 1 3)
                    -- -mat_type binbcsr)
   set_tests_properties(pc_stock_ex4_eisenstat_bs${bs} PROPERTIES LABELS "pc;stock" TIMEOUT 60)
 endforeach()
+
+# -pc_type gamg on stock ksp ex4 (-m 30 -n 30, GMRES): binbcsr takes aij's iterations on 1, 2 and 3 ranks,
+# bs 1 and 3 (the graph and the coarse operators come from binbcsr's AIJ shadow, level 0 smooths with
+# binbcsr's own MatMult).
+foreach(np 1 2 3)
+  foreach(bs 1 3)
+    add_test(NAME pc_stock_ex4_gamg_bs${bs}_np${np}
+             COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/mpi/compare_its.sh 0 ${MPIEXEC_CMD} -n ${np}
+                     -- $<TARGET_FILE:stock_ksp_ex4> -bs ${bs} -m 30 -n 30 -pc_type gamg -dll_append ${PLUGIN}
+                     -- -mat_type aij
+                     -- -mat_type binbcsr)
+    if(np GREATER 1)
+      set_tests_properties(pc_stock_ex4_gamg_bs${bs}_np${np} PROPERTIES LABELS "pc;stock;mpi" PROCESSORS 2 TIMEOUT 60)
+    else()
+      set_tests_properties(pc_stock_ex4_gamg_bs${bs}_np${np} PROPERTIES LABELS "pc;stock" TIMEOUT 60)
+    endif()
+  endforeach()
+endforeach()

@@ -12,7 +12,7 @@ static PetscErrorCode MatDestroy_MPIBinBCSR(Mat mat)
   delete MPIBinBCSR(mat);
   mat->data = nullptr;
   PetscCall(PetscObjectChangeTypeName((PetscObject)mat, nullptr));
-  const char *names[] = {"MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatBinBCSRSetCOOMirror_C", "MatBinBCSRGetCOOMirror_C", "MatMPIAIJSetPreallocation_C", "MatMPIBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatGetDiagonalBlock_C", "MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatConvert_mpibinbcsr_mpiaij_C", "MatConvert_mpibinbcsr_hypre_C"};
+  const char *names[] = {"MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatBinBCSRSetCOOMirror_C", "MatBinBCSRGetCOOMirror_C", "MatMPIAIJSetPreallocation_C", "MatMPIBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatGetDiagonalBlock_C", "MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatConvert_mpibinbcsr_mpiaij_C", "MatConvert_mpibinbcsr_hypre_C", "MatProductSetFromOptions_anytype_C"};
   for (const char *name : names) PetscCall(PetscObjectComposeFunction((PetscObject)mat, name, (void (*)(void)) nullptr));
   PetscFunctionReturn(0);
 }
@@ -47,6 +47,14 @@ static PetscErrorCode MatMPIAIJSetPreallocation_MPIBinBCSR(Mat mat, PetscInt d_n
   Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
 
   PetscFunctionBegin;
+  PetscCall(PetscLayoutSetUp(mat->rmap));
+  PetscCall(PetscLayoutSetUp(mat->cmap));
+  if (mat->rmap->bs != mat->cmap->bs) { /* a layout the bins cannot hold (PCGAMG's prolongators, made in the operator's type) */
+    PetscCall(PetscInfo(mat, "Row and column block sizes %" PetscInt_FMT " and %" PetscInt_FMT " differ: the matrix becomes %s\n", mat->rmap->bs, mat->cmap->bs, MATMPIAIJ));
+    PetscCall(MatSetType(mat, MATMPIAIJ));
+    PetscCall(MatMPIAIJSetPreallocation(mat, d_nz, d_nnz, o_nz, o_nnz));
+    PetscFunctionReturn(0);
+  }
   (void)o_nz;
   (void)o_nnz; /* B is sized exactly at the first final assembly */
   PetscCall(CreateDiagonalPart(mat));
@@ -408,6 +416,8 @@ PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
   mat->ops->createsubmatrices   = MatCreateSubMatrices_BinBCSR;
   mat->ops->createsubmatricesmpi = MatCreateSubMatricesMPI_BinBCSR;
   mat->ops->createsubmatrix     = MatCreateSubMatrix_BinBCSR;
+  mat->ops->creategraph         = MatCreateGraph_BinBCSR; /* PCGAMG, through the AIJ shadow */
+  mat->ops->productsetfromoptions = MatProductSetFromOptions_BinBCSR;
   mat->assembled                = PETSC_FALSE;
   mat->insertmode               = NOT_SET_VALUES;
 
@@ -426,6 +436,7 @@ PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetPrecision_C", MatBinBCSRSetPrecision_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetPrecision_C", MatBinBCSRGetPrecision_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatConvert_mpibinbcsr_mpiaij_C", MatConvert_MPIBinBCSR_MPIAIJ));
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatProductSetFromOptions_anytype_C", MatProductSetFromOptions_BinBCSR)); /* products with other types */
 #if defined(PETSC_HAVE_HYPRE)
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatConvert_mpibinbcsr_hypre_C", MatConvert_BinBCSR_HYPRE));
 #endif

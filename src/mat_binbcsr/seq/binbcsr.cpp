@@ -129,6 +129,12 @@ static PetscErrorCode MatSeqAIJSetPreallocation_SeqBinBCSR(Mat A, PetscInt nz, c
   PetscFunctionBegin;
   PetscCall(PetscLayoutSetUp(A->rmap));
   PetscCall(PetscLayoutSetUp(A->cmap));
+  if (A->rmap->bs != A->cmap->bs) { /* a layout the bins cannot hold (PCGAMG's prolongators, made in the operator's type) */
+    PetscCall(PetscInfo(A, "Row and column block sizes %" PetscInt_FMT " and %" PetscInt_FMT " differ: the matrix becomes %s\n", A->rmap->bs, A->cmap->bs, MATSEQAIJ));
+    PetscCall(MatSetType(A, MATSEQAIJ));
+    PetscCall(MatSeqAIJSetPreallocation(A, nz, nnz));
+    PetscFunctionReturn(0);
+  }
   bs = PetscMax(A->rmap->bs, 1);
   if (nnz) { /* point rows -> block rows: the largest point row of a block row, in blocks (upper bound) */
     const PetscInt mbs = A->rmap->n / bs;
@@ -543,7 +549,7 @@ static PetscErrorCode MatGetInfo_SeqBinBCSR_Basic(Mat A, MatInfoType flag, MatIn
   PetscFunctionReturn(0);
 }
 
-static const char *const composed_names[] = {"MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatBinBCSRSetCOOMirror_C", "MatBinBCSRGetCOOMirror_C", "MatSeqAIJSetPreallocation_C", "MatSeqBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatConvert_seqbinbcsr_seqaij_C", "MatConvert_seqbinbcsr_seqbaij_C"};
+static const char *const composed_names[] = {"MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatBinBCSRSetCOOMirror_C", "MatBinBCSRGetCOOMirror_C", "MatSeqAIJSetPreallocation_C", "MatSeqBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatConvert_seqbinbcsr_seqaij_C", "MatConvert_seqbinbcsr_seqbaij_C", "MatProductSetFromOptions_anytype_C"};
 
 static PetscErrorCode MatDestroy_SeqBinBCSR(Mat A)
 {
@@ -600,6 +606,8 @@ PetscErrorCode MatCreate_SeqBinBCSR(Mat A)
   A->ops->convertfrom         = MatConvertFrom_SeqBinBCSR;
   A->ops->setfromoptions      = MatSetFromOptions_SeqBinBCSR;
   A->ops->getinfo             = MatGetInfo_SeqBinBCSR_Basic;
+  A->ops->creategraph         = MatCreateGraph_BinBCSR; /* PCGAMG, through the AIJ shadow */
+  A->ops->productsetfromoptions = MatProductSetFromOptions_BinBCSR;
 
   PetscCall(PetscObjectChangeTypeName((PetscObject)A, MATSEQBINBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRSetBinWidth_C", MatBinBCSRSetBinWidth_SeqBinBCSR));
@@ -617,6 +625,7 @@ PetscErrorCode MatCreate_SeqBinBCSR(Mat A)
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatMultDotLocal_C", MatMultDotLocal_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatConvert_seqbinbcsr_seqaij_C", MatConvert_SeqBinBCSR_SeqAIJ));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatConvert_seqbinbcsr_seqbaij_C", MatConvert_SeqBinBCSR_SeqBAIJ));
+  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatProductSetFromOptions_anytype_C", MatProductSetFromOptions_BinBCSR)); /* products with other types */
 
   PetscCall(MatSeqBinBCSRSetOps_Ops(A));
   PetscFunctionReturn(0);
