@@ -35,3 +35,10 @@ foreach(np 1 2 3)
     endif()
   endforeach()
 endforeach()
+
+# No PETSc object left behind by the products' contexts, the shadows or GAMG's levels: PETSc's own
+# allocation dump at PetscFinalize must be empty.
+add_test(NAME unit_pc_malloc_dump COMMAND test_pc)
+set_tests_properties(unit_pc_malloc_dump PROPERTIES LABELS "pc" TIMEOUT 120
+                     ENVIRONMENT "PETSC_OPTIONS=-malloc_debug -malloc_dump"
+                     FAIL_REGULAR_EXPRESSION "[0-9]+ bytes [A-Za-z_0-9]+\\(\\) at")
