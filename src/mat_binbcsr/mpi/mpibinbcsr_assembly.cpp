@@ -5,7 +5,8 @@
 
 #include <algorithm>
 
-/* Sets the entries of one owned row; cols are global. */
+/* Sets the entries of one owned row; cols are global; vals NULL: zeros (PETSc's MatSetValues takes a
+   NULL array as zeros; DMDA's preallocation inserts its pattern that way). */
 static PetscErrorCode SetOwnedRow(Mat mat, PetscInt lrow, PetscInt n, const PetscInt cols[], const PetscScalar vals[], PetscInt vstride, InsertMode mode)
 {
   Mat_MPIBinBCSR                 *b      = MPIBinBCSR(mat);
@@ -20,7 +21,7 @@ static PetscErrorCode SetOwnedRow(Mat mat, PetscInt lrow, PetscInt n, const Pets
   bval.clear();
   for (PetscInt j = 0; j < n; j++) {
     const PetscInt    c = cols[j];
-    const PetscScalar v = vals[j * vstride];
+    const PetscScalar v = vals ? vals[j * vstride] : 0.0;
     if (c < 0) continue;
     PetscCheck(c < N, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", c, N);
     if (c >= cstart && c < cend) {
@@ -57,7 +58,7 @@ PETSC_INTERN PetscErrorCode MatSetValues_MPIBinBCSR(Mat mat, PetscInt m, const P
     const PetscInt row = idxm[i];
     if (row < 0) continue;
     PetscCheck(row < mat->rmap->N, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", row, mat->rmap->N);
-    const PetscScalar *vrow    = b->roworiented ? v + i * n : v + i;
+    const PetscScalar *vrow    = !v ? nullptr : b->roworiented ? v + i * n : v + i;
     const PetscInt     vstride = b->roworiented ? 1 : m;
     if (row >= rstart && row < rend) {
       PetscCall(SetOwnedRow(mat, row - rstart, n, idxn, vrow, vstride, mode));
@@ -67,7 +68,7 @@ PETSC_INTERN PetscErrorCode MatSetValues_MPIBinBCSR(Mat mat, PetscInt m, const P
         if (idxn[j] < 0) continue;
         b->stash_row.push_back(row);
         b->stash_col.push_back(idxn[j]);
-        b->stash_val.push_back(vrow[j * vstride]);
+        b->stash_val.push_back(vrow ? vrow[j * vstride] : 0.0);
       }
     }
   }

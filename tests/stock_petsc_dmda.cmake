@@ -1,0 +1,31 @@
+# PETSc's own DMDA programs with the matrix type chosen by -dm_mat_type: DMCreateMatrix preallocates
+# through the AIJ interface and then inserts the stencil pattern with MatSetValuesLocal and a NULL
+# value array (zeros), on one rank and on several (a NULL array crashed MATMPIBINBCSR before).
+# Compared with the same program on aij. Label: stock, mat_ops (+ mpi). Budget: a few seconds.
+binbcsr_stock_example(petsc_snes_ex5 snes/tutorials/ex5.c)
+binbcsr_stock_example(petsc_ksp_ex45 ksp/ksp/tutorials/ex45.c)
+
+# snes ex5 (Bratu, 2-D DMDA, analytic Jacobian): Newton with CG + Jacobi
+set(SNES_EX5 "@STOCK@/petsc_snes_ex5 -da_refine 3 -snes_converged_reason -ksp_converged_reason -snes_monitor_short -pc_type jacobi")
+# ksp ex45 (3-D Laplacian on a DMDA, KSPSetComputeOperators): CG + Jacobi
+set(KSP_EX45 "@STOCK@/petsc_ksp_ex45 -da_grid_x 13 -da_grid_y 11 -da_grid_z 9 -ksp_type cg -pc_type jacobi -ksp_converged_reason")
+string(REPLACE ";" " " MPIEXEC_LINE "${MPIEXEC_CMD}")
+foreach(np 1 2 3)
+  if(np EQUAL 1)
+    set(run "")
+    set(labels "stock;mat_ops")
+  else()
+    set(run "${MPIEXEC_LINE} -n ${np} ")
+    set(labels "stock;mat_ops;mpi")
+  endif()
+  binbcsr_stock_case(snes_ex5_dmda_np${np}
+    --keep "converged|SNES Function norm" --rtol 1e-8
+    --ref "${run}${SNES_EX5} -dm_mat_type aij"
+    --test "${run}${SNES_EX5} ${PLUGIN_ARGS} -dm_mat_type binbcsr")
+  binbcsr_stock_case(ksp_ex45_dmda_np${np}
+    --keep "converged|Residual norm" --rtol 1e-8
+    --ref "${run}${KSP_EX45} -dm_mat_type aij"
+    --test "${run}${KSP_EX45} ${PLUGIN_ARGS} -dm_mat_type binbcsr -mat_view ::ascii_info"
+    --expect "type: (seq|mpi)binbcsr")
+  set_tests_properties(stock_snes_ex5_dmda_np${np} stock_ksp_ex45_dmda_np${np} PROPERTIES LABELS "${labels}")
+endforeach()
