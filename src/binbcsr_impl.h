@@ -28,6 +28,12 @@ PETSC_INTERN PetscErrorCode MatCreateMPIMatConcatenateSeqMat_BinBCSR(MPI_Comm, M
 PETSC_INTERN PetscErrorCode MatConvert_BinBCSR_HYPRE(Mat, MatType, MatReuse, Mat *); /* composed as MatConvert_<type>_hypre_C */
 /* The seqaij/mpiaij copy of a binbcsr matrix, composed on it, refreshed when the matrix changed (collective) */
 PETSC_INTERN PetscErrorCode MatBinBCSRGetAIJShadow_Private(Mat, Mat *);
+/* and back: the shadow's values written into the matrix (both then in step) */
+PETSC_INTERN PetscErrorCode MatBinBCSRSetValuesFromAIJShadow_Private(Mat);
+/* Finite-difference Jacobians by colouring (MatFDColoring, SNES's default with a DMDA) through that shadow: binbcsr_fdcoloring.cpp */
+PETSC_INTERN PetscErrorCode MatFDColoringCreate_BinBCSR(Mat, ISColoring, MatFDColoring);
+PETSC_INTERN PetscErrorCode MatFDColoringSetUp_BinBCSR(Mat, ISColoring, MatFDColoring);
+PETSC_INTERN PetscErrorCode MatFDColoringApply_BinBCSR(Mat, MatFDColoring, Vec, void *);
 /* PCGAMG's needs through that shadow (MatCreateGraph, matrix products with binbcsr operands): binbcsr_shadow_ops.cpp */
 PETSC_INTERN PetscErrorCode MatCreateGraph_BinBCSR(Mat, PetscBool, PetscBool, PetscReal, Mat *);
 PETSC_INTERN PetscErrorCode MatProductSetFromOptions_BinBCSR(Mat); /* also composed as MatProductSetFromOptions_anytype_C */

@@ -4,12 +4,17 @@
 # Compared with the same program on aij. Label: stock, mat_ops (+ mpi). Budget: a few seconds.
 binbcsr_stock_example(petsc_snes_ex5 snes/tutorials/ex5.c)
 binbcsr_stock_example(petsc_ksp_ex45 ksp/ksp/tutorials/ex45.c)
+binbcsr_stock_example(petsc_snes_ex19 snes/tutorials/ex19.c)
 
 # snes ex5 (Bratu, 2-D DMDA, analytic Jacobian): Newton with CG + Jacobi
 set(SNES_EX5 "@STOCK@/petsc_snes_ex5 -da_refine 3 -snes_converged_reason -ksp_converged_reason -snes_monitor_short -pc_type jacobi")
 # ksp ex45 (3-D Laplacian on a DMDA, KSPSetComputeOperators): CG + Jacobi
 set(KSP_EX45 "@STOCK@/petsc_ksp_ex45 -da_grid_x 13 -da_grid_y 11 -da_grid_z 9 -ksp_type cg -pc_type jacobi -ksp_converged_reason")
 string(REPLACE ";" " " MPIEXEC_LINE "${MPIEXEC_CMD}")
+# snes ex19 (driven cavity, 4 unknowns per node: block size 4, the generic block path) has no Jacobian
+# routine: SNES computes it by finite differences with a colouring (MatFDColoring, through the AIJ
+# shadow, binbcsr_fdcoloring.cpp)
+set(SNES_EX19 "@STOCK@/petsc_snes_ex19 -da_refine 2 -snes_converged_reason -ksp_converged_reason -snes_monitor_short")
 foreach(np 1 2 3)
   if(np EQUAL 1)
     set(run "")
@@ -27,5 +32,15 @@ foreach(np 1 2 3)
     --ref "${run}${KSP_EX45} -dm_mat_type aij"
     --test "${run}${KSP_EX45} ${PLUGIN_ARGS} -dm_mat_type binbcsr -mat_view ::ascii_info"
     --expect "type: (seq|mpi)binbcsr")
-  set_tests_properties(stock_snes_ex5_dmda_np${np} stock_ksp_ex45_dmda_np${np} PROPERTIES LABELS "${labels}")
+  binbcsr_stock_case(snes_ex19_fdcoloring_np${np}
+    --keep "converged|SNES Function norm" --rtol 1e-6
+    --ref "${run}${SNES_EX19} -pc_type jacobi -dm_mat_type aij"
+    --test "${run}${SNES_EX19} -pc_type jacobi ${PLUGIN_ARGS} -dm_mat_type binbcsr -mat_view ::ascii_info"
+    --expect "type: (seq|mpi)binbcsr")
+  set_tests_properties(stock_snes_ex5_dmda_np${np} stock_ksp_ex45_dmda_np${np} stock_snes_ex19_fdcoloring_np${np} PROPERTIES LABELS "${labels}")
 endforeach()
+# and with PETSc's default preconditioner (ILU(0), 4x4 blocks: baij's, through the seqbaij copy)
+binbcsr_stock_case(snes_ex19_fdcoloring_ilu
+  --keep "converged|SNES Function norm" --rtol 1e-6
+  --ref "${SNES_EX19} -dm_mat_type baij"
+  --test "${SNES_EX19} ${PLUGIN_ARGS} -dm_mat_type binbcsr")

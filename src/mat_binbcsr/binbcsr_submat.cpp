@@ -153,6 +153,27 @@ PetscErrorCode MatBinBCSRGetAIJShadow_Private(Mat A, Mat *S)
   PetscFunctionReturn(0);
 }
 
+/* The reverse direction: the shadow's values (computed into it, e.g. by a finite-difference colouring)
+   written into A through the value maps, and the two marked in step. Collective on A. */
+PetscErrorCode MatBinBCSRSetValuesFromAIJShadow_Private(Mat A)
+{
+  PetscContainer   c;
+  AIJShadow       *sh;
+  PetscObjectState state;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectQuery((PetscObject)A, shadow_key, (PetscObject *)&c));
+  PetscCheck(c, PETSC_COMM_SELF, PETSC_ERR_PLIB, "No AIJ shadow to take the values from");
+  PetscCall(PetscContainerGetPointer(c, (void **)&sh));
+  PetscCheck(sh->S && sh->nzstate == A->nonzerostate, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "The matrix's pattern changed after its AIJ shadow was made");
+  PetscCheck(!sh->parts.empty(), PETSC_COMM_SELF, PETSC_ERR_SUP, "Values from the AIJ shadow need MATSEQBINBCSR parts (not -mat_mpibinbcsr_inner_type)");
+  for (const PartMap &p : sh->parts) PetscCall(MatSeqBinBCSRAIJScatter(p.aij, p.map, p.bin));
+  if (sh->parts[0].bin != A) PetscCall(PetscObjectStateIncrease((PetscObject)A)); /* the parts' states moved, not the parallel matrix's */
+  PetscCall(PetscObjectStateGet((PetscObject)A, &state));
+  sh->state = state;
+  PetscFunctionReturn(0);
+}
+
 namespace
 {
 /* A new binbcsr matrix (seq or mpi by T's communicator) with T's sizes and values and the storage

@@ -414,6 +414,9 @@ PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
   mat->ops->copy                = MatCopy_MPIBinBCSR;
   mat->ops->increaseoverlap     = MatIncreaseOverlap_BinBCSR;
   mat->ops->createsubmatrices   = MatCreateSubMatrices_BinBCSR;
+  mat->ops->fdcoloringcreate    = MatFDColoringCreate_BinBCSR;
+  mat->ops->fdcoloringsetup     = MatFDColoringSetUp_BinBCSR;
+  mat->ops->fdcoloringapply     = MatFDColoringApply_BinBCSR;
   mat->ops->createsubmatricesmpi = MatCreateSubMatricesMPI_BinBCSR;
   mat->ops->createsubmatrix     = MatCreateSubMatrix_BinBCSR;
   mat->ops->creategraph         = MatCreateGraph_BinBCSR; /* PCGAMG, through the AIJ shadow */

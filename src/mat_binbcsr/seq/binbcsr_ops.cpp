@@ -556,6 +556,9 @@ PetscErrorCode MatSeqBinBCSRSetOps_Ops(Mat A)
   /* submatrices through an AIJ shadow (binbcsr_submat.cpp); MatCreateSubMatrix uses createsubmatrices on one rank */
   A->ops->increaseoverlap               = MatIncreaseOverlap_BinBCSR;
   A->ops->createsubmatrices             = MatCreateSubMatrices_BinBCSR;
+  A->ops->fdcoloringcreate              = MatFDColoringCreate_BinBCSR;
+  A->ops->fdcoloringsetup               = MatFDColoringSetUp_BinBCSR;
+  A->ops->fdcoloringapply               = MatFDColoringApply_BinBCSR;
   A->ops->creatempimatconcatenateseqmat = MatCreateMPIMatConcatenateSeqMat_BinBCSR;
   A->ops->getrowij                      = MatGetRowIJ_SeqBinBCSR; /* binbcsr_rowij.cpp */
   A->ops->restorerowij                  = MatRestoreRowIJ_SeqBinBCSR;
