@@ -142,7 +142,16 @@ PetscErrorCode ProductSymbolic_Shadow(Mat C)
    "MatProductSetFromOptions_anytype_C" (what PETSc asks when the operands' types differ). */
 PetscErrorCode MatProductSetFromOptions_BinBCSR(Mat C)
 {
+  PetscBool dense = PETSC_FALSE, binA;
+
   PetscFunctionBegin;
+  if (C->product->type == MATPRODUCT_AB || C->product->type == MATPRODUCT_AtB) {
+    PetscCall(IsBinBCSR(C->product->A, &binA));
+    if (binA) PetscCall(PetscObjectBaseTypeCompareAny((PetscObject)C->product->B, &dense, MATSEQDENSE, MATMPIDENSE, ""));
+  }
+  /* binbcsr times a dense block of vectors: PETSc's column-by-column product (MatProductSymbolic_X_Dense)
+     with binbcsr's own MatMult / MatMultTranspose, no copy */
+  if (dense) PetscFunctionReturn(0);
   switch (C->product->type) {
   case MATPRODUCT_AB:
   case MATPRODUCT_AtB:

@@ -133,6 +133,22 @@ TEST_CASE("Matrix products with binbcsr operands (through the AIJ shadow) equal 
       PetscBool aij;
       PCHK(PetscObjectTypeCompareAny((PetscObject)ptap_a, &aij, MATSEQAIJ, MATMPIAIJ, ""));
       CHECK(aij);
+      { // a dense block of vectors: PETSc's column-by-column product with binbcsr's own MatMult, no AIJ copy
+        Mat      F, X, Y, YR;
+        PetscInt n;
+        PCHK(coo_matrix(fem, bs, MATBINBCSR, st, &F));
+        PCHK(MatGetLocalSize(F, &n, nullptr));
+        PCHK(MatCreateDense(PETSC_COMM_WORLD, n, PETSC_DECIDE, PETSC_DETERMINE, 3, nullptr, &X));
+        PCHK(MatSetRandom(X, nullptr));
+        PCHK(MatMatMult(F, X, MAT_INITIAL_MATRIX, PETSC_DEFAULT, &Y));
+        PCHK(MatMatMult(R, X, MAT_INITIAL_MATRIX, PETSC_DEFAULT, &YR));
+        CHECK(mat_rel_diff(Y, YR) < (st.single ? 1e-6 : 1e-13)); // F holds weight0 values, R (single: a copy of A) too
+        PetscObject shadow = nullptr;
+        PCHK(PetscObjectQuery((PetscObject)F, "MatBinBCSR_AIJShadow", &shadow));
+        CHECK(shadow == nullptr);
+        Mat ms[] = {F, X, Y, YR};
+        for (Mat &M : ms) PCHK(MatDestroy(&M));
+      }
       // a refill reaches the reused products (GAMG's coarse operators after a refill)
       Mat before;
       PCHK(MatDuplicate(ptap_a, MAT_COPY_VALUES, &before));
