@@ -118,9 +118,30 @@ BINBCSR_HD void bin_row_abs_sums(const V *bin_val, int len, int bw, int bs, doub
       }
 }
 
-/* col_sum[c] += |a_ic| over the entries of a bin of len slot groups (a scatter: a GPU needs atomics). */
+/* Column reductions (MatGetColumnNorms/Reductions, the 1-norm): red[c] = op over the entries of
+   point column c, for op one of: */
+enum reduction_kind { reduce_abs_sum = 0, reduce_square_sum = 1, reduce_abs_max = 2, reduce_sum = 3 };
+BINBCSR_HD double reduce(int kind, double acc, double v)
+{
+  const double a = v < 0 ? -v : v;
+  switch (kind) {
+  case reduce_abs_sum:
+    return acc + a;
+  case reduce_square_sum:
+    return acc + v * v;
+  case reduce_abs_max:
+    return a > acc ? a : acc;
+  default:
+    return acc + v;
+  }
+}
+
+/* red[c] = reduce(red[c], a_ic) over the entries of a bin of len slot groups whose lanes are the block
+   rows r0, r0 + 1, ... (a scatter: a GPU needs atomics). Padding adds zeros, which change no reduction.
+   mirror_rows > 0 (symmetric storage, mbs): a stored off-diagonal block (r, c) also stands for its
+   transpose (c, r), whose entries lie in the columns of block row r; phantom lanes (r >= mbs) skip it. */
 template <typename V, typename I>
-BINBCSR_HD void bin_col_abs_sums(const V *bin_val, const I *bin_col, int len, int bw, int bs, double *col_sum)
+BINBCSR_HD void bin_col_reductions(const V *bin_val, const I *bin_col, int len, int bw, int bs, int kind, I r0, I mirror_rows, double *red)
 {
   const int bs2 = bs * bs;
   for (int k = 0; k < len; k++) {
@@ -128,9 +149,75 @@ BINBCSR_HD void bin_col_abs_sums(const V *bin_val, const I *bin_col, int len, in
     for (int i = 0; i < bs; i++)
       for (int j = 0; j < bs; j++) {
         const V *v = bin_val + value_offset(k, i * bs + j, bw, bs2, 0);
-        for (int l = 0; l < bw; l++) col_sum[(long)cols[l] * bs + j] += v[l] < 0 ? -(double)v[l] : (double)v[l];
+        for (int l = 0; l < bw; l++) {
+          const long c = (long)cols[l] * bs + j;
+          red[c]       = reduce(kind, red[c], (double)v[l]);
+          if (mirror_rows && r0 + l < mirror_rows && cols[l] != r0 + l) {
+            const long r = (long)(r0 + l) * bs + i;
+            red[r]       = reduce(kind, red[r], (double)v[l]);
+          }
+        }
       }
   }
+}
+
+/* v_ij *= l_i r_j over one block (l: the bs factors of its block row or null, r: of its block column or
+   null); tile points at entry 0 of the slot's block for its lane. */
+template <typename V>
+BINBCSR_HD void slot_diagonal_scale(V *tile, int bw, int bs, const double *l, const double *r)
+{
+  for (int i = 0; i < bs; i++)
+    for (int j = 0; j < bs; j++) {
+      V     &v = tile[(i * bs + j) * bw];
+      double f = l ? l[i] : 1.0;
+      if (r) f *= r[j];
+      v = (V)(f * (double)v);
+    }
+}
+
+/* The same over the lane's nz real slots (padding stays zero whatever the factors): l at the lane's
+   rows, r the whole column scaling. */
+template <typename V, typename I>
+BINBCSR_HD void lane_diagonal_scale(V *bin_val, const I *bin_col, int nz, int bw, int bs, int lane, const double *l, const double *r)
+{
+  const int bs2 = bs * bs;
+  for (int k = 0; k < nz; k++) slot_diagonal_scale(bin_val + value_offset(k, 0, bw, bs2, lane), bw, bs, l, r ? r + (long)bin_col[(long)k * bw + lane] * bs : nullptr);
+}
+
+/* Row extremes (MatGetRowMaxAbs, MatGetRowMax, MatGetRowMin) with PETSc's AIJ rules: the value and the
+   column where it is reached, for each point row. */
+enum row_extreme_kind { extreme_max_abs = 0, extreme_max = 1, extreme_min = 2 };
+
+/* The state of a row before its stored entries are seen: for max/min, a row that does not store every
+   column holds implicit zeros, the first at column first_gap; a row that does starts from nothing. */
+template <typename I>
+BINBCSR_HD void row_extreme_start(int kind, bool dense, I first_gap, double *best, I *at)
+{
+  if (kind == extreme_max_abs || !dense) {
+    *best = 0.0;
+    *at   = kind == extreme_max_abs ? 0 : first_gap;
+  } else {
+    *best = kind == extreme_max ? -1.0 / 0.0 : 1.0 / 0.0;
+    *at   = -1;
+  }
+}
+
+/* best[i], at[i] (point row i of the block row) updated by one block of the row, whose columns are
+   c0 .. c0 + bs - 1; blocks must come in ascending column order: only a strictly better value moves
+   at[i], so ties keep the smallest column. transposed: the block is stored as (c, r) (the lower part of
+   symmetric storage), entry (i, j) of the row is its entry (j, i). */
+template <typename V, typename I>
+BINBCSR_HD void slot_row_extremes(const V *tile, int bw, int bs, bool transposed, I c0, int kind, double *best, I *at)
+{
+  for (int i = 0; i < bs; i++)
+    for (int j = 0; j < bs; j++) {
+      const double v = (double)tile[(transposed ? j * bs + i : i * bs + j) * bw];
+      const double x = kind == extreme_max_abs && v < 0 ? -v : v;
+      if (kind == extreme_min ? x < best[i] : x > best[i]) {
+        best[i] = x;
+        at[i]   = c0 + j;
+      }
+    }
 }
 
 } // namespace binbcsr

@@ -406,6 +406,16 @@ PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
   mat->ops->restorerow          = MatRestoreRow_MPIBinBCSR;
   mat->ops->norm                = MatNorm_MPIBinBCSR;
   mat->ops->getinfo             = MatGetInfo_MPIBinBCSR;
+  mat->ops->diagonalscale       = MatDiagonalScale_MPIBinBCSR;
+  mat->ops->getrowmaxabs        = MatGetRowMaxAbs_MPIBinBCSR;
+  mat->ops->getrowmax           = MatGetRowMax_MPIBinBCSR;
+  mat->ops->getrowmin           = MatGetRowMin_MPIBinBCSR;
+  mat->ops->getcolumnreductions = MatGetColumnReductions_MPIBinBCSR;
+  mat->ops->missingdiagonal     = MatMissingDiagonal_MPIBinBCSR;
+  mat->ops->equal               = MatEqual_MPIBinBCSR;
+  mat->ops->getvalues           = MatGetValues_MPIBinBCSR;
+  mat->ops->axpy                = MatAXPY_MPIBinBCSR;
+  mat->ops->transpose           = MatTranspose_MPIBinBCSR;
   mat->ops->getdiagonalblock    = MatGetDiagonalBlock_MPIBinBCSR;
   mat->ops->view                = MatView_MPIBinBCSR;
   mat->ops->load                = MatLoad_MPIBinBCSR;

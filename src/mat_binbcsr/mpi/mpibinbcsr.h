@@ -89,6 +89,44 @@ struct Mat_MPIBinBCSR {
 };
 
 static inline Mat_MPIBinBCSR *MPIBinBCSR(Mat mat) { return static_cast<Mat_MPIBinBCSR *>(mat->data); }
+static inline PetscInt         MPIBinBCSRGhosts(Mat mat) { return static_cast<PetscInt>(MPIBinBCSR(mat)->garray.size()); }
+
+/* A sequential vector on this rank's part of a parallel one (shares its array). */
+struct LocalView {
+  Vec                vec = nullptr, seq = nullptr;
+  PetscScalar       *a   = nullptr;
+  const PetscScalar *ra  = nullptr;
+  /* read_only: the vector may be read-locked (e.g. x of MatZeroRowsColumns); seq is then only read */
+  PetscErrorCode open(Vec v, bool read_only = false)
+  {
+    PetscInt n;
+    PetscFunctionBegin;
+    vec = v;
+    PetscCall(VecGetLocalSize(v, &n));
+    if (read_only) PetscCall(VecGetArrayRead(v, &ra));
+    else PetscCall(VecGetArray(v, &a));
+    PetscCall(VecCreateSeqWithArray(PETSC_COMM_SELF, 1, n, read_only ? const_cast<PetscScalar *>(ra) : a, &seq));
+    if (read_only) PetscCall(VecLockReadPush(seq));
+    PetscFunctionReturn(0);
+  }
+  PetscErrorCode close()
+  {
+    PetscFunctionBegin;
+    if (vec) {
+      if (ra) PetscCall(VecLockReadPop(seq));
+      PetscCall(VecDestroy(&seq));
+      if (ra) PetscCall(VecRestoreArrayRead(vec, &ra));
+      else PetscCall(VecRestoreArray(vec, &a));
+      vec = nullptr;
+      ra  = nullptr;
+    }
+    PetscFunctionReturn(0);
+  }
+};
+
+/* The configuration of one matrix (inner type, bin width, precision, storage, options replayed on the
+   parts) given to another, empty one (mpibinbcsr_convert.cpp): MatDuplicate, MatAXPY, MatTranspose. */
+PETSC_INTERN PetscErrorCode MatMPIBinBCSRCopyConfig(Mat from, Mat to);
 
 /* mpibinbcsr_parts.cpp: creating the parts, compressing B, the ghost scatter */
 PETSC_INTERN PetscErrorCode MatMPIBinBCSRCreatePart(Mat, PetscInt m, PetscInt n, Mat *);
@@ -125,6 +163,18 @@ PETSC_INTERN PetscErrorCode MatGetRow_MPIBinBCSR(Mat, PetscInt, PetscInt *, Pets
 PETSC_INTERN PetscErrorCode MatRestoreRow_MPIBinBCSR(Mat, PetscInt, PetscInt *, PetscInt **, PetscScalar **);
 PETSC_INTERN PetscErrorCode MatNorm_MPIBinBCSR(Mat, NormType, PetscReal *);
 PETSC_INTERN PetscErrorCode MatGetInfo_MPIBinBCSR(Mat, MatInfoType, MatInfo *);
+
+/* mpibinbcsr_rowops.cpp: rows, columns and whole-matrix operations */
+PETSC_INTERN PetscErrorCode MatDiagonalScale_MPIBinBCSR(Mat, Vec, Vec);
+PETSC_INTERN PetscErrorCode MatGetRowMaxAbs_MPIBinBCSR(Mat, Vec, PetscInt[]);
+PETSC_INTERN PetscErrorCode MatGetRowMax_MPIBinBCSR(Mat, Vec, PetscInt[]);
+PETSC_INTERN PetscErrorCode MatGetRowMin_MPIBinBCSR(Mat, Vec, PetscInt[]);
+PETSC_INTERN PetscErrorCode MatGetColumnReductions_MPIBinBCSR(Mat, PetscInt, PetscReal *);
+PETSC_INTERN PetscErrorCode MatMissingDiagonal_MPIBinBCSR(Mat, PetscBool *, PetscInt *);
+PETSC_INTERN PetscErrorCode MatEqual_MPIBinBCSR(Mat, Mat, PetscBool *);
+PETSC_INTERN PetscErrorCode MatGetValues_MPIBinBCSR(Mat, PetscInt, const PetscInt[], PetscInt, const PetscInt[], PetscScalar[]);
+PETSC_INTERN PetscErrorCode MatAXPY_MPIBinBCSR(Mat, PetscScalar, Mat, MatStructure);
+PETSC_INTERN PetscErrorCode MatTranspose_MPIBinBCSR(Mat, MatReuse, Mat *);
 
 /* mpibinbcsr_convert.cpp: conversion, load, view */
 PETSC_INTERN PetscErrorCode MatConvert_MPIBinBCSR_MPIAIJ(Mat, MatType, MatReuse, Mat *);

@@ -180,16 +180,11 @@ PETSC_INTERN PetscErrorCode MatView_MPIBinBCSR(Mat mat, PetscViewer viewer)
   PetscFunctionReturn(0);
 }
 
-PETSC_INTERN PetscErrorCode MatDuplicate_MPIBinBCSR(Mat mat, MatDuplicateOption op, Mat *newmat)
+PETSC_INTERN PetscErrorCode MatMPIBinBCSRCopyConfig(Mat from, Mat to)
 {
-  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
-  Mat             C;
+  Mat_MPIBinBCSR *b = MPIBinBCSR(from), *c = MPIBinBCSR(to);
 
   PetscFunctionBegin;
-  PetscCall(MatBinBCSRCreateLike_Private(mat, ((PetscObject)mat)->type_name, &C));
-  PetscCall(PetscLayoutSetUp(C->rmap));
-  PetscCall(PetscLayoutSetUp(C->cmap));
-  Mat_MPIBinBCSR *c = MPIBinBCSR(C);
   PetscCall(PetscStrncpy(c->inner_type, b->inner_type, sizeof(c->inner_type)));
   c->part_options       = b->part_options;
   c->ignore_new_offdiag = b->ignore_new_offdiag;
@@ -199,6 +194,20 @@ PETSC_INTERN PetscErrorCode MatDuplicate_MPIBinBCSR(Mat mat, MatDuplicateOption 
   c->precision          = b->precision;
   c->sym                = b->sym;
   c->coo_mirror         = b->coo_mirror;
+  PetscFunctionReturn(0);
+}
+
+PETSC_INTERN PetscErrorCode MatDuplicate_MPIBinBCSR(Mat mat, MatDuplicateOption op, Mat *newmat)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+  Mat             C;
+
+  PetscFunctionBegin;
+  PetscCall(MatBinBCSRCreateLike_Private(mat, ((PetscObject)mat)->type_name, &C));
+  PetscCall(PetscLayoutSetUp(C->rmap));
+  PetscCall(PetscLayoutSetUp(C->cmap));
+  PetscCall(MatMPIBinBCSRCopyConfig(mat, C));
+  Mat_MPIBinBCSR *c     = MPIBinBCSR(C);
   c->garray             = b->garray;
   c->compressed         = b->compressed;
   c->b_staging          = b->b_staging;

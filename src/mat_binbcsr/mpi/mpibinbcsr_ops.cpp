@@ -125,38 +125,6 @@ PETSC_INTERN PetscErrorCode MatGetDiagonal_MPIBinBCSR(Mat mat, Vec d)
   PetscFunctionReturn(0);
 }
 
-/* A sequential vector on this rank's part of a parallel one (shares its array). */
-struct LocalView {
-  Vec                vec = nullptr, seq = nullptr;
-  PetscScalar       *a   = nullptr;
-  const PetscScalar *ra  = nullptr;
-  /* read_only: the vector may be read-locked (e.g. x of MatZeroRowsColumns); seq is then only read */
-  PetscErrorCode open(Vec v, bool read_only = false)
-  {
-    PetscInt n;
-    PetscFunctionBegin;
-    vec = v;
-    PetscCall(VecGetLocalSize(v, &n));
-    if (read_only) PetscCall(VecGetArrayRead(v, &ra));
-    else PetscCall(VecGetArray(v, &a));
-    PetscCall(VecCreateSeqWithArray(PETSC_COMM_SELF, 1, n, read_only ? const_cast<PetscScalar *>(ra) : a, &seq));
-    if (read_only) PetscCall(VecLockReadPush(seq));
-    PetscFunctionReturn(0);
-  }
-  PetscErrorCode close()
-  {
-    PetscFunctionBegin;
-    if (vec) {
-      if (ra) PetscCall(VecLockReadPop(seq));
-      PetscCall(VecDestroy(&seq));
-      if (ra) PetscCall(VecRestoreArrayRead(vec, &ra));
-      else PetscCall(VecRestoreArray(vec, &a));
-      vec = nullptr;
-      ra  = nullptr;
-    }
-    PetscFunctionReturn(0);
-  }
-};
 
 PETSC_INTERN PetscErrorCode MatDiagonalSet_MPIBinBCSR(Mat mat, Vec d, InsertMode mode)
 {

@@ -163,6 +163,9 @@ PETSC_INTERN PetscErrorCode MatSeqBinBCSRBuildLowerIndex(Mat_SeqBinBCSR *);
 /* Refuses an operation that symmetric storage does not provide. */
 #define BinBCSRCheckNotSym(a, opname) PetscCheck(!(a)->sym, PETSC_COMM_SELF, PETSC_ERR_SUP, "%s is not available for MATSEQBINBCSR with symmetric storage (upper triangle only; -mat_binbcsr_symmetric_storage)", opname)
 
+/* Both built with the same bins, slots and columns (block size, bin width, storage): their value arrays
+   line up slot by slot (the precisions may differ). */
+PETSC_INTERN PetscBool MatSeqBinBCSRSameLayout(const Mat_SeqBinBCSR *, const Mat_SeqBinBCSR *);
 /* Slot of block (brow, bcol), -1 if the pattern has no such block (binary search in the lane). */
 PETSC_INTERN PetscInt MatSeqBinBCSRFindSlot(const Mat_SeqBinBCSR *, PetscInt brow, PetscInt bcol);
 

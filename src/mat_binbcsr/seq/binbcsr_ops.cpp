@@ -202,7 +202,9 @@ PetscErrorCode AXPYUnion(Mat Y, PetscScalar a, Mat X)
   PetscFunctionReturn(0);
 }
 
-PetscBool SameLayout(const Mat_SeqBinBCSR *y, const Mat_SeqBinBCSR *x)
+} // namespace
+
+PetscBool MatSeqBinBCSRSameLayout(const Mat_SeqBinBCSR *y, const Mat_SeqBinBCSR *x)
 {
   if (!y->built || !x->built) return PETSC_FALSE;
   if (y->bs != x->bs || y->bw != x->bw || y->mbs != x->mbs || y->nbs != x->nbs || y->nslots != x->nslots || y->sym != x->sym) return PETSC_FALSE;
@@ -210,8 +212,6 @@ PetscBool SameLayout(const Mat_SeqBinBCSR *y, const Mat_SeqBinBCSR *x)
   if (y->sym && !std::equal(y->real_slot, y->real_slot + y->nz, x->real_slot)) return PETSC_FALSE;
   return std::equal(y->bin_start, y->bin_start + y->nbins + 1, x->bin_start) && std::equal(y->row_nz, y->row_nz + y->mbs, x->row_nz) && std::equal(y->col, y->col + y->nslots, x->col) ? PETSC_TRUE : PETSC_FALSE;
 }
-
-} // namespace
 
 static PetscErrorCode MatZeroEntries_SeqBinBCSR(Mat A)
 {
@@ -308,7 +308,7 @@ static PetscErrorCode MatAXPY_SeqBinBCSR(Mat Y, PetscScalar alpha, Mat X, MatStr
   PetscCall(CheckBuilt(Y, "MatAXPY"));
   PetscCall(CheckFinite(Y, alpha, "the AXPY factor"));
   PetscCall(PetscObjectTypeCompare((PetscObject)X, MATSEQBINBCSR, &xbin));
-  if (xbin && SameLayout(y, (Mat_SeqBinBCSR *)X->data)) {
+  if (xbin && MatSeqBinBCSRSameLayout(y, (Mat_SeqBinBCSR *)X->data)) {
     /* the fast path: slot by slot, whatever each side's precision */
     const Mat_SeqBinBCSR *x  = (const Mat_SeqBinBCSR *)X->data;
     const int             bw = (int)y->bw, bs2 = (int)y->bs2;
@@ -448,6 +448,21 @@ static PetscErrorCode MatZeroRowsColumns_SeqBinBCSR(Mat A, PetscInt N, const Pet
   PetscFunctionReturn(0);
 }
 
+/* The 1-norm: the largest column sum of |a_ij| over the full matrix (with symmetric storage also the
+   infinity norm). */
+static PetscErrorCode MaxColumnSum(Mat A, PetscReal *nrm)
+{
+  double *col_sum;
+
+  PetscFunctionBegin;
+  PetscCall(PetscMalloc1(A->cmap->n, &col_sum));
+  PetscCall(MatSeqBinBCSRColumnReductions(A, binbcsr::reduce_abs_sum, col_sum));
+  *nrm = 0.0;
+  for (PetscInt j = 0; j < A->cmap->n; j++) *nrm = PetscMax(*nrm, col_sum[j]);
+  PetscCall(PetscFree(col_sum));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MatNorm_SeqBinBCSR(Mat A, NormType type, PetscReal *nrm)
 {
   Mat_SeqBinBCSR *a  = (Mat_SeqBinBCSR *)A->data;
@@ -470,16 +485,7 @@ static PetscErrorCode MatNorm_SeqBinBCSR(Mat A, NormType type, PetscReal *nrm)
       }
       *nrm = PetscSqrtReal(PetscMax(sum, 0.0));
     } else if (type == NORM_1 || type == NORM_INFINITY) {
-      double *row_sum;
-      PetscCall(PetscCalloc1((size_t)a->mbs * bs, &row_sum));
-      ForEachRealValue(a, [&](PetscInt v, PetscInt r, PetscInt c, PetscInt i, PetscInt j) {
-        const double x = PetscAbsScalar(BinBCSRGetValue(a, v));
-        row_sum[r * bs + i] += x;
-        if (c != r) row_sum[c * bs + j] += x;
-      });
-      *nrm = 0.0;
-      for (PetscInt i = 0; i < a->mbs * bs; i++) *nrm = PetscMax(*nrm, row_sum[i]);
-      PetscCall(PetscFree(row_sum));
+      PetscCall(MaxColumnSum(A, nrm));
     } else SETERRQ(PETSC_COMM_SELF, PETSC_ERR_SUP, "MATSEQBINBCSR has no %s norm", NormTypes[type]);
     PetscCall(PetscLogFlops(2.0 * a->nz * a->bs2));
     PetscFunctionReturn(0);
@@ -488,16 +494,7 @@ static PetscErrorCode MatNorm_SeqBinBCSR(Mat A, NormType type, PetscReal *nrm)
     const long n = (long)a->nslots * a->bs2;
     *nrm         = PetscSqrtReal(a->val ? binbcsr::values_sum_squares(n, a->val) : binbcsr::values_sum_squares(n, a->valf));
   } else if (type == NORM_1) {
-    double *col_sum;
-    PetscCall(PetscCalloc1((size_t)a->nbs * bs, &col_sum));
-    for (PetscInt b = 0; b < a->nbins; b++) {
-      const PetscInt s0 = a->bin_start[b], len = (a->bin_start[b + 1] - s0) / a->bw;
-      if (a->val) binbcsr::bin_col_abs_sums(a->val + (size_t)s0 * bs2, a->col + s0, (int)len, bw, bs, col_sum);
-      else binbcsr::bin_col_abs_sums(a->valf + (size_t)s0 * bs2, a->col + s0, (int)len, bw, bs, col_sum);
-    }
-    *nrm = 0.0;
-    for (PetscInt j = 0; j < a->nbs * bs; j++) *nrm = PetscMax(*nrm, col_sum[j]);
-    PetscCall(PetscFree(col_sum));
+    PetscCall(MaxColumnSum(A, nrm));
   } else if (type == NORM_INFINITY) {
     double *row_sum;
     PetscCall(PetscMalloc1((size_t)bs * bw, &row_sum));
@@ -552,6 +549,13 @@ PetscErrorCode MatSeqBinBCSRSetOps_Ops(Mat A)
   A->ops->norm              = MatNorm_SeqBinBCSR;
   A->ops->getinfo           = MatGetInfo_SeqBinBCSR;
   A->ops->transpose         = MatTranspose_SeqBinBCSR;
+  A->ops->diagonalscale     = MatDiagonalScale_SeqBinBCSR;
+  A->ops->getrowmaxabs      = MatGetRowMaxAbs_SeqBinBCSR;
+  A->ops->getrowmax         = MatGetRowMax_SeqBinBCSR;
+  A->ops->getrowmin         = MatGetRowMin_SeqBinBCSR;
+  A->ops->getcolumnreductions = MatGetColumnReductions_SeqBinBCSR;
+  A->ops->missingdiagonal   = MatMissingDiagonal_SeqBinBCSR;
+  A->ops->equal             = MatEqual_SeqBinBCSR;
   A->ops->load              = MatLoad_SeqBinBCSR;
   /* submatrices through an AIJ shadow (binbcsr_submat.cpp); MatCreateSubMatrix uses createsubmatrices on one rank */
   A->ops->increaseoverlap               = MatIncreaseOverlap_BinBCSR;

@@ -12,4 +12,15 @@ PETSC_INTERN PetscErrorCode MatView_SeqBinBCSR_Other(Mat, PetscViewer);
 /* MatTranspose: a new layout for the transposed block pattern (any MatReuse). */
 PETSC_INTERN PetscErrorCode MatTranspose_SeqBinBCSR(Mat, MatReuse, Mat *);
 
+/* Rows and columns of the full matrix (binbcsr_rowops.cpp) */
+PETSC_INTERN PetscErrorCode MatDiagonalScale_SeqBinBCSR(Mat, Vec, Vec);
+PETSC_INTERN PetscErrorCode MatGetRowMaxAbs_SeqBinBCSR(Mat, Vec, PetscInt[]);
+PETSC_INTERN PetscErrorCode MatGetRowMax_SeqBinBCSR(Mat, Vec, PetscInt[]);
+PETSC_INTERN PetscErrorCode MatGetRowMin_SeqBinBCSR(Mat, Vec, PetscInt[]);
+PETSC_INTERN PetscErrorCode MatGetColumnReductions_SeqBinBCSR(Mat, PetscInt, PetscReal *);
+PETSC_INTERN PetscErrorCode MatMissingDiagonal_SeqBinBCSR(Mat, PetscBool *, PetscInt *);
+PETSC_INTERN PetscErrorCode MatEqual_SeqBinBCSR(Mat, Mat, PetscBool *);
+/* red[j] (cmap->n, zeroed here) = the binbcsr::reduction_kind over point column j of the full matrix */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRColumnReductions(Mat, int kind, double *red);
+
 #endif
