@@ -285,6 +285,12 @@ TEST_CASE("MatEqual: values and pattern, across bin widths and precisions", "[ro
       PETSC_OK(MatAssemblyEnd(D, MAT_FINAL_ASSEMBLY));
       PETSC_OK(MatEqual(A, D, &eq));
       CHECK(!eq);
+      other    = c; // the same change in other bins (compared row by row)
+      other.bw = c.bw ? 0 : 3;
+      PETSC_OK(make(other, MATBINBCSR, &B));
+      PETSC_OK(MatEqual(B, D, &eq));
+      CHECK(!eq);
+      PETSC_OK(MatDestroy(&B));
       // a different pattern with the same values where both have entries
       Config sub = c;
       sub.drop   = true;
