@@ -9,22 +9,22 @@ endforeach()
 # -ksp_diagonal_scale (MatDiagonalScale) take aij's iteration count with -mat_type binbcsr, full and
 # symmetric storage, on 1 and 2 ranks (before these operations, binbcsr stopped with an error).
 binbcsr_stock_example(stock_ksp_ex4 ksp/ksp/tutorials/ex4.c)
-set(ROWOPS_EX4_CASES "rowmax\;-pc_type\;jacobi\;-pc_jacobi_type\;rowmax" "diagscale\;-ksp_diagonal_scale\;-ksp_diagonal_scale_fix\;-pc_type\;none")
-foreach(np 1 2)
-  foreach(case ${ROWOPS_EX4_CASES})
-    list(GET case 0 name)
-    list(SUBLIST case 1 -1 opts)
-    foreach(storage full sym)
-      set(extra "")
-      if(storage STREQUAL "sym")
-        set(extra -mat_binbcsr_symmetric_storage)
-      endif()
-      add_test(NAME mat_rowops_stock_ex4_${name}_${storage}_np${np}
-               COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/mpi/compare_its.sh 0 ${MPIEXEC_CMD} -n ${np}
-                       -- $<TARGET_FILE:stock_ksp_ex4> -bs 3 -m 20 -n 20 ${opts} -dll_append ${PLUGIN}
-                       -- -mat_type aij
-                       -- -mat_type binbcsr ${extra})
-      set_tests_properties(mat_rowops_stock_ex4_${name}_${storage}_np${np} PROPERTIES LABELS "mat_rowops;stock;mpi" PROCESSORS ${np} TIMEOUT 60)
-    endforeach()
-  endforeach()
-endforeach()
+# name, ranks, options of both runs, options of the binbcsr run
+function(rowops_stock_ex4 name np opts extra)
+  add_test(NAME mat_rowops_stock_ex4_${name}
+           COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/mpi/compare_its.sh 0 ${MPIEXEC_CMD} -n ${np}
+                   -- $<TARGET_FILE:stock_ksp_ex4> -bs 3 -m 20 -n 20 ${opts} -dll_append ${PLUGIN}
+                   -- -mat_type aij
+                   -- -mat_type binbcsr ${extra})
+  set(labels "mat_rowops;stock")
+  if(np GREATER 1)
+    set(labels "${labels};mpi")
+  endif()
+  set_tests_properties(mat_rowops_stock_ex4_${name} PROPERTIES LABELS "${labels}" PROCESSORS ${np} TIMEOUT 60)
+endfunction()
+set(ROWMAX -pc_type jacobi -pc_jacobi_type rowmax)
+set(DIAGSCALE -ksp_diagonal_scale -ksp_diagonal_scale_fix -pc_type none)
+rowops_stock_ex4(rowmax_np1 1 "${ROWMAX}" "")
+rowops_stock_ex4(rowmax_sym_np2 2 "${ROWMAX}" -mat_binbcsr_symmetric_storage)
+rowops_stock_ex4(diagscale_sym_np1 1 "${DIAGSCALE}" -mat_binbcsr_symmetric_storage)
+rowops_stock_ex4(diagscale_np2 2 "${DIAGSCALE}" "")
