@@ -66,10 +66,11 @@ PetscErrorCode SwapInShadows(Mat C, Mat orig[3], Mat shadow[3])
     orig[i]   = *ops[i];
     shadow[i] = nullptr;
     PetscCall(IsBinBCSR(orig[i], &bin));
-    if (!bin) continue;
-    PetscCall(MatBinBCSRGetAIJShadow_Private(orig[i], &shadow[i]));
-    *ops[i] = shadow[i];
+    if (bin) PetscCall(MatBinBCSRGetAIJShadow_Private(orig[i], &shadow[i]));
   }
+  /* only now, so that an error above leaves the product naming (and referencing) its own operands */
+  for (int i = 0; i < 3; i++)
+    if (shadow[i]) *ops[i] = shadow[i];
   PetscFunctionReturn(0);
 }
 
