@@ -46,6 +46,9 @@ PETSC_INTERN PetscErrorCode MatBinBCSRRegisterExternalFactors(void);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRComposeCOO(Mat, const PetscCount from[], PetscCount n, PetscCount nsrc); /* from[] < n: the caller's values, else received */
 PETSC_INTERN PetscErrorCode MatSetValuesCOOTwoSources_SeqBinBCSR(Mat, const PetscScalar v[], PetscCount n, const PetscScalar recv[], InsertMode);
 
+/* MatPermute of seq and mpi binbcsr: a new matrix of the same type and configuration (binbcsr_permute.cpp) */
+PETSC_INTERN PetscErrorCode MatPermute_BinBCSR(Mat, IS, IS, Mat *);
+
 /* Registered once by PetscBinBCSRRegisterAll(). */
 PETSC_EXTERN PetscLogEvent MAT_BinBCSR_BuildLayout; /* first final assembly: staging -> bins */
 PETSC_EXTERN PetscLogEvent MAT_BinBCSR_SetValuesCOO; /* slot refill by gather */

@@ -411,3 +411,58 @@ TEST_CASE("MatTranspose matches aij; symmetric storage is its own transpose", "[
     }
   }
 }
+
+TEST_CASE("MatPermute matches aij and keeps the type and its options", "[rowops]")
+{
+  for (const Config &c : configs()) {
+    SECTION(c.name())
+    {
+      Pair           p(c);
+      const PetscInt N = c.mbs() * c.bs, mbs = c.mbs(), bs = c.bs;
+      PetscInt       rstart, rend;
+      PETSC_OK(MatGetOwnershipRange(p.aij, &rstart, &rend));
+      // a permutation of whole blocks (7 and 5 are prime to 23 and 43) and one of points (5 is prime to 43, 69)
+      std::vector<PetscInt> blocks, points, other;
+      for (PetscInt i = rstart; i < rend; i++) {
+        blocks.push_back(((i / bs) * 7 + 3) % mbs * bs + i % bs);
+        points.push_back((i * 5 + 1) % N);
+        other.push_back(((i / bs) * 5 + 2) % mbs * bs + i % bs);
+      }
+      IS rb, rp, ro;
+      PETSC_OK(ISCreateGeneral(PETSC_COMM_WORLD, rend - rstart, blocks.data(), PETSC_COPY_VALUES, &rb));
+      PETSC_OK(ISCreateGeneral(PETSC_COMM_WORLD, rend - rstart, points.data(), PETSC_COPY_VALUES, &rp));
+      PETSC_OK(ISCreateGeneral(PETSC_COMM_WORLD, rend - rstart, other.data(), PETSC_COPY_VALUES, &ro));
+      PETSC_OK(ISSetPermutation(rb));
+      PETSC_OK(ISSetPermutation(rp));
+      PETSC_OK(ISSetPermutation(ro));
+      const std::pair<IS, IS> cases_full[] = {{rb, rb}, {rb, ro}, {rp, rb}}, cases_sym[] = {{rb, rb}, {rp, rp}};
+      for (const auto &rc : c.sym ? std::vector<std::pair<IS, IS>>(std::begin(cases_sym), std::end(cases_sym)) : std::vector<std::pair<IS, IS>>(std::begin(cases_full), std::end(cases_full))) {
+        Mat pb, pa;
+        PETSC_OK(MatPermute(p.bin, rc.first, rc.second, &pb));
+        PETSC_OK(MatPermute(p.aij, rc.first, rc.second, &pa));
+        CHECK(row_error(pb, pa) == 0.0);
+        PetscBool           isbin, sym;
+        MatBinBCSRPrecision prec;
+        PetscInt            bw, bw0;
+        PETSC_OK(PetscObjectTypeCompareAny((PetscObject)pb, &isbin, MATSEQBINBCSR, MATMPIBINBCSR, ""));
+        CHECK(isbin);
+        PETSC_OK(MatBinBCSRGetPrecision(pb, &prec));
+        PETSC_OK(MatBinBCSRGetSymmetricStorage(pb, &sym));
+        PETSC_OK(MatBinBCSRGetBinWidth(pb, &bw));
+        PETSC_OK(MatBinBCSRGetBinWidth(p.bin, &bw0));
+        CHECK(prec == c.prec);
+        CHECK(bool(sym) == c.sym);
+        CHECK(bw == bw0);
+        PETSC_OK(MatDestroy(&pb));
+        PETSC_OK(MatDestroy(&pa));
+      }
+      if (c.sym) {
+        Mat pb = nullptr;
+        PETSC_FAILS_WITH(MatPermute(p.bin, rb, ro, &pb), PETSC_ERR_SUP);
+      }
+      PETSC_OK(ISDestroy(&rb));
+      PETSC_OK(ISDestroy(&rp));
+      PETSC_OK(ISDestroy(&ro));
+    }
+  }
+}
