@@ -3,6 +3,7 @@
 # value array (zeros), on one rank and on several (a NULL array crashed MATMPIBINBCSR before).
 # Compared with the same program on aij. Label: stock, mat_ops (+ mpi). Budget: a few seconds.
 binbcsr_stock_example(petsc_snes_ex5 snes/tutorials/ex5.c)
+string(REPLACE ";" " " MPIEXEC_LINE "${MPIEXEC_CMD}")
 binbcsr_stock_example(petsc_ksp_ex45 ksp/ksp/tutorials/ex45.c)
 binbcsr_stock_example(petsc_snes_ex19 snes/tutorials/ex19.c)
 
@@ -10,7 +11,7 @@ binbcsr_stock_example(petsc_snes_ex19 snes/tutorials/ex19.c)
 set(SNES_EX5 "@STOCK@/petsc_snes_ex5 -da_refine 3 -snes_converged_reason -ksp_converged_reason -snes_monitor_short -pc_type jacobi")
 # ksp ex45 (3-D Laplacian on a DMDA, KSPSetComputeOperators): CG + Jacobi
 set(KSP_EX45 "@STOCK@/petsc_ksp_ex45 -da_grid_x 13 -da_grid_y 11 -da_grid_z 9 -ksp_type cg -pc_type jacobi -ksp_converged_reason")
-string(REPLACE ";" " " MPIEXEC_LINE "${MPIEXEC_CMD}")
+
 # snes ex19 (driven cavity, 4 unknowns per node: block size 4, the generic block path) has no Jacobian
 # routine: SNES computes it by finite differences with a colouring (MatFDColoring, through the AIJ
 # shadow, binbcsr_fdcoloring.cpp)

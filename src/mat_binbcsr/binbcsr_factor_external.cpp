@@ -51,9 +51,20 @@ PetscErrorCode GetFactorFrom(Mat A, MatSolverType package, MatFactorType ftype, 
   ExternalFactor *f;
 
   PetscFunctionBegin;
-  PetscCall(MatBinBCSRGetAIJShadow_Private(A, &S));
+  if (A->assembled) PetscCall(MatBinBCSRGetAIJShadow_Private(A, &S));
+  else { /* PCSetFromOptions asks for the factor before the values exist (ts ex2): the package's
+            factor of an empty AIJ matrix of A's layout; the symbolic phase gets the real shadow */
+    PetscMPIInt size;
+    PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)A), &size));
+    PetscCall(MatCreate(PetscObjectComm((PetscObject)A), &S));
+    PetscCall(MatSetLayouts(S, A->rmap, A->cmap));
+    PetscCall(MatSetType(S, size > 1 ? MATMPIAIJ : MATSEQAIJ));
+    PetscCall(MatSetUp(S));
+    PetscCall(MatPropagateSymmetryOptions(A, S));
+  }
   PetscCall(MatGetFactor(S, package, ftype, F));
   PetscCheck(*F, PetscObjectComm((PetscObject)A), PETSC_ERR_SUP, "%s has no %s factorisation of %s", package, MatFactorTypes[ftype], ((PetscObject)S)->type_name);
+  if (!A->assembled) PetscCall(MatDestroy(&S));
   f = new ExternalFactor;
   PetscCall(binbcsr_factor::Attach(*F, f));
   f->lusymbolic       = (*F)->ops->lufactorsymbolic;

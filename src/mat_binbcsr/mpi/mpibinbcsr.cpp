@@ -17,14 +17,23 @@ static PetscErrorCode MatDestroy_MPIBinBCSR(Mat mat)
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode MatMPIBinBCSRSetUpLayouts(Mat mat)
+{
+  PetscFunctionBegin;
+  PetscCall(PetscLayoutSetUp(mat->rmap));
+  PetscCall(PetscLayoutSetUp(mat->cmap));
+  if (mat->rmap->bs < 1) PetscCall(PetscLayoutSetBlockSize(mat->rmap, 1));
+  if (mat->cmap->bs < 1) PetscCall(PetscLayoutSetBlockSize(mat->cmap, 1));
+  PetscFunctionReturn(0);
+}
+
 /* Creates the diagonal part from the layouts of mat; B is created when the columns are compressed. */
 static PetscErrorCode CreateDiagonalPart(Mat mat)
 {
   Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
 
   PetscFunctionBegin;
-  PetscCall(PetscLayoutSetUp(mat->rmap));
-  PetscCall(PetscLayoutSetUp(mat->cmap));
+  PetscCall(MatMPIBinBCSRSetUpLayouts(mat));
   PetscCheck(mat->rmap->bs == mat->cmap->bs, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_INCOMP, "MATMPIBINBCSR needs equal row and column block sizes (%" PetscInt_FMT " vs %" PetscInt_FMT ")", mat->rmap->bs, mat->cmap->bs);
   PetscCall(MatMPIBinBCSRResetParts(mat));
   PetscCall(MatMPIBinBCSRCreatePart(mat, mat->rmap->n, mat->cmap->n, &b->A));
@@ -47,8 +56,7 @@ static PetscErrorCode MatMPIAIJSetPreallocation_MPIBinBCSR(Mat mat, PetscInt d_n
   Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
 
   PetscFunctionBegin;
-  PetscCall(PetscLayoutSetUp(mat->rmap));
-  PetscCall(PetscLayoutSetUp(mat->cmap));
+  PetscCall(MatMPIBinBCSRSetUpLayouts(mat));
   if (mat->rmap->bs != mat->cmap->bs) { /* a layout the bins cannot hold (PCGAMG's prolongators, made in the operator's type) */
     PetscCall(PetscInfo(mat, "Row and column block sizes %" PetscInt_FMT " and %" PetscInt_FMT " differ: the matrix becomes %s\n", mat->rmap->bs, mat->cmap->bs, MATMPIAIJ));
     PetscCall(MatSetType(mat, MATMPIAIJ));

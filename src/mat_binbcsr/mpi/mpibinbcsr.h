@@ -130,6 +130,9 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRCopyConfig(Mat from, Mat to);
 
 /* mpibinbcsr_parts.cpp: creating the parts, compressing B, the ghost scatter */
 PETSC_INTERN PetscErrorCode MatMPIBinBCSRCreatePart(Mat, PetscInt m, PetscInt n, Mat *);
+/* Layouts set up, an unset block size (-1: the program never gave one) made 1: every preallocation
+   path starts here, so that the parts and the ghost columns may read mat->rmap/cmap->bs. */
+PETSC_INTERN PetscErrorCode MatMPIBinBCSRSetUpLayouts(Mat);
 PETSC_INTERN PetscErrorCode MatMPIBinBCSRResetParts(Mat);
 PETSC_INTERN PetscErrorCode MatMPIBinBCSRSetUpScatter(Mat);
 PETSC_INTERN PetscErrorCode MatMPIBinBCSRGhostIndex(Mat, PetscInt gcol, PetscInt *lcol);

@@ -206,6 +206,7 @@ PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_MPIBinBCSR(Mat mat, PetscCoun
   MPI_Comm        comm = PetscObjectComm((PetscObject)mat);
 
   PetscFunctionBegin;
+  PetscCall(MatMPIBinBCSRSetUpLayouts(mat));
   PetscCheck(mat->rmap->bs == mat->cmap->bs, comm, PETSC_ERR_ARG_INCOMP, "MATMPIBINBCSR needs equal row and column block sizes");
   PetscCall(MatMPIBinBCSRResetParts(mat));
   const PetscInt rstart = mat->rmap->rstart, rend = mat->rmap->rend, cstart = mat->cmap->rstart, cend = mat->cmap->rend;

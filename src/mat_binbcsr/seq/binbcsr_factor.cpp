@@ -322,7 +322,22 @@ PetscErrorCode FactorShadow::Routed(Mat F)
 template <class Symbolic>
 PetscErrorCode ShadowSymbolic(Mat F, Mat A, IS row, IS col, Symbolic &&symbolic)
 {
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  FactorShadow   *f;
+
   PetscFunctionBegin;
+  /* a new pattern (or the first one: the factor was asked for before the matrix was assembled) */
+  PetscCall(binbcsr_factor::Get(F, &f));
+  if (f->nzstate != A->nonzerostate) {
+    PetscBool sbaij;
+    PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Symbolic factorisation needs an assembled MATSEQBINBCSR matrix");
+    PetscCall(PetscObjectTypeCompare((PetscObject)f->S, MATSEQSBAIJ, &sbaij));
+    f->bs      = a->bs;
+    f->bw      = a->bw;
+    f->nzstate = A->nonzerostate;
+    f->perm.clear();
+    PetscCall(BuildShadow(A, sbaij, f));
+  }
   PetscCall(binbcsr_factor::OnShadow<FactorShadow>(F, A, [&](FactorShadow *f, Mat) {
     IS r, c;
 
@@ -373,13 +388,23 @@ PetscErrorCode MatGetFactor_SeqBinBCSR_Petsc(Mat A, MatFactorType ftype, Mat *F)
 
   PetscFunctionBegin;
   PetscCheck(ftype == MAT_FACTOR_ICC || ftype == MAT_FACTOR_CHOLESKY || ftype == MAT_FACTOR_ILU || ftype == MAT_FACTOR_LU, PETSC_COMM_SELF, PETSC_ERR_SUP, "MATSEQBINBCSR provides ICC, Cholesky, ILU and LU (MATSOLVERPETSC), not %s", MatFactorTypes[ftype]);
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatGetFactor needs an assembled MATSEQBINBCSR matrix");
   PetscCheck(A->rmap->n == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Factorisation of a non-square MATSEQBINBCSR matrix (%" PetscInt_FMT " x %" PetscInt_FMT ")", A->rmap->n, A->cmap->n);
-  f          = new FactorShadow;
-  f->bs      = a->bs;
-  f->bw      = a->bw;
-  f->nzstate = A->nonzerostate;
-  PetscCall(BuildShadow(A, upper, f));
+  f = new FactorShadow;
+  if (a->built) {
+    f->bs      = a->bs;
+    f->bw      = a->bw;
+    f->nzstate = A->nonzerostate;
+    PetscCall(BuildShadow(A, upper, f));
+  } else { /* asked for before the first assembly (PCSetFromOptions does, e.g. in ts ex2): an empty
+              shadow of the right type and block size now, its pattern at the symbolic phase */
+    PetscCall(MatGetBlockSize(A, &f->bs));
+    f->nzstate = -1;
+    PetscCall(MatCreate(PETSC_COMM_SELF, &f->S));
+    PetscCall(MatSetSizes(f->S, A->rmap->n, A->cmap->n, A->rmap->n, A->cmap->n));
+    PetscCall(MatSetType(f->S, upper ? MATSEQSBAIJ : MATSEQBAIJ));
+    if (upper) PetscCall(MatSeqSBAIJSetPreallocation(f->S, f->bs, 0, nullptr));
+    else PetscCall(MatSeqBAIJSetPreallocation(f->S, f->bs, 0, nullptr));
+  }
 
   PetscCall(MatGetFactor(f->S, MATSOLVERPETSC, ftype, F));
   PetscCall(binbcsr_factor::Attach(*F, f));

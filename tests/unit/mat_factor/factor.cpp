@@ -386,15 +386,56 @@ TEST_CASE("unsupported factorisations are errors, not crashes", "[mat_factor][er
   CHECK(MatGetFactor(A, MATSOLVERPETSC, MAT_FACTOR_QR, &F) != 0);
   CHECK(MatGetFactor(A, MATSOLVERPETSC, MAT_FACTOR_ILUDT, &F) != 0);
   CHECK(F == nullptr);
-  // an unassembled matrix
+  // an unassembled matrix: the factor may be asked for (PCSetFromOptions does), but not computed
   Mat U;
   REQUIRE(MatCreate(PETSC_COMM_SELF, &U) == 0);
   REQUIRE(MatSetSizes(U, 9, 9, 9, 9) == 0);
   REQUIRE(MatSetType(U, MATSEQBINBCSR) == 0);
   REQUIRE(MatSetUp(U) == 0);
-  CHECK(MatGetFactor(U, MATSOLVERPETSC, MAT_FACTOR_ICC, &F) != 0);
+  REQUIRE(MatGetFactor(U, MATSOLVERPETSC, MAT_FACTOR_ICC, &F) == 0);
+  MatFactorInfo info;
+  REQUIRE(MatFactorInfoInitialize(&info) == 0);
+  CHECK(MatICCFactorSymbolic(F, U, nullptr, &info) != 0);
+  REQUIRE(MatDestroy(&F) == 0);
   REQUIRE(MatDestroy(&U) == 0);
   REQUIRE(MatDestroy(&A) == 0);
+}
+
+TEST_CASE("the factor asked for before the first assembly (PCSetFromOptions) factors the matrix assembled later", "[mat_factor]")
+{
+  for (PCType pc : {PCICC, PCILU, PCLU, PCCHOLESKY})
+    for (bool sym : {false, true}) {
+      CAPTURE(pc, sym);
+      const Pattern p = fem_pattern(4, 3, 3, 3);
+      Mat           A, Aref = build(p, MATSEQBAIJ);
+      REQUIRE(MatCreate(PETSC_COMM_SELF, &A) == 0);
+      REQUIRE(MatSetSizes(A, p.m, p.n, p.m, p.n) == 0);
+      REQUIRE(MatSetBlockSize(A, p.bs) == 0);
+      REQUIRE(MatSetType(A, MATSEQBINBCSR) == 0);
+      if (sym) REQUIRE(MatBinBCSRSetSymmetricStorage(A, PETSC_TRUE) == 0);
+      REQUIRE(MatSetUp(A) == 0);
+      const bool direct = !strcmp(pc, PCLU) || !strcmp(pc, PCCHOLESKY);
+      KSP        k      = make_ksp(PETSC_COMM_SELF, direct ? KSPPREONLY : KSPCG, pc, 1e-10);
+      REQUIRE(KSPSetOperators(k, A, A) == 0);
+      REQUIRE(KSPSetFromOptions(k) == 0); // PCFactor asks for the factor here, before any value
+      Mat F = nullptr;
+      PC  kpc;
+      REQUIRE(KSPGetPC(k, &kpc) == 0);
+      REQUIRE(PCFactorGetMatrix(kpc, &F) == 0);
+      CHECK(F != nullptr);
+      for (const Entry &e : p.entries) REQUIRE(MatSetValue(A, e.i, e.j, e.v, INSERT_VALUES) == 0);
+      REQUIRE(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY) == 0);
+      REQUIRE(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY) == 0);
+      Vec            b   = make_vec(p.m, 3);
+      const Solution got = solve_with(k, A, b);
+      const Solution ref = solve(Aref, direct ? KSPPREONLY : KSPCG, !strcmp(pc, PCCHOLESKY) ? PCLU : pc, b);
+      CHECK(got.relres < (direct ? 1e-13 : 1e-9));
+      if (strcmp(pc, PCCHOLESKY)) check_same(got, ref, 1e-9); // baij's own ICC/ILU/LU
+      REQUIRE(KSPDestroy(&k) == 0);
+      REQUIRE(VecDestroy(&b) == 0);
+      REQUIRE(MatDestroy(&A) == 0);
+      REQUIRE(MatDestroy(&Aref) == 0);
+    }
 }
 
 namespace
