@@ -58,6 +58,7 @@ struct Options {
   PetscInt    vtk_every = 1;
   char        dump[PETSC_MAX_PATH_LEN] = "";
   PetscBool   merge   = PETSC_TRUE;
+  PetscBool   rigid_body_modes = PETSC_TRUE;
   PetscBool   reorder = PETSC_TRUE;
   PetscInt    bin_order_window = FemScene().bin_order_window;
   PetscBool   quiet   = PETSC_FALSE;
@@ -109,6 +110,8 @@ PetscErrorCode GetOptions(Options &o)
                                nullptr));
   PetscCall(PetscOptionsBool("-fem_merge_blocks", "sum element blocks into unique COO blocks here (1) or let the Mat do it (0)",
                              "", o.merge, &o.merge, nullptr));
+  PetscCall(PetscOptionsBool("-fem_rigid_body_modes", "give the matrix the rest shape's rigid body modes as near null space (PCGAMG's coarse space; 0: GAMG's default, translations only)",
+                             "", o.rigid_body_modes, &o.rigid_body_modes, nullptr));
   PetscCall(PetscOptionsBool("-fem_reorder", "METIS partition / RCM renumbering of the nodes", "", o.reorder, &o.reorder, nullptr));
   PetscCall(PetscOptionsInt("-fem_bin_order_window", "with -fem_reorder: sort nodes by row length in windows of N (0 = off)", "", o.bin_order_window, &o.bin_order_window, nullptr));
   PetscCall(PetscOptionsInt("-fem_element_bench", "after the steps, time the element loop N more times (CPU time)", "",
@@ -269,6 +272,7 @@ int main(int argc, char **argv)
     scene.rayleigh_beta         = o.rayleigh[1];
     scene.is_static             = o.is_static;
     scene.merge_blocks          = o.merge;
+    scene.rigid_body_modes      = o.rigid_body_modes;
     scene.reorder               = o.reorder;
     scene.bin_order_window      = (int)o.bin_order_window;
   }

@@ -25,6 +25,7 @@ struct FemScene {
   double                rayleigh_alpha = 0, rayleigh_beta = 0;
   bool                  is_static = false; // Newton steps on K(x) dx = f(x) + f_ext instead of time steps
   bool                  merge_blocks = true;
+  bool                  rigid_body_modes = true; // the rest shape's rigid body modes as the matrix's near null space (PCGAMG)
   bool                  reorder = true;
   int                   bin_order_window = 256; // with reorder: sort rows by length in windows of this many nodes (physics/row_order.hpp); 0 = off
 };

@@ -246,6 +246,25 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode BlockSystemSetRigidBodyModes(BlockSystem *sys, const PetscScalar *coords_local)
+{
+  Vec          coords;
+  MatNullSpace modes;
+  PetscScalar *c;
+
+  PetscFunctionBegin;
+  PetscCall(MatCreateVecs(sys->A, &coords, nullptr));
+  PetscCall(VecSetBlockSize(coords, 3));
+  PetscCall(VecGetArrayWrite(coords, &c));
+  for (PetscInt i = 0; i < sys->row_end - sys->row_begin; i++) c[i] = coords_local[i];
+  PetscCall(VecRestoreArrayWrite(coords, &c));
+  PetscCall(MatNullSpaceCreateRigidBody(coords, &modes));
+  PetscCall(MatSetNearNullSpace(sys->A, modes));
+  PetscCall(MatNullSpaceDestroy(&modes));
+  PetscCall(VecDestroy(&coords));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode BlockSystemSetValues(BlockSystem *sys, const PetscScalar *block_values)
 {
   PetscFunctionBegin;

@@ -62,6 +62,11 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
 PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, PetscBool *offrank_full, PetscInt *bin_width = nullptr,
                                          PetscBool *lower_mirrored = nullptr);
 
+// The rigid body modes (3 translations, 3 rotations) of this rank's nodes (coords_local: 3 per block
+// row, in the rows' order) as the matrix's near null space, from which PCGAMG (and ML) build their
+// coarse spaces for elasticity; other preconditioners ignore it.
+PetscErrorCode BlockSystemSetRigidBodyModes(BlockSystem *sys, const PetscScalar *coords_local);
+
 // block_values: 9 * n_coo_blocks values, block k row-major at [9k, 9k+9). Summed over duplicates,
 // replacing the previous values. The array is remembered (not copied) for BlockSystemDumpMatrix: keep
 // it alive until the next call or the dump.
