@@ -1,5 +1,5 @@
 # Label `valgrind` (excluded from the default run; `scripts/test -L valgrind`): the matrix unit tests
-# (mat_core, mat_ops, mat_sym, mat_factor, mat_sub: 1 rank)
+# (mat_core, mat_ops, mat_sym, mat_factor, mat_sub, mat_rowops: 1 rank)
 # under memcheck, with --error-exitcode=1 and definite leaks counted as errors.
 #
 # valgrind 3.19 cannot decode the AVX-512 instructions that -march=native emits on AVX-512 machines,
@@ -7,7 +7,7 @@
 # build/valgrind (made by the first case, valgrind_build; the others require it as a fixture).
 find_program(VALGRIND_EXECUTABLE valgrind)
 set(VALGRIND_AREAS)
-foreach(area mat_core mat_ops mat_sym mat_factor mat_sub)
+foreach(area mat_core mat_ops mat_sym mat_factor mat_sub mat_rowops)
   if(IS_DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/unit/${area})
     list(APPEND VALGRIND_AREAS ${area})
   endif()
