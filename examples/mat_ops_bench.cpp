@@ -1,5 +1,6 @@
 // mat_ops_bench: times the value operations (MatAXPY with the same pattern, MatScale, MatShift,
-// MatNorm, MatZeroRowsColumns with x and b) on the 27-point 3x3-block stencil matrix, for seqaij,
+// MatNorm, MatZeroRowsColumns with x and b) and the row/column ones (MatDiagonalScale D A D,
+// MatGetRowMaxAbs with columns, MatGetColumnNorms 2) on the 27-point 3x3-block stencil matrix, for seqaij,
 // seqbaij and binbcsr in double and single storage, in one run. Prints the minimum over -repeats
 // runs of each operation in milliseconds (the machine is shared: the minimum is the least disturbed).
 //
@@ -59,7 +60,7 @@ int main(int argc, char **argv)
     {"binbcsr-sym", MATSEQBINBCSR, MAT_BINBCSR_PRECISION_DOUBLE, true},
     {"binbcsr-sym-single", MATSEQBINBCSR, MAT_BINBCSR_PRECISION_SINGLE, true},
   };
-  const char *ops[] = {"axpy_same", "scale", "shift", "norm_frobenius", "norm_1", "zero_rows_columns"};
+  const char *ops[] = {"axpy_same", "scale", "shift", "norm_frobenius", "norm_1", "zero_rows_columns", "diag_scale", "row_max_abs", "col_norms_2"};
   PetscCall(PetscPrintf(PETSC_COMM_SELF, "27-point 3x3-block stencil, %" PetscInt_FMT "^3 nodes, %" PetscInt_FMT " rows; minimum of %" PetscInt_FMT " runs, ms\n", grid.nx, 3 * grid.nodes(), repeats));
   PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-16s", "type"));
   for (const char *op : ops) PetscCall(PetscPrintf(PETSC_COMM_SELF, " %18s", op));
@@ -96,6 +97,23 @@ int main(int argc, char **argv)
     ms.push_back(t);
     PetscCall(Time(repeats, [&] { return MatZeroRowsColumns(A, (PetscInt)rows.size(), rows.data(), 1.0, x, b); }, &t));
     ms.push_back(t);
+
+    {
+      Vec                    d, rmax;
+      std::vector<PetscInt>  at(3 * grid.nodes());
+      std::vector<PetscReal> norms(3 * grid.nodes());
+      PetscCall(VecDuplicate(x, &d));
+      PetscCall(VecDuplicate(x, &rmax));
+      PetscCall(VecSet(d, 1.0001));
+      PetscCall(Time(repeats, [&] { return MatDiagonalScale(A, d, d); }, &t));
+      ms.push_back(t);
+      PetscCall(Time(repeats, [&] { return MatGetRowMaxAbs(A, rmax, at.data()); }, &t));
+      ms.push_back(t);
+      PetscCall(Time(repeats, [&] { return MatGetColumnNorms(A, NORM_2, norms.data()); }, &t));
+      ms.push_back(t);
+      PetscCall(VecDestroy(&d));
+      PetscCall(VecDestroy(&rmax));
+    }
 
     PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-16s", f.label));
     for (double v : ms) PetscCall(PetscPrintf(PETSC_COMM_SELF, " %18.3f", v));

@@ -121,27 +121,23 @@ BINBCSR_HD void bin_row_abs_sums(const V *bin_val, int len, int bw, int bs, doub
 /* Column reductions (MatGetColumnNorms/Reductions, the 1-norm): red[c] = op over the entries of
    point column c, for op one of: */
 enum reduction_kind { reduce_abs_sum = 0, reduce_square_sum = 1, reduce_abs_max = 2, reduce_sum = 3 };
-BINBCSR_HD double reduce(int kind, double acc, double v)
+template <int KIND>
+BINBCSR_HD double reduce(double acc, double v)
 {
   const double a = v < 0 ? -v : v;
-  switch (kind) {
-  case reduce_abs_sum:
-    return acc + a;
-  case reduce_square_sum:
-    return acc + v * v;
-  case reduce_abs_max:
-    return a > acc ? a : acc;
-  default:
-    return acc + v;
-  }
+  if constexpr (KIND == reduce_abs_sum) return acc + a;
+  else if constexpr (KIND == reduce_square_sum) return acc + v * v;
+  else if constexpr (KIND == reduce_abs_max) return a > acc ? a : acc;
+  else return acc + v;
 }
 
 /* red[c] = reduce(red[c], a_ic) over the entries of a bin of len slot groups whose lanes are the block
    rows r0, r0 + 1, ... (a scatter: a GPU needs atomics). Padding adds zeros, which change no reduction.
-   mirror_rows > 0 (symmetric storage, mbs): a stored off-diagonal block (r, c) also stands for its
-   transpose (c, r), whose entries lie in the columns of block row r; phantom lanes (r >= mbs) skip it. */
-template <typename V, typename I>
-BINBCSR_HD void bin_col_reductions(const V *bin_val, const I *bin_col, int len, int bw, int bs, int kind, I r0, I mirror_rows, double *red)
+   MIRROR (symmetric storage): a stored off-diagonal block (r, c) also stands for its transpose (c, r),
+   whose entries lie in the columns of block row r; phantom lanes (r >= mbs) have none. The kind and
+   the mirror are template arguments: tested per value they cost the 1-norm 2.4x. */
+template <int KIND, bool MIRROR, typename V, typename I>
+BINBCSR_HD void bin_col_reductions(const V *bin_val, const I *bin_col, int len, int bw, int bs, I r0, I mbs, double *red)
 {
   const int bs2 = bs * bs;
   for (int k = 0; k < len; k++) {
@@ -151,10 +147,12 @@ BINBCSR_HD void bin_col_reductions(const V *bin_val, const I *bin_col, int len, 
         const V *v = bin_val + value_offset(k, i * bs + j, bw, bs2, 0);
         for (int l = 0; l < bw; l++) {
           const long c = (long)cols[l] * bs + j;
-          red[c]       = reduce(kind, red[c], (double)v[l]);
-          if (mirror_rows && r0 + l < mirror_rows && cols[l] != r0 + l) {
-            const long r = (long)(r0 + l) * bs + i;
-            red[r]       = reduce(kind, red[r], (double)v[l]);
+          red[c]       = reduce<KIND>(red[c], (double)v[l]);
+          if constexpr (MIRROR) {
+            if (r0 + l < mbs && cols[l] != r0 + l) {
+              const long r = (long)(r0 + l) * bs + i;
+              red[r]       = reduce<KIND>(red[r], (double)v[l]);
+            }
           }
         }
       }
@@ -218,6 +216,40 @@ BINBCSR_HD void slot_row_extremes(const V *tile, int bw, int bs, bool transposed
         at[i]   = c0 + j;
       }
     }
+}
+
+/* MatGetRowMaxAbs over a whole bin whose lanes are the block rows r0, r0 + 1, ...: best[p], at[p] for
+   every point row p of the matrix, started at 0 and 0 by the caller (seqaij's start). Ties go to the
+   smaller column whatever the order the slots come in (symmetric storage colours them), which is
+   seqaij's first maximum in column order. Padding holds zeros, which never beat a start of 0, so all
+   len slot groups run. MIRROR (symmetric storage): a stored off-diagonal block (r, c) also offers its
+   entries, transposed, to the rows of block c (a scatter: a GPU needs atomics for it). */
+template <typename I>
+BINBCSR_HD void max_abs_offer(double a, I col, double *best, I *at)
+{
+  if (a > *best || (a == *best && a > 0 && col < *at)) {
+    *best = a;
+    *at   = col;
+  }
+}
+template <bool MIRROR, typename V, typename I>
+BINBCSR_HD void bin_row_max_abs(const V *bin_val, const I *bin_col, int len, int bw, int bs, I r0, I mbs, double *best, I *at)
+{
+  const int bs2 = bs * bs, lanes = mbs - r0 < bw ? (int)(mbs - r0) : bw; /* phantom lanes hold padding only */
+  for (int k = 0; k < len; k++) {
+    const I *cols = bin_col + (long)k * bw;
+    for (int i = 0; i < bs; i++)
+      for (int j = 0; j < bs; j++) {
+        const V *v = bin_val + value_offset(k, i * bs + j, bw, bs2, 0);
+        for (int l = 0; l < lanes; l++) {
+          const double a = v[l] < 0 ? -(double)v[l] : (double)v[l];
+          const I      r = r0 + l, c = cols[l];
+          max_abs_offer(a, c * bs + j, best + (long)r * bs + i, at + (long)r * bs + i);
+          if constexpr (MIRROR)
+            if (c != r) max_abs_offer(a, r * bs + i, best + (long)c * bs + j, at + (long)c * bs + j);
+        }
+      }
+  }
 }
 
 } // namespace binbcsr

@@ -12,6 +12,7 @@
 #include "binbcsr_ops.h"
 #include "../binbcsr_value_kernels.h"
 
+#include <algorithm>
 #include <vector>
 
 namespace
@@ -88,8 +89,23 @@ PetscErrorCode RowExtremes(Mat A, Vec v, PetscInt idx[], int kind, const char *o
   PetscCheck(!A->factortype, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Not for factored matrix");
   PetscCall(CheckVecSize(v, A->rmap->n, "The row vector"));
   if (!A->cmap->n) PetscFunctionReturn(0); /* MatGetRowMax/Min/MaxAbs have set v and idx */
-  if (a->sym) PetscCall(MatSeqBinBCSRBuildLowerIndex(a));
   PetscCall(VecGetArrayWrite(v, &x));
+  if (kind == binbcsr::extreme_max_abs) { /* whole bins at a time, straight into v (and idx) */
+    std::vector<PetscInt> scratch(idx ? 0 : A->rmap->n);
+    PetscInt             *col = idx ? idx : scratch.data();
+    std::fill(x, x + A->rmap->n, 0.0);
+    std::fill(col, col + A->rmap->n, 0);
+    for (PetscInt b = 0; b < a->nbins; b++) {
+      const PetscInt s0 = a->bin_start[b], len = (a->bin_start[b + 1] - s0) / a->bw;
+      WithValues(a, [&](const auto *val) {
+        if (a->sym) binbcsr::bin_row_max_abs<true>(val + (size_t)s0 * a->bs2, a->col + s0, (int)len, (int)a->bw, (int)bs, b * a->bw, a->mbs, x, col);
+        else binbcsr::bin_row_max_abs<false>(val + (size_t)s0 * a->bs2, a->col + s0, (int)len, (int)a->bw, (int)bs, b * a->bw, a->mbs, x, col);
+      });
+    }
+    PetscCall(VecRestoreArrayWrite(v, &x));
+    PetscFunctionReturn(0);
+  }
+  if (a->sym) PetscCall(MatSeqBinBCSRBuildLowerIndex(a));
   for (PetscInt r = 0; r < a->mbs; r++) {
     PetscInt nb = 0, gap = -1; /* blocks of the full row, first block column it does not hold */
     ForEachRowBlock(a, r, [&](PetscInt, PetscInt c, bool) {
@@ -112,6 +128,24 @@ PetscErrorCode RowExtremes(Mat A, Vec v, PetscInt idx[], int kind, const char *o
 
 } // namespace
 
+namespace
+{
+template <int KIND, bool MIRROR>
+void ColumnReductionsOf(const Mat_SeqBinBCSR *a, double *red)
+{
+  for (PetscInt b = 0; b < a->nbins; b++) {
+    const PetscInt s0 = a->bin_start[b], len = (a->bin_start[b + 1] - s0) / a->bw;
+    WithValues(a, [&](const auto *val) { binbcsr::bin_col_reductions<KIND, MIRROR>(val + (size_t)s0 * a->bs2, a->col + s0, (int)len, (int)a->bw, (int)a->bs, b * a->bw, a->mbs, red); });
+  }
+}
+template <int KIND>
+void ColumnReductionsOf(const Mat_SeqBinBCSR *a, double *red)
+{
+  if (a->sym) ColumnReductionsOf<KIND, true>(a, red);
+  else ColumnReductionsOf<KIND, false>(a, red);
+}
+} // namespace
+
 PetscErrorCode MatSeqBinBCSRColumnReductions(Mat A, int kind, double *red)
 {
   const Mat_SeqBinBCSR *a = (const Mat_SeqBinBCSR *)A->data;
@@ -119,9 +153,18 @@ PetscErrorCode MatSeqBinBCSRColumnReductions(Mat A, int kind, double *red)
   PetscFunctionBegin;
   PetscCall(CheckBuilt(A, "A column reduction"));
   PetscCall(PetscArrayzero(red, A->cmap->n));
-  for (PetscInt b = 0; b < a->nbins; b++) {
-    const PetscInt s0 = a->bin_start[b], len = (a->bin_start[b + 1] - s0) / a->bw;
-    WithValues(a, [&](const auto *val) { binbcsr::bin_col_reductions(val + (size_t)s0 * a->bs2, a->col + s0, (int)len, (int)a->bw, (int)a->bs, kind, b * a->bw, a->sym ? a->mbs : (PetscInt)0, red); });
+  switch (kind) {
+  case binbcsr::reduce_abs_sum:
+    ColumnReductionsOf<binbcsr::reduce_abs_sum>(a, red);
+    break;
+  case binbcsr::reduce_square_sum:
+    ColumnReductionsOf<binbcsr::reduce_square_sum>(a, red);
+    break;
+  case binbcsr::reduce_abs_max:
+    ColumnReductionsOf<binbcsr::reduce_abs_max>(a, red);
+    break;
+  default:
+    ColumnReductionsOf<binbcsr::reduce_sum>(a, red);
   }
   PetscCall(PetscLogFlops((a->sym ? 2.0 : 1.0) * a->nz * a->bs2));
   PetscFunctionReturn(0);

@@ -42,6 +42,7 @@ double entry(const Config &c, PetscInt i, PetscInt j)
   const unsigned a = c.sym ? (unsigned)std::min(i, j) : (unsigned)i, b = c.sym ? (unsigned)std::max(i, j) : (unsigned)j;
   const unsigned h = hash3(a, b, 30 + c.value_seed);
   double         u = h % 10 == 0 ? 0.0 : ((double)(h % 20001) - 10000.0) / 10000.0;
+  if (c.ties) u = (double)(h % 3) - 1.0;
   if (i == j) u += 2.0; // mostly positive diagonal
   /* rows of one sign, where the implicit zeros decide MatGetRowMax/Min (the row's block for full storage,
      the pair's first block for symmetric storage) */
