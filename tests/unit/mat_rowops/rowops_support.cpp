@@ -21,6 +21,13 @@ std::vector<Config> configs()
           c.bw   = bw;
           v.push_back(c);
         }
+  for (bool sym : {false, true}) { // the generic block size path
+    Config c;
+    c.bs   = 2;
+    c.sym  = sym;
+    c.prec = sym ? MAT_BINBCSR_PRECISION_SINGLE : MAT_BINBCSR_PRECISION_DOUBLE;
+    v.push_back(c);
+  }
   return v;
 }
 

@@ -43,6 +43,7 @@ struct Config {
 // bs 1 and 3, full and symmetric storage, double and single, default bin width with holes and 5 without
 // (neither divides
 // the rows: 43 rows of bs 1, 23 block rows of bs 3).
+// Plus bs 2 (the generic block size path), full double and symmetric single.
 std::vector<Config> configs();
 
 inline unsigned hash3(unsigned a, unsigned b, unsigned c)

@@ -426,7 +426,7 @@ TEST_CASE("MatPermute matches aij and keeps the type and its options", "[rowops]
       const PetscInt N = c.mbs() * c.bs, mbs = c.mbs(), bs = c.bs;
       PetscInt       rstart, rend;
       PETSC_OK(MatGetOwnershipRange(p.aij, &rstart, &rend));
-      // a permutation of whole blocks (7 and 5 are prime to 23 and 43) and one of points (5 is prime to 43, 69)
+      // a permutation of whole blocks (7 and 5 are prime to 23 and 43) and one of points (5 is prime to 43, 46, 69)
       std::vector<PetscInt> blocks, points, other;
       for (PetscInt i = rstart; i < rend; i++) {
         blocks.push_back(((i / bs) * 7 + 3) % mbs * bs + i % bs);
