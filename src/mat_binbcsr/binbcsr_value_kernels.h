@@ -184,10 +184,11 @@ BINBCSR_HD void lane_diagonal_scale(V *bin_val, const I *bin_col, int nz, int bw
 
 /* Row extremes (MatGetRowMaxAbs, MatGetRowMax, MatGetRowMin) with PETSc's AIJ rules: the value and the
    column where it is reached, for each point row. */
-enum row_extreme_kind { extreme_max_abs = 0, extreme_max = 1, extreme_min = 2 };
+enum row_extreme_kind { extreme_max_abs = 0, extreme_max = 1, extreme_min = 2, extreme_min_abs = 3 };
 
-/* The state of a row before its stored entries are seen: for max/min, a row that does not store every
-   column holds implicit zeros, the first at column first_gap; a row that does starts from nothing. */
+/* The state of a row before its stored entries are seen: for max/min/min-abs, a row that does not store
+   every column holds implicit zeros, the first at column first_gap; a row that does starts from
+   nothing. */
 template <typename I>
 BINBCSR_HD void row_extreme_start(int kind, bool dense, I first_gap, double *best, I *at)
 {
@@ -197,6 +198,23 @@ BINBCSR_HD void row_extreme_start(int kind, bool dense, I first_gap, double *bes
   } else {
     *best = kind == extreme_max ? -1.0 / 0.0 : 1.0 / 0.0;
     *at   = -1;
+  }
+}
+
+/* Whether v beats the row's best so far, and what is kept: |v| for max-abs, v itself otherwise (seqaij
+   keeps the signed entry of the smallest magnitude). */
+BINBCSR_HD bool row_extreme_beats(int kind, double v, double best)
+{
+  const double av = v < 0 ? -v : v, ab = best < 0 ? -best : best;
+  switch (kind) {
+  case extreme_max_abs:
+    return av > best;
+  case extreme_max:
+    return v > best;
+  case extreme_min:
+    return v < best;
+  default:
+    return av < ab;
   }
 }
 
@@ -210,9 +228,8 @@ BINBCSR_HD void slot_row_extremes(const V *tile, int bw, int bs, bool transposed
   for (int i = 0; i < bs; i++)
     for (int j = 0; j < bs; j++) {
       const double v = (double)tile[(transposed ? j * bs + i : i * bs + j) * bw];
-      const double x = kind == extreme_max_abs && v < 0 ? -v : v;
-      if (kind == extreme_min ? x < best[i] : x > best[i]) {
-        best[i] = x;
+      if (row_extreme_beats(kind, v, best[i])) {
+        best[i] = kind == extreme_max_abs && v < 0 ? -v : v;
         at[i]   = c0 + j;
       }
     }

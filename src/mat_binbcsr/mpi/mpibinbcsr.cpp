@@ -418,6 +418,7 @@ PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
   mat->ops->getrowmaxabs        = MatGetRowMaxAbs_MPIBinBCSR;
   mat->ops->getrowmax           = MatGetRowMax_MPIBinBCSR;
   mat->ops->getrowmin           = MatGetRowMin_MPIBinBCSR;
+  mat->ops->getrowminabs        = MatGetRowMinAbs_MPIBinBCSR;
   mat->ops->getcolumnreductions = MatGetColumnReductions_MPIBinBCSR;
   mat->ops->missingdiagonal     = MatMissingDiagonal_MPIBinBCSR;
   mat->ops->equal               = MatEqual_MPIBinBCSR;

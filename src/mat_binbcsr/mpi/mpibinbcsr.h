@@ -172,6 +172,7 @@ PETSC_INTERN PetscErrorCode MatDiagonalScale_MPIBinBCSR(Mat, Vec, Vec);
 PETSC_INTERN PetscErrorCode MatGetRowMaxAbs_MPIBinBCSR(Mat, Vec, PetscInt[]);
 PETSC_INTERN PetscErrorCode MatGetRowMax_MPIBinBCSR(Mat, Vec, PetscInt[]);
 PETSC_INTERN PetscErrorCode MatGetRowMin_MPIBinBCSR(Mat, Vec, PetscInt[]);
+PETSC_INTERN PetscErrorCode MatGetRowMinAbs_MPIBinBCSR(Mat, Vec, PetscInt[]);
 PETSC_INTERN PetscErrorCode MatGetColumnReductions_MPIBinBCSR(Mat, PetscInt, PetscReal *);
 PETSC_INTERN PetscErrorCode MatMissingDiagonal_MPIBinBCSR(Mat, PetscBool *, PetscInt *);
 PETSC_INTERN PetscErrorCode MatEqual_MPIBinBCSR(Mat, Mat, PetscBool *);

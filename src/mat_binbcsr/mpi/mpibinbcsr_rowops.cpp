@@ -23,32 +23,64 @@ PetscErrorCode CheckLocalSize(Vec v, PetscInt n, const char *what)
 /* Global point column of local column c of the off-diagonal part. */
 inline PetscInt GhostColumn(const Mat_MPIBinBCSR *b, PetscInt bs, PetscInt c) { return b->garray[c / bs] * bs + c % bs; }
 
-/* MatGetRowMax/Min through the merged global rows: the same kernels as the sequential type, over
-   point entries (bw = bs = 1), with the implicit zeros of the global row. */
-PetscErrorCode RowExtremesByRows(Mat mat, Vec v, PetscInt idx[], int kind)
+/* MatGetRowMax/Min/MinAbs as MPIAIJ computes them (PETSc's own tests compare the printed columns): the
+   diagonal part's own answer over the owned columns, the off-diagonal part's over the others (its
+   implicit zeros at the first global column outside the owned ones that it does not store), the better
+   of the two, the smaller column on a tie. The off-diagonal rows run the sequential kernels over point
+   entries (bw = bs = 1). */
+PetscErrorCode RowExtremesByParts(Mat mat, Vec v, PetscInt idx[], int kind, PetscErrorCode (*part_op)(Mat, Vec, PetscInt[]))
 {
-  const PetscInt rstart = mat->rmap->rstart, N = mat->cmap->N;
-  PetscScalar   *x;
+  Mat_MPIBinBCSR       *b = MPIBinBCSR(mat);
+  const PetscInt        m = mat->rmap->n, n = mat->cmap->n, N = mat->cmap->N, cstart = mat->cmap->rstart, bs = mat->cmap->bs;
+  std::vector<PetscInt> ia(m);
+  PetscScalar          *x;
+  LocalView             xv;
 
   PetscFunctionBegin;
-  PetscCall(CheckLocalSize(v, mat->rmap->n, "The row vector"));
+  PetscCall(CheckLocalSize(v, m, "The row vector"));
   if (!N) PetscFunctionReturn(0); /* set by MatGetRowMax/Min */
-  PetscCall(VecGetArrayWrite(v, &x));
-  for (PetscInt i = 0; i < mat->rmap->n; i++) {
-    PetscInt           nz, gap = -1, at;
-    const PetscInt    *cols;
-    const PetscScalar *vals;
-    double             best;
-    PetscCall(MatGetRow(mat, rstart + i, &nz, &cols, &vals));
-    for (PetscInt k = 0; k < nz && gap < 0; k++)
-      if (cols[k] != k) gap = k;
-    binbcsr::row_extreme_start(kind, nz == N, gap < 0 ? nz : gap, &best, &at);
-    for (PetscInt k = 0; k < nz; k++) binbcsr::slot_row_extremes(vals + k, 1, 1, false, cols[k], kind, &best, &at);
-    PetscCall(MatRestoreRow(mat, rstart + i, &nz, &cols, &vals));
-    x[i] = best;
-    if (idx) idx[i] = at;
+  if (!n) {                       /* no owned columns: MPIAIJ's answer */
+    PetscCall(VecGetArrayWrite(v, &x));
+    for (PetscInt r = 0; r < m; r++) {
+      x[r] = kind == binbcsr::extreme_max ? PETSC_MIN_REAL : kind == binbcsr::extreme_min ? PETSC_MAX_REAL : 0.0;
+      if (idx) idx[r] = -1;
+    }
+    PetscCall(VecRestoreArrayWrite(v, &x));
+    PetscFunctionReturn(0);
   }
-  PetscCall(VecRestoreArrayWrite(v, &x));
+  PetscCall(xv.open(v));
+  PetscCall(part_op(b->A, xv.seq, ia.data()));
+  PetscCall(xv.close());
+  if (N == n) { /* every column owned */
+    if (idx)
+      for (PetscInt r = 0; r < m; r++) idx[r] = ia[r] < 0 ? ia[r] : ia[r] + cstart;
+    PetscFunctionReturn(0);
+  }
+  const PetscBool ghosts = MPIBinBCSRGhosts(mat) ? PETSC_TRUE : PETSC_FALSE;
+  auto            position = [&](PetscInt j) { return j < cstart ? j : j + n; }; /* global column of the j-th not owned one */
+  std::vector<PetscInt> gcols;
+  PetscCall(VecGetArray(v, &x));
+  for (PetscInt r = 0; r < m; r++) {
+    PetscInt           nz = 0, gap = -1, at;
+    const PetscInt    *cols = nullptr;
+    const PetscScalar *vals = nullptr;
+    double             best;
+    if (ghosts) PetscCall(MatGetRow(b->B, r, &nz, &cols, &vals));
+    gcols.resize(nz);
+    for (PetscInt k = 0; k < nz; k++) gcols[k] = GhostColumn(b, bs, cols[k]);
+    for (PetscInt k = 0; k < nz && gap < 0; k++)
+      if (gcols[k] != position(k)) gap = position(k);
+    binbcsr::row_extreme_start(kind, nz == N - n, gap < 0 ? position(nz) : gap, &best, &at);
+    for (PetscInt k = 0; k < nz; k++) binbcsr::slot_row_extremes(vals + k, 1, 1, false, gcols[k], kind, &best, &at);
+    if (ghosts) PetscCall(MatRestoreRow(b->B, r, &nz, &cols, &vals));
+    /* the better of the two parts; the smaller column on a tie */
+    const PetscInt da = ia[r] + cstart;
+    if (binbcsr::row_extreme_beats(kind, best, x[r])) {
+      x[r] = best;
+      if (idx) idx[r] = at;
+    } else if (idx) idx[r] = binbcsr::row_extreme_beats(kind, x[r], best) || da <= at ? da : at;
+  }
+  PetscCall(VecRestoreArray(v, &x));
   PetscFunctionReturn(0);
 }
 
@@ -178,14 +210,21 @@ PETSC_INTERN PetscErrorCode MatGetRowMaxAbs_MPIBinBCSR(Mat mat, Vec v, PetscInt 
 PETSC_INTERN PetscErrorCode MatGetRowMax_MPIBinBCSR(Mat mat, Vec v, PetscInt idx[])
 {
   PetscFunctionBegin;
-  PetscCall(RowExtremesByRows(mat, v, idx, binbcsr::extreme_max));
+  PetscCall(RowExtremesByParts(mat, v, idx, binbcsr::extreme_max, MatGetRowMax));
   PetscFunctionReturn(0);
 }
 
 PETSC_INTERN PetscErrorCode MatGetRowMin_MPIBinBCSR(Mat mat, Vec v, PetscInt idx[])
 {
   PetscFunctionBegin;
-  PetscCall(RowExtremesByRows(mat, v, idx, binbcsr::extreme_min));
+  PetscCall(RowExtremesByParts(mat, v, idx, binbcsr::extreme_min, MatGetRowMin));
+  PetscFunctionReturn(0);
+}
+
+PETSC_INTERN PetscErrorCode MatGetRowMinAbs_MPIBinBCSR(Mat mat, Vec v, PetscInt idx[])
+{
+  PetscFunctionBegin;
+  PetscCall(RowExtremesByParts(mat, v, idx, binbcsr::extreme_min_abs, MatGetRowMinAbs));
   PetscFunctionReturn(0);
 }
 

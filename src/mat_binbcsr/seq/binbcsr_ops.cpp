@@ -553,6 +553,7 @@ PetscErrorCode MatSeqBinBCSRSetOps_Ops(Mat A)
   A->ops->getrowmaxabs      = MatGetRowMaxAbs_SeqBinBCSR;
   A->ops->getrowmax         = MatGetRowMax_SeqBinBCSR;
   A->ops->getrowmin         = MatGetRowMin_SeqBinBCSR;
+  A->ops->getrowminabs      = MatGetRowMinAbs_SeqBinBCSR;
   A->ops->getcolumnreductions = MatGetColumnReductions_SeqBinBCSR;
   A->ops->missingdiagonal   = MatMissingDiagonal_SeqBinBCSR;
   A->ops->equal             = MatEqual_SeqBinBCSR;

@@ -17,6 +17,7 @@ PETSC_INTERN PetscErrorCode MatDiagonalScale_SeqBinBCSR(Mat, Vec, Vec);
 PETSC_INTERN PetscErrorCode MatGetRowMaxAbs_SeqBinBCSR(Mat, Vec, PetscInt[]);
 PETSC_INTERN PetscErrorCode MatGetRowMax_SeqBinBCSR(Mat, Vec, PetscInt[]);
 PETSC_INTERN PetscErrorCode MatGetRowMin_SeqBinBCSR(Mat, Vec, PetscInt[]);
+PETSC_INTERN PetscErrorCode MatGetRowMinAbs_SeqBinBCSR(Mat, Vec, PetscInt[]);
 PETSC_INTERN PetscErrorCode MatGetColumnReductions_SeqBinBCSR(Mat, PetscInt, PetscReal *);
 PETSC_INTERN PetscErrorCode MatMissingDiagonal_SeqBinBCSR(Mat, PetscBool *, PetscInt *);
 PETSC_INTERN PetscErrorCode MatEqual_SeqBinBCSR(Mat, Mat, PetscBool *);

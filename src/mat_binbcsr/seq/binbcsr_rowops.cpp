@@ -1,6 +1,6 @@
 /*
    MATSEQBINBCSR operations over whole rows and columns: diagonal scaling, row extremes
-   (MatGetRowMaxAbs, MatGetRowMax, MatGetRowMin), column reductions (MatGetColumnNorms and the other
+   (MatGetRowMaxAbs, MatGetRowMax, MatGetRowMin, MatGetRowMinAbs), column reductions (MatGetColumnNorms and the other
    MatGetColumnReductions, also the 1-norm), the missing-diagonal check and equality.
 
    Symmetric storage keeps only the blocks (r, c) with c >= r; these operations see the full matrix:
@@ -249,6 +249,13 @@ PetscErrorCode MatGetRowMin_SeqBinBCSR(Mat A, Vec v, PetscInt idx[])
 {
   PetscFunctionBegin;
   PetscCall(RowExtremes(A, v, idx, binbcsr::extreme_min, "MatGetRowMin"));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatGetRowMinAbs_SeqBinBCSR(Mat A, Vec v, PetscInt idx[])
+{
+  PetscFunctionBegin;
+  PetscCall(RowExtremes(A, v, idx, binbcsr::extreme_min_abs, "MatGetRowMinAbs"));
   PetscFunctionReturn(0);
 }
 

@@ -140,10 +140,10 @@ TEST_CASE("MatDiagonalScale matches aij; symmetric storage takes only D A D", "[
   }
 }
 
-TEST_CASE("MatGetRowMaxAbs, MatGetRowMax, MatGetRowMin match aij, columns included", "[rowops]")
+TEST_CASE("MatGetRowMaxAbs, MatGetRowMax, MatGetRowMin, MatGetRowMinAbs match aij, columns included", "[rowops]")
 {
   typedef PetscErrorCode (*RowOp)(Mat, Vec, PetscInt[]);
-  const std::pair<const char *, RowOp> ops[] = {{"MatGetRowMaxAbs", MatGetRowMaxAbs}, {"MatGetRowMax", MatGetRowMax}, {"MatGetRowMin", MatGetRowMin}};
+  const std::pair<const char *, RowOp> ops[] = {{"MatGetRowMaxAbs", MatGetRowMaxAbs}, {"MatGetRowMax", MatGetRowMax}, {"MatGetRowMin", MatGetRowMin}, {"MatGetRowMinAbs", MatGetRowMinAbs}};
   std::vector<Config> cases = configs();
   for (Config c : configs()) { // and matrices whose rows reach their extremes in several columns
     c.ties = true;
