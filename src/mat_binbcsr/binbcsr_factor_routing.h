@@ -14,6 +14,7 @@
 #define BINBCSR_FACTOR_ROUTING_H
 
 #include <petsc/private/matimpl.h>
+#include "binbcsr_composed.h"
 
 namespace binbcsr_factor
 {
@@ -21,26 +22,15 @@ namespace binbcsr_factor
 template <class Ctx>
 PetscErrorCode Attach(Mat F, Ctx *f)
 {
-  PetscContainer c;
-
-  PetscFunctionBegin;
-  PetscCall(PetscContainerCreate(PETSC_COMM_SELF, &c));
-  PetscCall(PetscContainerSetPointer(c, f));
-  PetscCall(PetscContainerSetUserDestroy(c, Ctx::Destroy));
-  PetscCall(PetscObjectCompose((PetscObject)F, Ctx::key(), (PetscObject)c));
-  PetscCall(PetscContainerDestroy(&c));
-  PetscFunctionReturn(0);
+  return binbcsr::Compose((PetscObject)F, Ctx::key(), f, Ctx::Destroy);
 }
 
 template <class Ctx>
 PetscErrorCode Get(Mat F, Ctx **f)
 {
-  PetscContainer c;
-
   PetscFunctionBegin;
-  PetscCall(PetscObjectQuery((PetscObject)F, Ctx::key(), (PetscObject *)&c));
-  PetscCheck(c, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Factor of a binbcsr matrix without its routing (%s)", Ctx::key());
-  PetscCall(PetscContainerGetPointer(c, (void **)f));
+  PetscCall(binbcsr::QueryComposed((PetscObject)F, Ctx::key(), f));
+  PetscCheck(*f, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Factor of a binbcsr matrix without its routing (%s)", Ctx::key());
   PetscFunctionReturn(0);
 }
 

@@ -19,6 +19,7 @@
    MAT_INITIAL_MATRIX), as the AIJ product itself would give a wrong answer. */
 #include "binbcsr_impl.h"
 #include <petsc/private/matimpl.h>
+#include "binbcsr_composed.h"
 
 namespace
 {
@@ -38,13 +39,6 @@ struct ShadowProduct {
 };
 
 const char product_key[] = "MatBinBCSR_ShadowProduct";
-
-PetscErrorCode DestroyShadowProduct(void *ctx)
-{
-  PetscFunctionBegin;
-  delete static_cast<ShadowProduct *>(ctx);
-  PetscFunctionReturn(0);
-}
 
 /* The operands of the product of C (A, B, C), any of them NULL. */
 void Operands(Mat C, Mat *ops[3])
@@ -83,14 +77,12 @@ void SwapBack(Mat C, Mat orig[3])
 
 PetscErrorCode ProductNumeric_Shadow(Mat C)
 {
-  PetscContainer c;
   ShadowProduct *sp;
   Mat            orig[3], shadow[3];
 
   PetscFunctionBegin;
-  PetscCall(PetscObjectQuery((PetscObject)C, product_key, (PetscObject *)&c));
-  PetscCheck(c, PetscObjectComm((PetscObject)C), PETSC_ERR_PLIB, "binbcsr product: the numeric phase has lost its symbolic phase's context");
-  PetscCall(PetscContainerGetPointer(c, (void **)&sp));
+  PetscCall(binbcsr::QueryComposed((PetscObject)C, product_key, &sp));
+  PetscCheck(sp, PetscObjectComm((PetscObject)C), PETSC_ERR_PLIB, "binbcsr product: the numeric phase has lost its symbolic phase's context");
   PetscCall(SwapInShadows(C, orig, shadow)); /* refreshes each shadow (collective) */
   for (int i = 0; i < 3; i++) {
     if ((shadow[i] ? ((PetscObject)shadow[i])->id : 0) == sp->shadow[i]) continue;
@@ -106,7 +98,6 @@ PetscErrorCode ProductNumeric_Shadow(Mat C)
 PetscErrorCode ProductSymbolic_Shadow(Mat C)
 {
   Mat            orig[3], shadow[3];
-  PetscContainer c;
   ShadowProduct *sp;
 
   PetscFunctionBegin;
@@ -122,15 +113,7 @@ PetscErrorCode ProductSymbolic_Shadow(Mat C)
   PetscCall(ierr);
   PetscCheck(C->ops->productnumeric, PetscObjectComm((PetscObject)C), PETSC_ERR_PLIB, "binbcsr product: PETSc's AIJ symbolic phase left no numeric phase");
 
-  PetscCall(PetscObjectQuery((PetscObject)C, product_key, (PetscObject *)&c));
-  if (!c) {
-    sp = new ShadowProduct;
-    PetscCall(PetscContainerCreate(PETSC_COMM_SELF, &c));
-    PetscCall(PetscContainerSetPointer(c, sp));
-    PetscCall(PetscContainerSetUserDestroy(c, DestroyShadowProduct));
-    PetscCall(PetscObjectCompose((PetscObject)C, product_key, (PetscObject)c));
-    PetscCall(PetscContainerDestroy(&c));
-  } else PetscCall(PetscContainerGetPointer(c, (void **)&sp));
+  PetscCall(binbcsr::GetOrCompose((PetscObject)C, product_key, &sp));
   for (int i = 0; i < 3; i++) sp->shadow[i] = shadow[i] ? ((PetscObject)shadow[i])->id : 0; /* the shadows live with their matrices */
   sp->numeric               = C->ops->productnumeric;
   C->ops->productnumeric    = ProductNumeric_Shadow;

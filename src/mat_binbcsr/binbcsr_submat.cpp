@@ -16,6 +16,7 @@
    the shadow: no PETSc-internal reuse data whose life would have to follow the caller's arrays. */
 #include "mpi/mpibinbcsr.h"
 #include "seq/binbcsr.h"
+#include "binbcsr_composed.h"
 
 namespace
 {
@@ -115,7 +116,6 @@ PetscErrorCode DestroyShadow(void *ctx)
 /* The AIJ shadow of A holding A's current values. Collective on A. */
 PetscErrorCode MatBinBCSRGetAIJShadow_Private(Mat A, Mat *S)
 {
-  PetscContainer   c;
   AIJShadow       *sh;
   PetscObjectState state;
   PetscBool        mpi;
@@ -123,15 +123,7 @@ PetscErrorCode MatBinBCSRGetAIJShadow_Private(Mat A, Mat *S)
 
   PetscFunctionBegin;
   PetscCheck(A->assembled, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_WRONGSTATE, "Submatrices of an unassembled binbcsr matrix");
-  PetscCall(PetscObjectQuery((PetscObject)A, shadow_key, (PetscObject *)&c));
-  if (!c) {
-    sh = new AIJShadow;
-    PetscCall(PetscContainerCreate(PETSC_COMM_SELF, &c));
-    PetscCall(PetscContainerSetPointer(c, sh));
-    PetscCall(PetscContainerSetUserDestroy(c, DestroyShadow));
-    PetscCall(PetscObjectCompose((PetscObject)A, shadow_key, (PetscObject)c));
-    PetscCall(PetscContainerDestroy(&c));
-  } else PetscCall(PetscContainerGetPointer(c, (void **)&sh));
+  PetscCall(binbcsr::GetOrCompose((PetscObject)A, shadow_key, &sh, DestroyShadow));
   PetscCall(PetscObjectStateGet((PetscObject)A, &state));
   todo[0] = (!sh->S || sh->nzstate != A->nonzerostate || (!sh->parts.empty() && !PartsCurrent(A, sh))) ? 1 : 0; /* rebuild */
   todo[1] = (todo[0] || sh->state != state) ? 1 : 0;            /* refill */
@@ -157,14 +149,12 @@ PetscErrorCode MatBinBCSRGetAIJShadow_Private(Mat A, Mat *S)
    written into A through the value maps, and the two marked in step. Collective on A. */
 PetscErrorCode MatBinBCSRSetValuesFromAIJShadow_Private(Mat A)
 {
-  PetscContainer   c;
   AIJShadow       *sh;
   PetscObjectState state;
 
   PetscFunctionBegin;
-  PetscCall(PetscObjectQuery((PetscObject)A, shadow_key, (PetscObject *)&c));
-  PetscCheck(c, PETSC_COMM_SELF, PETSC_ERR_PLIB, "No AIJ shadow to take the values from");
-  PetscCall(PetscContainerGetPointer(c, (void **)&sh));
+  PetscCall(binbcsr::QueryComposed((PetscObject)A, shadow_key, &sh));
+  PetscCheck(sh, PETSC_COMM_SELF, PETSC_ERR_PLIB, "No AIJ shadow to take the values from");
   PetscCheck(sh->S && sh->nzstate == A->nonzerostate, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "The matrix's pattern changed after its AIJ shadow was made");
   PetscCheck(!sh->parts.empty(), PETSC_COMM_SELF, PETSC_ERR_SUP, "Values from the AIJ shadow need MATSEQBINBCSR parts (not -mat_mpibinbcsr_inner_type)");
   for (const PartMap &p : sh->parts) PetscCall(MatSeqBinBCSRAIJScatter(p.aij, p.map, p.bin));
@@ -204,33 +194,17 @@ PetscErrorCode NewFromAIJ(Mat parent, Mat T, PetscBool symmetric, Mat *B)
 
 const char submap_key[] = "MatBinBCSR_SubmatrixValueMap";
 
-PetscErrorCode DestroyValueMap(void *ctx)
-{
-  PetscFunctionBegin;
-  delete static_cast<std::vector<PetscInt> *>(ctx);
-  PetscFunctionReturn(0);
-}
-
 /* A sequential submatrix B refilled from T (seqaij, the same extraction as the one B was made from) by
    the value map composed on B, made at the first refill and remade if T's entry count differs. */
 PetscErrorCode RefillSeqByMap(Mat T, Mat B)
 {
-  PetscContainer         c;
   std::vector<PetscInt> *map;
   const PetscInt        *ia, *ja;
   PetscInt               n;
   PetscBool              done;
 
   PetscFunctionBegin;
-  PetscCall(PetscObjectQuery((PetscObject)B, submap_key, (PetscObject *)&c));
-  if (!c) {
-    map = new std::vector<PetscInt>;
-    PetscCall(PetscContainerCreate(PETSC_COMM_SELF, &c));
-    PetscCall(PetscContainerSetPointer(c, map));
-    PetscCall(PetscContainerSetUserDestroy(c, DestroyValueMap));
-    PetscCall(PetscObjectCompose((PetscObject)B, submap_key, (PetscObject)c));
-    PetscCall(PetscContainerDestroy(&c));
-  } else PetscCall(PetscContainerGetPointer(c, (void **)&map));
+  PetscCall(binbcsr::GetOrCompose((PetscObject)B, submap_key, &map));
   PetscCall(MatGetRowIJ(T, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
   const size_t nz = done ? (size_t)ia[n] : 0;
   PetscCall(MatRestoreRowIJ(T, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
