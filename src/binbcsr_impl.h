@@ -48,6 +48,8 @@ PETSC_INTERN PetscErrorCode MatSetValuesCOOTwoSources_SeqBinBCSR(Mat, const Pets
 
 /* MatPermute of seq and mpi binbcsr: a new matrix of the same type and configuration (binbcsr_permute.cpp) */
 PETSC_INTERN PetscErrorCode MatPermute_BinBCSR(Mat, IS, IS, Mat *);
+/* MatIsSymmetric of seq and mpi binbcsr: through the transpose (binbcsr_symmetry.cpp) */
+PETSC_INTERN PetscErrorCode MatIsSymmetric_BinBCSR(Mat, PetscReal, PetscBool *);
 
 /* Registered once by PetscBinBCSRRegisterAll(). */
 PETSC_EXTERN PetscLogEvent MAT_BinBCSR_BuildLayout; /* first final assembly: staging -> bins */

@@ -74,7 +74,7 @@ PetscErrorCode make(const Config &c, const char *type, Mat *A)
   PetscCall(PetscStrcmp(type, MATBINBCSR, &isbin));
   if (isbin) {
     PetscCall(MatBinBCSRSetPrecision(*A, c.prec));
-    PetscCall(MatBinBCSRSetSymmetricStorage(*A, c.sym ? PETSC_TRUE : PETSC_FALSE));
+    PetscCall(MatBinBCSRSetSymmetricStorage(*A, c.sym && !c.full_storage ? PETSC_TRUE : PETSC_FALSE));
     if (c.bw) PetscCall(MatBinBCSRSetBinWidth(*A, c.bw));
   }
   PetscCall(MatSetUp(*A));

@@ -31,7 +31,8 @@ struct Config {
   unsigned            value_seed = 1;
   bool                drop = false, extra = false;
   bool                float_values = false; // float-representable entries whatever the precision
-  bool                ties = false;         // entries -1, 0, 1 (times the scales): rows with equal extremes
+  bool                ties = false;
+  bool                full_storage = false; // symmetric values (sym) kept in full storage         // entries -1, 0, 1 (times the scales): rows with equal extremes
   PetscInt            mbs() const { return bs == 1 ? 43 : 23; }
   double              eps() const { return prec == MAT_BINBCSR_PRECISION_SINGLE ? FLT_EPSILON : DBL_EPSILON; }
   std::string         name() const

@@ -471,3 +471,25 @@ TEST_CASE("MatPermute matches aij and keeps the type and its options", "[rowops]
     }
   }
 }
+
+TEST_CASE("MatIsSymmetric answers as aij, within a tolerance", "[rowops]")
+{
+  for (Config c : configs()) {
+    for (bool full : {false, true}) {
+      if (full && !c.sym) continue;
+      c.full_storage = full;
+      SECTION(c.name() + (full ? " kept in full storage" : ""))
+      {
+        for (PetscReal tol : {0.0, 1e-3, 1e10}) {
+          Pair      p(c);
+          PetscBool fb, fa;
+          PETSC_OK(MatIsSymmetric(p.bin, tol, &fb));
+          PETSC_OK(MatIsSymmetric(p.aij, tol, &fa));
+          INFO("tol " << tol);
+          CHECK(fb == fa);
+          CHECK(bool(fb) == (c.sym || tol == 1e10)); // the scales make some differences exceed 1e-3
+        }
+      }
+    }
+  }
+}
