@@ -72,20 +72,6 @@ PetscErrorCode refill_pair(const FemProblem &fem, const Storage &st, Mat A, Mat 
   PetscFunctionReturn(0);
 }
 
-// max |S - T| / max |T| with S (binbcsr) converted to T's type.
-double rel_diff(Mat S, Mat T)
-{
-  Mat       C;
-  MatType   type;
-  PetscReal d = -1, t = 1;
-  MatGetType(T, &type);
-  if (MatConvert(S, type, MAT_INITIAL_MATRIX, &C)) return 1e300;
-  MatAXPY(C, -1.0, T, DIFFERENT_NONZERO_PATTERN);
-  MatNorm(C, NORM_MAX, &d);
-  MatNorm(T, NORM_MAX, &t);
-  MatDestroy(&C);
-  return d / t;
-}
 
 // Tolerance for comparing a binbcsr submatrix with aij's: exact for double (same values moved), the
 // float rounding of the entries for single.
@@ -124,17 +110,6 @@ struct ScopedOptions {
   }
 };
 
-double vec_rel_diff(Vec x, Vec y)
-{
-  Vec       d;
-  PetscReal nd = 0, ny = 1;
-  VecDuplicate(x, &d);
-  VecWAXPY(d, -1.0, x, y);
-  VecNorm(d, NORM_INFINITY, &nd);
-  VecNorm(y, NORM_INFINITY, &ny);
-  VecDestroy(&d);
-  return nd / ny;
-}
 
 } // namespace
 
@@ -180,7 +155,7 @@ TEST_CASE("binbcsr submatrices (MatIncreaseOverlap, MatCreateSubMatrices, MatCre
       MatBinBCSRPrecision prec;
       PCHK(MatBinBCSRGetPrecision(sa[0], &prec));
       CHECK((prec == MAT_BINBCSR_PRECISION_SINGLE) == st.single);
-      for (int i = 0; i < 2; ++i) CHECK(all_ranks(rel_diff(sa[i], sr[i]) <= sub_tol(st)));
+      for (int i = 0; i < 2; ++i) CHECK(all_ranks(mat_rel_diff(sa[i], sr[i]) <= sub_tol(st)));
 
       // parallel submatrix: fields 0 and 2 of this rank's rows (PCFIELDSPLIT's kind)
       std::vector<PetscInt> f02;
@@ -194,7 +169,7 @@ TEST_CASE("binbcsr submatrices (MatIncreaseOverlap, MatCreateSubMatrices, MatCre
       PetscBool isbin;
       PCHK(PetscObjectTypeCompareAny((PetscObject)pa, &isbin, MATSEQBINBCSR, MATMPIBINBCSR, ""));
       REQUIRE(all_ranks(isbin));
-      CHECK(all_ranks(rel_diff(pa, pr) <= sub_tol(st)));
+      CHECK(all_ranks(mat_rel_diff(pa, pr) <= sub_tol(st)));
 
       // refill: the same submatrix objects get the new values, their layout (nonzero state) stays
       PCHK(refill_pair(fem, st, A, R));
@@ -206,8 +181,8 @@ TEST_CASE("binbcsr submatrices (MatIncreaseOverlap, MatCreateSubMatrices, MatCre
       PCHK(MatCreateSubMatrix(R, fis, fis, MAT_REUSE_MATRIX, &pr));
       CHECK(all_ranks(sa[0] == keep[0] && sa[1] == keep[1] && pa == keep_p));
       CHECK(all_ranks(sa[0]->nonzerostate == nz0 && pa->nonzerostate == nzp));
-      for (int i = 0; i < 2; ++i) CHECK(all_ranks(rel_diff(sa[i], sr[i]) <= sub_tol(st)));
-      CHECK(all_ranks(rel_diff(pa, pr) <= sub_tol(st)));
+      for (int i = 0; i < 2; ++i) CHECK(all_ranks(mat_rel_diff(sa[i], sr[i]) <= sub_tol(st)));
+      CHECK(all_ranks(mat_rel_diff(pa, pr) <= sub_tol(st)));
 
       PCHK(MatDestroySubMatrices(2, &sa));
       PCHK(MatDestroySubMatrices(2, &sr));

@@ -118,4 +118,32 @@ inline bool all_ranks(bool ok, MPI_Comm comm = PETSC_COMM_WORLD)
   return g != 0;
 }
 
+// max |S - T| / max |T|, S converted to T's type (1e300 if it cannot be).
+inline double mat_rel_diff(Mat S, Mat T)
+{
+  Mat       C;
+  MatType   type;
+  PetscReal d = -1, t = 1;
+  MatGetType(T, &type);
+  if (MatConvert(S, type, MAT_INITIAL_MATRIX, &C)) return 1e300;
+  MatAXPY(C, -1.0, T, DIFFERENT_NONZERO_PATTERN);
+  MatNorm(C, NORM_MAX, &d);
+  MatNorm(T, NORM_MAX, &t);
+  MatDestroy(&C);
+  return d / t;
+}
+
+// max |x - y| / max |y|
+inline double vec_rel_diff(Vec x, Vec y)
+{
+  Vec       d;
+  PetscReal nd = 0, ny = 1;
+  VecDuplicate(x, &d);
+  VecWAXPY(d, -1.0, x, y);
+  VecNorm(d, NORM_INFINITY, &nd);
+  VecNorm(y, NORM_INFINITY, &ny);
+  VecDestroy(&d);
+  return nd / ny;
+}
+
 } // namespace mpitest

@@ -14,20 +14,6 @@ using namespace pctest;
 
 namespace {
 
-// max |S - T| / max |T| (S converted to T's type).
-double mat_rel_diff(Mat S, Mat T)
-{
-  Mat       C;
-  MatType   type;
-  PetscReal d = -1, t = 1;
-  MatGetType(T, &type);
-  if (MatConvert(S, type, MAT_INITIAL_MATRIX, &C)) return 1e300;
-  MatAXPY(C, -1.0, T, DIFFERENT_NONZERO_PATTERN);
-  MatNorm(C, NORM_MAX, &d);
-  MatNorm(T, NORM_MAX, &t);
-  MatDestroy(&C);
-  return d / t;
-}
 
 // The rigid body modes of the FEM grid (node coordinates i, j, k) as A's near null space.
 PetscErrorCode set_rigid_body_modes(const FemProblem &fem, Mat A)

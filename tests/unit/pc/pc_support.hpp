@@ -104,17 +104,6 @@ inline PetscErrorCode refill_pair(const FemProblem &fem, PetscInt bs, const Stor
   PetscFunctionReturn(0);
 }
 
-inline double vec_rel_diff(Vec x, Vec y)
-{
-  Vec       d;
-  PetscReal nd = 0, ny = 1;
-  VecDuplicate(x, &d);
-  VecWAXPY(d, -1.0, x, y);
-  VecNorm(d, NORM_INFINITY, &nd);
-  VecNorm(y, NORM_INFINITY, &ny);
-  VecDestroy(&d);
-  return nd / ny;
-}
 
 inline PetscErrorCode random_vec(Mat A, unsigned seed, Vec *b)
 {
