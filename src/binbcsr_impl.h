@@ -46,6 +46,11 @@ PETSC_INTERN PetscErrorCode MatBinBCSRRegisterExternalFactors(void);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRComposeCOO(Mat, const PetscCount from[], PetscCount n, PetscCount nsrc); /* from[] < n: the caller's values, else received */
 PETSC_INTERN PetscErrorCode MatSetValuesCOOTwoSources_SeqBinBCSR(Mat, const PetscScalar v[], PetscCount n, const PetscScalar recv[], InsertMode);
 
+/* An empty, set-up matrix of A's binbcsr type and configuration (bin width, precision, storage, MPI inner
+   type) with the given local sizes and block sizes; and the MatAXPY_Basic hook built on it, composed as
+   "MatAXPYGetPreallocation_C" (binbcsr_permute.cpp) */
+PETSC_INTERN PetscErrorCode MatBinBCSRCreateEmptyLike_Private(Mat A, PetscInt m, PetscInt n, PetscInt rbs, PetscInt cbs, Mat *C);
+PETSC_INTERN PetscErrorCode MatAXPYGetPreallocation_BinBCSR(Mat Y, Mat X, Mat *B);
 /* MatPermute of seq and mpi binbcsr: a new matrix of the same type and configuration (binbcsr_permute.cpp) */
 PETSC_INTERN PetscErrorCode MatPermute_BinBCSR(Mat, IS, IS, Mat *);
 /* MatIsSymmetric of seq and mpi binbcsr: through the transpose (binbcsr_symmetry.cpp) */

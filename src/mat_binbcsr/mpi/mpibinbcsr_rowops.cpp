@@ -122,19 +122,6 @@ PetscErrorCode AddRows(Mat dst, PetscScalar a, Mat src)
   PetscFunctionReturn(0);
 }
 
-/* An empty MATMPIBINBCSR with mat's configuration and the given local sizes and block sizes, set up */
-PetscErrorCode CreateEmptyLike(Mat mat, PetscInt m, PetscInt n, PetscInt rbs, PetscInt cbs, Mat *C)
-{
-  PetscFunctionBegin;
-  PetscCall(MatCreate(PetscObjectComm((PetscObject)mat), C));
-  PetscCall(MatSetSizes(*C, m, n, PETSC_DETERMINE, PETSC_DETERMINE));
-  PetscCall(MatSetBlockSizes(*C, rbs, cbs));
-  PetscCall(MatSetType(*C, MATMPIBINBCSR));
-  PetscCall(MatMPIBinBCSRCopyConfig(mat, *C));
-  PetscCall(MatSetUp(*C));
-  PetscFunctionReturn(0);
-}
-
 } // namespace
 
 PETSC_INTERN PetscErrorCode MatDiagonalScale_MPIBinBCSR(Mat mat, Vec ll, Vec rr)
@@ -346,7 +333,7 @@ PETSC_INTERN PetscErrorCode MatAXPY_MPIBinBCSR(Mat Y, PetscScalar a, Mat X, MatS
     PetscFunctionReturn(0);
   }
   Mat C;
-  PetscCall(CreateEmptyLike(Y, Y->rmap->n, Y->cmap->n, Y->rmap->bs, Y->cmap->bs, &C));
+  PetscCall(MatBinBCSRCreateEmptyLike_Private(Y, Y->rmap->n, Y->cmap->n, Y->rmap->bs, Y->cmap->bs, &C));
   PetscCall(AddRows(C, 1.0, Y));
   PetscCall(AddRows(C, a, X));
   PetscCall(MatAssemblyBegin(C, MAT_FINAL_ASSEMBLY));
@@ -369,7 +356,7 @@ PETSC_INTERN PetscErrorCode MatTranspose_MPIBinBCSR(Mat mat, MatReuse reuse, Mat
     else if (reuse == MAT_REUSE_MATRIX && *B != mat) PetscCall(MatCopy(mat, *B, SAME_NONZERO_PATTERN));
     PetscFunctionReturn(0);
   }
-  PetscCall(CreateEmptyLike(mat, mat->cmap->n, mat->rmap->n, mat->cmap->bs, mat->rmap->bs, &C));
+  PetscCall(MatBinBCSRCreateEmptyLike_Private(mat, mat->cmap->n, mat->rmap->n, mat->cmap->bs, mat->rmap->bs, &C));
   for (PetscInt r = mat->rmap->rstart; r < mat->rmap->rend; r++) {
     PetscInt           nz;
     const PetscInt    *cols;

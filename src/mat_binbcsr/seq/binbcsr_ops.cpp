@@ -569,6 +569,7 @@ PetscErrorCode MatSeqBinBCSRSetOps_Ops(Mat A)
   A->ops->creatempimatconcatenateseqmat = MatCreateMPIMatConcatenateSeqMat_BinBCSR;
   A->ops->getrowij                      = MatGetRowIJ_SeqBinBCSR; /* binbcsr_rowij.cpp */
   A->ops->restorerowij                  = MatRestoreRowIJ_SeqBinBCSR;
+  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatAXPYGetPreallocation_C", MatAXPYGetPreallocation_BinBCSR));
 #if defined(PETSC_HAVE_HYPRE)
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatConvert_seqbinbcsr_hypre_C", MatConvert_BinBCSR_HYPRE));
 #endif

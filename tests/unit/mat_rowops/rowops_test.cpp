@@ -370,6 +370,23 @@ TEST_CASE("MatAXPY with the same, a subset and a different pattern keeps the typ
           PETSC_OK(MatBinBCSRGetBinWidth(y.bin, &bw));
           CHECK(bw == c.bw);
         }
+        // X of another type (aij): PETSc's own path, which takes binbcsr's matrix for the union
+        // ("MatAXPYGetPreallocation_C") and so keeps the options
+        {
+          Mat y2;
+          PETSC_OK(make(c, MATBINBCSR, &y2));
+          PETSC_OK(MatAXPY(y2, a, x.aij, str));
+          CHECK(row_error(y2, y.aij) <= 2 * kRoundings * c.eps());
+          PETSC_OK(MatBinBCSRGetPrecision(y2, &prec));
+          PETSC_OK(MatBinBCSRGetSymmetricStorage(y2, &sym));
+          CHECK(prec == c.prec);
+          CHECK(bool(sym) == c.sym);
+          if (c.bw) {
+            PETSC_OK(MatBinBCSRGetBinWidth(y2, &bw));
+            CHECK(bw == c.bw);
+          }
+          PETSC_OK(MatDestroy(&y2));
+        }
         // the result is a working matrix: products agree
         Vec u, vb, va;
         PETSC_OK(make_vec(y.aij, false, 5, &u));
