@@ -53,8 +53,9 @@ PETSC_INTERN PetscErrorCode MatBinBCSRCreateEmptyLike_Private(Mat A, PetscInt m,
 PETSC_INTERN PetscErrorCode MatAXPYGetPreallocation_BinBCSR(Mat Y, Mat X, Mat *B);
 /* MatPermute of seq and mpi binbcsr: a new matrix of the same type and configuration (binbcsr_permute.cpp) */
 PETSC_INTERN PetscErrorCode MatPermute_BinBCSR(Mat, IS, IS, Mat *);
-/* MatIsSymmetric of seq and mpi binbcsr: through the transpose (binbcsr_symmetry.cpp) */
+/* MatIsSymmetric (through the transpose) and MatFindZeroDiagonals of seq and mpi binbcsr (binbcsr_queries.cpp) */
 PETSC_INTERN PetscErrorCode MatIsSymmetric_BinBCSR(Mat, PetscReal, PetscBool *);
+PETSC_INTERN PetscErrorCode MatFindZeroDiagonals_BinBCSR(Mat, IS *);
 
 /* Registered once by PetscBinBCSRRegisterAll(). */
 PETSC_EXTERN PetscLogEvent MAT_BinBCSR_BuildLayout; /* first final assembly: staging -> bins */

@@ -427,6 +427,7 @@ PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
   mat->ops->transpose           = MatTranspose_MPIBinBCSR;
   mat->ops->permute             = MatPermute_BinBCSR;
   mat->ops->issymmetric         = MatIsSymmetric_BinBCSR;
+  mat->ops->findzerodiagonals   = MatFindZeroDiagonals_BinBCSR;
   mat->ops->getdiagonalblock    = MatGetDiagonalBlock_MPIBinBCSR;
   mat->ops->view                = MatView_MPIBinBCSR;
   mat->ops->load                = MatLoad_MPIBinBCSR;

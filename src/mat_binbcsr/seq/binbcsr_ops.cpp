@@ -559,6 +559,7 @@ PetscErrorCode MatSeqBinBCSRSetOps_Ops(Mat A)
   A->ops->equal             = MatEqual_SeqBinBCSR;
   A->ops->permute           = MatPermute_BinBCSR;
   A->ops->issymmetric       = MatIsSymmetric_BinBCSR;
+  A->ops->findzerodiagonals = MatFindZeroDiagonals_BinBCSR;
   A->ops->load              = MatLoad_SeqBinBCSR;
   /* submatrices through an AIJ shadow (binbcsr_submat.cpp); MatCreateSubMatrix uses createsubmatrices on one rank */
   A->ops->increaseoverlap               = MatIncreaseOverlap_BinBCSR;

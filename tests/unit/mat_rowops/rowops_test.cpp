@@ -242,6 +242,37 @@ TEST_CASE("MatMissingDiagonal matches aij on every rank", "[rowops]")
       }
 }
 
+TEST_CASE("MatFindZeroDiagonals matches aij (missing and stored zero diagonals)", "[rowops]")
+{
+  for (const Config &c : configs()) {
+    SECTION(c.name())
+    {
+      Pair p(c);
+      // a stored zero on the diagonal of the first row of block 2 (a present block)
+      const PetscInt i = 2 * c.bs;
+      PetscInt       rstart, rend;
+      PETSC_OK(MatGetOwnershipRange(p.aij, &rstart, &rend));
+      for (Mat M : {p.bin, p.aij}) {
+        const PetscScalar zero = 0.0;
+        if (i >= rstart && i < rend) PETSC_OK(MatSetValues(M, 1, &i, 1, &i, &zero, INSERT_VALUES));
+        PETSC_OK(MatAssemblyBegin(M, MAT_FINAL_ASSEMBLY));
+        PETSC_OK(MatAssemblyEnd(M, MAT_FINAL_ASSEMBLY));
+      }
+      IS        zb, za;
+      PetscBool eq;
+      PetscInt  n;
+      PETSC_OK(MatFindZeroDiagonals(p.bin, &zb));
+      PETSC_OK(MatFindZeroDiagonals(p.aij, &za));
+      PETSC_OK(ISEqualUnsorted(zb, za, &eq));
+      CHECK(eq);
+      PETSC_OK(ISGetSize(zb, &n));
+      CHECK(n >= 1 + (c.holes ? 3 * c.bs : 0)); // the stored zero, and the empty block rows 5, 12, 19
+      PETSC_OK(ISDestroy(&zb));
+      PETSC_OK(ISDestroy(&za));
+    }
+  }
+}
+
 TEST_CASE("MatEqual: values and pattern, across bin widths and precisions", "[rowops]")
 {
   for (const Config &c : configs()) {

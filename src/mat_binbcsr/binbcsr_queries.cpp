@@ -1,4 +1,10 @@
-/* MatIsSymmetric for seq and mpi binbcsr. Symmetric storage is symmetric by construction. Otherwise the
+/* Whole-matrix questions for seq and mpi binbcsr: MatFindZeroDiagonals (what
+   -pc_fieldsplit_detect_saddle_point asks) and MatIsSymmetric.
+
+   MatFindZeroDiagonals: the rows whose diagonal entry is zero or not stored, from MatGetDiagonal (the
+   stored diagonal slots), as global rows of this rank.
+
+   MatIsSymmetric: Symmetric storage is symmetric by construction. Otherwise the
    transpose (MatTranspose of the type: a new layout, or the MPI exchange) is compared row by row with
    the matrix: symmetric when |a_ij - a_ji| <= tol everywhere, an entry one side lacks counting as zero
    (aij also asks for the same pattern; the simulation matrices have symmetric patterns). */
@@ -7,6 +13,7 @@
 
 #include <cmath>
 #include <map>
+#include <vector>
 
 PETSC_INTERN PetscErrorCode MatIsSymmetric_BinBCSR(Mat A, PetscReal tol, PetscBool *flg)
 {
@@ -41,5 +48,23 @@ PETSC_INTERN PetscErrorCode MatIsSymmetric_BinBCSR(Mat A, PetscReal tol, PetscBo
   }
   PetscCall(MatDestroy(&T));
   PetscCall(MPIU_Allreduce(&local, flg, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)A)));
+  PetscFunctionReturn(0);
+}
+
+PETSC_INTERN PetscErrorCode MatFindZeroDiagonals_BinBCSR(Mat A, IS *zrows)
+{
+  Vec                d;
+  const PetscScalar *da;
+  std::vector<PetscInt> rows;
+
+  PetscFunctionBegin;
+  PetscCall(MatCreateVecs(A, nullptr, &d));
+  PetscCall(MatGetDiagonal(A, d));
+  PetscCall(VecGetArrayRead(d, &da));
+  for (PetscInt i = 0; i < A->rmap->n; i++)
+    if (da[i] == 0.0) rows.push_back(A->rmap->rstart + i);
+  PetscCall(VecRestoreArrayRead(d, &da));
+  PetscCall(VecDestroy(&d));
+  PetscCall(ISCreateGeneral(PetscObjectComm((PetscObject)A), (PetscInt)rows.size(), rows.data(), PETSC_COPY_VALUES, zrows));
   PetscFunctionReturn(0);
 }
