@@ -106,3 +106,13 @@ PetscErrorCode MatMultDotLocal(Mat A, Vec x, Vec y, PetscScalar *xdoty)
   }
   PetscFunctionReturn(0);
 }
+
+PetscErrorCode MatBinBCSRCheckVecLocalSize(Vec v, PetscInt n, const char *what)
+{
+  PetscInt nv;
+
+  PetscFunctionBegin;
+  PetscCall(VecGetLocalSize(v, &nv));
+  PetscCheck(nv == n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "%s has %" PetscInt_FMT " local entries, the matrix needs %" PetscInt_FMT, what, nv, n);
+  PetscFunctionReturn(0);
+}

@@ -11,14 +11,6 @@
 namespace
 {
 
-PetscErrorCode CheckLocalSize(Vec v, PetscInt n, const char *what)
-{
-  PetscInt nv;
-  PetscFunctionBegin;
-  PetscCall(VecGetLocalSize(v, &nv));
-  PetscCheck(nv == n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "%s has %" PetscInt_FMT " local entries, the matrix needs %" PetscInt_FMT, what, nv, n);
-  PetscFunctionReturn(0);
-}
 
 /* Global point column of local column c of the off-diagonal part. */
 inline PetscInt GhostColumn(const Mat_MPIBinBCSR *b, PetscInt bs, PetscInt c) { return b->garray[c / bs] * bs + c % bs; }
@@ -37,7 +29,7 @@ PetscErrorCode RowExtremesByParts(Mat mat, Vec v, PetscInt idx[], int kind, Pets
   LocalView             xv;
 
   PetscFunctionBegin;
-  PetscCall(CheckLocalSize(v, m, "The row vector"));
+  PetscCall(MatBinBCSRCheckVecLocalSize(v, m, "The row vector"));
   if (!N) PetscFunctionReturn(0); /* set by MatGetRowMax/Min */
   if (!n) {                       /* no owned columns: MPIAIJ's answer */
     PetscCall(VecGetArrayWrite(v, &x));
@@ -130,8 +122,8 @@ PETSC_INTERN PetscErrorCode MatDiagonalScale_MPIBinBCSR(Mat mat, Vec ll, Vec rr)
   LocalView       lv, rv;
 
   PetscFunctionBegin;
-  if (ll) PetscCall(CheckLocalSize(ll, mat->rmap->n, "The left scaling vector"));
-  if (rr) PetscCall(CheckLocalSize(rr, mat->cmap->n, "The right scaling vector"));
+  if (ll) PetscCall(MatBinBCSRCheckVecLocalSize(ll, mat->rmap->n, "The left scaling vector"));
+  if (rr) PetscCall(MatBinBCSRCheckVecLocalSize(rr, mat->cmap->n, "The right scaling vector"));
   if (b->sym && ll != rr) { /* decided together, before any rank starts the collective scatter */
     PetscBool same = (ll && rr) ? PETSC_TRUE : PETSC_FALSE, all;
     if (same) PetscCall(VecEqual(ll, rr, &same));
@@ -164,7 +156,7 @@ PETSC_INTERN PetscErrorCode MatGetRowMaxAbs_MPIBinBCSR(Mat mat, Vec v, PetscInt 
   PetscScalar          *x;
 
   PetscFunctionBegin;
-  PetscCall(CheckLocalSize(v, m, "The row vector"));
+  PetscCall(MatBinBCSRCheckVecLocalSize(v, m, "The row vector"));
   PetscCall(VecCreateSeq(PETSC_COMM_SELF, m, &va));
   PetscCall(MatGetRowMaxAbs(b->A, va, ia.data()));
   if (MPIBinBCSRGhosts(mat)) {

@@ -46,14 +46,6 @@ PetscErrorCode CheckBuilt(Mat A, const char *op)
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode CheckVecSize(Vec v, PetscInt n, const char *what)
-{
-  PetscInt nv;
-  PetscFunctionBegin;
-  PetscCall(VecGetLocalSize(v, &nv));
-  PetscCheck(nv == n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "%s has %" PetscInt_FMT " entries, the matrix needs %" PetscInt_FMT, what, nv, n);
-  PetscFunctionReturn(0);
-}
 
 /* The same scaling on both sides: the same vector, or equal entries (the MPI type passes two views of
    one vector). */
@@ -87,7 +79,7 @@ PetscErrorCode RowExtremes(Mat A, Vec v, PetscInt idx[], int kind, const char *o
   PetscFunctionBegin;
   PetscCall(CheckBuilt(A, op));
   PetscCheck(!A->factortype, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Not for factored matrix");
-  PetscCall(CheckVecSize(v, A->rmap->n, "The row vector"));
+  PetscCall(MatBinBCSRCheckVecLocalSize(v, A->rmap->n, "The row vector"));
   if (!A->cmap->n) PetscFunctionReturn(0); /* MatGetRowMax/Min/MaxAbs have set v and idx */
   PetscCall(VecGetArrayWrite(v, &x));
   if (kind == binbcsr::extreme_max_abs) { /* whole bins at a time, straight into v (and idx) */
@@ -202,8 +194,8 @@ PetscErrorCode MatDiagonalScale_SeqBinBCSR(Mat A, Vec ll, Vec rr)
 
   PetscFunctionBegin;
   PetscCall(CheckBuilt(A, "MatDiagonalScale"));
-  if (ll) PetscCall(CheckVecSize(ll, A->rmap->n, "The left scaling vector"));
-  if (rr) PetscCall(CheckVecSize(rr, A->cmap->n, "The right scaling vector"));
+  if (ll) PetscCall(MatBinBCSRCheckVecLocalSize(ll, A->rmap->n, "The left scaling vector"));
+  if (rr) PetscCall(MatBinBCSRCheckVecLocalSize(rr, A->cmap->n, "The right scaling vector"));
   if (a->sym) {
     PetscBool same;
     PetscCall(SameScaling(ll, rr, &same));
