@@ -9,9 +9,10 @@
    own routine with the shadow in place of the binbcsr matrix. Solves are the factor's own.
 
    The shadow and the map live as long as the factor Mat (a PC keeps it between solves, so a refilled
-   matrix costs one value copy plus the numeric factorisation). Orderings are BAIJ's: LU defaults to
-   nested dissection and ILU to natural, and both take any of PETSc's orderings (computed on the
-   binbcsr matrix through MatGetRowIJ); ICC and Cholesky are natural only, as PETSc's sbaij. */
+   matrix costs one value copy plus the numeric factorisation). All four take PETSc's orderings
+   (computed on the binbcsr matrix through MatGetRowIJ): LU and ILU pass them to BAIJ's factor; ICC and
+   Cholesky, which seqsbaij factors in natural order only, get a shadow of the renumbered matrix and
+   permuting solves. LU and Cholesky default to nested dissection, ILU and ICC to natural. */
 #include "binbcsr.h"
 #include "../binbcsr_factor_routing.h"
 #include <algorithm>
@@ -163,13 +164,26 @@ PetscErrorCode FactorShadow::Shadow(Mat A, Mat *shadow)
   PetscFunctionReturn(0);
 }
 
-/* S (re)built from A's pattern in the numbering of f->perm: seqsbaij (upper) or seqbaij. */
+/* S (re)built from A's pattern in the numbering of f->perm: seqsbaij (upper) or seqbaij; f's block
+   size, bin width and nonzero state taken from A. Before A's first assembly (PCSetFromOptions asks for
+   the factor then, e.g. in ts ex2) S has A's sizes and block size but no blocks, and a nonzero state
+   that no matrix has: the symbolic phase builds the pattern. */
 PetscErrorCode BuildShadow(Mat A, PetscBool upper, FactorShadow *f)
 {
+  Mat_SeqBinBCSR       *a = (Mat_SeqBinBCSR *)A->data;
   std::vector<PetscInt> bi, bj;
 
   PetscFunctionBegin;
-  PetscCall(BuildShadowPattern(A, upper, f, bi, bj));
+  if (a->built) {
+    f->bs      = a->bs;
+    f->bw      = a->bw;
+    f->nzstate = A->nonzerostate;
+    PetscCall(BuildShadowPattern(A, upper, f, bi, bj));
+  } else {
+    PetscCall(MatGetBlockSize(A, &f->bs));
+    f->nzstate = -1;
+    bi.assign(A->rmap->n / f->bs + 1, 0);
+  }
   PetscCall(MatDestroy(&f->S));
   PetscCall(MatCreate(PETSC_COMM_SELF, &f->S));
   PetscCall(MatSetSizes(f->S, A->rmap->n, A->cmap->n, A->rmap->n, A->cmap->n));
@@ -332,9 +346,6 @@ PetscErrorCode ShadowSymbolic(Mat F, Mat A, IS row, IS col, Symbolic &&symbolic)
     PetscBool sbaij;
     PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Symbolic factorisation needs an assembled MATSEQBINBCSR matrix");
     PetscCall(PetscObjectTypeCompare((PetscObject)f->S, MATSEQSBAIJ, &sbaij));
-    f->bs      = a->bs;
-    f->bw      = a->bw;
-    f->nzstate = A->nonzerostate;
     f->perm.clear();
     PetscCall(BuildShadow(A, sbaij, f));
   }
@@ -382,29 +393,14 @@ PetscErrorCode LUSymbolic(Mat F, Mat A, IS row, IS col, const MatFactorInfo *inf
 
 PetscErrorCode MatGetFactor_SeqBinBCSR_Petsc(Mat A, MatFactorType ftype, Mat *F)
 {
-  Mat_SeqBinBCSR       *a     = (Mat_SeqBinBCSR *)A->data;
-  const PetscBool       upper = (ftype == MAT_FACTOR_ICC || ftype == MAT_FACTOR_CHOLESKY) ? PETSC_TRUE : PETSC_FALSE;
-  FactorShadow         *f;
+  const PetscBool upper = (ftype == MAT_FACTOR_ICC || ftype == MAT_FACTOR_CHOLESKY) ? PETSC_TRUE : PETSC_FALSE;
+  FactorShadow   *f;
 
   PetscFunctionBegin;
   PetscCheck(ftype == MAT_FACTOR_ICC || ftype == MAT_FACTOR_CHOLESKY || ftype == MAT_FACTOR_ILU || ftype == MAT_FACTOR_LU, PETSC_COMM_SELF, PETSC_ERR_SUP, "MATSEQBINBCSR provides ICC, Cholesky, ILU and LU (MATSOLVERPETSC), not %s", MatFactorTypes[ftype]);
   PetscCheck(A->rmap->n == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Factorisation of a non-square MATSEQBINBCSR matrix (%" PetscInt_FMT " x %" PetscInt_FMT ")", A->rmap->n, A->cmap->n);
   f = new FactorShadow;
-  if (a->built) {
-    f->bs      = a->bs;
-    f->bw      = a->bw;
-    f->nzstate = A->nonzerostate;
-    PetscCall(BuildShadow(A, upper, f));
-  } else { /* asked for before the first assembly (PCSetFromOptions does, e.g. in ts ex2): an empty
-              shadow of the right type and block size now, its pattern at the symbolic phase */
-    PetscCall(MatGetBlockSize(A, &f->bs));
-    f->nzstate = -1;
-    PetscCall(MatCreate(PETSC_COMM_SELF, &f->S));
-    PetscCall(MatSetSizes(f->S, A->rmap->n, A->cmap->n, A->rmap->n, A->cmap->n));
-    PetscCall(MatSetType(f->S, upper ? MATSEQSBAIJ : MATSEQBAIJ));
-    if (upper) PetscCall(MatSeqSBAIJSetPreallocation(f->S, f->bs, 0, nullptr));
-    else PetscCall(MatSeqBAIJSetPreallocation(f->S, f->bs, 0, nullptr));
-  }
+  PetscCall(BuildShadow(A, upper, f));
 
   PetscCall(MatGetFactor(f->S, MATSOLVERPETSC, ftype, F));
   PetscCall(binbcsr_factor::Attach(*F, f));
