@@ -84,7 +84,6 @@ set_tests_properties(articulated_bridge_icc articulated_bridge_icc_binbcsr artic
                      articulated_bad_scene PROPERTIES LABELS "articulated" TIMEOUT 60)
 
 set(ART_MPI "${ART} -options_file ${OPTS}/loop.opts -steps 100 -ksp_rtol 1e-12 -progress_every 1000")
-string(REPLACE ";" " " MPIEXEC_LINE "${MPIEXEC_CMD}")
 add_test(NAME articulated_mpi_np2
          COMMAND ${SUMMARY_SAME} "energy_final joint_error_final corrections_per_step" 1e-6
                  "${ART_MPI}" "${MPIEXEC_LINE} -n 2 ${ART_MPI}" "${MPIEXEC_LINE} -n 2 ${ART_MPI} -mat_type baij"

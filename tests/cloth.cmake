@@ -29,7 +29,6 @@ set_tests_properties(cloth_bad_stiffness PROPERTIES PASS_REGULAR_EXPRESSION "non
 set_tests_properties(cloth_drape_sphere cloth_stiff_dt30 cloth_same_result_mat_types cloth_bad_dt cloth_bad_n cloth_bad_pins
                      cloth_bad_stiffness PROPERTIES LABELS "cloth" TIMEOUT 60)
 
-string(REPLACE ";" " " MPIEXEC_LINE "${MPIEXEC_CMD}")
 add_test(NAME cloth_mpi_np2
          COMMAND ${SUMMARY_SAME} "energy_final max_stretch contacts" 1e-6
                  "${CLOTH_SAME}" "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME}" "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg"

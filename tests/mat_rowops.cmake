@@ -34,21 +34,20 @@ rowops_stock_ex4(diagscale_sym_np1 1 "${DIAGSCALE}" -mat_binbcsr_symmetric_stora
 binbcsr_stock_example(stock_mat_ex114 mat/tests/ex114.c)
 binbcsr_stock_example(stock_mat_ex138 mat/tests/ex138.c)
 # (tests/stock_compare.sh: same printed lines, numbers to 1e-10; "type:" lines dropped, the type differs)
-string(REPLACE ";" " " ROWOPS_MPIEXEC "${MPIEXEC_CMD}")
 set(ROWOPS_SPD ${PETSC_DATAFILES_DIR}/matrices/spd-real-int32-float64)
 # (testcase 0 and 2 on one rank: dense and sparse rows; 0 and 1 on three: a stored zero tied with the
 # implicit ones, whole rows on one rank)
 foreach(case "1;0" "1;2" "3;0" "3;1")
   list(GET case 0 np)
   list(GET case 1 tc)
-  set(prog "${ROWOPS_MPIEXEC} -n ${np} $<TARGET_FILE:stock_mat_ex114> -testcase ${tc}")
+  set(prog "${MPIEXEC_LINE} -n ${np} $<TARGET_FILE:stock_mat_ex114> -testcase ${tc}")
   add_test(NAME mat_rowops_stock_mat_ex114_tc${tc}_np${np}
            COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/stock_compare.sh --drop "type:"
                    --ref "${prog} -mat_type aij" --test "${prog} -dll_append ${PLUGIN} -mat_type binbcsr")
   set_tests_properties(mat_rowops_stock_mat_ex114_tc${tc}_np${np} PROPERTIES LABELS "mat_rowops;stock;mpi" PROCESSORS 2 TIMEOUT 60)
 endforeach()
 foreach(np 2) # (1 rank: the same kernels)
-  set(prog "${ROWOPS_MPIEXEC} -n ${np} $<TARGET_FILE:stock_mat_ex138> -f ${ROWOPS_SPD} -viewer_binary_skip_info")
+  set(prog "${MPIEXEC_LINE} -n ${np} $<TARGET_FILE:stock_mat_ex138> -f ${ROWOPS_SPD} -viewer_binary_skip_info")
   add_test(NAME mat_rowops_stock_mat_ex138_np${np}
            COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/stock_compare.sh
                    --ref "${prog} -mat_type aij"

@@ -3,7 +3,6 @@
 # value array (zeros), on one rank and on several (a NULL array crashed MATMPIBINBCSR before).
 # Compared with the same program on aij. Label: stock, mat_ops (+ mpi). Budget: a few seconds.
 binbcsr_stock_example(petsc_snes_ex5 snes/tutorials/ex5.c)
-string(REPLACE ";" " " MPIEXEC_LINE "${MPIEXEC_CMD}")
 binbcsr_stock_example(petsc_ksp_ex45 ksp/ksp/tutorials/ex45.c)
 binbcsr_stock_example(petsc_snes_ex19 snes/tutorials/ex19.c)
 

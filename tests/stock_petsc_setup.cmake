@@ -5,7 +5,6 @@
 # Label: stock, mat_ops (+ mpi). Budget: a few seconds.
 binbcsr_stock_example(petsc_ksp_ex2 ksp/ksp/tutorials/ex2.c)
 binbcsr_stock_example(petsc_ts_ex2 ts/tutorials/ex2.c)
-string(REPLACE ";" " " MPIEXEC_LINE "${MPIEXEC_CMD}")
 
 set(KSP_EX2 "@STOCK@/petsc_ksp_ex2 -ksp_converged_reason")
 foreach(np 2 3)
