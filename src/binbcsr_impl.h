@@ -53,9 +53,14 @@ PETSC_INTERN PetscErrorCode MatBinBCSRCreateEmptyLike_Private(Mat A, PetscInt m,
 PETSC_INTERN PetscErrorCode MatAXPYGetPreallocation_BinBCSR(Mat Y, Mat X, Mat *B);
 /* MatPermute of seq and mpi binbcsr: a new matrix of the same type and configuration (binbcsr_permute.cpp) */
 PETSC_INTERN PetscErrorCode MatPermute_BinBCSR(Mat, IS, IS, Mat *);
-/* MatIsSymmetric (through the transpose) and MatFindZeroDiagonals of seq and mpi binbcsr (binbcsr_queries.cpp) */
+/* MatIsSymmetric (through the transpose), MatFindZeroDiagonals, MatFindNonzeroRows of seq and mpi binbcsr (binbcsr_queries.cpp) */
 PETSC_INTERN PetscErrorCode MatIsSymmetric_BinBCSR(Mat, PetscReal, PetscBool *);
 PETSC_INTERN PetscErrorCode MatFindZeroDiagonals_BinBCSR(Mat, IS *);
+PETSC_INTERN PetscErrorCode MatFindNonzeroRows_BinBCSR(Mat, IS *);
+/* MatSetRandom (the stored pattern), MatRealPart, MatImaginaryPart of seq and mpi binbcsr (binbcsr_value_fill.cpp) */
+PETSC_INTERN PetscErrorCode MatSetRandom_BinBCSR(Mat, PetscRandom);
+PETSC_INTERN PetscErrorCode MatRealPart_BinBCSR(Mat);
+PETSC_INTERN PetscErrorCode MatImaginaryPart_BinBCSR(Mat);
 
 /* A clear error unless v has n local entries (what: the argument's name in the message): binbcsr_api.cpp */
 PETSC_INTERN PetscErrorCode MatBinBCSRCheckVecLocalSize(Vec v, PetscInt n, const char *what);

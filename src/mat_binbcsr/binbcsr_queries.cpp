@@ -1,8 +1,12 @@
 /* Whole-matrix questions for seq and mpi binbcsr: MatFindZeroDiagonals (what
-   -pc_fieldsplit_detect_saddle_point asks) and MatIsSymmetric.
+   -pc_fieldsplit_detect_saddle_point asks), MatFindNonzeroRows and MatIsSymmetric.
 
    MatFindZeroDiagonals: the rows whose diagonal entry is zero or not stored, from MatGetDiagonal (the
    stored diagonal slots), as global rows of this rank.
+
+   MatFindNonzeroRows: the rows with a nonzero value, from MatGetRowMaxAbs (exact, where PETSc's generic
+   path multiplies by a random vector), with aij's conventions: NULL when no row is zero (on any rank),
+   global rows of this rank otherwise (a stored zero does not make a row nonzero).
 
    MatIsSymmetric: Symmetric storage is symmetric by construction. Otherwise the
    transpose (MatTranspose of the type: a new layout, or the MPI exchange) is compared row by row with
@@ -66,5 +70,27 @@ PETSC_INTERN PetscErrorCode MatFindZeroDiagonals_BinBCSR(Mat A, IS *zrows)
   PetscCall(VecRestoreArrayRead(d, &da));
   PetscCall(VecDestroy(&d));
   PetscCall(ISCreateGeneral(PetscObjectComm((PetscObject)A), (PetscInt)rows.size(), rows.data(), PETSC_COPY_VALUES, zrows));
+  PetscFunctionReturn(0);
+}
+
+PETSC_INTERN PetscErrorCode MatFindNonzeroRows_BinBCSR(Mat A, IS *keptrows)
+{
+  Vec                   m;
+  const PetscScalar    *ma;
+  std::vector<PetscInt> rows;
+  PetscInt              nzero, gzero;
+
+  PetscFunctionBegin;
+  PetscCall(MatCreateVecs(A, nullptr, &m));
+  PetscCall(MatGetRowMaxAbs(A, m, nullptr));
+  PetscCall(VecGetArrayRead(m, &ma));
+  for (PetscInt i = 0; i < A->rmap->n; i++)
+    if (ma[i] != 0.0) rows.push_back(A->rmap->rstart + i); /* NaN counts as nonzero, as in aij */
+  PetscCall(VecRestoreArrayRead(m, &ma));
+  PetscCall(VecDestroy(&m));
+  nzero = A->rmap->n - (PetscInt)rows.size();
+  PetscCall(MPIU_Allreduce(&nzero, &gzero, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)A)));
+  *keptrows = nullptr;
+  if (gzero) PetscCall(ISCreateGeneral(PetscObjectComm((PetscObject)A), (PetscInt)rows.size(), rows.data(), PETSC_COPY_VALUES, keptrows));
   PetscFunctionReturn(0);
 }

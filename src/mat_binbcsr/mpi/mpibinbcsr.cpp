@@ -403,6 +403,7 @@ PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
   mat->ops->getdiagonal         = MatGetDiagonal_MPIBinBCSR;
   mat->ops->diagonalset         = MatDiagonalSet_MPIBinBCSR;
   mat->ops->invertblockdiagonal = MatInvertBlockDiagonal_MPIBinBCSR;
+  mat->ops->invertvariableblockdiagonal = MatInvertVariableBlockDiagonal_MPIBinBCSR;
   mat->ops->sor                 = MatSOR_MPIBinBCSR;
   mat->ops->multdiagonalblock   = MatMultDiagonalBlock_MPIBinBCSR;
   mat->ops->scale               = MatScale_MPIBinBCSR;
@@ -428,6 +429,12 @@ PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
   mat->ops->permute             = MatPermute_BinBCSR;
   mat->ops->issymmetric         = MatIsSymmetric_BinBCSR;
   mat->ops->findzerodiagonals   = MatFindZeroDiagonals_BinBCSR;
+  mat->ops->findnonzerorows     = MatFindNonzeroRows_BinBCSR;
+  mat->ops->setrandom           = MatSetRandom_BinBCSR;
+  mat->ops->realpart            = MatRealPart_BinBCSR;
+  mat->ops->imaginarypart       = MatImaginaryPart_BinBCSR;
+  mat->ops->getrowij            = MatGetRowIJ_MPIBinBCSR;
+  mat->ops->restorerowij        = MatRestoreRowIJ_MPIBinBCSR;
   mat->ops->getdiagonalblock    = MatGetDiagonalBlock_MPIBinBCSR;
   mat->ops->view                = MatView_MPIBinBCSR;
   mat->ops->load                = MatLoad_MPIBinBCSR;

@@ -155,6 +155,7 @@ PETSC_INTERN PetscErrorCode MatMultDotLocal_MPIBinBCSR(Mat, Vec, Vec, PetscScala
 PETSC_INTERN PetscErrorCode MatGetDiagonal_MPIBinBCSR(Mat, Vec);
 PETSC_INTERN PetscErrorCode MatDiagonalSet_MPIBinBCSR(Mat, Vec, InsertMode);
 PETSC_INTERN PetscErrorCode MatInvertBlockDiagonal_MPIBinBCSR(Mat, const PetscScalar **);
+PETSC_INTERN PetscErrorCode MatInvertVariableBlockDiagonal_MPIBinBCSR(Mat, PetscInt, const PetscInt *, PetscScalar *);
 PETSC_INTERN PetscErrorCode MatSOR_MPIBinBCSR(Mat, Vec, PetscReal, MatSORType, PetscReal, PetscInt, PetscInt, Vec);
 PETSC_INTERN PetscErrorCode MatMultDiagonalBlock_MPIBinBCSR(Mat, Vec, Vec); /* mpibinbcsr_sor.cpp */
 PETSC_INTERN PetscErrorCode MatScale_MPIBinBCSR(Mat, PetscScalar);
@@ -179,6 +180,10 @@ PETSC_INTERN PetscErrorCode MatEqual_MPIBinBCSR(Mat, Mat, PetscBool *);
 PETSC_INTERN PetscErrorCode MatGetValues_MPIBinBCSR(Mat, PetscInt, const PetscInt[], PetscInt, const PetscInt[], PetscScalar[]);
 PETSC_INTERN PetscErrorCode MatAXPY_MPIBinBCSR(Mat, PetscScalar, Mat, MatStructure);
 PETSC_INTERN PetscErrorCode MatTranspose_MPIBinBCSR(Mat, MatReuse, Mat *);
+
+/* mpibinbcsr_rowij.cpp: the local rows' structure, global columns (MPIAIJ's MatGetRowIJ) */
+PETSC_INTERN PetscErrorCode MatGetRowIJ_MPIBinBCSR(Mat, PetscInt, PetscBool, PetscBool, PetscInt *, const PetscInt *[], const PetscInt *[], PetscBool *);
+PETSC_INTERN PetscErrorCode MatRestoreRowIJ_MPIBinBCSR(Mat, PetscInt, PetscBool, PetscBool, PetscInt *, const PetscInt *[], const PetscInt *[], PetscBool *);
 
 /* mpibinbcsr_convert.cpp: conversion, load, view */
 PETSC_INTERN PetscErrorCode MatConvert_MPIBinBCSR_MPIAIJ(Mat, MatType, MatReuse, Mat *);

@@ -144,6 +144,26 @@ PETSC_INTERN PetscErrorCode MatInvertBlockDiagonal_MPIBinBCSR(Mat mat, const Pet
   PetscFunctionReturn(0);
 }
 
+/* The variable blocks lie in the rows of this rank (MatSetVariableBlockSizes checks their sum), so in the
+   diagonal part, as for MPIAIJ. Unlike MPIAIJ, the matrix's MatSetErrorIfFailure reaches the part and a
+   zero pivot the part met is reported on the matrix, where PCVPBJACOBI looks for it. */
+PETSC_INTERN PetscErrorCode MatInvertVariableBlockDiagonal_MPIBinBCSR(Mat mat, PetscInt nblocks, const PetscInt *bsizes, PetscScalar *diag)
+{
+  Mat A = MPIBinBCSR(mat)->A;
+
+  PetscFunctionBegin;
+  PetscCheck(mat->rmap->rstart == mat->cmap->rstart && mat->rmap->n == mat->cmap->n, PETSC_COMM_SELF, PETSC_ERR_SUP, "Only for matrices whose row and column layouts agree");
+  A->erroriffailure = mat->erroriffailure;
+  PetscCall(MatFactorClearError(A));
+  PetscCall(MatInvertVariableBlockDiagonal(A, nblocks, bsizes, diag));
+  if (A->factorerrortype) {
+    mat->factorerrortype             = A->factorerrortype;
+    mat->factorerror_zeropivot_row   = A->factorerror_zeropivot_row + mat->rmap->rstart;
+    mat->factorerror_zeropivot_value = A->factorerror_zeropivot_value;
+  }
+  PetscFunctionReturn(0);
+}
+
 PETSC_INTERN PetscErrorCode MatScale_MPIBinBCSR(Mat mat, PetscScalar a)
 {
   Mat_MPIBinBCSR *b = MPIBinBCSR(mat);

@@ -594,6 +594,7 @@ PetscErrorCode MatCreate_SeqBinBCSR(Mat A)
   A->ops->multtransposeadd    = MatMultTransposeAdd_SeqBinBCSR;
   A->ops->getdiagonal         = MatGetDiagonal_SeqBinBCSR;
   A->ops->invertblockdiagonal = MatInvertBlockDiagonal_SeqBinBCSR;
+  A->ops->invertvariableblockdiagonal = MatInvertVariableBlockDiagonal_SeqBinBCSR;
   A->ops->sor                 = MatSOR_SeqBinBCSR;
   A->ops->multdiagonalblock   = MatMultDiagonalBlock_SeqBinBCSR;
   A->ops->assemblyend         = MatAssemblyEnd_SeqBinBCSR;

@@ -195,6 +195,7 @@ PETSC_INTERN PetscErrorCode MatMultTransposeAdd_SeqBinBCSR(Mat, Vec, Vec, Vec);
 PETSC_INTERN PetscErrorCode MatMultDotLocal_SeqBinBCSR(Mat, Vec, Vec, PetscScalar *);
 PETSC_INTERN PetscErrorCode MatGetDiagonal_SeqBinBCSR(Mat, Vec);
 PETSC_INTERN PetscErrorCode MatInvertBlockDiagonal_SeqBinBCSR(Mat, const PetscScalar **);
+PETSC_INTERN PetscErrorCode MatInvertVariableBlockDiagonal_SeqBinBCSR(Mat, PetscInt, const PetscInt *, PetscScalar *);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRInvertDiagonalBlocks(Mat, PetscReal shift, MatScalar *out, PetscInt *zero_row);
 PETSC_INTERN PetscErrorCode MatSOR_SeqBinBCSR(Mat, Vec, PetscReal, MatSORType, PetscReal, PetscInt, PetscInt, Vec);
 PETSC_INTERN PetscErrorCode MatMultDiagonalBlock_SeqBinBCSR(Mat, Vec, Vec);

@@ -560,6 +560,10 @@ PetscErrorCode MatSeqBinBCSRSetOps_Ops(Mat A)
   A->ops->permute           = MatPermute_BinBCSR;
   A->ops->issymmetric       = MatIsSymmetric_BinBCSR;
   A->ops->findzerodiagonals = MatFindZeroDiagonals_BinBCSR;
+  A->ops->findnonzerorows   = MatFindNonzeroRows_BinBCSR;
+  A->ops->setrandom         = MatSetRandom_BinBCSR;
+  A->ops->realpart          = MatRealPart_BinBCSR;
+  A->ops->imaginarypart     = MatImaginaryPart_BinBCSR;
   A->ops->load              = MatLoad_SeqBinBCSR;
   /* submatrices through an AIJ shadow (binbcsr_submat.cpp); MatCreateSubMatrix uses createsubmatrices on one rank */
   A->ops->increaseoverlap               = MatIncreaseOverlap_BinBCSR;

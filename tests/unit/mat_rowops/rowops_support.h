@@ -62,6 +62,21 @@ double entry(const Config &c, PetscInt i, PetscInt j); // the stored value (floa
 // type "aij" or "binbcsr"; binbcsr gets the config's storage options
 PetscErrorCode make(const Config &c, const char *type, Mat *A);
 
+// The same matrix as binbcsr and as aij.
+struct Pair {
+  Mat bin = nullptr, aij = nullptr;
+  explicit Pair(const Config &c)
+  {
+    PETSC_OK(make(c, MATBINBCSR, &bin));
+    PETSC_OK(make(c, MATAIJ, &aij));
+  }
+  ~Pair()
+  {
+    MatDestroy(&bin);
+    MatDestroy(&aij);
+  }
+};
+
 // Largest |got_ij - want_ij| / (sum_j |want_ij|) over the rows (collective); rows of zeros compare
 // absolutely.
 double row_error(Mat got, Mat want);

@@ -16,20 +16,6 @@ namespace
 
 constexpr double kRoundings = 4.0;
 
-struct Pair {
-  Mat bin = nullptr, aij = nullptr;
-  explicit Pair(const Config &c)
-  {
-    PETSC_OK(make(c, MATBINBCSR, &bin));
-    PETSC_OK(make(c, MATAIJ, &aij));
-  }
-  ~Pair()
-  {
-    MatDestroy(&bin);
-    MatDestroy(&aij);
-  }
-};
-
 // |got_i - want_i| <= tol * scale_i for all i (collective)
 bool vec_close(Vec got, Vec want, const std::vector<double> &scale, double tol)
 {
