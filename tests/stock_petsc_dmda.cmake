@@ -44,3 +44,17 @@ binbcsr_stock_case(snes_ex19_fdcoloring_ilu
   --keep "converged|SNES Function norm" --rtol 1e-6
   --ref "${SNES_EX19} -dm_mat_type baij"
   --test "${SNES_EX19} ${PLUGIN_ARGS} -dm_mat_type binbcsr")
+
+# ksp ex25 (1-D DMDA, DM_BOUNDARY_NONE): on 2 and 3 ranks DMDA takes its generic 1-D AIJ path
+# (DMCreateMatrix_DA_1d_MPIAIJ, through the AIJ preallocation answers) and binbcsr gives aij's
+# iterations. On one rank DMDA writes an AIJ matrix's private data instead (README, limits): not run.
+binbcsr_stock_example(petsc_ksp_ex25 ksp/ksp/tutorials/ex25.c)
+set(KSP_EX25 "@STOCK@/petsc_ksp_ex25 -ksp_converged_reason")
+foreach(np 2 3)
+  binbcsr_stock_case(ksp_ex25_dmda1d_np${np}
+    --keep "converged|Residual norm" --atol 1e-10
+    --ref "${MPIEXEC_LINE} -n ${np} ${KSP_EX25} -dm_mat_type aij"
+    --test "${MPIEXEC_LINE} -n ${np} ${KSP_EX25} ${PLUGIN_ARGS} -dm_mat_type binbcsr -mat_view ::ascii_info"
+    --expect "type: mpibinbcsr")
+  set_tests_properties(stock_ksp_ex25_dmda1d_np${np} PROPERTIES LABELS "stock;mat_ops;mpi" PROCESSORS 2)
+endforeach()
