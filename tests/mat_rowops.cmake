@@ -54,3 +54,14 @@ foreach(np 2) # (1 rank: the same kernels)
                    --test "${prog} -dll_append ${PLUGIN} -mat_type binbcsr -matload_block_size 3 -mat_binbcsr_symmetric_storage")
   set_tests_properties(mat_rowops_stock_mat_ex138_np${np} PROPERTIES LABELS "mat_rowops;stock;mpi" PROCESSORS 2 TIMEOUT 60)
 endforeach()
+
+# PETSc's own PCVPBJACOBI test (snes tests ex5: blocks of 1, 2, 2 rows set by MatSetVariableBlockSizes,
+# one rank by design) with -mat_type binbcsr against aij (before MatInvertVariableBlockDiagonal binbcsr
+# stopped there). The unit tests (whole_ops_test.cpp) compare the blocks and solves on 1-3 ranks.
+binbcsr_stock_example(stock_snes_tests_ex5 snes/tests/ex5.c)
+set(prog "$<TARGET_FILE:stock_snes_tests_ex5> -snes_monitor_short -snes_converged_reason")
+add_test(NAME mat_rowops_stock_snes_ex5_vpbjacobi
+         COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/stock_compare.sh --keep "SNES Function norm|converged|Norm of error" --rtol 1e-4
+                 --ref "${prog} -mat_type aij" --test "${prog} -dll_append ${PLUGIN} -mat_type binbcsr -mat_view ::ascii_info"
+                 --expect "BIN-CSR")
+set_tests_properties(mat_rowops_stock_snes_ex5_vpbjacobi PROPERTIES LABELS "mat_rowops;stock" TIMEOUT 60)
