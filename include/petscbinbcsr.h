@@ -56,6 +56,18 @@ PETSC_EXTERN PetscErrorCode MatBinBCSRGetSymmetricStorage(Mat, PetscBool *);
    answers PETSC_FALSE on matrices of other types. */
 PETSC_EXTERN PetscErrorCode MatBinBCSRSetCOOMirror(Mat, PetscBool);
 PETSC_EXTERN PetscErrorCode MatBinBCSRGetCOOMirror(Mat, PetscBool *);
+/* Streams: the product y = A x (whole storage, block size 1 or 3, bin width 4, 8, 16 or 32) sweeps
+   this many runs of consecutive bins side by side, so one core streams the values from that many
+   places at once (the hardware prefetcher keeps more cache lines in flight for several streams):
+   1, 2, 4 or 8, default 4. A traversal order only: the layout, the results and every other
+   operation are the same for any value, and it may change at any time. Option
+   -mat_binbcsr_streams. The setter is a no-op and the getter answers 1 on matrices of other types. */
+PETSC_EXTERN PetscErrorCode MatBinBCSRSetStreams(Mat, PetscInt);
+PETSC_EXTERN PetscErrorCode MatBinBCSRGetStreams(Mat, PetscInt *);
+/* The -mat_binbcsr_* options of the options database (under the matrix's prefix) applied to a matrix
+   whose type the program chose with MatSetType: MatSetFromOptions would also let -mat_type replace
+   that type. A no-op on matrices of other types. */
+PETSC_EXTERN PetscErrorCode MatBinBCSRSetFromOptions(Mat);
 
 /* y = A x and *xdoty = the local (this rank's rows, unreduced) part of x^T y, in one pass over A when
    the matrix type provides it (composed "MatMultDotLocal_C"), otherwise MatMult and a local dot.

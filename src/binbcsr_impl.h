@@ -3,6 +3,10 @@
 #ifndef BINBCSR_IMPL_H
 #define BINBCSR_IMPL_H
 
+/* Default MatBinBCSRSetStreams (seq and mpi): 4 runs of bins swept side by side (docs/mat_binbcsr.md:
+   on the 48^3 stencil 2, 4, 6 and 8 runs all beat 1; 4 was the fastest or within the noise of it). */
+#define BINBCSR_DEFAULT_STREAMS 4
+
 #include <petscbinbcsr.h>
 #include <petsc/private/petscimpl.h>
 

@@ -1,4 +1,5 @@
 #include "common/stencil.h"
+#include <petscbinbcsr.h>
 
 #include <cmath>
 #include <cstring>
@@ -81,8 +82,10 @@ PetscErrorCode CreateStencilMatrix(MPI_Comm comm, const StencilGrid &grid, MatTy
   if (prefix) PetscCall(MatSetOptionsPrefix(*A, prefix));
   PetscCall(MatSetSizes(*A, nlocal, nlocal, bs * nodes, bs * nodes));
   PetscCall(MatSetBlockSize(*A, bs));
-  if (type) PetscCall(MatSetType(*A, type));
-  else PetscCall(MatSetFromOptions(*A));
+  if (type) {
+    PetscCall(MatSetType(*A, type));
+    PetscCall(MatBinBCSRSetFromOptions(*A)); /* -mat_binbcsr_bin_width, ... (not -mat_type: the caller chose the type) */
+  } else PetscCall(MatSetFromOptions(*A));
 
   // Exact preallocation, in blocks (d/o: diagonal/off-diagonal part; u: upper triangle for SBAIJ).
   const PetscInt        m = rend - rstart;

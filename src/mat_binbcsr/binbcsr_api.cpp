@@ -1,6 +1,21 @@
 /* Public setters and getters of MATBINBCSR: dispatch to the composed implementation of the actual
    type (seq or mpi), and do nothing on other types so user code can call them unconditionally. */
 #include "binbcsr_impl.h"
+#include <petsc/private/matimpl.h>
+
+PetscErrorCode MatBinBCSRSetFromOptions(Mat A)
+{
+  PetscErrorCode (*is_binbcsr)(Mat, PetscInt) = nullptr;
+
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscCall(PetscObjectQueryFunction((PetscObject)A, "MatBinBCSRSetBinWidth_C", &is_binbcsr));
+  if (!is_binbcsr || !A->ops->setfromoptions) PetscFunctionReturn(0);
+  PetscObjectOptionsBegin((PetscObject)A);
+  PetscCall((*A->ops->setfromoptions)(A, PetscOptionsObject));
+  PetscOptionsEnd();
+  PetscFunctionReturn(0);
+}
 
 PetscErrorCode MatBinBCSRSetBinWidth(Mat A, PetscInt bw)
 {
@@ -75,6 +90,26 @@ PetscErrorCode MatBinBCSRGetCOOMirror(Mat A, PetscBool *flg)
   PetscValidBoolPointer(flg, 2);
   *flg = PETSC_FALSE;
   PetscTryMethod(A, "MatBinBCSRGetCOOMirror_C", (Mat, PetscBool *), (A, flg));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatBinBCSRSetStreams(Mat A, PetscInt streams)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidLogicalCollectiveInt(A, streams, 2);
+  PetscCheck(streams == 1 || streams == 2 || streams == 4 || streams == 8, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_OUTOFRANGE, "Streams %" PetscInt_FMT ": must be 1, 2, 4 or 8", streams);
+  PetscTryMethod(A, "MatBinBCSRSetStreams_C", (Mat, PetscInt), (A, streams));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatBinBCSRGetStreams(Mat A, PetscInt *streams)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidIntPointer(streams, 2);
+  *streams = 1;
+  PetscTryMethod(A, "MatBinBCSRGetStreams_C", (Mat, PetscInt *), (A, streams));
   PetscFunctionReturn(0);
 }
 

@@ -1,7 +1,7 @@
 /*
    AVX-512 bodies of the two products of 3x3 blocks at bin width 8 (one zmm register of doubles per
-   block entry), the shape of the cloth, the stencils and the FE scenes: a whole bin of the whole-storage
-   product (bin_mult_3x8) and of the symmetric one (sym_bin_mult_3x8). CPU only: binbcsr_kernels.h
+   block entry), the shape of the cloth, the stencils and the FE scenes: whole bins of the whole-storage
+   product (bins_mult_3x8) and of the symmetric one (sym_bin_mult_3x8). CPU only: binbcsr_kernels.h
    includes this header when the compiler targets AVX-512; the portable per-lane kernels stay the
    definition (and the CUDA path), and the unit tests compare both with seqaij.
 
@@ -45,34 +45,58 @@ inline void add_xyz(double *ys, __m512d s0, __m512d s1, __m512d s2)
   _mm512_storeu_pd(ys + 16, _mm512_add_pd(_mm512_loadu_pd(ys + 16), hi));
 }
 
-/* The whole-storage product of one bin (3x3 blocks, 8 lanes): acc[i] (lane l in element l) +=
-   sum over the bin's len slot groups of block(i, j) x_c(j), the accumulators in registers for the
-   whole bin. Consecutive-column groups load x (split_xyz); the others gather it with 32-bit offsets. */
+/* One slot group of the whole-storage product (3x3 blocks, 8 lanes): a[i] (lane l in element l) +=
+   block(i, j) x_c(j). Consecutive-column groups load x (split_xyz); the others gather it with 32-bit
+   offsets. */
 template <typename V, typename I>
-inline void bin_mult_3x8(const V *t, const I *c, int len, const double *x, double (*acc)[8])
+inline void group_mult_3x8(const V *t, const I *c, const double *x, __m512d *a)
 {
   static_assert(sizeof(I) == 4, "32-bit column indices");
-  __m512d       a0 = _mm512_loadu_pd(acc[0]), a1 = _mm512_loadu_pd(acc[1]), a2 = _mm512_loadu_pd(acc[2]);
   const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  for (int k = 0; k < len; k++, c += 8, t += 72) {
-    prefetch_values(t, 72 * (int)sizeof(V));
-    const __m256i ci = _mm256_loadu_si256((const __m256i *)c);
-    __m512d       x0, x1, x2;
-    /* unit_stride<8>(c) as one vector compare: the indices are in a register already */
-    if (_mm256_cmpeq_epi32_mask(ci, _mm256_add_epi32(_mm256_set1_epi32((int)c[0]), iota)) == 0xFF) split_xyz(x + (long)c[0] * 3, x0, x1, x2);
-    else {
-      const __m256i off = _mm256_add_epi32(ci, _mm256_add_epi32(ci, ci)); /* 3 c */
-      x0                = _mm512_i32gather_pd(off, x, 8);
-      x1                = _mm512_i32gather_pd(off, x + 1, 8);
-      x2                = _mm512_i32gather_pd(off, x + 2, 8);
-    }
-    a0 = _mm512_fmadd_pd(load8(t + 16), x2, _mm512_fmadd_pd(load8(t + 8), x1, _mm512_fmadd_pd(load8(t), x0, a0)));
-    a1 = _mm512_fmadd_pd(load8(t + 40), x2, _mm512_fmadd_pd(load8(t + 32), x1, _mm512_fmadd_pd(load8(t + 24), x0, a1)));
-    a2 = _mm512_fmadd_pd(load8(t + 64), x2, _mm512_fmadd_pd(load8(t + 56), x1, _mm512_fmadd_pd(load8(t + 48), x0, a2)));
+  prefetch_values(t, 72 * (int)sizeof(V));
+  const __m256i ci = _mm256_loadu_si256((const __m256i *)c);
+  __m512d       x0, x1, x2;
+  /* unit_stride<8>(c) as one vector compare: the indices are in a register already */
+  if (_mm256_cmpeq_epi32_mask(ci, _mm256_add_epi32(_mm256_set1_epi32((int)c[0]), iota)) == 0xFF) split_xyz(x + (long)c[0] * 3, x0, x1, x2);
+  else {
+    const __m256i off = _mm256_add_epi32(ci, _mm256_add_epi32(ci, ci)); /* 3 c */
+    x0                = _mm512_i32gather_pd(off, x, 8);
+    x1                = _mm512_i32gather_pd(off, x + 1, 8);
+    x2                = _mm512_i32gather_pd(off, x + 2, 8);
   }
-  _mm512_storeu_pd(acc[0], a0);
-  _mm512_storeu_pd(acc[1], a1);
-  _mm512_storeu_pd(acc[2], a2);
+  a[0] = _mm512_fmadd_pd(load8(t + 16), x2, _mm512_fmadd_pd(load8(t + 8), x1, _mm512_fmadd_pd(load8(t), x0, a[0])));
+  a[1] = _mm512_fmadd_pd(load8(t + 40), x2, _mm512_fmadd_pd(load8(t + 32), x1, _mm512_fmadd_pd(load8(t + 24), x0, a[1])));
+  a[2] = _mm512_fmadd_pd(load8(t + 64), x2, _mm512_fmadd_pd(load8(t + 56), x1, _mm512_fmadd_pd(load8(t + 48), x0, a[2])));
+}
+
+/* The whole-storage product of K bins swept together (3x3 blocks, 8 lanes): acc[q][i] (lane l in
+   element l) += block row i of bin q times x over its len[q] slot groups, the groups of the K bins taken
+   in turn; the accumulators stay in registers for the whole sweep. K bins far apart in memory are K
+   streams for the hardware prefetcher (bins_sweep in binbcsr_mult.cpp says why). */
+template <int K, typename V, typename I>
+inline void bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, const int *len, const double *x, double (*const *acc)[8])
+{
+  __m512d  a[K][3];
+  const V *t[K];
+  const I *c[K];
+  int      common = len[0];
+  for (int q = 0; q < K; q++) {
+    t[q]   = bin_val[q];
+    c[q]   = bin_col[q];
+    common = len[q] < common ? len[q] : common;
+    for (int i = 0; i < 3; i++) a[q][i] = _mm512_loadu_pd(acc[q][i]);
+  }
+  const auto group = [&](int q) {
+    group_mult_3x8(t[q], c[q], x, a[q]);
+    t[q] += 72;
+    c[q] += 8;
+  };
+  for (int k = 0; k < common; k++)
+    for (int q = 0; q < K; q++) group(q);
+  for (int q = 0; q < K; q++)
+    for (int k = common; k < len[q]; k++) group(q);
+  for (int q = 0; q < K; q++)
+    for (int i = 0; i < 3; i++) _mm512_storeu_pd(acc[q][i], a[q][i]);
 }
 
 /* sym_bin_mult (binbcsr_kernels.h) for 3x3 blocks and 8 lanes, the whole bin in registers: the lanes'

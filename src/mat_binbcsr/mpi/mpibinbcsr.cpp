@@ -12,7 +12,7 @@ static PetscErrorCode MatDestroy_MPIBinBCSR(Mat mat)
   delete MPIBinBCSR(mat);
   mat->data = nullptr;
   PetscCall(PetscObjectChangeTypeName((PetscObject)mat, nullptr));
-  const char *names[] = {"MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatBinBCSRSetCOOMirror_C", "MatBinBCSRGetCOOMirror_C", "MatMPIAIJSetPreallocation_C", "MatMPIBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatGetDiagonalBlock_C", "MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatConvert_mpibinbcsr_mpiaij_C", "MatConvert_mpibinbcsr_hypre_C", "MatProductSetFromOptions_anytype_C", "MatAXPYGetPreallocation_C"};
+  const char *names[] = {"MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatBinBCSRSetCOOMirror_C", "MatBinBCSRGetCOOMirror_C", "MatBinBCSRSetStreams_C", "MatBinBCSRGetStreams_C", "MatMPIAIJSetPreallocation_C", "MatMPIBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatGetDiagonalBlock_C", "MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatConvert_mpibinbcsr_mpiaij_C", "MatConvert_mpibinbcsr_hypre_C", "MatProductSetFromOptions_anytype_C", "MatAXPYGetPreallocation_C"};
   for (const char *name : names) PetscCall(PetscObjectComposeFunction((PetscObject)mat, name, (void (*)(void)) nullptr));
   PetscFunctionReturn(0);
 }
@@ -124,6 +124,27 @@ static PetscErrorCode MatBinBCSRGetBinWidth_MPIBinBCSR(Mat mat, PetscInt *bw)
   PetscFunctionReturn(0);
 }
 
+static PetscErrorCode MatBinBCSRSetStreams_MPIBinBCSR(Mat mat, PetscInt streams)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  b->streams = streams;
+  if (b->A) PetscCall(MatBinBCSRSetStreams(b->A, streams));
+  if (b->B) PetscCall(MatBinBCSRSetStreams(b->B, streams));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRGetStreams_MPIBinBCSR(Mat mat, PetscInt *streams)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  if (b->A) PetscCall(MatBinBCSRGetStreams(b->A, streams));
+  else *streams = b->streams ? b->streams : BINBCSR_DEFAULT_STREAMS;
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MatBinBCSRSetPrecision_MPIBinBCSR(Mat mat, MatBinBCSRPrecision p)
 {
   Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
@@ -218,6 +239,11 @@ static PetscErrorCode MatSetFromOptions_MPIBinBCSR(Mat mat, PetscOptionItems *Pe
   PetscCall(PetscOptionsBool("-mat_binbcsr_symmetric_storage", "Store the upper triangle of the diagonal part only (symmetric matrices; the lower triangle given is ignored)", "MatBinBCSRSetSymmetricStorage", sym, &sym, &flg));
   if (flg) PetscCall(MatBinBCSRSetSymmetricStorage_MPIBinBCSR(mat, sym));
   PetscCall(PetscOptionsBool("-mat_binbcsr_coo_mirror", "COO entries of off-diagonal blocks also fill the transposed place (give one triangle of a symmetric matrix)", "MatBinBCSRSetCOOMirror", b->coo_mirror, &b->coo_mirror, nullptr));
+  {
+    PetscInt streams = b->streams ? b->streams : BINBCSR_DEFAULT_STREAMS;
+    PetscCall(PetscOptionsInt("-mat_binbcsr_streams", "Runs of bins the product sweeps side by side (1, 2, 4, 8)", "MatBinBCSRSetStreams", streams, &streams, &flg));
+    if (flg) PetscCall(MatBinBCSRSetStreams(mat, streams));
+  }
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }
@@ -279,6 +305,7 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRCreatePart(Mat mat, PetscInt m, PetscIn
   PetscCall(MatSetType(*part, b->inner_type));
   if (b->bin_width) PetscCall(MatBinBCSRSetBinWidth(*part, b->bin_width));
   if (b->precision_set) PetscCall(MatBinBCSRSetPrecision(*part, b->precision));
+  if (b->streams) PetscCall(MatBinBCSRSetStreams(*part, b->streams));
   if (b->sym && part == &b->A) PetscCall(MatBinBCSRSetSymmetricStorage(*part, PETSC_TRUE)); /* B stays full */
   for (const auto &[op, flg] : b->part_options) {
     const bool wholematrix = op == MAT_SYMMETRIC || op == MAT_SPD || op == MAT_HERMITIAN || op == MAT_STRUCTURALLY_SYMMETRIC || op == MAT_SYMMETRY_ETERNAL || op == MAT_STRUCTURAL_SYMMETRY_ETERNAL || op == MAT_SPD_ETERNAL;
@@ -465,6 +492,8 @@ PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetSymmetricStorage_C", MatBinBCSRGetSymmetricStorage_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetCOOMirror_C", MatBinBCSRSetCOOMirror_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetCOOMirror_C", MatBinBCSRGetCOOMirror_MPIBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetStreams_C", MatBinBCSRSetStreams_MPIBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetStreams_C", MatBinBCSRGetStreams_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetBinWidth_C", MatBinBCSRGetBinWidth_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetPrecision_C", MatBinBCSRSetPrecision_MPIBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetPrecision_C", MatBinBCSRGetPrecision_MPIBinBCSR));

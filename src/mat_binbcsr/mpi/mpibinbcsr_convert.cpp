@@ -108,10 +108,7 @@ PETSC_INTERN PetscErrorCode MatConvertFrom_MPIBinBCSR(Mat src, MatType newtype, 
     PetscFunctionReturn(0);
   }
   PetscCall(MatBinBCSRCreateLike_Private(src, newtype, &M));
-  /* the -mat_binbcsr_* options apply to converted matrices too (MatSetFromOptions could change the type) */
-  PetscObjectOptionsBegin((PetscObject)M);
-  if (M->ops->setfromoptions) PetscCall((*M->ops->setfromoptions)(M, PetscOptionsObject));
-  PetscOptionsEnd();
+  PetscCall(MatBinBCSRSetFromOptions(M)); /* the -mat_binbcsr_* options apply to converted matrices too */
   PetscCall(MatBinBCSRPreallocateAndFill_Private(src, M));
   if (reuse == MAT_INPLACE_MATRIX) PetscCall(MatHeaderReplace(src, &M));
   else *newmat = M;
@@ -192,6 +189,7 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRCopyConfig(Mat from, Mat to)
   c->bin_width          = b->bin_width;
   c->precision_set      = b->precision_set;
   c->precision          = b->precision;
+  c->streams            = b->streams;
   c->sym                = b->sym;
   c->coo_mirror         = b->coo_mirror;
   PetscFunctionReturn(0);

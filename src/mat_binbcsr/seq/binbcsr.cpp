@@ -509,12 +509,27 @@ static PetscErrorCode MatBinBCSRGetCOOMirror_SeqBinBCSR(Mat A, PetscBool *flg)
   PetscFunctionReturn(0);
 }
 
+static PetscErrorCode MatBinBCSRSetStreams_SeqBinBCSR(Mat A, PetscInt streams)
+{
+  PetscFunctionBegin;
+  ((Mat_SeqBinBCSR *)A->data)->streams = streams;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRGetStreams_SeqBinBCSR(Mat A, PetscInt *streams)
+{
+  PetscFunctionBegin;
+  *streams = ((Mat_SeqBinBCSR *)A->data)->streams;
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MatSetFromOptions_SeqBinBCSR(Mat A, PetscOptionItems *PetscOptionsObject)
 {
   Mat_SeqBinBCSR     *a = (Mat_SeqBinBCSR *)A->data;
   PetscInt            bw;
   MatBinBCSRPrecision p  = a->precision;
   PetscBool           set, sym;
+  PetscInt            streams = a->streams;
 
   PetscFunctionBegin;
   PetscCall(MatBinBCSRGetBinWidth_SeqBinBCSR(A, &bw));
@@ -527,6 +542,8 @@ static PetscErrorCode MatSetFromOptions_SeqBinBCSR(Mat A, PetscOptionItems *Pets
   PetscCall(PetscOptionsBool("-mat_binbcsr_symmetric_storage", "Store the upper triangle only (symmetric matrices; the lower triangle given is ignored)", "MatBinBCSRSetSymmetricStorage", sym, &sym, &set));
   if (set) PetscCall(MatBinBCSRSetSymmetricStorage_SeqBinBCSR(A, sym));
   PetscCall(PetscOptionsBool("-mat_binbcsr_coo_mirror", "COO entries of off-diagonal blocks also fill the transposed place (give one triangle of a symmetric matrix)", "MatBinBCSRSetCOOMirror", a->coo_mirror, &a->coo_mirror, nullptr));
+  PetscCall(PetscOptionsInt("-mat_binbcsr_streams", "Runs of bins the product sweeps side by side (1, 2, 4, 8)", "MatBinBCSRSetStreams", streams, &streams, &set));
+  if (set) PetscCall(MatBinBCSRSetStreams(A, streams));
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }
@@ -549,7 +566,7 @@ static PetscErrorCode MatGetInfo_SeqBinBCSR_Basic(Mat A, MatInfoType flag, MatIn
   PetscFunctionReturn(0);
 }
 
-static const char *const composed_names[] = {"MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatBinBCSRSetCOOMirror_C", "MatBinBCSRGetCOOMirror_C", "MatSeqAIJSetPreallocation_C", "MatSeqBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatConvert_seqbinbcsr_seqaij_C", "MatConvert_seqbinbcsr_seqbaij_C", "MatProductSetFromOptions_anytype_C", "MatAXPYGetPreallocation_C"};
+static const char *const composed_names[] = {"MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatBinBCSRSetCOOMirror_C", "MatBinBCSRGetCOOMirror_C", "MatBinBCSRSetStreams_C", "MatBinBCSRGetStreams_C", "MatSeqAIJSetPreallocation_C", "MatSeqBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatConvert_seqbinbcsr_seqaij_C", "MatConvert_seqbinbcsr_seqbaij_C", "MatProductSetFromOptions_anytype_C", "MatAXPYGetPreallocation_C"};
 
 static PetscErrorCode MatDestroy_SeqBinBCSR(Mat A)
 {
@@ -578,6 +595,7 @@ PetscErrorCode MatCreate_SeqBinBCSR(Mat A)
   A->data        = (void *)a;
   a->bw          = BinBCSRDefaultBinWidth(1);
   a->precision   = MAT_BINBCSR_PRECISION_DOUBLE;
+  a->streams     = BINBCSR_DEFAULT_STREAMS;
   a->roworiented = PETSC_TRUE;
   a->bs          = 1;
   a->bs2         = 1;
@@ -619,6 +637,8 @@ PetscErrorCode MatCreate_SeqBinBCSR(Mat A)
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRGetSymmetricStorage_C", MatBinBCSRGetSymmetricStorage_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRSetCOOMirror_C", MatBinBCSRSetCOOMirror_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRGetCOOMirror_C", MatBinBCSRGetCOOMirror_SeqBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRSetStreams_C", MatBinBCSRSetStreams_SeqBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRGetStreams_C", MatBinBCSRGetStreams_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatSeqAIJSetPreallocation_C", MatSeqAIJSetPreallocation_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatSeqBAIJSetPreallocation_C", MatSeqBAIJSetPreallocation_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatSetPreallocationCOO_C", MatSetPreallocationCOO_SeqBinBCSR));

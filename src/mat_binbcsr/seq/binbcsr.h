@@ -65,6 +65,7 @@ typedef struct {
                                     preallocation (MAT_NEW_NONZERO_ALLOCATION_ERR). Once the layout
                                     exists a new location is an error unless nonew == 1. */
   PetscBool           roworiented; /* MAT_ROW_ORIENTED for MatSetValues(Blocked) */
+  PetscInt            streams;     /* MatBinBCSRSetStreams: runs of bins the product sweeps side by side */
   PetscBool           sym;         /* symmetric storage: only blocks with block column >= block row
                                       are stored; entries below the block diagonal are ignored. The
                                       slots of a bin are ordered by an edge colouring (below). */

@@ -73,6 +73,7 @@ static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues
   b->precision   = a->precision;
   b->nonew       = a->nonew;
   b->roworiented = a->roworiented;
+  b->streams     = a->streams;
   b->sym         = a->sym;
   b->bs          = a->bs;
   b->bs2         = a->bs2;
@@ -214,11 +215,7 @@ PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat A, MatType type, MatReuse reuse, Ma
     PetscCall(MatSetSizes(B, A->rmap->n, A->cmap->n, A->rmap->N, A->cmap->N));
     PetscCall(MatSetBlockSize(B, bs));
     PetscCall(MatSetType(B, type));
-    /* -mat_binbcsr_bin_width / _precision apply to converted matrices too (not MatSetFromOptions:
-       -mat_type would change the type) */
-    PetscObjectOptionsBegin((PetscObject)B);
-    PetscCall((*B->ops->setfromoptions)(B, PetscOptionsObject));
-    PetscOptionsEnd();
+    PetscCall(MatBinBCSRSetFromOptions(B)); /* the -mat_binbcsr_* options apply to converted matrices too */
   }
   bs = PetscAbs(B->rmap->bs);
   mbs = m / bs;
@@ -398,6 +395,7 @@ PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
     if ((a->bs == 1 || a->bs == 3) && (a->bw == 4 || a->bw == 8 || a->bw == 16 || a->bw == 32)) { /* the shapes of the vectorised sweeps */
       const PetscInt groups = a->nslots / a->bw, unit = MatSeqBinBCSRCountUnitStrideGroups(a);
       PetscCall(PetscViewerASCIIPrintf(viewer, "slot groups over consecutive block columns (x%s read without gathers): %" PetscInt_FMT " of %" PetscInt_FMT " (%.1f%%)\n", a->sym ? " and y" : "", unit, groups, groups ? 100.0 * (double)unit / (double)groups : 0.0));
+      if (!a->sym) PetscCall(PetscViewerASCIIPrintf(viewer, "product: %" PetscInt_FMT " run(s) of bins swept side by side (-mat_binbcsr_streams)\n", a->streams));
     }
     if (a->coo_jmap || a->coo_mirror) {
       const char *refill = a->coo_slot_state == 1 ? "by whole blocks" : a->coo_slot_state == -1 ? "value by value (the list is not made of whole blocks)" : "path chosen at the first refill";

@@ -25,65 +25,102 @@ template <typename V>
 struct BinSweep {
   const PetscInt *bin_start, *col;
   const V        *val;
-  PetscInt        nbins, mbs, bs;
+  PetscInt        nbins, mbs, bs, streams;
 };
 
-/* y[rows of the bins] = z + A x, and *dot += x.y over the rows when dot is non-null.
-   BW is the bin width as a constant: the lanes' accumulators stay in registers and the inner loop
+/* acc[i][l] += block row i of lane l times x_c over one slot group (c: the group's BW columns, t: its
+   tiles). BW is the bin width as a constant: the lanes' accumulators stay in registers and the loop
    over the lanes becomes SIMD (column indices and values are unit-stride across lanes). */
 template <int BS, int BW, typename V>
-void mult_bins_fixed(const BinSweep<V> &m, const double *x, const double *z, double *y, double *dot)
+inline void group_mult(const V *t, const PetscInt *c, const double *x, double (*acc)[BW])
+{
+  binbcsr::prefetch_values(t, BW * BS * BS * (int)sizeof(V));
+  if (binbcsr::unit_stride<BW>(c)) { /* consecutive columns: x_c by plain loads, no gathers */
+    const double *xs = x + (size_t)c[0] * BS;
+    BINBCSR_LANE_LOOP
+    for (int l = 0; l < BW; l++) {
+      double yl[BS];
+      for (int i = 0; i < BS; i++) yl[i] = acc[i][l];
+      binbcsr::slot_mult<BS, V>(t + l, BW, BS, xs + l * BS, yl);
+      for (int i = 0; i < BS; i++) acc[i][l] = yl[i];
+    }
+    return;
+  }
+  BINBCSR_LANE_LOOP
+  for (int l = 0; l < BW; l++) {
+    const int ci = (int)c[l] * BS; /* 32-bit offsets (PetscInt is 32-bit here): vgatherdpd */
+    double    xc[BS], yl[BS];
+    for (int j = 0; j < BS; j++) xc[j] = x[ci + j];
+    for (int i = 0; i < BS; i++) yl[i] = acc[i][l];
+    binbcsr::slot_mult<BS, V>(t + l, BW, BS, xc, yl);
+    for (int i = 0; i < BS; i++) acc[i][l] = yl[i];
+  }
+}
+
+/* K bins swept together: the slot groups of bins[0..K-1] in turn, then y of their rows = z + acc, and
+   *dot += x.y over them when dot is non-null. Why several bins at once: one core streaming one array
+   out of memory is limited by the cache lines it has in flight, and the hardware prefetcher keeps more
+   of them in flight for several streams than for one. On this project's machine one core read one
+   array at 10.0-10.5 GB/s, two at 11.9-12.4 and four at 13.0-14.1 GB/s; the 48^3 stencil's product
+   took 15.0-18.6 ms with 4 streams against 20.2-22.3 ms with one (docs/mat_binbcsr.md). */
+template <int K, int BS, int BW, typename V>
+void bins_sweep(const BinSweep<V> &m, const PetscInt *bins, const double *x, const double *z, double *y, double &d, bool want_dot)
 {
   constexpr int BS2 = BS * BS;
-  double        d   = 0.0;
-  for (PetscInt b = 0; b < m.nbins; b++) {
-    const PetscInt  s0  = m.bin_start[b];
-    const PetscInt  len = (m.bin_start[b + 1] - s0) / BW;
+  double        acc[K][BS][BW] = {};
+  const V      *t[K];
+  const PetscInt *c[K];
+  int           len[K], common = 0;
+  for (int q = 0; q < K; q++) {
+    const PetscInt s0 = m.bin_start[bins[q]];
+    t[q]              = m.val + (size_t)s0 * BS2;
+    c[q]              = m.col + s0;
+    len[q]            = (int)((m.bin_start[bins[q] + 1] - s0) / BW);
+    common            = q == 0 || len[q] < common ? len[q] : common;
+  }
+#if defined(BINBCSR_AVX512)
+  if constexpr (BS == 3 && BW == 8) {
+    double(*accq[K])[8];
+    for (int q = 0; q < K; q++) accq[q] = acc[q];
+    binbcsr::avx512::bins_mult_3x8<K>(t, c, len, x, accq);
+  } else
+#endif
+  {
+    for (int k = 0; k < common; k++)
+      for (int q = 0; q < K; q++) group_mult<BS, BW, V>(t[q] + (size_t)k * BW * BS2, c[q] + (size_t)k * BW, x, acc[q]);
+    for (int q = 0; q < K; q++)
+      for (int k = common; k < len[q]; k++) group_mult<BS, BW, V>(t[q] + (size_t)k * BW * BS2, c[q] + (size_t)k * BW, x, acc[q]);
+  }
+  for (int q = 0; q < K; q++) {
     /* y += A x in place: an empty bin changes nothing (the off-diagonal part of an MPI matrix is
        mostly empty bins; writing their rows back cost a tenth of the diagonal part's product) */
-    if (!len && z == y && !dot) continue;
-    const PetscInt *c   = m.col + s0;
-    const V        *t   = m.val + (size_t)s0 * BS2;
-    double          acc[BS][BW];
-    for (int i = 0; i < BS; i++)
-      for (int l = 0; l < BW; l++) acc[i][l] = 0.0;
-#if defined(BINBCSR_AVX512)
-    if constexpr (BS == 3 && BW == 8) binbcsr::avx512::bin_mult_3x8(t, c, (int)len, x, acc);
-    else
-#endif
-    for (PetscInt k = 0; k < len; k++, c += BW, t += BW * BS2) {
-      binbcsr::prefetch_values(t, BW * BS2 * (int)sizeof(V));
-      if (binbcsr::unit_stride<BW>(c)) { /* consecutive columns: x_c by plain loads, no gathers */
-        const double *xs = x + (size_t)c[0] * BS;
-        BINBCSR_LANE_LOOP
-        for (int l = 0; l < BW; l++) {
-          double yl[BS];
-          for (int i = 0; i < BS; i++) yl[i] = acc[i][l];
-          binbcsr::slot_mult<BS, V>(t + l, BW, BS, xs + l * BS, yl);
-          for (int i = 0; i < BS; i++) acc[i][l] = yl[i];
-        }
-        continue;
-      }
-      BINBCSR_LANE_LOOP
-      for (int l = 0; l < BW; l++) {
-        const int ci = (int)c[l] * BS; /* 32-bit offsets (PetscInt is 32-bit here): vgatherdpd */
-        double    xc[BS], yl[BS];
-        for (int j = 0; j < BS; j++) xc[j] = x[ci + j];
-        for (int i = 0; i < BS; i++) yl[i] = acc[i][l];
-        binbcsr::slot_mult<BS, V>(t + l, BW, BS, xc, yl);
-        for (int i = 0; i < BS; i++) acc[i][l] = yl[i];
-      }
-    }
-    const PetscInt r0 = b * BW, nl = PetscMin((PetscInt)BW, m.mbs - r0);
+    if (!len[q] && z == y && !want_dot) continue;
+    const PetscInt r0 = bins[q] * BW, nl = PetscMin((PetscInt)BW, m.mbs - r0);
     for (PetscInt l = 0; l < nl; l++) {
       for (int i = 0; i < BS; i++) {
         const size_t p  = (size_t)(r0 + l) * BS + i;
-        const double yv = (z ? z[p] : 0.0) + acc[i][l];
+        const double yv = (z ? z[p] : 0.0) + acc[q][i][l];
         y[p]            = yv;
-        if (dot) d += x[p] * yv;
+        if (want_dot) d += x[p] * yv;
       }
     }
   }
+}
+
+/* y[rows of the bins] = z + A x, and *dot += x.y over the rows when dot is non-null. The bins are cut
+   into K runs of consecutive bins, swept side by side (bin j of every run together); the nbins % K bins
+   left over follow one at a time. */
+template <int K, int BS, int BW, typename V>
+void mult_bins_fixed(const BinSweep<V> &m, const double *x, const double *z, double *y, double *dot)
+{
+  const PetscInt run = m.nbins / K;
+  double         d   = 0.0;
+  PetscInt       bins[K];
+  for (PetscInt j = 0; j < run; j++) {
+    for (int q = 0; q < K; q++) bins[q] = q * run + j;
+    bins_sweep<K, BS, BW, V>(m, bins, x, z, y, d, dot != nullptr);
+  }
+  for (PetscInt b = K * run; b < m.nbins; b++) bins_sweep<1, BS, BW, V>(m, &b, x, z, y, d, dot != nullptr);
   if (dot) *dot += d;
 }
 
@@ -140,11 +177,24 @@ void with_constant_shape(PetscInt bs, PetscInt bw, F &&f)
 template <typename V>
 void mult_dispatch(const Mat_SeqBinBCSR *a, const V *val, const double *x, const double *z, double *y, double *dot, double *acc)
 {
-  const BinSweep<V> m = {a->bin_start, a->col, val, a->nbins, a->mbs, a->bs};
+  const BinSweep<V> m = {a->bin_start, a->col, val, a->nbins, a->mbs, a->bs, a->streams};
   if (dot) *dot = 0.0;
   with_constant_shape(a->bs, a->bw, [&](auto BS, auto BW) {
-    if constexpr (BS > 0 && BW > 0) mult_bins_fixed<BS, BW, V>(m, x, z, y, dot);
-    else mult_bins_any<BS, V>(m, a->bw, x, z, y, dot, acc);
+    if constexpr (BS > 0 && BW > 0) {
+      switch (m.streams) {
+      case 8:
+        mult_bins_fixed<8, BS, BW, V>(m, x, z, y, dot);
+        break;
+      case 4:
+        mult_bins_fixed<4, BS, BW, V>(m, x, z, y, dot);
+        break;
+      case 2:
+        mult_bins_fixed<2, BS, BW, V>(m, x, z, y, dot);
+        break;
+      default:
+        mult_bins_fixed<1, BS, BW, V>(m, x, z, y, dot);
+      }
+    } else mult_bins_any<BS, V>(m, a->bw, x, z, y, dot, acc);
   });
 }
 
