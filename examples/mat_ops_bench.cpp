@@ -1,6 +1,7 @@
 // mat_ops_bench: times the value operations (MatAXPY with the same pattern, MatScale, MatShift,
 // MatNorm, MatZeroRowsColumns with x and b) and the row/column ones (MatDiagonalScale D A D,
-// MatGetRowMaxAbs with columns, MatGetColumnNorms 2) on the 27-point 3x3-block stencil matrix, for seqaij,
+// MatGetRowMaxAbs with columns, MatGetColumnNorms 2), MatInvertVariableBlockDiagonal (PCVPBJACOBI's set-up,
+// one block of 3 rows per node) and MatFindNonzeroRows on the 27-point 3x3-block stencil matrix, for seqaij,
 // seqbaij and binbcsr in double and single storage, in one run. Prints the minimum over -repeats
 // runs of each operation in milliseconds (the machine is shared: the minimum is the least disturbed).
 //
@@ -60,7 +61,7 @@ int main(int argc, char **argv)
     {"binbcsr-sym", MATSEQBINBCSR, MAT_BINBCSR_PRECISION_DOUBLE, true},
     {"binbcsr-sym-single", MATSEQBINBCSR, MAT_BINBCSR_PRECISION_SINGLE, true},
   };
-  const char *ops[] = {"axpy_same", "scale", "shift", "norm_frobenius", "norm_1", "zero_rows_columns", "diag_scale", "row_max_abs", "col_norms_2"};
+  const char *ops[] = {"axpy_same", "scale", "shift", "norm_frobenius", "norm_1", "zero_rows_columns", "diag_scale", "row_max_abs", "col_norms_2", "vpb_inverse", "nonzero_rows"};
   PetscCall(PetscPrintf(PETSC_COMM_SELF, "27-point 3x3-block stencil, %" PetscInt_FMT "^3 nodes, %" PetscInt_FMT " rows; minimum of %" PetscInt_FMT " runs, ms\n", grid.nx, 3 * grid.nodes(), repeats));
   PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-16s", "type"));
   for (const char *op : ops) PetscCall(PetscPrintf(PETSC_COMM_SELF, " %18s", op));
@@ -113,6 +114,21 @@ int main(int argc, char **argv)
       ms.push_back(t);
       PetscCall(VecDestroy(&d));
       PetscCall(VecDestroy(&rmax));
+    }
+    {
+      PetscBool                has;
+      std::vector<PetscInt>    sizes(grid.nodes(), 3);
+      std::vector<PetscScalar> inv(9 * grid.nodes());
+      IS                       kept;
+      t = -1; /* not provided by the type */
+      PetscCall(MatHasOperation(A, MATOP_INVERT_VBLOCK_DIAGONAL, &has));
+      if (has) PetscCall(Time(repeats, [&] { return MatInvertVariableBlockDiagonal(A, (PetscInt)sizes.size(), sizes.data(), inv.data()); }, &t));
+      ms.push_back(t);
+      PetscCall(Time(repeats, [&] {
+        PetscCall(MatFindNonzeroRows(A, &kept));
+        return ISDestroy(&kept);
+      }, &t));
+      ms.push_back(t);
     }
 
     PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-16s", f.label));
