@@ -5,8 +5,9 @@
    stored diagonal slots), as global rows of this rank.
 
    MatFindNonzeroRows: the rows with a nonzero value, from MatGetRowMaxAbs (exact, where PETSc's generic
-   path multiplies by a random vector), with aij's conventions: NULL when no row is zero (on any rank),
-   global rows of this rank otherwise (a stored zero does not make a row nonzero).
+   path multiplies by a random vector), the rows it finds zero looked at again for NaN (which the
+   maximum skips and aij counts as nonzero), with aij's conventions: NULL when no row is zero (on any
+   rank), global rows of this rank otherwise (a stored zero does not make a row nonzero).
 
    MatIsSymmetric: Symmetric storage is symmetric by construction. Otherwise the
    transpose (MatTranspose of the type: a new layout, or the MPI exchange) is compared row by row with
@@ -84,8 +85,17 @@ PETSC_INTERN PetscErrorCode MatFindNonzeroRows_BinBCSR(Mat A, IS *keptrows)
   PetscCall(MatCreateVecs(A, nullptr, &m));
   PetscCall(MatGetRowMaxAbs(A, m, nullptr));
   PetscCall(VecGetArrayRead(m, &ma));
-  for (PetscInt i = 0; i < A->rmap->n; i++)
-    if (ma[i] != 0.0) rows.push_back(A->rmap->rstart + i); /* NaN counts as nonzero, as in aij */
+  for (PetscInt i = 0; i < A->rmap->n; i++) {
+    PetscBool nonzero = ma[i] != 0.0 ? PETSC_TRUE : PETSC_FALSE;
+    if (!nonzero) { /* the maximum skips NaN; aij counts it (NaN != 0): look at the (few) rows left */
+      PetscInt           n;
+      const PetscScalar *v;
+      PetscCall(MatGetRow(A, A->rmap->rstart + i, &n, nullptr, &v));
+      for (PetscInt k = 0; k < n && !nonzero; k++) nonzero = v[k] != 0.0 ? PETSC_TRUE : PETSC_FALSE;
+      PetscCall(MatRestoreRow(A, A->rmap->rstart + i, &n, nullptr, &v));
+    }
+    if (nonzero) rows.push_back(A->rmap->rstart + i);
+  }
   PetscCall(VecRestoreArrayRead(m, &ma));
   PetscCall(VecDestroy(&m));
   nzero = A->rmap->n - (PetscInt)rows.size();

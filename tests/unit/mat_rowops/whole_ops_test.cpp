@@ -331,6 +331,21 @@ TEST_CASE("MatFindNonzeroRows, MatGetColumnVector, MatRealPart/ImaginaryPart/Con
       PETSC_OK(MatNorm(p.bin, NORM_FROBENIUS, &nrm));
       CHECK(nrm == 0.0);
       CHECK(pattern(p.bin) == pat);
+      // a NaN alone in a zero row: nonzero for aij (the row maximum skips NaN)
+      PetscInt rstart, rend;
+      PETSC_OK(MatGetOwnershipRange(p.aij, &rstart, &rend));
+      for (Mat M : {p.bin, p.aij}) {
+        if (rstart <= 2 && 2 < rend) PETSC_OK(MatSetValue(M, 2, 2, NAN, INSERT_VALUES));
+        PETSC_OK(MatAssemblyBegin(M, MAT_FINAL_ASSEMBLY));
+        PETSC_OK(MatAssemblyEnd(M, MAT_FINAL_ASSEMBLY));
+      }
+      IS kb, ka;
+      PETSC_OK(MatFindNonzeroRows(p.bin, &kb));
+      PETSC_OK(MatFindNonzeroRows(p.aij, &ka));
+      CHECK(is_indices(kb) == is_indices(ka));
+      CHECK(is_indices(kb) == (rstart <= 2 && 2 < rend ? std::vector<PetscInt>{2} : std::vector<PetscInt>{}));
+      PETSC_OK(ISDestroy(&kb));
+      PETSC_OK(ISDestroy(&ka));
     }
   }
 }
