@@ -56,7 +56,7 @@ PETSC_EXTERN PetscErrorCode MatBinBCSRGetSymmetricStorage(Mat, PetscBool *);
    answers PETSC_FALSE on matrices of other types. */
 PETSC_EXTERN PetscErrorCode MatBinBCSRSetCOOMirror(Mat, PetscBool);
 PETSC_EXTERN PetscErrorCode MatBinBCSRGetCOOMirror(Mat, PetscBool *);
-/* Streams: the product y = A x (whole storage, block size 1 or 3, bin width 4, 8, 16 or 32) sweeps
+/* Streams: the product y = A x (block size 1 or 3, bin width 4, 8, 16 or 32; whole or symmetric storage) sweeps
    this many runs of consecutive bins side by side, so one core streams the values from that many
    places at once (the hardware prefetcher keeps more cache lines in flight for several streams):
    1, 2, 4 or 8, default 4. A traversal order only: the layout, the results and every other

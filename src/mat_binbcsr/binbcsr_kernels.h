@@ -196,66 +196,87 @@ BINBCSR_HD void sym_unit_group_mult(const V *t, const double *xs, const double (
   }
 }
 
-/* The same for a whole bin of BW lanes (BW, BS compile-time), lanes in lock step per slot: the lane
-   loop is the SIMD loop. Gathers x_c, fused multiply-adds into BS accumulators per lane, and a masked
-   scatter-add of block^T x_r into y_c (conflict-free by the colouring). Lanes whose row is >= mbs are
-   phantom: their slots are padding (zeros, column own = mbs - 1, masked out) and their acc is
-   dropped. On exit y_r += acc for the real lanes. */
+/* One slot group of sym_bins_mult (BW lanes in lock step, the lane loop is the SIMD loop): acc +=
+   block x_c, and a masked scatter-add of block^T x_r into y_c (conflict-free by the colouring). */
 template <int BS, int BW, typename V, typename I>
-BINBCSR_HD void sym_bin_mult(const V *bin_val, const I *bin_col, int len, I r0, I mbs, const double *x, double *y)
+BINBCSR_HD void sym_group_mult(const V *t, const I *c, I r0, const I *own, const double (*xr)[BW], const double *x, double *y, double (*acc)[BW])
+{
+  constexpr int BS2 = BS * BS;
+  prefetch_values(t, BW * BS2 * (int)sizeof(V));
+  if (unit_stride<BW>(c)) { /* contiguous x_c and y_c: plain loads and stores instead of gathers and scatters */
+    const I c0 = c[0];
+    /* c0 == r0: the diagonal blocks or padding of every lane, nothing to scatter */
+    if (c0 == r0) sym_unit_group_mult<BS, BW, V, false>(t, x + (long)c0 * BS, xr, nullptr, acc);
+    else sym_unit_group_mult<BS, BW, V, true>(t, x + (long)c0 * BS, xr, y + (long)c0 * BS, acc);
+    return;
+  }
+#pragma omp simd
+  for (int l = 0; l < BW; l++) {
+    const I   cl = c[l];
+    const int ci = (int)cl * BS; /* 32-bit offsets: vgatherdpd, fewer index instructions */
+    double    xc[BS], v[BS2];
+    for (int j = 0; j < BS; j++) xc[j] = x[ci + j];
+    for (int e = 0; e < BS2; e++) v[e] = (double)t[e * BW + l];
+    for (int i = 0; i < BS; i++) {
+      double s = acc[i][l];
+      for (int j = 0; j < BS; j++) s += v[i * BS + j] * xc[j];
+      acc[i][l] = s;
+    }
+    if (cl != own[l]) {
+      for (int j = 0; j < BS; j++) {
+        double s = 0.0;
+        for (int i = 0; i < BS; i++) s += v[i * BS + j] * xr[i][l];
+        y[ci + j] += s;
+      }
+    }
+  }
+}
+
+/* The symmetric product of K whole bins of BW lanes (BW, BS compile-time), swept together: the slot
+   groups of the K bins in turn (several streams for the prefetcher, as the whole-storage bins_sweep),
+   each group through sym_group_mult. Lanes whose row is >= mbs are phantom: their slots are padding
+   (zeros, column own = mbs - 1, masked out) and their acc is dropped. On exit y_r += acc for the real
+   lanes of every bin. Scatters of one bin may land in the rows of another bin of the sweep: all are
+   additions into y, and a bin's own rows are added only at its end. */
+template <int K, int BS, int BW, typename V, typename I>
+BINBCSR_HD void sym_bins_mult(const V *const *bin_val, const I *const *bin_col, const int *len, const I *r0, I mbs, const double *x, double *y)
 {
 #if defined(BINBCSR_AVX512)
   if constexpr (BS == 3 && BW == 8 && sizeof(I) == 4) {
-    avx512::sym_bin_mult_3x8(bin_val, bin_col, len, r0, mbs, x, y);
+    avx512::sym_bins_mult_3x8<K>(bin_val, bin_col, len, r0, mbs, x, y);
     return;
   }
 #endif
   constexpr int BS2 = BS * BS;
-  double        acc[BS][BW], xr[BS][BW];
-  I             own[BW];
-  for (int l = 0; l < BW; l++) {
-    const bool real = r0 + l < mbs;
-    own[l]          = real ? r0 + l : mbs - 1;
-    for (int i = 0; i < BS; i++) {
-      acc[i][l] = 0.0;
-      xr[i][l]  = real ? x[(long)(r0 + l) * BS + i] : 0.0;
-    }
-  }
-  for (int k = 0; k < len; k++) {
-    const I *c = bin_col + (long)k * BW;
-    const V *t = bin_val + (long)k * BW * BS2;
-    prefetch_values(t, BW * BS2 * (int)sizeof(V));
-    if (unit_stride<BW>(c)) { /* contiguous x_c and y_c: plain loads and stores instead of gathers and scatters */
-      const I c0 = c[0];
-      /* c0 == r0: the diagonal blocks or padding of every lane, nothing to scatter */
-      if (c0 == r0) sym_unit_group_mult<BS, BW, V, false>(t, x + (long)c0 * BS, xr, nullptr, acc);
-      else sym_unit_group_mult<BS, BW, V, true>(t, x + (long)c0 * BS, xr, y + (long)c0 * BS, acc);
-      continue;
-    }
-#pragma omp simd
+  double        acc[K][BS][BW], xr[K][BS][BW];
+  I             own[K][BW];
+  int           common = len[0];
+  for (int q = 0; q < K; q++) {
+    common = len[q] < common ? len[q] : common;
     for (int l = 0; l < BW; l++) {
-      const I   cl = c[l];
-      const int ci = (int)cl * BS; /* 32-bit offsets: vgatherdpd, fewer index instructions */
-      double    xc[BS], v[BS2];
-      for (int j = 0; j < BS; j++) xc[j] = x[ci + j];
-      for (int e = 0; e < BS2; e++) v[e] = (double)t[e * BW + l];
+      const bool real = r0[q] + l < mbs;
+      own[q][l]       = real ? r0[q] + l : mbs - 1;
       for (int i = 0; i < BS; i++) {
-        double s = acc[i][l];
-        for (int j = 0; j < BS; j++) s += v[i * BS + j] * xc[j];
-        acc[i][l] = s;
-      }
-      if (cl != own[l]) {
-        for (int j = 0; j < BS; j++) {
-          double s = 0.0;
-          for (int i = 0; i < BS; i++) s += v[i * BS + j] * xr[i][l];
-          y[ci + j] += s;
-        }
+        acc[q][i][l] = 0.0;
+        xr[q][i][l]  = real ? x[(long)(r0[q] + l) * BS + i] : 0.0;
       }
     }
   }
-  for (int l = 0; l < BW; l++)
-    if (r0 + l < mbs)
-      for (int i = 0; i < BS; i++) y[(long)(r0 + l) * BS + i] += acc[i][l];
+  for (int k = 0; k < common; k++)
+    for (int q = 0; q < K; q++) sym_group_mult<BS, BW, V, I>(bin_val[q] + (long)k * BW * BS2, bin_col[q] + (long)k * BW, r0[q], own[q], xr[q], x, y, acc[q]);
+  for (int q = 0; q < K; q++)
+    for (int k = common; k < len[q]; k++) sym_group_mult<BS, BW, V, I>(bin_val[q] + (long)k * BW * BS2, bin_col[q] + (long)k * BW, r0[q], own[q], xr[q], x, y, acc[q]);
+  for (int q = 0; q < K; q++)
+    for (int l = 0; l < BW; l++)
+      if (r0[q] + l < mbs)
+        for (int i = 0; i < BS; i++) y[(long)(r0[q] + l) * BS + i] += acc[q][i][l];
+}
+
+/* One bin of sym_bins_mult. */
+template <int BS, int BW, typename V, typename I>
+BINBCSR_HD void sym_bin_mult(const V *bin_val, const I *bin_col, int len, I r0, I mbs, const double *x, double *y)
+{
+  sym_bins_mult<1, BS, BW, V, I>(&bin_val, &bin_col, &len, &r0, mbs, x, y);
 }
 
 /* COO refill of one value: the sum of the entries perm[jmap[v] .. jmap[v+1]-1], where an index p < n

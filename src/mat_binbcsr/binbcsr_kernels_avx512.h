@@ -1,7 +1,7 @@
 /*
    AVX-512 bodies of the two products of 3x3 blocks at bin width 8 (one zmm register of doubles per
    block entry), the shape of the cloth, the stencils and the FE scenes: whole bins of the whole-storage
-   product (bins_mult_3x8) and of the symmetric one (sym_bin_mult_3x8). CPU only: binbcsr_kernels.h
+   product (bins_mult_3x8) and of the symmetric one (sym_bins_mult_3x8). CPU only: binbcsr_kernels.h
    includes this header when the compiler targets AVX-512; the portable per-lane kernels stay the
    definition (and the CUDA path), and the unit tests compare both with seqaij.
 
@@ -99,58 +99,98 @@ inline void bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, cons
     for (int i = 0; i < 3; i++) _mm512_storeu_pd(acc[q][i], a[q][i]);
 }
 
-/* sym_bin_mult (binbcsr_kernels.h) for 3x3 blocks and 8 lanes, the whole bin in registers: the lanes'
+/* sym_bins_mult (binbcsr_kernels.h) for 3x3 blocks and 8 lanes, each bin in registers: the lanes'
    accumulators and x_r stay in zmm registers from the first slot group to the last (a per-group body
    kept them in memory, a store and a reload per group on the critical path: the cloth's product took
    1.02 ms instead of 0.84, docs/mat_binbcsr.md). Consecutive-column
    groups load x and update y contiguously; the others gather x and gather-add-scatter y for the lanes
    whose column is not their own row (conflict-free within a group: the colouring). Same semantics as
-   the portable sym_bin_mult: on exit y_r += acc for the real lanes. */
+   the portable sym_bins_mult: on exit y_r += acc for the real lanes of every bin. */
 template <typename V, typename I>
-inline void sym_bin_mult_3x8(const V *bin_val, const I *bin_col, int len, I r0, I mbs, const double *x, double *y)
+struct SymBin3x8 {
+  const V *t;
+  const I *c;
+  I        r0;
+  int      nreal;
+  __m256i  own;
+  __m512d  r[3], a[3];
+};
+
+template <typename V, typename I>
+inline void sym_bin_begin_3x8(SymBin3x8<V, I> &b, const V *bin_val, const I *bin_col, I r0, I mbs, const double *x)
 {
-  static_assert(sizeof(I) == 4, "32-bit column indices");
-  const int     nreal = mbs - r0 < 8 ? (int)(mbs - r0) : 8;
-  const __m256i iota  = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  const __m256i own   = _mm256_mask_blend_epi32((__mmask8)((1u << nreal) - 1), _mm256_set1_epi32((int)mbs - 1), _mm256_add_epi32(_mm256_set1_epi32((int)r0), iota));
-  __m512d       r[3], a[3] = {_mm512_setzero_pd(), _mm512_setzero_pd(), _mm512_setzero_pd()};
-  if (nreal == 8) split_xyz(x + (long)r0 * 3, r[0], r[1], r[2]);
+  const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  b.t                = bin_val;
+  b.c                = bin_col;
+  b.r0               = r0;
+  b.nreal            = mbs - r0 < 8 ? (int)(mbs - r0) : 8;
+  b.own              = _mm256_mask_blend_epi32((__mmask8)((1u << b.nreal) - 1), _mm256_set1_epi32((int)mbs - 1), _mm256_add_epi32(_mm256_set1_epi32((int)r0), iota));
+  for (int i = 0; i < 3; i++) b.a[i] = _mm512_setzero_pd();
+  if (b.nreal == 8) split_xyz(x + (long)r0 * 3, b.r[0], b.r[1], b.r[2]);
   else {
     alignas(64) double xr[3][8] = {};
-    for (int l = 0; l < nreal; l++)
+    for (int l = 0; l < b.nreal; l++)
       for (int i = 0; i < 3; i++) xr[i][l] = x[(long)(r0 + l) * 3 + i];
-    for (int i = 0; i < 3; i++) r[i] = _mm512_load_pd(xr[i]);
+    for (int i = 0; i < 3; i++) b.r[i] = _mm512_load_pd(xr[i]);
   }
-  const V *t = bin_val;
-  const I *c = bin_col;
-  for (int k = 0; k < len; k++, c += 8, t += 72) {
-    prefetch_values(t, 72 * (int)sizeof(V));
-    const __m256i ci = _mm256_loadu_si256((const __m256i *)c);
-    __m512d       v[9], xc[3], s[3];
-    for (int e = 0; e < 9; e++) v[e] = load8(t + e * 8);
-    const bool unit = _mm256_cmpeq_epi32_mask(ci, _mm256_add_epi32(_mm256_set1_epi32((int)c[0]), iota)) == 0xFF;
-    __m256i    off  = _mm256_add_epi32(ci, _mm256_add_epi32(ci, ci)); /* 3 c */
-    if (unit) split_xyz(x + (long)c[0] * 3, xc[0], xc[1], xc[2]);
-    else
-      for (int j = 0; j < 3; j++) xc[j] = _mm512_i32gather_pd(off, x + j, 8);
-    for (int i = 0; i < 3; i++) a[i] = _mm512_fmadd_pd(v[3 * i + 2], xc[2], _mm512_fmadd_pd(v[3 * i + 1], xc[1], _mm512_fmadd_pd(v[3 * i], xc[0], a[i])));
-    const __mmask8 scatter = _mm256_cmpneq_epi32_mask(ci, own); /* not the diagonal block, not padding */
-    if (!scatter) continue;
-    for (int j = 0; j < 3; j++) s[j] = _mm512_fmadd_pd(v[6 + j], r[2], _mm512_fmadd_pd(v[3 + j], r[1], _mm512_mul_pd(v[j], r[0])));
-    if (unit) add_xyz(y + (long)c[0] * 3, s[0], s[1], s[2]); /* all lanes scatter: c0 != r0 */
-    else
-      for (int j = 0; j < 3; j++) {
-        const __m512d yc = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), scatter, off, y + j, 8);
-        _mm512_mask_i32scatter_pd(y + j, scatter, off, _mm512_add_pd(yc, s[j]), 8);
-      }
-  }
-  if (nreal == 8) add_xyz(y + (long)r0 * 3, a[0], a[1], a[2]);
+}
+
+template <typename V, typename I>
+inline void sym_bin_group_3x8(SymBin3x8<V, I> &b, const double *x, double *y)
+{
+  static_assert(sizeof(I) == 4, "32-bit column indices");
+  const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const V      *t    = b.t;
+  const I      *c    = b.c;
+  b.t += 72;
+  b.c += 8;
+  prefetch_values(t, 72 * (int)sizeof(V));
+  const __m256i ci = _mm256_loadu_si256((const __m256i *)c);
+  __m512d       v[9], xc[3], s[3];
+  for (int e = 0; e < 9; e++) v[e] = load8(t + e * 8);
+  const bool unit = _mm256_cmpeq_epi32_mask(ci, _mm256_add_epi32(_mm256_set1_epi32((int)c[0]), iota)) == 0xFF;
+  __m256i    off  = _mm256_add_epi32(ci, _mm256_add_epi32(ci, ci)); /* 3 c */
+  if (unit) split_xyz(x + (long)c[0] * 3, xc[0], xc[1], xc[2]);
+  else
+    for (int j = 0; j < 3; j++) xc[j] = _mm512_i32gather_pd(off, x + j, 8);
+  for (int i = 0; i < 3; i++) b.a[i] = _mm512_fmadd_pd(v[3 * i + 2], xc[2], _mm512_fmadd_pd(v[3 * i + 1], xc[1], _mm512_fmadd_pd(v[3 * i], xc[0], b.a[i])));
+  const __mmask8 scatter = _mm256_cmpneq_epi32_mask(ci, b.own); /* not the diagonal block, not padding */
+  if (!scatter) return;
+  for (int j = 0; j < 3; j++) s[j] = _mm512_fmadd_pd(v[6 + j], b.r[2], _mm512_fmadd_pd(v[3 + j], b.r[1], _mm512_mul_pd(v[j], b.r[0])));
+  if (unit) add_xyz(y + (long)c[0] * 3, s[0], s[1], s[2]); /* all lanes scatter: c0 != r0 */
+  else
+    for (int j = 0; j < 3; j++) {
+      const __m512d yc = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), scatter, off, y + j, 8);
+      _mm512_mask_i32scatter_pd(y + j, scatter, off, _mm512_add_pd(yc, s[j]), 8);
+    }
+}
+
+template <typename V, typename I>
+inline void sym_bin_end_3x8(const SymBin3x8<V, I> &b, double *y)
+{
+  if (b.nreal == 8) add_xyz(y + (long)b.r0 * 3, b.a[0], b.a[1], b.a[2]);
   else {
     alignas(64) double acc[3][8];
-    for (int i = 0; i < 3; i++) _mm512_store_pd(acc[i], a[i]);
-    for (int l = 0; l < nreal; l++)
-      for (int i = 0; i < 3; i++) y[(long)(r0 + l) * 3 + i] += acc[i][l];
+    for (int i = 0; i < 3; i++) _mm512_store_pd(acc[i], b.a[i]);
+    for (int l = 0; l < b.nreal; l++)
+      for (int i = 0; i < 3; i++) y[(long)(b.r0 + l) * 3 + i] += acc[i][l];
   }
+}
+
+template <int K, typename V, typename I>
+inline void sym_bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, const int *len, const I *r0, I mbs, const double *x, double *y)
+{
+  SymBin3x8<V, I> b[K];
+  int             common = len[0];
+  for (int q = 0; q < K; q++) {
+    sym_bin_begin_3x8(b[q], bin_val[q], bin_col[q], r0[q], mbs, x);
+    common = len[q] < common ? len[q] : common;
+  }
+  for (int k = 0; k < common; k++)
+    for (int q = 0; q < K; q++) sym_bin_group_3x8(b[q], x, y);
+  for (int q = 0; q < K; q++)
+    for (int k = common; k < len[q]; k++) sym_bin_group_3x8(b[q], x, y);
+  for (int q = 0; q < K; q++) sym_bin_end_3x8(b[q], y);
 }
 
 } // namespace avx512

@@ -395,7 +395,7 @@ PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
     if ((a->bs == 1 || a->bs == 3) && (a->bw == 4 || a->bw == 8 || a->bw == 16 || a->bw == 32)) { /* the shapes of the vectorised sweeps */
       const PetscInt groups = a->nslots / a->bw, unit = MatSeqBinBCSRCountUnitStrideGroups(a);
       PetscCall(PetscViewerASCIIPrintf(viewer, "slot groups over consecutive block columns (x%s read without gathers): %" PetscInt_FMT " of %" PetscInt_FMT " (%.1f%%)\n", a->sym ? " and y" : "", unit, groups, groups ? 100.0 * (double)unit / (double)groups : 0.0));
-      if (!a->sym) PetscCall(PetscViewerASCIIPrintf(viewer, "product: %" PetscInt_FMT " run(s) of bins swept side by side (-mat_binbcsr_streams)\n", a->streams));
+      PetscCall(PetscViewerASCIIPrintf(viewer, "product: %" PetscInt_FMT " run(s) of bins swept side by side (-mat_binbcsr_streams)\n", a->streams));
     }
     if (a->coo_jmap || a->coo_mirror) {
       const char *refill = a->coo_slot_state == 1 ? "by whole blocks" : a->coo_slot_state == -1 ? "value by value (the list is not made of whole blocks)" : "path chosen at the first refill";

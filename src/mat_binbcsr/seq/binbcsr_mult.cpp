@@ -174,6 +174,26 @@ void with_constant_shape(PetscInt bs, PetscInt bw, F &&f)
   else f(integral_constant<int, 0>{}, integral_constant<int, 0>{});
 }
 
+/* Calls f(K) with the run count K (MatBinBCSRSetStreams: 1, 2, 4 or 8) as a compile-time constant. */
+template <class F>
+void with_streams(PetscInt streams, F &&f)
+{
+  using std::integral_constant;
+  switch (streams) {
+  case 8:
+    f(integral_constant<int, 8>{});
+    break;
+  case 4:
+    f(integral_constant<int, 4>{});
+    break;
+  case 2:
+    f(integral_constant<int, 2>{});
+    break;
+  default:
+    f(integral_constant<int, 1>{});
+  }
+}
+
 template <typename V>
 void mult_dispatch(const Mat_SeqBinBCSR *a, const V *val, const double *x, const double *z, double *y, double *dot, double *acc)
 {
@@ -181,36 +201,47 @@ void mult_dispatch(const Mat_SeqBinBCSR *a, const V *val, const double *x, const
   if (dot) *dot = 0.0;
   with_constant_shape(a->bs, a->bw, [&](auto BS, auto BW) {
     if constexpr (BS > 0 && BW > 0) {
-      switch (m.streams) {
-      case 8:
-        mult_bins_fixed<8, BS, BW, V>(m, x, z, y, dot);
-        break;
-      case 4:
-        mult_bins_fixed<4, BS, BW, V>(m, x, z, y, dot);
-        break;
-      case 2:
-        mult_bins_fixed<2, BS, BW, V>(m, x, z, y, dot);
-        break;
-      default:
-        mult_bins_fixed<1, BS, BW, V>(m, x, z, y, dot);
-      }
+      with_streams(m.streams, [&](auto K) { mult_bins_fixed<K, BS, BW, V>(m, x, z, y, dot); });
     } else mult_bins_any<BS, V>(m, a->bw, x, z, y, dot, acc);
   });
 }
 
-/* Symmetric storage: y += A x with the upper triangle (y holds z or zero on entry); *dot += x.y over
-   the rows of each bin once they are final (no later bin scatters into rows of earlier bins). */
-template <int BS, int BW, typename V>
+/* Symmetric storage: y += A x with the upper triangle (y holds z or zero on entry), the bins cut into K
+   runs swept side by side as mult_bins_fixed does. *dot += x.y over the rows: with one run, bin by bin
+   once its rows are final (no later bin scatters into rows of earlier bins); with several, a bin's rows
+   may still receive scatters from the bins of earlier runs, so the dot is a pass of its own at the end
+   (x and y, a small fraction of the bytes of the matrix). */
+template <int K, int BS, int BW, typename V>
 void sym_mult_bins_fixed(const Mat_SeqBinBCSR *a, const V *val, const double *x, double *y, double *dot)
 {
-  constexpr int BS2 = BS * BS;
-  double        d   = 0.0;
-  for (PetscInt b = 0; b < a->nbins; b++) {
-    const PetscInt s0 = a->bin_start[b], len = (a->bin_start[b + 1] - s0) / BW, r0 = b * BW;
-    binbcsr::sym_bin_mult<BS, BW, V, PetscInt>(val + (size_t)s0 * BS2, a->col + s0, (int)len, r0, a->mbs, x, y);
-    if (dot)
-      for (PetscInt p = r0 * BS; p < PetscMin(a->mbs, r0 + BW) * BS; p++) d += x[p] * y[p];
+  constexpr int  BS2 = BS * BS;
+  const PetscInt run = a->nbins / K;
+  double         d   = 0.0;
+  const auto     sweep = [&](auto KC, const PetscInt *bins) {
+    constexpr int   Kc = decltype(KC)::value;
+    const V        *t[Kc];
+    const PetscInt *c[Kc];
+    int             len[Kc];
+    PetscInt        r0[Kc];
+    for (int q = 0; q < Kc; q++) {
+      const PetscInt s0 = a->bin_start[bins[q]];
+      t[q]              = val + (size_t)s0 * BS2;
+      c[q]              = a->col + s0;
+      len[q]            = (int)((a->bin_start[bins[q] + 1] - s0) / BW);
+      r0[q]             = bins[q] * BW;
+    }
+    binbcsr::sym_bins_mult<Kc, BS, BW, V, PetscInt>(t, c, len, r0, a->mbs, x, y);
+    if (dot && K == 1)
+      for (PetscInt p = r0[0] * BS; p < PetscMin(a->mbs, r0[0] + BW) * BS; p++) d += x[p] * y[p];
+  };
+  PetscInt bins[K];
+  for (PetscInt j = 0; j < run; j++) {
+    for (int q = 0; q < K; q++) bins[q] = q * run + j;
+    sweep(std::integral_constant<int, K>{}, bins);
   }
+  for (PetscInt b = K * run; b < a->nbins; b++) sweep(std::integral_constant<int, 1>{}, &b);
+  if (dot && K > 1)
+    for (PetscInt p = 0; p < a->mbs * BS; p++) d += x[p] * y[p];
   if (dot) *dot += d;
 }
 
@@ -238,8 +269,9 @@ void sym_mult_dispatch(const Mat_SeqBinBCSR *a, const V *val, const double *x, d
 {
   if (dot) *dot = 0.0;
   with_constant_shape(a->bs, a->bw, [&](auto BS, auto BW) {
-    if constexpr (BS > 0 && BW > 0) sym_mult_bins_fixed<BS, BW, V>(a, val, x, y, dot);
-    else sym_mult_bins_any<BS, V>(a, val, x, y, dot, acc);
+    if constexpr (BS > 0 && BW > 0) {
+      with_streams(a->streams, [&](auto K) { sym_mult_bins_fixed<K, BS, BW, V>(a, val, x, y, dot); });
+    } else sym_mult_bins_any<BS, V>(a, val, x, y, dot, acc);
   });
 }
 
