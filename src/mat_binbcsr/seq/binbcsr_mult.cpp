@@ -61,7 +61,7 @@ inline void group_mult(const V *t, const PetscInt *c, const double *x, double (*
    *dot += x.y over them when dot is non-null. Why several bins at once: one core streaming one array
    out of memory is limited by the cache lines it has in flight, and the hardware prefetcher keeps more
    of them in flight for several streams than for one. On this project's machine one core read one
-   array at 10.0-10.5 GB/s, two at 11.9-12.4 and four at 13.0-14.1 GB/s; the 48^3 stencil's product
+   array at 9.9-10.5 GB/s, two at 11.9-12.4 and four at 13.0-14.1 GB/s; the 48^3 stencil's product
    took 16.2-20.0 ms with 4 runs against 20.2-22.9 ms with one (docs/mat_binbcsr.md). */
 template <int K, int BS, int BW, typename V>
 void bins_sweep(const BinSweep<V> &m, const PetscInt *bins, const double *x, const double *z, double *y, double &d, bool want_dot)
