@@ -1,10 +1,14 @@
-// binbcsr_tune: MatMult of MATSEQBINBCSR for several bin widths and both precisions against seqbaij
-// and seqaij on the 27-point 3x3-block stencil, timed round-robin in one run (so load from other
-// processes hits all variants alike); reports the minimum over the rounds. This is the measurement
-// behind the default bin width (docs/mat_binbcsr.md).
+// binbcsr_tune: MatMult of MATSEQBINBCSR for several bin widths, both precisions and several stream
+// counts (MatBinBCSRSetStreams) against seqbaij and seqaij on the 27-point 3x3-block stencil, timed
+// round-robin in one run (so load from other processes hits all variants alike); reports the minimum
+// over the rounds. This is the measurement behind the default bin width and stream count
+// (docs/mat_binbcsr.md).
 //
-//   binbcsr_tune [-stencil_n 48] [-bin_widths 1,2,4,8,16,32] [-repeats 15] [-batch 10] [-bs 3] [-coo]
-//                [-timer cpu|wall]
+//   binbcsr_tune [-stencil_n 48] [-bin_widths 1,2,4,8,16,32] [-streams 4] [-repeats 15] [-batch 10]
+//                [-bs 3] [-coo] [-timer cpu|wall]
+//
+// -streams 1,2,4,8 times each matrix with each stream count (one matrix per width and precision:
+// the stream count is a traversal order, set before each batch).
 //
 // -bs 1 measures BIN-CSR on the same stencil seen as a scalar matrix.
 // -coo also times the COO refill (MatSetValuesCOO, INSERT) of seqaij and binbcsr (default bin width,
@@ -31,8 +35,10 @@ double    Now()
 
 struct Variant {
   std::string name;
-  Mat         A   = nullptr;
-  double      best = 1e300;
+  Mat         A       = nullptr;
+  PetscInt    streams = 0; /* MatBinBCSRSetStreams before each batch; 0: aij/baij */
+  bool        owner   = true; /* destroys A (binbcsr matrices are shared by their stream counts) */
+  double      best    = 1e300;
 };
 
 PetscErrorCode MakeBinBCSR(Mat src, PetscInt bs, PetscInt bw, MatBinBCSRPrecision prec, Mat *A)
@@ -111,6 +117,7 @@ int main(int argc, char **argv)
 {
   StencilGrid          grid;
   PetscInt             widths[16] = {1, 2, 4, 8, 16, 32}, nw = 6, repeats = 15, batch = 10, bs = 3;
+  PetscInt             streams[4] = {4}, ns = 1;
   PetscBool            coo = PETSC_FALSE;
   std::vector<Variant> vars;
   Mat                  aij, baij;
@@ -125,6 +132,9 @@ int main(int argc, char **argv)
     PetscBool flg;
     PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-bin_widths", widths, &nset, &flg));
     if (flg) nw = nset;
+    nset = 4;
+    PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-streams", streams, &nset, &flg));
+    if (flg) ns = nset;
   }
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-repeats", &repeats, nullptr));
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-batch", &batch, nullptr));
@@ -144,24 +154,32 @@ int main(int argc, char **argv)
   vars.push_back({"seqbaij", baij});
   for (PetscInt w = 0; w < nw; w++)
     for (int p = 0; p < 2; p++) {
-      Variant v;
-      v.name = std::string(p ? "single" : "double") + " bw " + std::to_string(widths[w]);
-      PetscCall(MakeBinBCSR(aij, bs, widths[w], p ? MAT_BINBCSR_PRECISION_SINGLE : MAT_BINBCSR_PRECISION_DOUBLE, &v.A));
-      vars.push_back(v);
+      Mat A;
+      PetscCall(MakeBinBCSR(aij, bs, widths[w], p ? MAT_BINBCSR_PRECISION_SINGLE : MAT_BINBCSR_PRECISION_DOUBLE, &A));
+      for (PetscInt k = 0; k < ns; k++) {
+        Variant v;
+        v.name    = std::string(p ? "single" : "double") + " bw " + std::to_string(widths[w]) + (ns > 1 ? " K " + std::to_string(streams[k]) : "");
+        v.A       = A;
+        v.streams = streams[k];
+        v.owner   = k == 0;
+        vars.push_back(v);
+      }
     }
   PetscCall(MatCreateVecs(aij, &x, &y));
   PetscCall(VecSet(x, 1.0));
   for (PetscInt r = 0; r < repeats; r++)
     for (Variant &v : vars) {
+      if (v.streams) PetscCall(MatBinBCSRSetStreams(v.A, v.streams));
       PetscCall(MatMult(v.A, x, y)); /* warm */
       const double t0 = Now();
       for (PetscInt b = 0; b < batch; b++) PetscCall(MatMult(v.A, x, y));
       v.best = PetscMin(v.best, (Now() - t0) / batch);
     }
   PetscCall(PetscPrintf(PETSC_COMM_SELF, "stencil %" PetscInt_FMT "^3, bs %" PetscInt_FMT ", %" PetscInt_FMT " rounds of %" PetscInt_FMT " MatMults, minimum per MatMult (%s time)\n", grid.nx, bs, repeats, batch, use_wall ? "wall" : "process CPU"));
-  PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-16s %10s %8s %8s\n", "variant", "ms", "x baij", "x aij"));
-  for (Variant &v : vars) PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-16s %10.4f %8.2f %8.2f\n", v.name.c_str(), 1e3 * v.best, vars[1].best / v.best, vars[0].best / v.best));
-  for (Variant &v : vars) PetscCall(MatDestroy(&v.A));
+  PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-20s %10s %8s %8s\n", "variant", "ms", "x baij", "x aij"));
+  for (Variant &v : vars) PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-20s %10.4f %8.2f %8.2f\n", v.name.c_str(), 1e3 * v.best, vars[1].best / v.best, vars[0].best / v.best));
+  for (Variant &v : vars)
+    if (v.owner) PetscCall(MatDestroy(&v.A));
   if (coo) PetscCall(TimeCOO(grid, repeats));
   PetscCall(VecDestroy(&x));
   PetscCall(VecDestroy(&y));
