@@ -48,6 +48,21 @@ BINBCSR_HD void prefetch_values(const V *tile, int nbytes)
 #endif
 }
 
+/* The slot groups of K bins swept together (len[q]: the groups of bin q): group(q, k) for group k of
+   bin q, one group of each bin in turn while every bin has one left, then the rest of each bin. The
+   products sweep several bins at once because the bins are then several streams for the hardware
+   prefetcher (binbcsr_mult.cpp's bins_sweep says why). */
+template <int K, class G>
+BINBCSR_HD void interleave_groups(const int *len, G &&group)
+{
+  int common = len[0];
+  for (int q = 1; q < K; q++) common = len[q] < common ? len[q] : common;
+  for (int k = 0; k < common; k++)
+    for (int q = 0; q < K; q++) group(q, k);
+  for (int q = 0; q < K; q++)
+    for (int k = common; k < len[q]; k++) group(q, k);
+}
+
 /* acc[i] += sum_j block(i,j) * xc[j]: one slot of one lane (xc = x at the slot's block column). */
 template <int BS, typename V>
 BINBCSR_HD void slot_mult(const V *tile, int bw, int bs_rt, const double *xc, double *acc)
@@ -171,7 +186,7 @@ BINBCSR_HD bool unit_stride(const I *c)
 namespace binbcsr
 {
 
-/* One slot group of sym_bin_mult whose lanes read the consecutive block columns xs, xs + BS, ...:
+/* One slot group of sym_bins_mult whose lanes read the consecutive block columns xs, xs + BS, ...:
    acc += block x_c and, with SCATTER, y_c += block^T x_r, by unit-stride loads and stores. The
    branch is a template argument: a run-time test inside the lane loop stops GCC from vectorising it. */
 template <int BS, int BW, typename V, bool SCATTER>
@@ -250,9 +265,7 @@ BINBCSR_HD void sym_bins_mult(const V *const *bin_val, const I *const *bin_col, 
   constexpr int BS2 = BS * BS;
   double        acc[K][BS][BW], xr[K][BS][BW];
   I             own[K][BW];
-  int           common = len[0];
   for (int q = 0; q < K; q++) {
-    common = len[q] < common ? len[q] : common;
     for (int l = 0; l < BW; l++) {
       const bool real = r0[q] + l < mbs;
       own[q][l]       = real ? r0[q] + l : mbs - 1;
@@ -262,21 +275,11 @@ BINBCSR_HD void sym_bins_mult(const V *const *bin_val, const I *const *bin_col, 
       }
     }
   }
-  for (int k = 0; k < common; k++)
-    for (int q = 0; q < K; q++) sym_group_mult<BS, BW, V, I>(bin_val[q] + (long)k * BW * BS2, bin_col[q] + (long)k * BW, r0[q], own[q], xr[q], x, y, acc[q]);
-  for (int q = 0; q < K; q++)
-    for (int k = common; k < len[q]; k++) sym_group_mult<BS, BW, V, I>(bin_val[q] + (long)k * BW * BS2, bin_col[q] + (long)k * BW, r0[q], own[q], xr[q], x, y, acc[q]);
+  interleave_groups<K>(len, [&](int q, int k) { sym_group_mult<BS, BW, V, I>(bin_val[q] + (long)k * BW * BS2, bin_col[q] + (long)k * BW, r0[q], own[q], xr[q], x, y, acc[q]); });
   for (int q = 0; q < K; q++)
     for (int l = 0; l < BW; l++)
       if (r0[q] + l < mbs)
         for (int i = 0; i < BS; i++) y[(long)(r0[q] + l) * BS + i] += acc[q][i][l];
-}
-
-/* One bin of sym_bins_mult. */
-template <int BS, int BW, typename V, typename I>
-BINBCSR_HD void sym_bin_mult(const V *bin_val, const I *bin_col, int len, I r0, I mbs, const double *x, double *y)
-{
-  sym_bins_mult<1, BS, BW, V, I>(&bin_val, &bin_col, &len, &r0, mbs, x, y);
 }
 
 /* COO refill of one value: the sum of the entries perm[jmap[v] .. jmap[v+1]-1], where an index p < n

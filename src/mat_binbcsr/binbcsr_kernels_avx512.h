@@ -76,25 +76,10 @@ inline void group_mult_3x8(const V *t, const I *c, const double *x, __m512d *a)
 template <int K, typename V, typename I>
 inline void bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, const int *len, const double *x, double (*const *acc)[8])
 {
-  __m512d  a[K][3];
-  const V *t[K];
-  const I *c[K];
-  int      common = len[0];
-  for (int q = 0; q < K; q++) {
-    t[q]   = bin_val[q];
-    c[q]   = bin_col[q];
-    common = len[q] < common ? len[q] : common;
-    for (int i = 0; i < 3; i++) a[q][i] = _mm512_loadu_pd(acc[q][i]);
-  }
-  const auto group = [&](int q) {
-    group_mult_3x8(t[q], c[q], x, a[q]);
-    t[q] += 72;
-    c[q] += 8;
-  };
-  for (int k = 0; k < common; k++)
-    for (int q = 0; q < K; q++) group(q);
+  __m512d a[K][3];
   for (int q = 0; q < K; q++)
-    for (int k = common; k < len[q]; k++) group(q);
+    for (int i = 0; i < 3; i++) a[q][i] = _mm512_loadu_pd(acc[q][i]);
+  interleave_groups<K>(len, [&](int q, int k) { group_mult_3x8(bin_val[q] + (long)k * 72, bin_col[q] + (long)k * 8, x, a[q]); });
   for (int q = 0; q < K; q++)
     for (int i = 0; i < 3; i++) _mm512_storeu_pd(acc[q][i], a[q][i]);
 }
@@ -180,6 +165,8 @@ inline void sym_bin_end_3x8(const SymBin3x8<V, I> &b, double *y)
 template <int K, typename V, typename I>
 inline void sym_bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, const int *len, const I *r0, I mbs, const double *x, double *y)
 {
+  /* interleave_groups' order written out: through its lambda this body ran slower (upper double at
+     48^3, three alternations: 7.0-7.6 ms against 6.5-6.9) */
   SymBin3x8<V, I> b[K];
   int             common = len[0];
   for (int q = 0; q < K; q++) {

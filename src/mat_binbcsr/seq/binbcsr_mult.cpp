@@ -25,8 +25,44 @@ template <typename V>
 struct BinSweep {
   const PetscInt *bin_start, *col;
   const V        *val;
-  PetscInt        nbins, mbs, bs, streams;
+  PetscInt        nbins, mbs, bs;
 };
+
+/* The slices of K bins: values, columns and slot groups (len) of bins[q]. */
+template <int K, typename V>
+struct BinSlices {
+  const V        *t[K];
+  const PetscInt *c[K];
+  int             len[K];
+};
+
+template <int K, int BS, int BW, typename V>
+BinSlices<K, V> bin_slices(const PetscInt *bin_start, const PetscInt *col, const V *val, const PetscInt *bins)
+{
+  BinSlices<K, V> s;
+  for (int q = 0; q < K; q++) {
+    const PetscInt s0 = bin_start[bins[q]];
+    s.t[q]            = val + (size_t)s0 * BS * BS;
+    s.c[q]            = col + s0;
+    s.len[q]          = (int)((bin_start[bins[q] + 1] - s0) / BW);
+  }
+  return s;
+}
+
+/* The order of the products' sweeps: the nbins bins cut into K runs of consecutive bins, f(K, bins)
+   for bin j of every run together, then f(1, &b) for each of the nbins % K bins left over. K and the
+   count passed to f are compile-time constants (std::integral_constant). */
+template <int K, class F>
+void for_each_sweep(PetscInt nbins, F &&f)
+{
+  const PetscInt run = nbins / K;
+  PetscInt       bins[K];
+  for (PetscInt j = 0; j < run; j++) {
+    for (int q = 0; q < K; q++) bins[q] = q * run + j;
+    f(std::integral_constant<int, K>{}, bins);
+  }
+  for (PetscInt b = K * run; b < nbins; b++) f(std::integral_constant<int, 1>{}, &b);
+}
 
 /* acc[i][l] += block row i of lane l times x_c over one slot group (c: the group's BW columns, t: its
    tiles). BW is the bin width as a constant: the lanes' accumulators stay in registers and the loop
@@ -66,35 +102,21 @@ inline void group_mult(const V *t, const PetscInt *c, const double *x, double (*
 template <int K, int BS, int BW, typename V>
 void bins_sweep(const BinSweep<V> &m, const PetscInt *bins, const double *x, const double *z, double *y, double &d, bool want_dot)
 {
-  constexpr int BS2 = BS * BS;
-  double        acc[K][BS][BW] = {};
-  const V      *t[K];
-  const PetscInt *c[K];
-  int           len[K], common = 0;
-  for (int q = 0; q < K; q++) {
-    const PetscInt s0 = m.bin_start[bins[q]];
-    t[q]              = m.val + (size_t)s0 * BS2;
-    c[q]              = m.col + s0;
-    len[q]            = (int)((m.bin_start[bins[q] + 1] - s0) / BW);
-    common            = q == 0 || len[q] < common ? len[q] : common;
-  }
+  constexpr int         BS2            = BS * BS;
+  double                acc[K][BS][BW] = {};
+  const BinSlices<K, V> s              = bin_slices<K, BS, BW, V>(m.bin_start, m.col, m.val, bins);
 #if defined(BINBCSR_AVX512)
   if constexpr (BS == 3 && BW == 8) {
     double(*accq[K])[8];
     for (int q = 0; q < K; q++) accq[q] = acc[q];
-    binbcsr::avx512::bins_mult_3x8<K>(t, c, len, x, accq);
+    binbcsr::avx512::bins_mult_3x8<K>(s.t, s.c, s.len, x, accq);
   } else
 #endif
-  {
-    for (int k = 0; k < common; k++)
-      for (int q = 0; q < K; q++) group_mult<BS, BW, V>(t[q] + (size_t)k * BW * BS2, c[q] + (size_t)k * BW, x, acc[q]);
-    for (int q = 0; q < K; q++)
-      for (int k = common; k < len[q]; k++) group_mult<BS, BW, V>(t[q] + (size_t)k * BW * BS2, c[q] + (size_t)k * BW, x, acc[q]);
-  }
+  binbcsr::interleave_groups<K>(s.len, [&](int q, int k) { group_mult<BS, BW, V>(s.t[q] + (size_t)k * BW * BS2, s.c[q] + (size_t)k * BW, x, acc[q]); });
   for (int q = 0; q < K; q++) {
     /* y += A x in place: an empty bin changes nothing (the off-diagonal part of an MPI matrix is
        mostly empty bins; writing their rows back cost a tenth of the diagonal part's product) */
-    if (!len[q] && z == y && !want_dot) continue;
+    if (!s.len[q] && z == y && !want_dot) continue;
     const PetscInt r0 = bins[q] * BW, nl = PetscMin((PetscInt)BW, m.mbs - r0);
     for (PetscInt l = 0; l < nl; l++) {
       for (int i = 0; i < BS; i++) {
@@ -107,20 +129,13 @@ void bins_sweep(const BinSweep<V> &m, const PetscInt *bins, const double *x, con
   }
 }
 
-/* y[rows of the bins] = z + A x, and *dot += x.y over the rows when dot is non-null. The bins are cut
-   into K runs of consecutive bins, swept side by side (bin j of every run together); the nbins % K bins
-   left over follow one at a time. */
+/* y[rows of the bins] = z + A x, and *dot += x.y over the rows when dot is non-null; the bins in
+   for_each_sweep's order (K runs side by side). */
 template <int K, int BS, int BW, typename V>
 void mult_bins_fixed(const BinSweep<V> &m, const double *x, const double *z, double *y, double *dot)
 {
-  const PetscInt run = m.nbins / K;
-  double         d   = 0.0;
-  PetscInt       bins[K];
-  for (PetscInt j = 0; j < run; j++) {
-    for (int q = 0; q < K; q++) bins[q] = q * run + j;
-    bins_sweep<K, BS, BW, V>(m, bins, x, z, y, d, dot != nullptr);
-  }
-  for (PetscInt b = K * run; b < m.nbins; b++) bins_sweep<1, BS, BW, V>(m, &b, x, z, y, d, dot != nullptr);
+  double d = 0.0;
+  for_each_sweep<K>(m.nbins, [&](auto KC, const PetscInt *bins) { bins_sweep<decltype(KC)::value, BS, BW, V>(m, bins, x, z, y, d, dot != nullptr); });
   if (dot) *dot += d;
 }
 
@@ -197,49 +212,33 @@ void with_streams(PetscInt streams, F &&f)
 template <typename V>
 void mult_dispatch(const Mat_SeqBinBCSR *a, const V *val, const double *x, const double *z, double *y, double *dot, double *acc)
 {
-  const BinSweep<V> m = {a->bin_start, a->col, val, a->nbins, a->mbs, a->bs, a->streams};
+  const BinSweep<V> m = {a->bin_start, a->col, val, a->nbins, a->mbs, a->bs};
   if (dot) *dot = 0.0;
   with_constant_shape(a->bs, a->bw, [&](auto BS, auto BW) {
     if constexpr (BS > 0 && BW > 0) {
-      with_streams(m.streams, [&](auto K) { mult_bins_fixed<K, BS, BW, V>(m, x, z, y, dot); });
+      with_streams(a->streams, [&](auto K) { mult_bins_fixed<K, BS, BW, V>(m, x, z, y, dot); });
     } else mult_bins_any<BS, V>(m, a->bw, x, z, y, dot, acc);
   });
 }
 
-/* Symmetric storage: y += A x with the upper triangle (y holds z or zero on entry), the bins cut into K
-   runs swept side by side as mult_bins_fixed does. *dot += x.y over the rows: with one run, bin by bin
+/* Symmetric storage: y += A x with the upper triangle (y holds z or zero on entry), the bins in
+   for_each_sweep's order (K runs side by side). *dot += x.y over the rows: with one run, bin by bin
    once its rows are final (no later bin scatters into rows of earlier bins); with several, a bin's rows
    may still receive scatters from the bins of earlier runs, so the dot is a pass of its own at the end
    (x and y, a small fraction of the bytes of the matrix). */
 template <int K, int BS, int BW, typename V>
 void sym_mult_bins_fixed(const Mat_SeqBinBCSR *a, const V *val, const double *x, double *y, double *dot)
 {
-  constexpr int  BS2 = BS * BS;
-  const PetscInt run = a->nbins / K;
-  double         d   = 0.0;
-  const auto     sweep = [&](auto KC, const PetscInt *bins) {
-    constexpr int   Kc = decltype(KC)::value;
-    const V        *t[Kc];
-    const PetscInt *c[Kc];
-    int             len[Kc];
-    PetscInt        r0[Kc];
-    for (int q = 0; q < Kc; q++) {
-      const PetscInt s0 = a->bin_start[bins[q]];
-      t[q]              = val + (size_t)s0 * BS2;
-      c[q]              = a->col + s0;
-      len[q]            = (int)((a->bin_start[bins[q] + 1] - s0) / BW);
-      r0[q]             = bins[q] * BW;
-    }
-    binbcsr::sym_bins_mult<Kc, BS, BW, V, PetscInt>(t, c, len, r0, a->mbs, x, y);
+  double d = 0.0;
+  for_each_sweep<K>(a->nbins, [&](auto KC, const PetscInt *bins) {
+    constexpr int          Kc = decltype(KC)::value;
+    const BinSlices<Kc, V> s  = bin_slices<Kc, BS, BW, V>(a->bin_start, a->col, val, bins);
+    PetscInt               r0[Kc];
+    for (int q = 0; q < Kc; q++) r0[q] = bins[q] * BW;
+    binbcsr::sym_bins_mult<Kc, BS, BW, V, PetscInt>(s.t, s.c, s.len, r0, a->mbs, x, y);
     if (dot && K == 1)
       for (PetscInt p = r0[0] * BS; p < PetscMin(a->mbs, r0[0] + BW) * BS; p++) d += x[p] * y[p];
-  };
-  PetscInt bins[K];
-  for (PetscInt j = 0; j < run; j++) {
-    for (int q = 0; q < K; q++) bins[q] = q * run + j;
-    sweep(std::integral_constant<int, K>{}, bins);
-  }
-  for (PetscInt b = K * run; b < a->nbins; b++) sweep(std::integral_constant<int, 1>{}, &b);
+  });
   if (dot && K > 1)
     for (PetscInt p = 0; p < a->mbs * BS; p++) d += x[p] * y[p];
   if (dot) *dot += d;
