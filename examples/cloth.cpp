@@ -9,12 +9,14 @@
 // a progress line every -progress_every steps, -vtk PREFIX (triangle surface per -vtk_every steps),
 // -dump_matrix FILE (first step's matrix), and a final `summary key=value ...` line; -cloth_timer cpu times
 // in process CPU time instead of wall time (a shared machine).
+#include "common/run_guard.h"
 #include "common/sim_driver.h"
 #include "physics/cloth_step.hpp"
 #include "physics/vtk_writer.hpp"
 
 #include <petscbinbcsr.h>
 
+#include <cmath>
 #include <cstring>
 
 static bool WriteFrame(const std::string &path, const physics::Cloth &cloth)
@@ -129,6 +131,21 @@ int main(int argc, char **argv)
   PetscCall(write_frame(0));
 
   const double e0 = physics::cloth_energy(cloth);
+  RunGuard     guard;
+  {
+    // The scene's energy scale: its weight over its size, plus the kinetic energy it starts with. The
+    // sphere's contact projection adds spring energy (7 J, 1.5 x the scale, for 20 x 20 particles
+    // draped for 20 steps), so the bound is 4 x the scale; a spring at twice its rest length is no
+    // cloth any more.
+    double m = 0, ke0 = 0;
+    for (int p = 0; p < cloth.particle_count(); ++p) m += cloth.mass[p], ke0 += 0.5 * cloth.mass[p] * cloth.velocity[p].squaredNorm();
+    HealthBounds hb;
+    hb.energy_scale  = m * cloth.gravity.norm() * opt.size + ke0;
+    hb.energy_growth = 4.0;
+    hb.max_stretch   = 2.0;
+    PetscCall(RunGuardFromOptions(comm, hb, &guard));
+    RunGuardStart(&guard, e0, NAN);
+  }
   const auto   now = cpu_timer ? ProcessCpuTime : WallTime;
   double       step_ms_total = 0, max_stretch = 0;
   long long    nan_steps = 0, unconverged = 0, contacts = 0, done = 0;
@@ -155,7 +172,15 @@ int main(int argc, char **argv)
     }
     if (step == 1 && out.dump) PetscCall(BlockSystemDumpMatrix(&rs.sys, out.dump_path));
     PetscCall(write_frame(step));
-    if (!finite) break;
+    StepHealth health;
+    health.solver_reason = rs.last.reason;
+    health.energy        = physics::cloth_energy(cloth);
+    health.finite        = finite && std::isfinite(health.energy);
+    health.max_stretch   = r.max_stretch;
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &health.max_stretch, 1, MPI_DOUBLE, MPI_MAX, comm));
+    bool stop;
+    PetscCall(RunGuardCheckStep(comm, &guard, step, health, &stop));
+    if (stop) break;
   }
 
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &max_stretch, 1, MPI_DOUBLE, MPI_MAX, comm));
@@ -181,9 +206,10 @@ int main(int argc, char **argv)
   s.add("energy_final", physics::cloth_energy(cloth));
   s.add("kinetic_final", ke);
   s.add("nan", nan_steps);
+  RunGuardAddSummary(s, guard);
   PetscCall(PrintSummary(comm, s));
 
   PetscCall(ReplicatedSolverDestroy(&rs));
   PetscCall(PetscFinalize());
-  return 0;
+  return guard.exit_code;
 }
