@@ -15,7 +15,7 @@
 #include <petscbinbcsr.h>
 
 #include "common/fem_simulation.h"
-#include "common/run_guard.h"
+#include "common/fem_health.h"
 #include "common/summary.h"
 #include "physics/box_mesh.hpp"
 #include "physics/corotational_assembly.hpp"
@@ -339,36 +339,11 @@ int main(int argc, char **argv)
       r = std::min(r, physics::element_signed_volume(model.mesh, x.data(), e) / model.volume[e]);
     return r;
   };
-  auto inverted_fraction = [&] {
-    long long n = 0;
-    for (int e = 0; e < model.element_count(); ++e) n += !(physics::element_signed_volume(model.mesh, x.data(), e) > 0);
-    return model.element_count() ? (double)n / model.element_count() : 0.0;
-  };
-  // Kinetic + elastic + the potential of gravity: implicit Euler only loses it, so a gain is the
-  // integration (or the solver) breaking down.
-  auto total_energy = [&] {
-    const physics::FemEnergy e = physics::fem_energy(model, x.data(), v.data());
-    double                   w = 0;
-    for (size_t k = 0; k < x.size(); ++k) w += sim.f_gravity[k] * (x[k] - X[k]);
-    return e.kinetic + e.elastic - w;
-  };
+  auto inverted_fraction = [&] { return FemInvertedFraction(sim); };
+  auto total_energy      = [&] { return FemTotalEnergy(sim); };
   RunGuard guard;
-  {
-    // The scene's energy scale: its weight over its size, plus the energy it starts with.
-    double weight[3] = {0, 0, 0};
-    for (int i = 0; i < n_nodes; ++i)
-      if (!sim.fixed[i])
-        for (int d = 0; d < 3; ++d) weight[d] += sim.f_gravity[3 * i + d];
-    const auto         bb = physics::bounding_box(model.mesh);
-    const double       diag = std::sqrt(std::pow(bb[3] - bb[0], 2) + std::pow(bb[4] - bb[1], 2) + std::pow(bb[5] - bb[2], 2));
-    const physics::FemEnergy e0 = physics::fem_energy(model, x.data(), v.data());
-    HealthBounds       hb;
-    hb.energy_scale      = std::sqrt(weight[0] * weight[0] + weight[1] * weight[1] + weight[2] * weight[2]) * diag + std::abs(e0.kinetic) + std::abs(e0.elastic);
-    hb.energy_growth     = 0.5;
-    hb.inverted_fraction = 0;
-    PetscCall(RunGuardFromOptions(comm, hb, &guard));
-    RunGuardStart(&guard, total_energy(), inverted_fraction());
-  }
+  PetscCall(RunGuardFromOptions(comm, FemHealthBounds(sim), &guard));
+  RunGuardStart(&guard, total_energy(), inverted_fraction());
   PetscInt    nnz;
   const char *mat_type, *ksp_type;
   PetscCall(BlockSystemGetInfo(&sim.sys, &nnz, &mat_type, &ksp_type));
