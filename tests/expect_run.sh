@@ -2,7 +2,8 @@
 # expect_run.sh EXIT REGEX [REGEX...] -- COMMAND...: runs the command and passes only when its exit
 # status is EXIT (a number, or `nonzero` for any failure) and its output (stdout and stderr together)
 # matches every REGEX (Perl syntax; `.` also matches newlines, as in CTest's PASS_REGULAR_EXPRESSION,
-# which alone would ignore the exit status).
+# which alone would ignore the exit status). Write a newline in a REGEX as \n (in CMake "\\n"): grep
+# would take a literal one as the start of another pattern.
 set -u
 want=$1; shift
 regexes=()
