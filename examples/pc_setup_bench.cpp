@@ -9,8 +9,8 @@
 //   mpiexec -n 2 build/examples/pc_setup_bench -stencil_n 20 -pcs asm,gasm,redundant,fieldsplit,mumps,hypre
 static char help[] = "PC set-up time, first and after a refill, binbcsr against aij.\n";
 
-#include "common/bench_util.h"
-#include "common/stencil.h"
+#include "sim/bench_util.h"
+#include "sim/stencil.h"
 
 #include <petscbinbcsr.h>
 #include <petscksp.h>

@@ -10,7 +10,7 @@
 #include <petscbinbcsr.h>
 #include <petsc/private/matimpl.h>
 
-#include "common/stencil.h"
+#include "sim/stencil.h"
 #include "physics/partition.hpp"
 
 #include <algorithm>

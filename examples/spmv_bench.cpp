@@ -32,9 +32,9 @@
 //   + 8 N (x) + 8 N (y)
 #include <petscbinbcsr.h>
 
-#include "common/bench_util.h"
-#include "common/stencil.h"
-#include "common/stream.h"
+#include "sim/bench_util.h"
+#include "sim/stencil.h"
+#include "sim/stream.h"
 
 #include <algorithm>
 #include <cmath>

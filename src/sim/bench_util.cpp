@@ -1,4 +1,4 @@
-#include "common/bench_util.h"
+#include "sim/bench_util.h"
 
 #include <petscbinbcsr.h>
 

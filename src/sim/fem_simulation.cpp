@@ -1,5 +1,5 @@
-#include "common/fem_simulation.h"
-#include "common/summary.h"
+#include "sim/fem_simulation.h"
+#include "sim/summary.h"
 #include "physics/partition.hpp"
 #include "physics/row_order.hpp"
 

@@ -8,7 +8,7 @@
 // (physics::assign_elements_to_parts); the right-hand side is summed with
 // MPI_Reduce_scatter and dv gathered back with MPI_Allgatherv.
 #pragma once
-#include "common/sim_system.h"
+#include "sim/sim_system.h"
 #include "physics/corotational_assembly.hpp"
 #include "physics/fem_model.hpp"
 

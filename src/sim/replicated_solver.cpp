@@ -1,5 +1,5 @@
-#include "common/replicated_solver.h"
-#include "common/summary.h"
+#include "sim/replicated_solver.h"
+#include "sim/summary.h"
 
 #include "physics/partition.hpp"
 #include "physics/row_order.hpp"

@@ -17,7 +17,7 @@
 //   that its Mat type stores (ReplicatedSolverOwnsRow, ReplicatedSolverStoresBlock): the physics computes
 //   just those and set_matrix passes its values straight to the COO refill (cloth).
 #pragma once
-#include "common/sim_system.h"
+#include "sim/sim_system.h"
 #include "physics/block_solver.hpp"
 
 #include <vector>

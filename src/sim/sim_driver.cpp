@@ -1,4 +1,4 @@
-#include "common/sim_driver.h"
+#include "sim/sim_driver.h"
 
 #include "physics/vtk_writer.hpp"
 

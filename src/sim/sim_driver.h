@@ -2,8 +2,8 @@
 // (-steps, -progress_every, -vtk PREFIX, -vtk_every, -dump_matrix FILE), writing a frame plus the .pvd
 // collection, and the solver part of the summary line.
 #pragma once
-#include "common/replicated_solver.h"
-#include "common/summary.h"
+#include "sim/replicated_solver.h"
+#include "sim/summary.h"
 
 #include <functional>
 #include <string>

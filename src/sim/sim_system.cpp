@@ -1,4 +1,4 @@
-#include "common/sim_system.h"
+#include "sim/sim_system.h"
 
 #include <petscbinbcsr.h>
 

@@ -1,4 +1,4 @@
-#include "common/stencil.h"
+#include "sim/stencil.h"
 #include <petscbinbcsr.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "common/stream.h"
+#include "sim/stream.h"
 
 #include <algorithm>
 #include <ctime>

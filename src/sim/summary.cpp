@@ -1,4 +1,4 @@
-#include "common/summary.h"
+#include "sim/summary.h"
 
 #include <ctime>
 

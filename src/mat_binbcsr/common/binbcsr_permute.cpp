@@ -7,7 +7,7 @@
    owner. A permutation that splits blocks is allowed: the blocks it touches are stored whole, with
    zeros. Symmetric storage stays symmetric only under the same permutation on both sides; anything
    else is refused. */
-#include "mpi/mpibinbcsr.h"
+#include "../mpi/mpibinbcsr.h"
 #include <petsc/private/matimpl.h>
 #include <petscis.h>
 

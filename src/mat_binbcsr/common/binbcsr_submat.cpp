@@ -14,8 +14,8 @@
    their values written into the caller's binbcsr submatrices in place, which keep their layout and
    nonzero state, so a PC on them redoes only its numeric set-up. Nothing is kept between calls but
    the shadow: no PETSc-internal reuse data whose life would have to follow the caller's arrays. */
-#include "mpi/mpibinbcsr.h"
-#include "seq/binbcsr.h"
+#include "../mpi/mpibinbcsr.h"
+#include "../seq/binbcsr.h"
 #include "binbcsr_composed.h"
 
 namespace

@@ -17,8 +17,8 @@
    MatRealPart / MatImaginaryPart: the plug-in stores real values (PETSc built with real scalars, as
    Debian's), so the real part is the matrix itself and the imaginary part is zero, as aij computes them
    for real scalars; MatConjugate needs nothing (PETSc's interface does nothing for real scalars). */
-#include "mpi/mpibinbcsr.h"
-#include "seq/binbcsr.h"
+#include "../mpi/mpibinbcsr.h"
+#include "../seq/binbcsr.h"
 
 #include <cstdint>
 

@@ -4,7 +4,7 @@
 // each instantiation: with GCC 12 the hand-written AVX-512 body agrees bit for bit, the portable one at
 // bs 3 / bin width 4 in the last bits). Used by unit_mat_core (whole storage) and unit_mat_sym.
 #pragma once
-#include "mat_core/support.h"
+#include "support/mat_support.hpp"
 
 namespace mat_core
 {

@@ -1,6 +1,6 @@
 // Filling a MATSEQBINBCSR: MatSetValues(Blocked) with INSERT/ADD before and after the layout exists,
 // the preallocation entry points stock programs use, the COO interface, options, and bad input.
-#include "support.h"
+#include "support/mat_support.hpp"
 #include <map>
 
 using namespace mat_core;

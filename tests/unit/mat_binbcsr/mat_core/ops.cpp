@@ -1,6 +1,6 @@
 // MatGetDiagonal, MatInvertBlockDiagonal, MatGetRow, MatDuplicate, MatCopy, MatConvert (both ways),
 // precision switching and MatView of MATSEQBINBCSR against seqaij/seqbaij.
-#include "support.h"
+#include "support/mat_support.hpp"
 #include <petsc/private/matimpl.h>
 #include <cstdio>
 #include <fstream>

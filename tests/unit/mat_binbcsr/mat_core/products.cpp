@@ -1,6 +1,6 @@
 // MatMult, MatMultAdd, MatMultTranspose(+Add) and MatMultDotLocal of MATSEQBINBCSR against seqaij, on
 // random, FEM-like and wild patterns, several bin widths, block sizes and both precisions.
-#include "support.h"
+#include "support/mat_support.hpp"
 
 using namespace mat_core;
 

@@ -1,7 +1,7 @@
 // MatBinBCSRSetStreams on whole storage (streams_check.h says what is checked), on patterns where the
 // bins are not a multiple of the runs, rows of one bin differ wildly in length, and unit-stride and
 // gathered slot groups alternate; and the setter, option, view and bad values.
-#include "streams_check.h"
+#include "support/streams_check.hpp"
 
 using namespace mat_core;
 

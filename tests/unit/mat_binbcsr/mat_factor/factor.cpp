@@ -4,7 +4,7 @@
 // and the residual checked against the binbcsr matrix itself. Written for any communicator size: the
 // serial cases run on PETSC_COMM_SELF, the block-Jacobi case on PETSC_COMM_WORLD (CTest runs this
 // program on 1 and 2 ranks).
-#include "mat_core/support.h"
+#include "support/mat_support.hpp"
 #include <petscksp.h>
 #include <cstring>
 

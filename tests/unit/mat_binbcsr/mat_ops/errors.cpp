@@ -1,5 +1,5 @@
 // Bad input to the value operations: a PETSc error code, never a crash or silent garbage.
-#include "harness.h"
+#include "harness.hpp"
 
 #include <cmath>
 #include <limits>

@@ -1,4 +1,4 @@
-#include "harness.h"
+#include "harness.hpp"
 
 #include <algorithm>
 #include <cmath>

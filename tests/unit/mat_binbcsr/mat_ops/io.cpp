@@ -1,5 +1,5 @@
 // PETSc binary files: MatView/MatLoad round trips with seqaij files, block sizes, malformed files.
-#include "harness.h"
+#include "harness.hpp"
 
 #include <cstdio>
 #include <string>

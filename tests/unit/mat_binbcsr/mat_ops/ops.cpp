@@ -1,5 +1,5 @@
 // Each value operation on every flavour and pattern, against seqaij.
-#include "harness.h"
+#include "harness.hpp"
 
 #include <cmath>
 #include <random>

@@ -1,4 +1,4 @@
-#include "rowops_support.h"
+#include "rowops_support.hpp"
 
 #include <algorithm>
 #include <map>

@@ -5,7 +5,7 @@
 // Single precision is compared against aij holding the float-rounded entries, so selections (row
 // extremes, their columns) must agree exactly and computed values within a few float roundings of the
 // row (or column) scale.
-#include "rowops_support.h"
+#include "rowops_support.hpp"
 
 #include <algorithm>
 

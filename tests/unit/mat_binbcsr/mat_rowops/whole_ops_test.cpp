@@ -1,7 +1,7 @@
 // Operations a PETSc user expects of aij, on -mat_type binbcsr (seq on one rank, mpi on more) against
 // aij holding the same entries: MatInvertVariableBlockDiagonal and PCVPBJACOBI, MatSetRandom,
 // MatFindNonzeroRows, MatGetColumnVector, MatRealPart/MatImaginaryPart/MatConjugate, MatGetRowIJ.
-#include "rowops_support.h"
+#include "rowops_support.hpp"
 
 #include <petscksp.h>
 

@@ -8,7 +8,7 @@
 // rounded ones), so that both sides solve the same system and can be compared tightly.
 #include <catch2/catch.hpp>
 
-#include "mpi/fem_problem.hpp"
+#include "support/fem_problem.hpp"
 #include <petsc/private/matimpl.h> // nonzerostate
 
 #include <cmath>

@@ -1,7 +1,7 @@
 // MatSOR of MATSEQBINBCSR (whole and symmetric storage, bs 1, 2, 3, double and single values) against
 // a dense block-SOR reference computed here, against seqaij's MatSOR for bs 1, through PCSOR in CG,
 // and its errors.
-#include "support_sym.h"
+#include "support_sym.hpp"
 #include <petscksp.h>
 
 using namespace mat_sym;

@@ -3,8 +3,8 @@
 // Patterns: a random symmetric one whose bins are no multiple of the runs, the ragged end rows whose
 // last bins have more slot groups than rows, a stencil with unit-stride groups, bs 1 and 3, bin widths
 // 4-32, both precisions.
-#include "mat_core/streams_check.h"
-#include "support_sym.h"
+#include "support/streams_check.hpp"
+#include "support_sym.hpp"
 
 using namespace mat_sym;
 

@@ -1,7 +1,7 @@
 // Fixtures of the symmetric-storage tests: symmetric patterns (random, FEM-like, ragged, end rows)
 // and builders that create seqaij / seqsbaij / seqbinbcsr (full or symmetric storage) from them.
 #pragma once
-#include "mat_core/support.h"
+#include "support/mat_support.hpp"
 #include "mat_binbcsr/seq/binbcsr.h"
 #include <map>
 

@@ -1,6 +1,6 @@
 // MATSEQBINBCSR with symmetric storage (upper triangle, colour-ordered bins): every operation against
 // seqaij (and seqbaij/seqsbaij where they define the operation) on symmetric patterns.
-#include "support_sym.h"
+#include "support_sym.hpp"
 #include <cstdio>
 #include <cstring>
 #include <unistd.h>

@@ -6,7 +6,7 @@
 // PETSC_COMM_SELF.
 #include <catch2/catch.hpp>
 
-#include "mpi/fem_problem.hpp"
+#include "support/fem_problem.hpp"
 
 #include <petscbinbcsr.h>
 

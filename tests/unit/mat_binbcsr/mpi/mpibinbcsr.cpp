@@ -4,7 +4,7 @@
 // so that every rank passes or fails together instead of leaving the others waiting.
 #include <catch2/catch.hpp>
 
-#include "mpi/fem_problem.hpp"
+#include "support/fem_problem.hpp"
 #include <petsc/private/petscimpl.h> // PetscObjectStateGet
 
 #include <cmath>

@@ -4,7 +4,7 @@
 #pragma once
 #include <catch2/catch.hpp>
 
-#include "mpi/fem_problem.hpp"
+#include "support/fem_problem.hpp"
 
 #include <cmath>
 #include <string>

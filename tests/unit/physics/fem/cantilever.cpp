@@ -4,7 +4,7 @@
 // at x = L. P2 must be within 2%; P1 locks (the numbers are printed and bounded, not hidden).
 #include <catch2/catch.hpp>
 
-#include "fem/fem_test_util.hpp"
+#include "fem_test_util.hpp"
 #include "physics/box_mesh.hpp"
 
 #include <cmath>

@@ -4,8 +4,8 @@
 #include <catch2/catch.hpp>
 #include <petscbinbcsr.h>
 
-#include "common/fem_simulation.h"
-#include "fem/fem_test_util.hpp"
+#include "sim/fem_simulation.h"
+#include "fem_test_util.hpp"
 #include "physics/box_mesh.hpp"
 
 #include <Eigen/Eigenvalues>

@@ -2,7 +2,7 @@
 // corotational forces, patch tests for P1 and P2.
 #include <catch2/catch.hpp>
 
-#include "fem/fem_test_util.hpp"
+#include "fem_test_util.hpp"
 #include "physics/box_mesh.hpp"
 #include "physics/polar_decomposition.hpp"
 

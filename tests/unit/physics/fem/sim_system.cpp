@@ -3,7 +3,7 @@
 #include <catch2/catch.hpp>
 #include <petscbinbcsr.h>
 
-#include "common/sim_system.h"
+#include "sim/sim_system.h"
 
 #include <cmath>
 #include <cstdio>

@@ -2,8 +2,8 @@
 #include <catch2/catch.hpp>
 #include <petscmat.h>
 
-#include "common/stencil.h"
-#include "common/stream.h"
+#include "sim/stencil.h"
+#include "sim/stream.h"
 
 #include <cmath>
 #include <vector>
