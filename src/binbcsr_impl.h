@@ -66,7 +66,11 @@ PETSC_INTERN PetscErrorCode MatSetRandom_BinBCSR(Mat, PetscRandom);
 PETSC_INTERN PetscErrorCode MatRealPart_BinBCSR(Mat);
 PETSC_INTERN PetscErrorCode MatImaginaryPart_BinBCSR(Mat);
 
-/* A clear error unless v has n local entries (what: the argument's name in the message): binbcsr_api.cpp */
+/* The -mat_binbcsr_* options (one list for seq and mpi), read inside a type's MatSetFromOptions and
+   applied through the public setters: common/binbcsr_options.cpp */
+PETSC_INTERN PetscErrorCode MatBinBCSRReadOptions_Private(Mat, PetscOptionItems *);
+
+/* A clear error unless v has n local entries (what: the argument's name in the message): interface/binbcsr_api.cpp */
 PETSC_INTERN PetscErrorCode MatBinBCSRCheckVecLocalSize(Vec v, PetscInt n, const char *what);
 
 /* Registered once by PetscBinBCSRRegisterAll(). */
