@@ -1,7 +1,8 @@
-/* MATMPIBINBCSR: constructor, destructor, preallocation answers, options and the bin-width /
-   precision setters (forwarded to both parts). The layout is described in mpibinbcsr.h. */
+/* MATMPIBINBCSR as a PETSc type: ops table, composed functions, constructor, destructor, preallocation
+   answers, options and the configuration setters (forwarded to both parts). The layout is described
+   in mpibinbcsr.h. */
 #include "mpibinbcsr.h"
-#include "../common/binbcsr_compose_list.h"
+#include "../common/binbcsr_type.h"
 
 #include <algorithm>
 #include <cstring>
@@ -92,6 +93,19 @@ static PetscErrorCode MatSetUp_MPIBinBCSR(Mat mat)
   PetscFunctionReturn(0);
 }
 
+/* A setting of the matrix applied to each part that exists (the parts made later get it from the
+   matrix's own copy, MatMPIBinBCSRCreatePart). */
+template <class T>
+static PetscErrorCode MatMPIBinBCSRSetOnParts(Mat mat, PetscErrorCode (*set)(Mat, T), T v)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  if (b->A) PetscCall(set(b->A, v));
+  if (b->B) PetscCall(set(b->B, v));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MatBinBCSRSetBinWidth_MPIBinBCSR(Mat mat, PetscInt bw)
 {
   Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
@@ -99,8 +113,7 @@ static PetscErrorCode MatBinBCSRSetBinWidth_MPIBinBCSR(Mat mat, PetscInt bw)
   PetscFunctionBegin;
   PetscCheck(bw >= 1, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_OUTOFRANGE, "bin width must be >= 1, got %" PetscInt_FMT, bw);
   b->bin_width = bw;
-  if (b->A) PetscCall(MatBinBCSRSetBinWidth(b->A, bw));
-  if (b->B) PetscCall(MatBinBCSRSetBinWidth(b->B, bw));
+  PetscCall(MatMPIBinBCSRSetOnParts(mat, MatBinBCSRSetBinWidth, bw));
   PetscFunctionReturn(0);
 }
 
@@ -121,8 +134,7 @@ static PetscErrorCode MatBinBCSRSetStreams_MPIBinBCSR(Mat mat, PetscInt streams)
 
   PetscFunctionBegin;
   b->streams = streams;
-  if (b->A) PetscCall(MatBinBCSRSetStreams(b->A, streams));
-  if (b->B) PetscCall(MatBinBCSRSetStreams(b->B, streams));
+  PetscCall(MatMPIBinBCSRSetOnParts(mat, MatBinBCSRSetStreams, streams));
   PetscFunctionReturn(0);
 }
 
@@ -143,8 +155,7 @@ static PetscErrorCode MatBinBCSRSetPrecision_MPIBinBCSR(Mat mat, MatBinBCSRPreci
   PetscFunctionBegin;
   b->precision_set = PETSC_TRUE;
   b->precision     = p;
-  if (b->A) PetscCall(MatBinBCSRSetPrecision(b->A, p));
-  if (b->B) PetscCall(MatBinBCSRSetPrecision(b->B, p));
+  PetscCall(MatMPIBinBCSRSetOnParts(mat, MatBinBCSRSetPrecision, p));
   PetscFunctionReturn(0);
 }
 
@@ -383,6 +394,7 @@ static const struct _MatOps &MatOps_MPIBinBCSR(void)
 {
   static const struct _MatOps ops = [] {
     struct _MatOps o = {};
+    BinBCSRSetCommonOps(o); /* common/: the same function for seq and mpi */
     /* values in and out, assembly */
     o.setvalues      = MatSetValues_MPIBinBCSR;
     o.getvalues      = MatGetValues_MPIBinBCSR;
@@ -396,7 +408,6 @@ static const struct _MatOps &MatOps_MPIBinBCSR(void)
     o.setup          = MatSetUp_MPIBinBCSR;
     o.setfromoptions = MatSetFromOptions_MPIBinBCSR;
     o.zeroentries    = MatZeroEntries_MPIBinBCSR;
-    o.setrandom      = MatSetRandom_BinBCSR;
     /* products and the diagonal */
     o.mult                        = MatMult_MPIBinBCSR;
     o.multadd                     = MatMultAdd_MPIBinBCSR;
@@ -408,7 +419,6 @@ static const struct _MatOps &MatOps_MPIBinBCSR(void)
     o.invertvariableblockdiagonal = MatInvertVariableBlockDiagonal_MPIBinBCSR;
     o.sor                         = MatSOR_MPIBinBCSR;
     o.multdiagonalblock           = MatMultDiagonalBlock_MPIBinBCSR;
-    o.productsetfromoptions       = MatProductSetFromOptions_BinBCSR;
     /* value operations */
     o.scale           = MatScale_MPIBinBCSR;
     o.shift           = MatShift_MPIBinBCSR;
@@ -418,8 +428,6 @@ static const struct _MatOps &MatOps_MPIBinBCSR(void)
     o.zerorowscolumns = MatZeroRowsColumns_MPIBinBCSR;
     o.norm            = MatNorm_MPIBinBCSR;
     o.getinfo         = MatGetInfo_MPIBinBCSR;
-    o.realpart        = MatRealPart_BinBCSR;
-    o.imaginarypart   = MatImaginaryPart_BinBCSR;
     /* rows and columns (mpibinbcsr_rowops.cpp) */
     o.diagonalscale       = MatDiagonalScale_MPIBinBCSR;
     o.getrowmaxabs        = MatGetRowMaxAbs_MPIBinBCSR;
@@ -429,11 +437,7 @@ static const struct _MatOps &MatOps_MPIBinBCSR(void)
     o.getcolumnreductions = MatGetColumnReductions_MPIBinBCSR;
     o.missingdiagonal     = MatMissingDiagonal_MPIBinBCSR;
     o.equal               = MatEqual_MPIBinBCSR;
-    /* whole-matrix queries and new matrices */
-    o.issymmetric       = MatIsSymmetric_BinBCSR;
-    o.findzerodiagonals = MatFindZeroDiagonals_BinBCSR;
-    o.findnonzerorows   = MatFindNonzeroRows_BinBCSR;
-    o.permute           = MatPermute_BinBCSR;
+    /* new matrices, view, load */
     o.transpose         = MatTranspose_MPIBinBCSR;
     o.duplicate         = MatDuplicate_MPIBinBCSR;
     o.copy              = MatCopy_MPIBinBCSR;
@@ -441,15 +445,9 @@ static const struct _MatOps &MatOps_MPIBinBCSR(void)
     o.destroy           = MatDestroy_MPIBinBCSR;
     o.view              = MatView_MPIBinBCSR;
     o.load              = MatLoad_MPIBinBCSR;
-    /* through the AIJ shadow (common/): submatrices, finite-difference colouring, PCGAMG's graph */
-    o.increaseoverlap      = MatIncreaseOverlap_BinBCSR;
-    o.createsubmatrices    = MatCreateSubMatrices_BinBCSR;
+    /* submatrices through the AIJ shadow (common/) */
     o.createsubmatricesmpi = MatCreateSubMatricesMPI_BinBCSR;
     o.createsubmatrix      = MatCreateSubMatrix_BinBCSR;
-    o.fdcoloringcreate     = MatFDColoringCreate_BinBCSR;
-    o.fdcoloringsetup      = MatFDColoringSetUp_BinBCSR;
-    o.fdcoloringapply      = MatFDColoringApply_BinBCSR;
-    o.creategraph          = MatCreateGraph_BinBCSR;
     return o;
   }();
   return ops;

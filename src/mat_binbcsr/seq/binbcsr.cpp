@@ -4,7 +4,7 @@
    value operations: binbcsr_ops.cpp. */
 #include "binbcsr.h"
 #include "binbcsr_ops.h"
-#include "../common/binbcsr_compose_list.h"
+#include "../common/binbcsr_type.h"
 
 static PetscErrorCode MatSetOption_SeqBinBCSR(Mat A, MatOption op, PetscBool flg)
 {
@@ -101,13 +101,6 @@ static PetscErrorCode MatBinBCSRSetPrecision_SeqBinBCSR(Mat A, MatBinBCSRPrecisi
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode MatBinBCSRGetPrecision_SeqBinBCSR(Mat A, MatBinBCSRPrecision *p)
-{
-  PetscFunctionBegin;
-  *p = ((Mat_SeqBinBCSR *)A->data)->precision;
-  PetscFunctionReturn(0);
-}
-
 static PetscErrorCode MatBinBCSRSetSymmetricStorage_SeqBinBCSR(Mat A, PetscBool flg)
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
@@ -125,38 +118,21 @@ static PetscErrorCode MatBinBCSRSetSymmetricStorage_SeqBinBCSR(Mat A, PetscBool 
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode MatBinBCSRGetSymmetricStorage_SeqBinBCSR(Mat A, PetscBool *flg)
+/* Settings that are a field of Mat_SeqBinBCSR and nothing more (the COO mirror, the streams, and the
+   getters of precision and storage): written and read as they are, by one pair of functions. */
+template <class T, T Mat_SeqBinBCSR::*field>
+static PetscErrorCode MatSeqBinBCSRSetField(Mat A, T v)
 {
   PetscFunctionBegin;
-  *flg = ((Mat_SeqBinBCSR *)A->data)->sym;
+  ((Mat_SeqBinBCSR *)A->data)->*field = v;
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode MatBinBCSRSetCOOMirror_SeqBinBCSR(Mat A, PetscBool flg)
+template <class T, T Mat_SeqBinBCSR::*field>
+static PetscErrorCode MatSeqBinBCSRGetField(Mat A, T *v)
 {
   PetscFunctionBegin;
-  ((Mat_SeqBinBCSR *)A->data)->coo_mirror = flg;
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode MatBinBCSRGetCOOMirror_SeqBinBCSR(Mat A, PetscBool *flg)
-{
-  PetscFunctionBegin;
-  *flg = ((Mat_SeqBinBCSR *)A->data)->coo_mirror;
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode MatBinBCSRSetStreams_SeqBinBCSR(Mat A, PetscInt streams)
-{
-  PetscFunctionBegin;
-  ((Mat_SeqBinBCSR *)A->data)->streams = streams;
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode MatBinBCSRGetStreams_SeqBinBCSR(Mat A, PetscInt *streams)
-{
-  PetscFunctionBegin;
-  *streams = ((Mat_SeqBinBCSR *)A->data)->streams;
+  *v = ((Mat_SeqBinBCSR *)A->data)->*field;
   PetscFunctionReturn(0);
 }
 
@@ -179,6 +155,7 @@ static const struct _MatOps &MatOps_SeqBinBCSR(void)
 {
   static const struct _MatOps ops = [] {
     struct _MatOps o = {};
+    BinBCSRSetCommonOps(o); /* common/: the same function for seq and mpi */
     /* values in and out, assembly */
     o.setvalues        = MatSetValues_SeqBinBCSR;
     o.setvaluesblocked = MatSetValuesBlocked_SeqBinBCSR;
@@ -192,7 +169,6 @@ static const struct _MatOps &MatOps_SeqBinBCSR(void)
     o.setup            = MatSetUp_SeqBinBCSR;
     o.setfromoptions   = MatSetFromOptions_SeqBinBCSR;
     o.zeroentries      = MatZeroEntries_SeqBinBCSR;
-    o.setrandom        = MatSetRandom_BinBCSR;
     /* products and the diagonal */
     o.mult                        = MatMult_SeqBinBCSR;
     o.multadd                     = MatMultAdd_SeqBinBCSR;
@@ -203,7 +179,6 @@ static const struct _MatOps &MatOps_SeqBinBCSR(void)
     o.invertvariableblockdiagonal = MatInvertVariableBlockDiagonal_SeqBinBCSR;
     o.sor                         = MatSOR_SeqBinBCSR;
     o.multdiagonalblock           = MatMultDiagonalBlock_SeqBinBCSR;
-    o.productsetfromoptions       = MatProductSetFromOptions_BinBCSR;
     /* value operations (binbcsr_ops.cpp) */
     o.scale           = MatScale_SeqBinBCSR;
     o.shift           = MatShift_SeqBinBCSR;
@@ -213,8 +188,6 @@ static const struct _MatOps &MatOps_SeqBinBCSR(void)
     o.zerorowscolumns = MatZeroRowsColumns_SeqBinBCSR;
     o.norm            = MatNorm_SeqBinBCSR;
     o.getinfo         = MatGetInfo_SeqBinBCSR;
-    o.realpart        = MatRealPart_BinBCSR;
-    o.imaginarypart   = MatImaginaryPart_BinBCSR;
     /* rows and columns (binbcsr_rowops.cpp) */
     o.diagonalscale       = MatDiagonalScale_SeqBinBCSR;
     o.getrowmaxabs        = MatGetRowMaxAbs_SeqBinBCSR;
@@ -224,11 +197,7 @@ static const struct _MatOps &MatOps_SeqBinBCSR(void)
     o.getcolumnreductions = MatGetColumnReductions_SeqBinBCSR;
     o.missingdiagonal     = MatMissingDiagonal_SeqBinBCSR;
     o.equal               = MatEqual_SeqBinBCSR;
-    /* whole-matrix queries and new matrices (common/) */
-    o.issymmetric       = MatIsSymmetric_BinBCSR;
-    o.findzerodiagonals = MatFindZeroDiagonals_BinBCSR;
-    o.findnonzerorows   = MatFindNonzeroRows_BinBCSR;
-    o.permute           = MatPermute_BinBCSR;
+    /* new matrices, view, load */
     o.transpose         = MatTranspose_SeqBinBCSR;
     o.duplicate         = MatDuplicate_SeqBinBCSR;
     o.copy              = MatCopy_SeqBinBCSR;
@@ -236,15 +205,8 @@ static const struct _MatOps &MatOps_SeqBinBCSR(void)
     o.destroy           = MatDestroy_SeqBinBCSR;
     o.view              = MatView_SeqBinBCSR;
     o.load              = MatLoad_SeqBinBCSR;
-    /* through the AIJ shadow (common/): submatrices (MatCreateSubMatrix uses createsubmatrices on one
-       rank), finite-difference colouring, PCGAMG's graph */
-    o.increaseoverlap               = MatIncreaseOverlap_BinBCSR;
-    o.createsubmatrices             = MatCreateSubMatrices_BinBCSR;
+    /* through the AIJ shadow (common/; MatCreateSubMatrix uses createsubmatrices on one rank) */
     o.creatempimatconcatenateseqmat = MatCreateMPIMatConcatenateSeqMat_BinBCSR;
-    o.fdcoloringcreate              = MatFDColoringCreate_BinBCSR;
-    o.fdcoloringsetup               = MatFDColoringSetUp_BinBCSR;
-    o.fdcoloringapply               = MatFDColoringApply_BinBCSR;
-    o.creategraph                   = MatCreateGraph_BinBCSR;
     return o;
   }();
   return ops;
@@ -255,13 +217,13 @@ static const BinBCSRComposed composed[] = {
   BINBCSR_COMPOSED("MatBinBCSRSetBinWidth_C", MatBinBCSRSetBinWidth_SeqBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRGetBinWidth_C", MatBinBCSRGetBinWidth_SeqBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRSetPrecision_C", MatBinBCSRSetPrecision_SeqBinBCSR),
-  BINBCSR_COMPOSED("MatBinBCSRGetPrecision_C", MatBinBCSRGetPrecision_SeqBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRGetPrecision_C", (&MatSeqBinBCSRGetField<MatBinBCSRPrecision, &Mat_SeqBinBCSR::precision>)),
   BINBCSR_COMPOSED("MatBinBCSRSetSymmetricStorage_C", MatBinBCSRSetSymmetricStorage_SeqBinBCSR),
-  BINBCSR_COMPOSED("MatBinBCSRGetSymmetricStorage_C", MatBinBCSRGetSymmetricStorage_SeqBinBCSR),
-  BINBCSR_COMPOSED("MatBinBCSRSetCOOMirror_C", MatBinBCSRSetCOOMirror_SeqBinBCSR),
-  BINBCSR_COMPOSED("MatBinBCSRGetCOOMirror_C", MatBinBCSRGetCOOMirror_SeqBinBCSR),
-  BINBCSR_COMPOSED("MatBinBCSRSetStreams_C", MatBinBCSRSetStreams_SeqBinBCSR),
-  BINBCSR_COMPOSED("MatBinBCSRGetStreams_C", MatBinBCSRGetStreams_SeqBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRGetSymmetricStorage_C", (&MatSeqBinBCSRGetField<PetscBool, &Mat_SeqBinBCSR::sym>)),
+  BINBCSR_COMPOSED("MatBinBCSRSetCOOMirror_C", (&MatSeqBinBCSRSetField<PetscBool, &Mat_SeqBinBCSR::coo_mirror>)),
+  BINBCSR_COMPOSED("MatBinBCSRGetCOOMirror_C", (&MatSeqBinBCSRGetField<PetscBool, &Mat_SeqBinBCSR::coo_mirror>)),
+  BINBCSR_COMPOSED("MatBinBCSRSetStreams_C", (&MatSeqBinBCSRSetField<PetscInt, &Mat_SeqBinBCSR::streams>)),
+  BINBCSR_COMPOSED("MatBinBCSRGetStreams_C", (&MatSeqBinBCSRGetField<PetscInt, &Mat_SeqBinBCSR::streams>)),
   BINBCSR_COMPOSED("MatSeqAIJSetPreallocation_C", MatSeqAIJSetPreallocation_SeqBinBCSR),
   BINBCSR_COMPOSED("MatSeqBAIJSetPreallocation_C", MatSeqBAIJSetPreallocation_SeqBinBCSR),
   BINBCSR_COMPOSED("MatSetPreallocationCOO_C", MatSetPreallocationCOO_SeqBinBCSR),
