@@ -39,7 +39,7 @@
 
    (row 1's slot k=1 and row 3's slots k=1,2 are padding: zero values, repeated last column; the
    phantom lane of bin 2 has no column, its padding reads column 0). The padding overhead is
-   nslots / nz - 1 (here 12/8 - 1 = 50%; FEM matrices give a few %). tests/unit/mat_core/layout.cpp
+   nslots / nz - 1 (here 12/8 - 1 = 50%; FEM matrices give a few %). tests/unit/mat_binbcsr/mat_core/layout.cpp
    checks this example.
 */
 #ifndef BINBCSR_SEQ_H

@@ -194,7 +194,7 @@ TEST_CASE("MatSOR errors: apply lower, mixed apply upper, a singular diagonal bl
   Mat     A = build_sym(p, 4, MAT_BINBCSR_PRECISION_DOUBLE, true);
   Vec     b = make_vec(p.m, 1), x;
   REQUIRE(VecDuplicate(b, &x) == 0);
-  // (Eisenstat and SOR_APPLY_UPPER work: tests/unit/pc/eisenstat_test.cpp)
+  // (Eisenstat and SOR_APPLY_UPPER work: tests/unit/mat_binbcsr/pc/eisenstat_test.cpp)
   CHECK(MatSOR(A, b, 1.0, SOR_APPLY_LOWER, 0.0, 1, 1, x) == PETSC_ERR_SUP);
   CHECK(MatSOR(A, b, 1.0, (MatSORType)(SOR_APPLY_UPPER | SOR_FORWARD_SWEEP), 0.0, 1, 1, x) == PETSC_ERR_ARG_WRONG);
   CHECK(MatSOR(A, b, 1.0, SOR_ZERO_INITIAL_GUESS, 0.0, 1, 1, x) == PETSC_ERR_ARG_WRONG);

@@ -1,4 +1,4 @@
-// Shared by the PC tests (PCEISENSTAT, PCGAMG on binbcsr): the FEM problem of tests/unit/mpi as a bs 3
+// Shared by the PC tests (PCEISENSTAT, PCGAMG on binbcsr): the FEM problem of tests/unit/mat_binbcsr/mpi as a bs 3
 // (3 unknowns per node) or bs 1 (one per node) matrix, assembled through COO on any communicator size,
 // refilled in place, and the storage variants of binbcsr. Every function is collective.
 #pragma once

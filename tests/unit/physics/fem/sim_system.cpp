@@ -1,4 +1,4 @@
-// BlockSystem (examples/common/sim_system): COO blocks with duplicates, refill in place, the same
+// BlockSystem (src/sim/sim_system): COO blocks with duplicates, refill in place, the same
 // solution for every Mat type, clear errors for bad input and for GPU types this PETSc lacks.
 #include <catch2/catch.hpp>
 #include <petscbinbcsr.h>
