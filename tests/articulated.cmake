@@ -98,7 +98,7 @@ add_test(NAME articulated_vtk_dump
          COMMAND sh -c "rm -rf art_out && mkdir art_out && ${ART} -options_file ${OPTS}/loop.opts -steps 4 -vtk art_out/loop -vtk_every 2 -dump_matrix art_out/A.bin -progress_every 10 && test -s art_out/loop_00004.vtu && grep -q 'NumberOfCells=\"3\"' art_out/loop_00004.vtu && grep -q loop_00002.vtu art_out/loop.pvd && test -s art_out/A.bin")
 set_tests_properties(articulated_vtk_dump PROPERTIES LABELS "articulated" TIMEOUT 60)
 
-# When the physics or the solver breaks the run says so (examples/common/run_guard.h): a link mass of
+# When the physics or the solver breaks the run says so (src/sim/run_guard.h): a link mass of
 # 1e300 or 1e-300 makes the state nonfinite in the first step (energy -nan), which ends the run with a
 # message and a non-zero exit status (exit code 3, or 2 when a solve fails first); serial and on 2 ranks.
 foreach(mass 1e300 1e-300)

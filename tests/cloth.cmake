@@ -37,7 +37,7 @@ add_test(NAME cloth_vtk_dump
          COMMAND sh -c "rm -rf cloth_out && mkdir cloth_out && ${CLOTH} -cloth_n 6 -steps 2 -sphere -vtk cloth_out/c -dump_matrix cloth_out/A.bin -progress_every 10 && grep -q 'NumberOfCells=\"50\"' cloth_out/c_00002.vtu && grep -q c_00001.vtu cloth_out/c.pvd && test -s cloth_out/A.bin")
 set_tests_properties(cloth_vtk_dump PROPERTIES LABELS "cloth" TIMEOUT 60)
 
-# When the physics or the solver breaks the run says so (examples/common/run_guard.h). Springs of
+# When the physics or the solver breaks the run says so (src/sim/run_guard.h). Springs of
 # 1e12 N/m (energy 2.9e8 J from 0 in 5 steps) and a time step of 1 s (a spring at 1108 x its rest
 # length) are `unstable` with a warning; -on_unstable stop ends the run with exit code 4. With GAMG
 # the 160 x 160 cloth's CG fails from step 3 on: the run stops there with exit code 2.

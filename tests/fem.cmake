@@ -47,7 +47,7 @@ fem_test(fem_mpi2_gamg_rigid_body_modes 0 "ranks=2 .*cg_its=(1[0-9]|2[0-5])[. ].
 set_tests_properties(fem_mpi2_gamg_rigid_body_modes PROPERTIES LABELS "fem;mpi")
 fem_test(fem_gamg_translations_only 0 "cg_its=(3[5-9]|4[0-9]|5[0-5])[. ].*status=ok" ${FEM} ${FEM_BEAM_GAMG} -fem_rigid_body_modes 0)
 
-# When the physics or the solver breaks the run says so (examples/common/run_guard.h). A body that
+# When the physics or the solver breaks the run says so (src/sim/run_guard.h). A body that
 # gravity crushes through itself (min volume ratio -1.8e10 by step 5) is `unstable`, with a warning,
 # and -on_unstable stop ends the run there with exit code 4; serial and on 2 ranks.
 set(FEM_CRUSHED -mesh_box 1,0.1,0.1,6,2,2 -fem_order 1 -fix xmin -gravity 0,0,-1e6 -dt 0.1 -steps 5 -fem_quiet)

@@ -1,7 +1,7 @@
 /* MATMPIBINBCSR conversion to and from other types, parallel MatLoad, MatView (per-rank info of
    the parts; other formats through an MPIAIJ copy), MatDuplicate and MatCopy. */
 #include "mpibinbcsr.h"
-#include "../binbcsr_load.h"
+#include "../common/binbcsr_load.h"
 
 #include <algorithm>
 

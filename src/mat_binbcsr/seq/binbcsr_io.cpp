@@ -7,7 +7,7 @@
    checks are binbcsr_load.cpp's, shared with the parallel loader.
 */
 #include "binbcsr_ops.h"
-#include "../binbcsr_load.h"
+#include "../common/binbcsr_load.h"
 
 #include <algorithm>
 #include <vector>
