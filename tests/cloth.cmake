@@ -8,6 +8,12 @@ set(OPTS ${CMAKE_SOURCE_DIR}/options)
 add_test(NAME cloth_drape_sphere
          COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && max_stretch<1.3 && contacts>0 && unknowns==1200"
                  -- ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 20 -steps 60 -progress_every 1000)
+# The scene as options/cloth.opts sets it (strain limit 5%), at a resolution a test affords: every stretch
+# spring stays within a few percent of its rest length over 30 steps that hang it from its corners and
+# drop it on the sphere (the thesis's setting, options/cloth_thesis.opts, stretches the corners far).
+add_test(NAME cloth_scene_stretch_bounded
+         COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && max_stretch<1.08 && contacts>0 && diverged_solves==0"
+                 -- ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 40 -steps 30 -progress_every 1000)
 add_test(NAME cloth_stiff_dt30
          COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && max_stretch<1.1"
                  -- ${CLOTH} -cloth_n 10 -cloth_k_stretch 1e6 -cloth_k_shear 1e5 -cloth_k_bend 1e4 -dt 0.0333333 -steps 30
@@ -26,7 +32,7 @@ add_test(NAME cloth_bad_pins COMMAND ${CLOTH} -cloth_n 4 -cloth_pins elbows)
 set_tests_properties(cloth_bad_pins PROPERTIES PASS_REGULAR_EXPRESSION "unknown -cloth_pins elbows")
 add_test(NAME cloth_bad_stiffness COMMAND ${CLOTH} -cloth_n 4 -cloth_k_bend -5)
 set_tests_properties(cloth_bad_stiffness PROPERTIES PASS_REGULAR_EXPRESSION "non-negative")
-set_tests_properties(cloth_drape_sphere cloth_stiff_dt30 cloth_same_result_mat_types cloth_bad_dt cloth_bad_n cloth_bad_pins
+set_tests_properties(cloth_drape_sphere cloth_scene_stretch_bounded cloth_stiff_dt30 cloth_same_result_mat_types cloth_bad_dt cloth_bad_n cloth_bad_pins
                      cloth_bad_stiffness PROPERTIES LABELS "cloth" TIMEOUT 60)
 
 add_test(NAME cloth_mpi_np2
