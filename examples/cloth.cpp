@@ -8,8 +8,10 @@
 // -sphere_radius, -sphere_centre x,y,z), -cloth_strain_limit S (stretch springs kept within (1 + S) x rest length,
 // Provot; 0: off) and -cloth_strain_limit_sweeps N. Time: -dt, -steps, -cloth_exact_jacobian (drop Choi-Ko). Output:
 // a progress line every -progress_every steps, -vtk PREFIX (triangle surface per -vtk_every steps),
-// -dump_matrix FILE (first step's matrix), and a final `summary key=value ...` line; -cloth_timer cpu times
+// -dump_matrix FILE (first step's matrix), -write_positions / -reference_positions FILE (rms and largest
+// position difference against another run, common/position_file.h), and a final `summary key=value ...` line; -cloth_timer cpu times
 // in process CPU time instead of wall time (a shared machine).
+#include "common/position_file.h"
 #include "common/sim_driver.h"
 #include "physics/cloth_step.hpp"
 #include "physics/vtk_writer.hpp"
@@ -188,6 +190,11 @@ int main(int argc, char **argv)
   s.add("energy_final", physics::cloth_energy(cloth));
   s.add("kinetic_final", ke);
   s.add("nan", nan_steps);
+  {
+    std::vector<double> xyz;
+    for (const Eigen::Vector3d &x : cloth.position) xyz.insert(xyz.end(), {x[0], x[1], x[2]});
+    PetscCall(DriverComparePositions(comm, xyz, s));
+  }
   PetscCall(PrintSummary(comm, s));
 
   PetscCall(ReplicatedSolverDestroy(&rs));

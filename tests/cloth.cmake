@@ -43,6 +43,11 @@ add_test(NAME cloth_mpi_np2
                  "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg -mat_binbcsr_coo_mirror")
 set_tests_properties(cloth_mpi_np2 PROPERTIES LABELS "cloth;mpi" TIMEOUT 60)
 
+# The error measure of bench/tradeoff.sh: a run against its own positions differs by exactly 0, against a
+# loosely converged run by more; a reference of another size is an error.
+add_test(NAME cloth_reference_positions
+         COMMAND sh -c "${CLOTH} -cloth_n 6 -steps 3 -progress_every 10 -ksp_rtol 1e-10 -write_positions cloth_ref_positions.txt >/dev/null && ${SUMMARY_CHECK} 'rms_position_diff==0 && max_position_diff==0' -- ${CLOTH} -cloth_n 6 -steps 3 -progress_every 10 -ksp_rtol 1e-10 -reference_positions cloth_ref_positions.txt && ${SUMMARY_CHECK} 'rms_position_diff>1e-5' -- ${CLOTH} -cloth_n 6 -steps 3 -progress_every 10 -ksp_rtol 1e-2 -reference_positions cloth_ref_positions.txt && ${CLOTH} -cloth_n 7 -steps 1 -reference_positions cloth_ref_positions.txt 2>&1 | grep -q 'this run has 49 positions'")
+set_tests_properties(cloth_reference_positions PROPERTIES LABELS "cloth" TIMEOUT 60)
 add_test(NAME cloth_vtk_dump
          COMMAND sh -c "rm -rf cloth_out && mkdir cloth_out && ${CLOTH} -cloth_n 6 -steps 2 -sphere -vtk cloth_out/c -dump_matrix cloth_out/A.bin -progress_every 10 && grep -q 'NumberOfCells=\"50\"' cloth_out/c_00002.vtu && grep -q c_00001.vtu cloth_out/c.pvd && test -s cloth_out/A.bin")
 set_tests_properties(cloth_vtk_dump PROPERTIES LABELS "cloth" TIMEOUT 60)
