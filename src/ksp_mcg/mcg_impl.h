@@ -63,5 +63,8 @@ typedef struct {
 
 PETSC_INTERN PetscErrorCode KSPSolve_MCG(KSP);
 PETSC_INTERN PetscErrorCode MCGUpdateBlockDiagonal(KSP);
+/* Whether KSPMCG's own preconditioner data (built from the Pmat with id/state built_id/built_state; built:
+   it exists) must be rebuilt: the Pmat changed and the PC is not told to reuse its preconditioner. */
+PETSC_INTERN PetscErrorCode MCGPreconditionerStale(KSP, PetscBool built, PetscObjectId built_id, PetscObjectState built_state, Mat *Pmat, PetscObjectId *id, PetscObjectState *state, PetscBool *stale);
 
 #endif

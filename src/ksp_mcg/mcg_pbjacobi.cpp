@@ -37,23 +37,19 @@ static PetscErrorCode MCGFirstSingularBlock(Mat P, PetscInt *row)
 PETSC_INTERN PetscErrorCode MCGUpdateBlockDiagonal(KSP ksp)
 {
   KSP_MCG           *mcg = (KSP_MCG *)ksp->data;
-  PC                 pc  = ksp->pc;
   Mat                Pmat;
   PetscObjectId      id;
   PetscObjectState   state;
-  PetscBool          reuse;
+  PetscBool          stale;
   PetscInt           n, nb, bad, bad_all;
   MatFactorError     err;
   const PetscScalar *inv;
 
   PetscFunctionBegin;
-  PetscCall(PCGetOperators(pc, nullptr, &Pmat));
-  PetscCall(PetscObjectGetId((PetscObject)Pmat, &id));
-  PetscCall(PetscObjectStateGet((PetscObject)Pmat, &state));
-  PetscCall(PCGetReusePreconditioner(pc, &reuse));
+  PetscCall(MCGPreconditionerStale(ksp, (PetscBool)!!mcg->binv, mcg->binv_id, mcg->binv_state, &Pmat, &id, &state, &stale));
   PetscCall(MatGetLocalSize(Pmat, &n, nullptr));
   nb = n / 3;
-  if (mcg->binv && mcg->binv_n == nb && (reuse || (id == mcg->binv_id && state == mcg->binv_state))) PetscFunctionReturn(0);
+  if (!stale && mcg->binv_n == nb) PetscFunctionReturn(0);
   if (mcg->binv_n != nb) {
     PetscCall(PetscFree(mcg->binv));
     mcg->binv_n = 0;

@@ -70,6 +70,19 @@ static PetscErrorCode MCGChoosePath(KSP ksp, Mat Amat)
    zero), absolute value if -pc_jacobi_abs, and zeros replaced by 1 when -pc_jacobi_fixdiagonal (the
    default) unless the matrix is known to be SPD. Rebuilt when the preconditioning matrix or its state
    changes, except when the PC is told to reuse its preconditioner. */
+PetscErrorCode MCGPreconditionerStale(KSP ksp, PetscBool built, PetscObjectId built_id, PetscObjectState built_state, Mat *Pmat, PetscObjectId *id, PetscObjectState *state, PetscBool *stale)
+{
+  PetscBool reuse;
+
+  PetscFunctionBegin;
+  PetscCall(PCGetOperators(ksp->pc, nullptr, Pmat));
+  PetscCall(PetscObjectGetId((PetscObject)*Pmat, id));
+  PetscCall(PetscObjectStateGet((PetscObject)*Pmat, state));
+  PetscCall(PCGetReusePreconditioner(ksp->pc, &reuse));
+  *stale = (PetscBool)!(built && (reuse || (*id == built_id && *state == built_state)));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MCGUpdateDiagonal(KSP ksp)
 {
   KSP_MCG         *mcg = (KSP_MCG *)ksp->data;
@@ -77,16 +90,13 @@ static PetscErrorCode MCGUpdateDiagonal(KSP ksp)
   Mat              Pmat;
   PetscObjectId    id;
   PetscObjectState state;
-  PetscBool        reuse, useabs, fixdiag, isset = PETSC_FALSE, isspd = PETSC_FALSE; /* MatIsSPDKnown leaves isspd unset when unknown */
+  PetscBool        stale, useabs, fixdiag, isset = PETSC_FALSE, isspd = PETSC_FALSE; /* MatIsSPDKnown leaves isspd unset when unknown */
   PetscInt         n, zeros = 0;
   PetscScalar     *d;
 
   PetscFunctionBegin;
-  PetscCall(PCGetOperators(pc, nullptr, &Pmat));
-  PetscCall(PetscObjectGetId((PetscObject)Pmat, &id));
-  PetscCall(PetscObjectStateGet((PetscObject)Pmat, &state));
-  PetscCall(PCGetReusePreconditioner(pc, &reuse));
-  if (mcg->dinv && (reuse || (id == mcg->dinv_id && state == mcg->dinv_state))) PetscFunctionReturn(0);
+  PetscCall(MCGPreconditionerStale(ksp, (PetscBool)!!mcg->dinv, mcg->dinv_id, mcg->dinv_state, &Pmat, &id, &state, &stale));
+  if (!stale) PetscFunctionReturn(0);
   if (mcg->dinv) {
     PetscInt nd, nm;
     PetscCall(VecGetLocalSize(mcg->dinv, &nd));
