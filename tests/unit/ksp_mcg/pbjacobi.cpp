@@ -1,7 +1,7 @@
 // KSPMCG's fused point-block Jacobi (-pc_type pbjacobi, 3x3 blocks): the same iterates as KSPCG with
 // PCPBJACOBI on every storage binbcsr offers, rebuilt when the values change, a singular block named.
 #include <catch2/catch.hpp>
-#include "mcg_test_problems.h"
+#include "mcg_test_problems.hpp"
 #include <cstring>
 
 using namespace mcg_test;
