@@ -5,11 +5,14 @@
 //
 // Scene: -cloth_n, -cloth_size (m), -cloth_mass (kg), -cloth_k_stretch, -cloth_k_shear, -cloth_k_bend (N/m),
 // -cloth_damping (N s/m), -cloth_pins corners|four|top|none, -cloth_hanging, -sphere (drape over a sphere;
-// -sphere_radius, -sphere_centre x,y,z). Time: -dt, -steps, -cloth_exact_jacobian (drop Choi-Ko). Output:
+// -sphere_radius, -sphere_centre x,y,z), -cloth_strain_limit S (stretch springs kept within (1 + S) x rest length,
+// Provot; 0: off) and -cloth_strain_limit_sweeps N. Time: -dt, -steps, -cloth_exact_jacobian (drop Choi-Ko). Output:
 // a progress line every -progress_every steps, -vtk PREFIX (triangle surface per -vtk_every steps),
-// -dump_matrix FILE (first step's matrix), and a final `summary key=value ...` line; -cloth_timer cpu times
+// -dump_matrix FILE (first step's matrix), -write_positions / -reference_positions FILE (rms and largest
+// position difference against another run, sim/position_file.h), and a final `summary key=value ...` line; -cloth_timer cpu times
 // in process CPU time instead of wall time (a shared machine).
 #include "sim/run_guard.h"
+#include "sim/position_file.h"
 #include "sim/sim_driver.h"
 #include "physics/cloth_step.hpp"
 #include "physics/vtk_writer.hpp"
@@ -72,6 +75,12 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetRealArray(nullptr, nullptr, "-sphere_centre", centre, &ncentre, &set));
   PetscCheck(!set || ncentre == 3, comm, PETSC_ERR_ARG_SIZ, "-sphere_centre needs 3 numbers, got %" PetscInt_FMT, ncentre);
   PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-cloth_exact_jacobian", &exact, nullptr));
+  {
+    PetscInt sweeps = params.strain_limit.max_sweeps;
+    PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-cloth_strain_limit", &params.strain_limit.max_strain, nullptr));
+    PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-cloth_strain_limit_sweeps", &sweeps, nullptr));
+    params.strain_limit.max_sweeps = (int)sweeps;
+  }
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-dt", &params.dt, nullptr));
   {
     const char *timers[] = {"wall", "cpu"};
@@ -89,7 +98,7 @@ int main(int argc, char **argv)
   else if (!std::strcmp(pins, "none")) opt.pins = physics::ClothPins::None;
   else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "unknown -cloth_pins %s (corners, four, top, none)", pins);
   const std::string bad = physics::validate_params(params);
-  PetscCheck(bad.empty(), comm, PETSC_ERR_ARG_OUTOFRANGE, "%s (-dt %g)", bad.c_str(), (double)params.dt);
+  PetscCheck(bad.empty(), comm, PETSC_ERR_ARG_OUTOFRANGE, "%s (-dt %g, -cloth_strain_limit %g, -cloth_strain_limit_sweeps %d)", bad.c_str(), (double)params.dt, (double)params.strain_limit.max_strain, params.strain_limit.max_sweeps);
   PetscCheck(!sphere || radius > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-sphere_radius must be positive, got %g", (double)radius);
 
   physics::Cloth cloth;
@@ -206,6 +215,11 @@ int main(int argc, char **argv)
   s.add("energy_final", physics::cloth_energy(cloth));
   s.add("kinetic_final", ke);
   s.add("nan", nan_steps);
+  {
+    std::vector<double> xyz;
+    for (const Eigen::Vector3d &x : cloth.position) xyz.insert(xyz.end(), {x[0], x[1], x[2]});
+    PetscCall(DriverComparePositions(comm, xyz, s));
+  }
   RunGuardAddSummary(s, guard);
   PetscCall(PrintSummary(comm, s));
 
