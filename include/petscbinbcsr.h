@@ -74,6 +74,22 @@ PETSC_EXTERN PetscErrorCode MatBinBCSRSetFromOptions(Mat);
    The caller reduces the dot across ranks, typically together with other dots. */
 PETSC_EXTERN PetscErrorCode MatMultDotLocal(Mat, Vec, Vec, PetscScalar *);
 
+/* Device copy of a MATSEQBINBCSR (the device library, docs/gpu.md): NONE (default), REFERENCE (the
+   host executor the GPU one is tested against), CUDA (an NVIDIA GPU; an error where this build has no
+   cuda executor or the machine no GPU, never a silent fallback). After each final assembly or
+   MatSetValuesCOO the device copy is refreshed (COO: the COO values are uploaded and gathered on the
+   device); MatMult on host vectors copies x in and y out (slow: event BinBCSRDevMult); KSPMCG with
+   PCJACOBI or PCNONE runs the whole solve on the device. One process only: MATMPIBINBCSR refuses a
+   device. Option -mat_binbcsr_device none|reference|cuda. A no-op on matrices of other types. */
+typedef enum {
+  MAT_BINBCSR_DEVICE_NONE      = 0,
+  MAT_BINBCSR_DEVICE_REFERENCE = 1,
+  MAT_BINBCSR_DEVICE_CUDA      = 2
+} MatBinBCSRDevice;
+PETSC_EXTERN const char *const MatBinBCSRDevices[];
+PETSC_EXTERN PetscErrorCode MatBinBCSRSetDevice(Mat, MatBinBCSRDevice);
+PETSC_EXTERN PetscErrorCode MatBinBCSRGetDevice(Mat, MatBinBCSRDevice *);
+
 /* KSPMCG: run exactly n iterations per solve, computing no norm (n = 0: off, use the tolerances).
    Option -ksp_mcg_fixed_iterations n. */
 PETSC_EXTERN PetscErrorCode KSPMCGSetFixedIterations(KSP, PetscInt);

@@ -75,5 +75,8 @@ PETSC_EXTERN PetscLogEvent MAT_BinBCSR_SetValuesCOO; /* slot refill by gather */
 PETSC_EXTERN PetscLogEvent MAT_BinBCSR_MultDot;      /* y = A x fused with x.y */
 PETSC_EXTERN PetscLogEvent KSP_MCG_FusedUpdate;      /* x, r, z (Jacobi), p, s updates + local dots */
 PETSC_EXTERN PetscLogEvent KSP_MCG_Reduction;        /* the one global reduction per iteration */
+PETSC_EXTERN PetscLogEvent MAT_BinBCSR_DeviceMult;   /* MatMult of a device matrix on host vectors (copies in and out) */
+PETSC_EXTERN PetscLogEvent MAT_BinBCSR_DeviceUpload; /* values to the device: whole array, or COO values + gather */
+PETSC_EXTERN PetscLogEvent KSP_MCG_DeviceSolve;      /* a KSPMCG solve run on the device */
 
 #endif

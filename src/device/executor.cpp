@@ -25,7 +25,7 @@ std::unique_ptr<Executor> make_executor(const std::string &name, std::string *wh
 #if defined(BINBCSR_DEVICE_HAVE_CUDA)
     return make_cuda_executor(why);
 #else
-    *why = "the cuda executor is not built into this library (no CUDA toolkit at configure time, or -DBINBCSR_DEVICE_CUDA=OFF)";
+    *why = "the cuda executor is not built into this library (the PETSc plug-in links the reference executor only; scripts/gpu_check builds the cuda one, docs/gpu.md)";
     return nullptr;
 #endif
   }

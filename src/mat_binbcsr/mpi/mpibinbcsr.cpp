@@ -240,6 +240,11 @@ static PetscErrorCode MatSetFromOptions_MPIBinBCSR(Mat mat, PetscOptionItems *Pe
   if (flg) PetscCall(MatBinBCSRSetSymmetricStorage_MPIBinBCSR(mat, sym));
   PetscCall(PetscOptionsBool("-mat_binbcsr_coo_mirror", "COO entries of off-diagonal blocks also fill the transposed place (give one triangle of a symmetric matrix)", "MatBinBCSRSetCOOMirror", b->coo_mirror, &b->coo_mirror, nullptr));
   {
+    MatBinBCSRDevice d = MAT_BINBCSR_DEVICE_NONE;
+    PetscCall(PetscOptionsEnum("-mat_binbcsr_device", "Device copy (one process only)", "MatBinBCSRSetDevice", MatBinBCSRDevices, (PetscEnum)d, (PetscEnum *)&d, &flg));
+    if (flg) PetscCall(MatBinBCSRSetDevice(mat, d)); /* refuses any device: docs/gpu.md */
+  }
+  {
     PetscInt streams = b->streams ? b->streams : BINBCSR_DEFAULT_STREAMS;
     PetscCall(PetscOptionsInt("-mat_binbcsr_streams", "Runs of bins the product sweeps side by side (1, 2, 4, 8)", "MatBinBCSRSetStreams", streams, &streams, &flg));
     if (flg) PetscCall(MatBinBCSRSetStreams(mat, streams));
