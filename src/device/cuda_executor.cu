@@ -9,7 +9,7 @@
    CUDA graph, replayed (a fixed-iteration solve: one graph of all its iterations, one copy at the end). */
 #include "mcg_driver.h"
 #include "reference.h"
-#include "mat_binbcsr/cuda/binbcsr_cuda.cuh"
+#include "mat_binbcsr/kernels/cuda/binbcsr_cuda.cuh"
 
 #include <cuda_runtime.h>
 #include <map>

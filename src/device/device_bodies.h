@@ -7,7 +7,7 @@
 #ifndef BINBCSR_DEVICE_BODIES_H
 #define BINBCSR_DEVICE_BODIES_H
 
-#include "mat_binbcsr/binbcsr_kernels.h"
+#include "mat_binbcsr/kernels/binbcsr_kernels.h"
 #include "ksp_mcg/mcg_kernels.h"
 #include <math.h>
 

@@ -1,5 +1,5 @@
 #include "host_bins.h"
-#include "mat_binbcsr/binbcsr_layout.h"
+#include "mat_binbcsr/kernels/binbcsr_layout.h"
 
 #include <algorithm>
 #include <stdexcept>

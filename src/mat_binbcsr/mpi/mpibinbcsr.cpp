@@ -249,6 +249,7 @@ static PetscErrorCode MatSetFromOptions_MPIBinBCSR(Mat mat, PetscOptionItems *Pe
     PetscCall(PetscOptionsInt("-mat_binbcsr_streams", "Runs of bins the product sweeps side by side (1, 2, 4, 8)", "MatBinBCSRSetStreams", streams, &streams, &flg));
     if (flg) PetscCall(MatBinBCSRSetStreams(mat, streams));
   }
+  PetscCall(MatBinBCSRKernelFromOptions_Private(PetscOptionsObject, mat, b->kernel));
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }
@@ -311,6 +312,7 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRCreatePart(Mat mat, PetscInt m, PetscIn
   if (b->bin_width) PetscCall(MatBinBCSRSetBinWidth(*part, b->bin_width));
   if (b->precision_set) PetscCall(MatBinBCSRSetPrecision(*part, b->precision));
   if (b->streams) PetscCall(MatBinBCSRSetStreams(*part, b->streams));
+  if (b->kernel) PetscCall(MatBinBCSRSetKernel(*part, b->kernel));
   if (b->sym && part == &b->A) PetscCall(MatBinBCSRSetSymmetricStorage(*part, PETSC_TRUE)); /* B stays full */
   for (const auto &[op, flg] : b->part_options) {
     const bool wholematrix = op == MAT_SYMMETRIC || op == MAT_SPD || op == MAT_HERMITIAN || op == MAT_STRUCTURALLY_SYMMETRIC || op == MAT_SYMMETRY_ETERNAL || op == MAT_STRUCTURAL_SYMMETRY_ETERNAL || op == MAT_SPD_ETERNAL;

@@ -544,6 +544,7 @@ static PetscErrorCode MatSetFromOptions_SeqBinBCSR(Mat A, PetscOptionItems *Pets
   PetscCall(PetscOptionsBool("-mat_binbcsr_coo_mirror", "COO entries of off-diagonal blocks also fill the transposed place (give one triangle of a symmetric matrix)", "MatBinBCSRSetCOOMirror", a->coo_mirror, &a->coo_mirror, nullptr));
   PetscCall(PetscOptionsInt("-mat_binbcsr_streams", "Runs of bins the product sweeps side by side (1, 2, 4, 8)", "MatBinBCSRSetStreams", streams, &streams, &set));
   if (set) PetscCall(MatBinBCSRSetStreams(A, streams));
+  PetscCall(MatBinBCSRKernelFromOptions_Private(PetscOptionsObject, A, a->kernel));
   {
     MatBinBCSRDevice d;
     PetscCall(MatBinBCSRGetDevice(A, &d));
