@@ -589,7 +589,7 @@ int main(int argc, char **argv)
   CKB(cublasCreate(&bh));
   std::vector<BlockMatrix> mats;
   for (int s : sizes) mats.push_back(stencil_matrix(s));
-  for (const std::string &f : files) mats.push_back(read_petsc_binary(f, bs));
+  for (const std::string &f : files) mats.push_back(read_matrix(f, bs));
   for (const BlockMatrix &A : mats) {
     const ScalarCSR S = scalar_csr(A);
     spmv_table(A, S, sh, bw_triad);

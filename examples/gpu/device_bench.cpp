@@ -134,6 +134,6 @@ int main(int argc, char **argv)
   }
   if (sizes.empty() && files.empty()) sizes = {16};
   for (int s : sizes) bench(*E, gpu_bench::stencil_matrix(s), batch_s);
-  for (const std::string &f : files) bench(*E, gpu_bench::read_petsc_binary(f, 3), batch_s);
+  for (const std::string &f : files) bench(*E, gpu_bench::read_matrix(f, 3), batch_s);
   return 0;
 }

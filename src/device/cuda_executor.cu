@@ -173,23 +173,24 @@ __global__ void __launch_bounds__(T) k_residual(long n, int zero, const double *
   }
 }
 
-/* u = M^-1 r and the partials of r.u, r.r, u.u (stride 3). */
+/* The block's sums of r.u, r.r, u.u, x.x as its partials (stride 4, the order gather_dots reads). */
+__device__ void store_block_sums(double ru, double rr, double uu, double xx, double *partials)
+{
+  const double v[4] = {ru, rr, uu, xx};
+  for (int c = 0; c < 4; c++) {
+    const double t = binbcsr::cuda::block_sum(v[c]);
+    if (threadIdx.x == 0) partials[blockIdx.x * 4 + c] = t;
+    __syncthreads(); /* block_sum's shared words are reused */
+  }
+}
+
+/* u = M^-1 r and the partials of r.u, r.r, u.u (x.x: 0). */
 template <bool J>
 __global__ void __launch_bounds__(T) k_precondition(long n, const double *r, const double *dinv, double *u, double *partials)
 {
   double ru = 0, rr = 0, uu = 0;
   for (long i = (long)blockIdx.x * blockDim.x + threadIdx.x; i < n; i += (long)gridDim.x * blockDim.x) mcg_precondition_index<J, double>(i, r, dinv, u, ru, rr, uu);
-  ru = binbcsr::cuda::block_sum(ru);
-  __syncthreads();
-  rr = binbcsr::cuda::block_sum(rr);
-  __syncthreads();
-  uu = binbcsr::cuda::block_sum(uu);
-  if (threadIdx.x == 0) {
-    partials[blockIdx.x * 4 + 0] = ru;
-    partials[blockIdx.x * 4 + 1] = rr;
-    partials[blockIdx.x * 4 + 2] = uu;
-    partials[blockIdx.x * 4 + 3] = 0.0;
-  }
+  store_block_sums(ru, rr, uu, 0.0, partials);
 }
 
 /* The iteration's vector pass (mcg_update_index), partials of r.u, r.r, u.u, x.x (stride 4). */
@@ -200,19 +201,7 @@ __global__ void __launch_bounds__(T) k_update(long n, const MCGState *st, double
   const double alpha = st->alpha, beta = st->beta;
   double       ru = 0, rr = 0, uu = 0, xx = 0;
   for (long i = (long)blockIdx.x * blockDim.x + threadIdx.x; i < n; i += (long)gridDim.x * blockDim.x) mcg_update_index<J, double>(i, alpha, beta, u, w, p, s, x, r, dinv, ru, rr, uu, xx);
-  ru = binbcsr::cuda::block_sum(ru);
-  __syncthreads();
-  rr = binbcsr::cuda::block_sum(rr);
-  __syncthreads();
-  uu = binbcsr::cuda::block_sum(uu);
-  __syncthreads();
-  xx = binbcsr::cuda::block_sum(xx);
-  if (threadIdx.x == 0) {
-    partials[blockIdx.x * 4 + 0] = ru;
-    partials[blockIdx.x * 4 + 1] = rr;
-    partials[blockIdx.x * 4 + 2] = uu;
-    partials[blockIdx.x * 4 + 3] = xx;
-  }
+  store_block_sums(ru, rr, uu, xx, partials);
 }
 
 /* Gathers the dots of a pass (vector partials: ru, rr, uu, xx; product partials: u.w) into MCG order. */
