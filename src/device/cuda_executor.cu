@@ -280,8 +280,13 @@ public:
   }
   ~CudaMatrix() override
   {
-    for (auto &g : graphs) cudaGraphExecDestroy(g.second);
+    drop_graphs();
     cudaStreamDestroy(stream);
+  }
+  void drop_graphs()
+  {
+    for (auto &g : graphs) cudaGraphExecDestroy(g.second);
+    graphs.clear();
   }
   const Layout &layout() const override { return lay; }
   Precision     precision() const override { return prec; }
@@ -431,6 +436,7 @@ struct CudaOps {
     const auto key = std::make_tuple(k, dinv, b, x, jacobi);
     auto       it  = A.graphs.find(key);
     if (it == A.graphs.end()) {
+      if (A.graphs.size() >= 16) A.drop_graphs(); /* solves with ever new vectors: keep a few */
       cudaGraph_t g;
       CK(cudaStreamBeginCapture(A.stream, cudaStreamCaptureModeThreadLocal));
       for (int t = 0; t < k; t++) launch_iteration();
@@ -481,8 +487,7 @@ SolveResult CudaMatrix<V>::solve(const Vector &dinv, const Vector &b, Vector &x,
     state.resize(1);
   }
   if (hist.n < its) { /* the graphs hold the old pointer */
-    for (auto &g : graphs) cudaGraphExecDestroy(g.second);
-    graphs.clear();
+    drop_graphs();
     hist.resize(its);
   }
   CudaOps<V> ops{*this, dp(dinv), dp(b), dp(x), st.jacobi, n, vec_blocks()};

@@ -65,12 +65,11 @@ PetscErrorCode KSPSolve_MCG_Device(KSP ksp, Mat Amat, Mat Pmat, PetscBool *done)
   if (st.jacobi) PetscCall(MatSeqBinBCSRDeviceCachedVector(Amat, 1, mcg->dinv, &dinv));
   else dinv = b; /* unused */
   {
-    PetscScalar *xa;
-    PetscInt     n;
-    PetscCall(VecGetLocalSize(ksp->vec_sol, &n));
-    std::unique_ptr<binbcsr::device::Vector> x;
+    PetscScalar             *xa;
+    binbcsr::device::Vector *x;
+    PetscCall(MatSeqBinBCSRDeviceCachedVector(Amat, 2, nullptr, &x));
     PetscCall(VecGetArray(ksp->vec_sol, &xa));
-    BinBCSRDeviceTry(x = E->vector(n); if (!st.guess_zero) x->upload(xa); res = M->solve(*dinv, *b, *x, st); x->download(xa));
+    BinBCSRDeviceTry(if (!st.guess_zero) x->upload(xa); res = M->solve(*dinv, *b, *x, st); x->download(xa));
     PetscCall(VecRestoreArray(ksp->vec_sol, &xa));
   }
   PetscCall(at_start_err);

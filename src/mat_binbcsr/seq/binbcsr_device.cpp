@@ -249,9 +249,11 @@ PetscErrorCode MatSeqBinBCSRDeviceCachedVector(Mat A, int slot, Vec v, Vector **
   PetscFunctionBegin;
   PetscCall(GetCopy(A, &dc));
   PetscCheck(dc, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "the matrix has no device copy");
-  PetscCall(VecGetLocalSize(v, &n));
-  PetscCall(PetscObjectGetId((PetscObject)v, &id));
-  PetscCall(PetscObjectStateGet((PetscObject)v, &st));
+  if (v) {
+    PetscCall(VecGetLocalSize(v, &n));
+    PetscCall(PetscObjectGetId((PetscObject)v, &id));
+    PetscCall(PetscObjectStateGet((PetscObject)v, &st));
+  } else n = A->rmap->n; /* a work vector: allocated once, never uploaded here */
   if ((int)dc->cached.size() <= slot) {
     dc->cached.resize(slot + 1);
     dc->cached_of.resize(slot + 1, {-1, -1});
@@ -260,7 +262,7 @@ PetscErrorCode MatSeqBinBCSRDeviceCachedVector(Mat A, int slot, Vec v, Vector **
     BinBCSRDeviceTry(dc->cached[slot] = dc->exec->vector(n));
     dc->cached_of[slot] = {-1, -1};
   }
-  if (dc->cached_of[slot] != std::make_pair(id, st)) {
+  if (v && dc->cached_of[slot] != std::make_pair(id, st)) {
     const PetscScalar *va;
     PetscCall(VecGetArrayRead(v, &va));
     BinBCSRDeviceTry(dc->cached[slot]->upload(va));

@@ -10,7 +10,8 @@
    since), or nullptr when A has no device copy (any other type, or device none). */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRGetDeviceMatrix(Mat A, binbcsr::device::Executor **E, binbcsr::device::Matrix **M);
 /* A device vector of A's size holding v's values, cached on A under `slot` (0, 1, ...) and uploaded
-   only when v's id or state changed. */
+   only when v's id or state changed; v = NULL: a work vector of A's row size, kept, never uploaded (the
+   device solve's x: the same device arrays every solve keep its captured CUDA graphs valid). */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRDeviceCachedVector(Mat A, int slot, Vec v, binbcsr::device::Vector **dv);
 
 /* Turns a device library exception into a PETSc error. */
