@@ -13,6 +13,8 @@
 PETSC_EXTERN PetscErrorCode MatCreate_SeqBinBCSR(Mat);
 PETSC_EXTERN PetscErrorCode MatCreate_MPIBinBCSR(Mat);
 PETSC_EXTERN PetscErrorCode KSPCreate_MCG(KSP);
+/* -mat_binbcsr_kernel (seq and mpi readers): binbcsr_kernel_api.cpp */
+PETSC_INTERN PetscErrorCode MatBinBCSRKernelFromOptions_Private(PetscOptionItems *, Mat, MatBinBCSRKernel);
 /* ICC, Cholesky (through seqsbaij), ILU, LU (through seqbaij) for MATSOLVERPETSC: seq/binbcsr_factor.cpp */
 PETSC_INTERN PetscErrorCode MatGetFactor_SeqBinBCSR_Petsc(Mat, MatFactorType, Mat *);
 
@@ -79,5 +81,8 @@ PETSC_EXTERN PetscLogEvent MAT_BinBCSR_SetValuesCOO; /* slot refill by gather */
 PETSC_EXTERN PetscLogEvent MAT_BinBCSR_MultDot;      /* y = A x fused with x.y */
 PETSC_EXTERN PetscLogEvent KSP_MCG_FusedUpdate;      /* x, r, z (Jacobi), p, s updates + local dots */
 PETSC_EXTERN PetscLogEvent KSP_MCG_Reduction;        /* the one global reduction per iteration */
+PETSC_EXTERN PetscLogEvent MAT_BinBCSR_DeviceMult;   /* MatMult of a device matrix on host vectors (copies in and out) */
+PETSC_EXTERN PetscLogEvent MAT_BinBCSR_DeviceUpload; /* values to the device: whole array, or COO values + gather */
+PETSC_EXTERN PetscLogEvent KSP_MCG_DeviceSolve;      /* a KSPMCG solve run on the device */
 
 #endif

@@ -5,8 +5,12 @@ PetscLogEvent MAT_BinBCSR_SetValuesCOO = 0;
 PetscLogEvent MAT_BinBCSR_MultDot      = 0;
 PetscLogEvent KSP_MCG_FusedUpdate      = 0;
 PetscLogEvent KSP_MCG_Reduction        = 0;
+PetscLogEvent MAT_BinBCSR_DeviceMult   = 0;
+PetscLogEvent MAT_BinBCSR_DeviceUpload = 0;
+PetscLogEvent KSP_MCG_DeviceSolve      = 0;
 
 const char *const MatBinBCSRPrecisions[] = {"double", "single", "MatBinBCSRPrecision", "MAT_BINBCSR_PRECISION_", nullptr};
+const char *const MatBinBCSRDevices[]    = {"none", "reference", "cuda", "MatBinBCSRDevice", "MAT_BINBCSR_DEVICE_", nullptr};
 
 static PetscBool registered = PETSC_FALSE;
 
@@ -41,6 +45,9 @@ PetscErrorCode PetscBinBCSRRegisterAll(void)
   PetscCall(PetscLogEventRegister("BinBCSRMultDot", MAT_CLASSID, &MAT_BinBCSR_MultDot));
   PetscCall(PetscLogEventRegister("MCGFusedUpdate", KSP_CLASSID, &KSP_MCG_FusedUpdate));
   PetscCall(PetscLogEventRegister("MCGReduction", KSP_CLASSID, &KSP_MCG_Reduction));
+  PetscCall(PetscLogEventRegister("BinBCSRDevMult", MAT_CLASSID, &MAT_BinBCSR_DeviceMult));
+  PetscCall(PetscLogEventRegister("BinBCSRDevUp", MAT_CLASSID, &MAT_BinBCSR_DeviceUpload));
+  PetscCall(PetscLogEventRegister("MCGDeviceSolve", KSP_CLASSID, &KSP_MCG_DeviceSolve));
   PetscFunctionReturn(0);
 }
 

@@ -1,8 +1,8 @@
 // Host-side matrices of the GPU benchmark (examples/gpu/binbcsr_gpu_bench.cu): the 27-point block
 // stencil, PETSc binary files, the scalar CSR every cuSPARSE format starts from, and the bins of
-// src/mat_binbcsr/binbcsr_layout.h. Plain C++17; a failed read exits with a message.
+// src/mat_binbcsr/kernels/binbcsr_layout.h. Plain C++17; a failed read exits with a message.
 #pragma once
-#include "mat_binbcsr/binbcsr_layout.h"
+#include "mat_binbcsr/kernels/binbcsr_layout.h"
 
 #include <algorithm>
 #include <cmath>
@@ -204,6 +204,61 @@ Bins<V> make_bins(const std::vector<int> &ptr, const std::vector<int> &col, cons
       for (int e = 0; e < bs * bs; e++) B.val[binbcsr::value_index(s, e, bw, bs * bs)] = (V)val[(size_t)(ptr[r] + k) * bs * bs + e];
     }
   return B;
+}
+
+// The compact form scripts/gpu_check ships the driver matrices in (a GPU machine receives at most 64 MiB
+// of the tree; PETSc binary costs 12 bytes a nonzero, this 4 + 4/bs^2): "BBM1", then int32 bs, mbs,
+// nblocks, ptr[mbs + 1], col[nblocks], float32 values[nblocks * bs^2] (row-major blocks). The values
+// are the matrix's rounded to float once; the benchmarks run them in double as well (the timings do not
+// depend on the digits, and every check compares with the host product of the same values).
+void write_compact(const BlockMatrix &A, const std::string &path)
+{
+  std::ofstream f(path, std::ios::binary);
+  const int32_t head[4] = {0x314d4242, A.bs, A.mbs, (int32_t)A.col.size()};
+  f.write((const char *)head, sizeof head);
+  f.write((const char *)A.ptr.data(), sizeof(int) * A.ptr.size());
+  f.write((const char *)A.col.data(), sizeof(int) * A.col.size());
+  std::vector<float> v(A.val.begin(), A.val.end());
+  f.write((const char *)v.data(), sizeof(float) * v.size());
+  if (!f) {
+    std::fprintf(stderr, "cannot write %s\n", path.c_str());
+    std::exit(2);
+  }
+}
+BlockMatrix read_compact(const std::string &path)
+{
+  std::ifstream f(path, std::ios::binary);
+  int32_t       head[4] = {0, 0, 0, 0};
+  f.read((char *)head, sizeof head);
+  if (!f || head[0] != 0x314d4242 || head[1] < 1 || head[1] > 8 || head[2] < 1 || head[3] < 0) {
+    std::fprintf(stderr, "%s: not a compact block matrix (BBM1)\n", path.c_str());
+    std::exit(2);
+  }
+  BlockMatrix A;
+  A.name = path.substr(path.find_last_of('/') + 1);
+  A.bs   = head[1];
+  A.mbs  = head[2];
+  A.ptr.resize((size_t)A.mbs + 1);
+  A.col.resize(head[3]);
+  std::vector<float> v((size_t)head[3] * A.bs * A.bs);
+  f.read((char *)A.ptr.data(), sizeof(int) * A.ptr.size());
+  f.read((char *)A.col.data(), sizeof(int) * A.col.size());
+  f.read((char *)v.data(), sizeof(float) * v.size());
+  bool ok = f && A.ptr[0] == 0 && A.ptr[A.mbs] == head[3];
+  for (int r = 0; ok && r < A.mbs; r++) ok = A.ptr[r] <= A.ptr[r + 1];
+  for (size_t k = 0; ok && k < A.col.size(); k++) ok = A.col[k] >= 0 && A.col[k] < A.mbs;
+  if (!ok) {
+    std::fprintf(stderr, "%s: truncated or inconsistent compact block matrix\n", path.c_str());
+    std::exit(2);
+  }
+  A.val.assign(v.begin(), v.end());
+  return A;
+}
+// A matrix file: compact (.bbm) or PETSc binary (anything else).
+BlockMatrix read_matrix(const std::string &path, int bs)
+{
+  if (path.size() > 4 && path.compare(path.size() - 4, 4, ".bbm") == 0) return read_compact(path);
+  return read_petsc_binary(path, bs);
 }
 
 } // namespace gpu_bench

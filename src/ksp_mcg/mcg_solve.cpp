@@ -19,6 +19,7 @@
    type's fused product-and-dot kernel when the type composes one (binbcsr does). */
 #include "mcg_impl.h"
 #include "mcg_kernels.h"
+#include "mcg_device_solve.h"
 
 /* Decides how z = M^-1 r is applied in this solve, and why not fused when it is not. */
 static PetscErrorCode MCGChoosePath(KSP ksp, Mat Amat)
@@ -364,6 +365,11 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
   }
   if (mcg->how == MCG_PC_JACOBI) PetscCall(MCGUpdateDiagonal(ksp));
   if (mcg->how == MCG_PC_PBJACOBI) PetscCall(MCGUpdateBlockDiagonal(ksp));
+  {
+    PetscBool on_device; /* a matrix with a device copy (MatBinBCSRSetDevice): the whole solve there */
+    PetscCall(KSPSolve_MCG_Device(ksp, Amat, Pmat, &on_device));
+    if (on_device) PetscFunctionReturn(0);
+  }
   max_its           = mcg->fixed_its > 0 ? mcg->fixed_its : ksp->max_it;
   mcg->restarts     = 0;
   mcg->true_checks  = 0;

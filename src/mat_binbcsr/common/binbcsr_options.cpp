@@ -52,5 +52,6 @@ PetscErrorCode MatBinBCSRReadOptions_Private(Mat A, PetscOptionItems *PetscOptio
   PetscCall(OptionBool(PetscOptionsObject, A, "-mat_binbcsr_symmetric_storage", "Store the upper triangle only (symmetric matrices; the lower triangle given is ignored; on several ranks, of the diagonal part)", "MatBinBCSRSetSymmetricStorage", MatBinBCSRGetSymmetricStorage, MatBinBCSRSetSymmetricStorage));
   PetscCall(OptionBool(PetscOptionsObject, A, "-mat_binbcsr_coo_mirror", "COO entries of off-diagonal blocks also fill the transposed place (give one triangle of a symmetric matrix)", "MatBinBCSRSetCOOMirror", MatBinBCSRGetCOOMirror, MatBinBCSRSetCOOMirror));
   PetscCall(OptionInt(PetscOptionsObject, A, "-mat_binbcsr_streams", "Runs of bins the product sweeps side by side (1, 2, 4, 8)", "MatBinBCSRSetStreams", MatBinBCSRGetStreams, MatBinBCSRSetStreams));
+  PetscCall(OptionEnum(PetscOptionsObject, A, "-mat_binbcsr_device", "Device copy: none, reference (host executor), cuda (one process only)", "MatBinBCSRSetDevice", MatBinBCSRDevices, MatBinBCSRGetDevice, MatBinBCSRSetDevice));
   PetscFunctionReturn(0);
 }

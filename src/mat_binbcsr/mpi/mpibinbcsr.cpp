@@ -232,6 +232,7 @@ static PetscErrorCode MatSetFromOptions_MPIBinBCSR(Mat mat, PetscOptionItems *Pe
     PetscCall(PetscStrncpy(b->inner_type, inner, sizeof(b->inner_type)));
   }
   PetscCall(MatBinBCSRReadOptions_Private(mat, PetscOptionsObject)); /* the -mat_binbcsr_* options, forwarded to both parts */
+  PetscCall(MatBinBCSRKernelFromOptions_Private(PetscOptionsObject, mat, b->kernel));
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }
@@ -294,6 +295,7 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRCreatePart(Mat mat, PetscInt m, PetscIn
   if (b->bin_width) PetscCall(MatBinBCSRSetBinWidth(*part, b->bin_width));
   if (b->precision_set) PetscCall(MatBinBCSRSetPrecision(*part, b->precision));
   if (b->streams) PetscCall(MatBinBCSRSetStreams(*part, b->streams));
+  if (b->kernel) PetscCall(MatBinBCSRSetKernel(*part, b->kernel));
   if (b->sym && part == &b->A) PetscCall(MatBinBCSRSetSymmetricStorage(*part, PETSC_TRUE)); /* B stays full */
   for (const auto &[op, flg] : b->part_options) {
     const bool wholematrix = op == MAT_SYMMETRIC || op == MAT_SPD || op == MAT_HERMITIAN || op == MAT_STRUCTURALLY_SYMMETRIC || op == MAT_SYMMETRY_ETERNAL || op == MAT_STRUCTURAL_SYMMETRY_ETERNAL || op == MAT_SPD_ETERNAL;
