@@ -43,7 +43,7 @@ BINBCSR_HD void mcg_update_index(long i, Scalar alpha, Scalar beta, Scalar *u, c
 
 /* y = B x for one 3x3 block B stored column-major (the order of MatInvertBlockDiagonal()). */
 template <typename Scalar>
-MCG_HOST_DEVICE inline void mcg_block3_apply(const Scalar *B, Scalar x0, Scalar x1, Scalar x2, Scalar &y0, Scalar &y1, Scalar &y2)
+BINBCSR_HD void mcg_block3_apply(const Scalar *B, Scalar x0, Scalar x1, Scalar x2, Scalar &y0, Scalar &y1, Scalar &y2)
 {
   y0 = B[0] * x0 + B[3] * x1 + B[6] * x2;
   y1 = B[1] * x0 + B[4] * x1 + B[7] * x2;
@@ -54,7 +54,7 @@ MCG_HOST_DEVICE inline void mcg_block3_apply(const Scalar *B, Scalar x0, Scalar 
    u_b = binv_b r_b, binv_b the inverse of the 3x3 diagonal block of block row b (column-major, 9
    scalars per block row). */
 template <typename Scalar>
-MCG_HOST_DEVICE inline void mcg_update_block3(long b, Scalar alpha, Scalar beta, Scalar *u, const Scalar *w, Scalar *p, Scalar *s, Scalar *x, Scalar *r, const Scalar *binv, Scalar &ru, Scalar &rr, Scalar &uu, Scalar &xx)
+BINBCSR_HD void mcg_update_block3(long b, Scalar alpha, Scalar beta, Scalar *u, const Scalar *w, Scalar *p, Scalar *s, Scalar *x, Scalar *r, const Scalar *binv, Scalar &ru, Scalar &rr, Scalar &uu, Scalar &xx)
 {
   Scalar rb[3];
   for (int c = 0; c < 3; c++) {
@@ -81,7 +81,7 @@ MCG_HOST_DEVICE inline void mcg_update_block3(long b, Scalar alpha, Scalar beta,
 
 /* u_b = binv_b r_b and the local dots of r and u for block row b: start of a solve with point-block Jacobi. */
 template <typename Scalar>
-MCG_HOST_DEVICE inline void mcg_precondition_block3(long b, const Scalar *r, const Scalar *binv, Scalar *u, Scalar &ru, Scalar &rr, Scalar &uu)
+BINBCSR_HD void mcg_precondition_block3(long b, const Scalar *r, const Scalar *binv, Scalar *u, Scalar &ru, Scalar &rr, Scalar &uu)
 {
   const Scalar r0 = r[3 * b], r1 = r[3 * b + 1], r2 = r[3 * b + 2];
   Scalar       u0, u1, u2;
