@@ -12,7 +12,7 @@ else()
 endif()
 if(BINBCSR_NVCC)
   # The GPU benchmark (examples/gpu/, run by scripts/gpu_bench on a machine with a GPU) and the CUDA
-  # kernels it drives (src/mat_binbcsr/cuda/): built and linked against cuSPARSE and cuBLAS with warnings
+  # kernels it drives (src/mat_binbcsr/kernels/cuda/, src/ksp_mcg/mcg_device.cuh): built and linked against cuSPARSE and cuBLAS with warnings
   # as errors, so the CUDA code cannot rot where no GPU runs it. Running it needs a GPU (docs/gpu.md).
   add_test(NAME cuda_gpu_bench_build
            COMMAND ${BINBCSR_NVCC} -std=c++17 -O1 -arch=sm_90 -I${PROJECT_SOURCE_DIR}/src

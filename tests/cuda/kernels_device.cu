@@ -20,8 +20,8 @@ __global__ void coo_refill(const double *coo_v, long n, const double *recv, cons
 // Instantiations: block sizes 1 and 3, double and single storage.
 } // namespace binbcsr_device_check
 
-template __global__ void binbcsr::cuda::sym_bin_mult<3, double>(const double *, const int *, const int *, int, int, int, const double *, double *);
-template __global__ void binbcsr::cuda::sym_bin_mult<3, float>(const float *, const int *, const int *, int, int, int, const double *, double *);
+template __global__ void binbcsr::cuda::sym_bin_mult<3, double>(const double *, const int *, const int *, const int *, int, int, int, const double *, double *);
+template __global__ void binbcsr::cuda::sym_bin_mult<3, float>(const float *, const int *, const int *, const int *, int, int, int, const double *, double *);
 
 // The kernels of binbcsr_cuda.cuh for block sizes 1 and 3 in both precisions (the GPU benchmark
 // instantiates the ones it runs; these are the rest a backend would need).

@@ -53,5 +53,6 @@ PetscErrorCode MatBinBCSRReadOptions_Private(Mat A, PetscOptionItems *PetscOptio
   PetscCall(OptionBool(PetscOptionsObject, A, "-mat_binbcsr_coo_mirror", "COO entries of off-diagonal blocks also fill the transposed place (give one triangle of a symmetric matrix)", "MatBinBCSRSetCOOMirror", MatBinBCSRGetCOOMirror, MatBinBCSRSetCOOMirror));
   PetscCall(OptionInt(PetscOptionsObject, A, "-mat_binbcsr_streams", "Runs of bins the product sweeps side by side (1, 2, 4, 8)", "MatBinBCSRSetStreams", MatBinBCSRGetStreams, MatBinBCSRSetStreams));
   PetscCall(OptionEnum(PetscOptionsObject, A, "-mat_binbcsr_device", "Device copy: none, reference (host executor), cuda (one process only)", "MatBinBCSRSetDevice", MatBinBCSRDevices, MatBinBCSRGetDevice, MatBinBCSRSetDevice));
+  PetscCall(OptionEnum(PetscOptionsObject, A, "-mat_binbcsr_kernel", "Body set of the products (auto: the best this CPU has)", "MatBinBCSRSetKernel", MatBinBCSRKernels, MatBinBCSRGetKernel, MatBinBCSRSetKernel));
   PetscFunctionReturn(0);
 }

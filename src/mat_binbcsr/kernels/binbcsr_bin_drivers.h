@@ -49,6 +49,25 @@ struct BinSlices {
   int        len[K];
 };
 
+/* nz[q][l]: the real blocks of lane l of bins[q] (0 for a phantom lane), whole storage. */
+template <int K, int BW>
+inline void lane_lengths(const BinMatrix &m, const int *bins, int (*nz)[BW])
+{
+  for (int q = 0; q < K; q++)
+    for (int l = 0; l < BW; l++) nz[q][l] = bins[q] * BW + l < m.mbs ? m.row_nz[bins[q] * BW + l] : 0;
+}
+
+/* kd[q][l]: the slot group of the diagonal block of lane l of bins[q] (-1: none), symmetric storage. */
+template <int K, int BW>
+inline void diagonal_groups(const BinMatrix &m, const int *bins, int (*kd)[BW])
+{
+  for (int q = 0; q < K; q++)
+    for (int l = 0; l < BW; l++) {
+      const int r = bins[q] * BW + l;
+      kd[q][l]    = r < m.mbs && m.diag_slot[r] >= 0 ? (m.diag_slot[r] - m.bin_start[bins[q]]) / BW : -1;
+    }
+}
+
 template <int K, int BS, int BW, typename V>
 inline BinSlices<K, V> bin_slices(const BinMatrix &m, const int *bins)
 {
@@ -78,20 +97,23 @@ inline void for_each_sweep(int nbins, F &&f)
   for (int b = K * run; b < nbins; b++) f(std::integral_constant<int, 1>{}, &b);
 }
 
-/* acc[i][l] += block row i of lane l times x_c over one slot group (c: the group's BW columns, t: its
-   tiles). BW is the bin width as a constant: the lanes' accumulators stay in registers and the loop
-   over the lanes becomes SIMD (column indices and values are unit-stride across lanes). */
+/* acc[i][l] += block row i of lane l times x_c over slot group k (c: the group's BW columns, t: its
+   tiles; nz: the lanes' real blocks). BW is the bin width as a constant: the lanes' accumulators stay
+   in registers and the loop over the lanes becomes SIMD (column indices and values are unit-stride
+   across lanes). x_c of a padding slot reads as zero (a select, no branch): its zero value times a
+   NaN or Inf of x would put a NaN into a row that does not have one. */
 template <int BS, int BW, typename V>
-inline void group_mult(const V *t, const int *c, const double *x, double (*acc)[BW])
+inline void group_mult(const V *t, const int *c, const double *x, double (*acc)[BW], int k, const int *nz)
 {
   prefetch_values(t, BW * BS * BS * (int)sizeof(V));
   if (unit_stride<BW>(c)) { /* consecutive columns: x_c by plain loads, no gathers */
     const double *xs = x + (size_t)c[0] * BS;
     BINBCSR_LANE_LOOP
     for (int l = 0; l < BW; l++) {
-      double yl[BS];
+      double yl[BS], xc[BS];
+      for (int j = 0; j < BS; j++) xc[j] = k < nz[l] ? xs[l * BS + j] : 0.0;
       for (int i = 0; i < BS; i++) yl[i] = acc[i][l];
-      slot_mult<BS, V>(t + l, BW, BS, xs + l * BS, yl);
+      slot_mult<BS, V>(t + l, BW, BS, xc, yl);
       for (int i = 0; i < BS; i++) acc[i][l] = yl[i];
     }
     return;
@@ -100,7 +122,7 @@ inline void group_mult(const V *t, const int *c, const double *x, double (*acc)[
   for (int l = 0; l < BW; l++) {
     const int ci = c[l] * BS; /* 32-bit offsets: vgatherdpd */
     double    xc[BS], yl[BS];
-    for (int j = 0; j < BS; j++) xc[j] = x[ci + j];
+    for (int j = 0; j < BS; j++) xc[j] = k < nz[l] ? x[ci + j] : 0.0;
     for (int i = 0; i < BS; i++) yl[i] = acc[i][l];
     slot_mult<BS, V>(t + l, BW, BS, xc, yl);
     for (int i = 0; i < BS; i++) acc[i][l] = yl[i];
@@ -118,14 +140,16 @@ inline void bins_sweep(const BinMatrix &m, const int *bins, const double *x, con
   constexpr int         BS2            = BS * BS;
   double                acc[K][BS][BW] = {};
   const BinSlices<K, V> s              = bin_slices<K, BS, BW, V>(m, bins);
+  int                   nz[K][BW];
+  lane_lengths<K, BW>(m, bins, nz);
 #if defined(BINBCSR_HAND_AVX512)
   if constexpr (BS == 3 && BW == 8) {
     double(*accq[K])[8];
     for (int q = 0; q < K; q++) accq[q] = acc[q];
-    avx512::bins_mult_3x8<K>(s.t, s.c, s.len, x, accq);
+    avx512::bins_mult_3x8<K>(s.t, s.c, s.len, nz, x, accq);
   } else
 #endif
-    interleave_groups<K>(s.len, [&](int q, int k) { group_mult<BS, BW, V>(s.t[q] + (size_t)k * BW * BS2, s.c[q] + (size_t)k * BW, x, acc[q]); });
+    interleave_groups<K>(s.len, [&](int q, int k) { group_mult<BS, BW, V>(s.t[q] + (size_t)k * BW * BS2, s.c[q] + (size_t)k * BW, x, acc[q], k, nz[q]); });
   for (int q = 0; q < K; q++) {
     /* y += A x in place: an empty bin changes nothing (the off-diagonal part of an MPI matrix is
        mostly empty bins; writing their rows back cost a tenth of the diagonal part's product) */
@@ -160,11 +184,11 @@ void mult_any(const BinMatrix &m, const double *x, const double *z, double *y, d
   const V  *val = values<V>(m);
   double    d   = 0.0;
   for (int b = 0; b < m.nbins; b++) {
-    const int s0 = m.bin_start[b], len = (m.bin_start[b + 1] - s0) / bw;
+    const int s0 = m.bin_start[b];
     for (int l = 0; l < bw && b * bw + l < m.mbs; l++) {
       const int r = b * bw + l;
       for (int i = 0; i < bs; i++) acc[i] = z ? z[(size_t)r * bs + i] : 0.0;
-      lane_mult<BS, V, int>(val + (size_t)s0 * bs2, m.col + s0, len, bw, bs, l, x, acc);
+      lane_mult<BS, V, int>(val + (size_t)s0 * bs2, m.col + s0, m.row_nz[r], bw, bs, l, x, acc);
       for (int i = 0; i < bs; i++) {
         y[(size_t)r * bs + i] = acc[i];
         if (dot) d += x[(size_t)r * bs + i] * acc[i];
@@ -186,13 +210,14 @@ void sym_mult_fixed(const BinMatrix &m, const double *x, const double *, double 
   for_each_sweep<K>(m.nbins, [&](auto KC, const int *bins) {
     constexpr int          Kc = decltype(KC)::value;
     const BinSlices<Kc, V> s  = bin_slices<Kc, BS, BW, V>(m, bins);
-    int                    r0[Kc];
+    int                    r0[Kc], kd[Kc][BW];
     for (int q = 0; q < Kc; q++) r0[q] = bins[q] * BW;
+    diagonal_groups<Kc, BW>(m, bins, kd);
 #if defined(BINBCSR_HAND_AVX512)
-    if constexpr (BS == 3 && BW == 8) avx512::sym_bins_mult_3x8<Kc>(s.t, s.c, s.len, r0, m.mbs, x, y);
+    if constexpr (BS == 3 && BW == 8) avx512::sym_bins_mult_3x8<Kc>(s.t, s.c, s.len, r0, m.mbs, kd, x, y);
     else
 #endif
-      sym_bins_mult<Kc, BS, BW, V, int>(s.t, s.c, s.len, r0, m.mbs, x, y);
+      sym_bins_mult<Kc, BS, BW, V, int>(s.t, s.c, s.len, r0, m.mbs, kd, x, y);
     if (dot && K == 1)
       for (size_t p = (size_t)r0[0] * BS; p < (size_t)(m.mbs < r0[0] + BW ? m.mbs : r0[0] + BW) * BS; p++) d += x[p] * y[p];
   });
@@ -212,7 +237,8 @@ void sym_mult_any(const BinMatrix &m, const double *x, const double *, double *y
     const int s0 = m.bin_start[b], len = (m.bin_start[b + 1] - s0) / bw, r0 = b * bw, r1 = m.mbs < r0 + bw ? m.mbs : r0 + bw;
     for (int r = r0; r < r1; r++) {
       for (int i = 0; i < bs; i++) acc[i] = 0.0;
-      sym_lane_mult<BS, V, int>(val + (size_t)s0 * bs2, m.col + s0, len, bw, bs, r - r0, r, x, x + (size_t)r * bs, y, acc);
+      const int kd = m.diag_slot[r] >= 0 ? (m.diag_slot[r] - s0) / bw : -1;
+      sym_lane_mult<BS, V, int>(val + (size_t)s0 * bs2, m.col + s0, len, bw, bs, r - r0, r, kd, x, x + (size_t)r * bs, y, acc);
       for (int i = 0; i < bs; i++) y[(size_t)r * bs + i] += acc[i];
     }
     if (dot)
@@ -311,6 +337,14 @@ inline bool bodies_of(const Shape &s, Body &b, bool fixed_only)
 inline bool bodies(const Shape &s, Body &b, bool fixed_only)
 {
   return s.single ? bodies_of<float>(s, b, fixed_only) : bodies_of<double>(s, b, fixed_only);
+}
+
+/* The table function of a SIMD body set: its fixed shapes, or none when the compiler could not target
+   it (`targeted` false: the translation unit is a stub and the dispatch never offers the set). */
+inline bool simd_bodies(const Shape &s, Body &b, BodySet set, bool targeted)
+{
+  b.set = set;
+  return targeted && bodies(s, b, true);
 }
 
 } // namespace drivers

@@ -89,10 +89,12 @@ BINBCSR_HD void slot_mult_transpose(const V *tile, int bw, int bs_rt, const doub
   }
 }
 
-/* acc = acc + (row of the bin at `lane`) * x over the bin's len slot columns (padding included: it
-   holds zeros and a valid column). bin_val / bin_col point at the bin's first tile / slot. */
+/* acc = acc + (row of the bin at `lane`) * x over the lane's first nz slots, its real blocks: padding
+   is never read (its zero times a NaN or Inf of x would be a NaN the row does not have). A caller that
+   has no row lengths (the CUDA benchmark) passes the bin's len and reads the padding (zeros, valid
+   columns). bin_val / bin_col point at the bin's first tile / slot. */
 template <int BS, typename V, typename I>
-BINBCSR_HD void lane_mult(const V *bin_val, const I *bin_col, int len, int bw, int bs_rt, int lane, const double *x, double *acc)
+BINBCSR_HD void lane_mult(const V *bin_val, const I *bin_col, int nz, int bw, int bs_rt, int lane, const double *x, double *acc)
 {
   const int bs  = BS ? BS : bs_rt;
   const int bs2 = bs * bs;
@@ -101,7 +103,7 @@ BINBCSR_HD void lane_mult(const V *bin_val, const I *bin_col, int len, int bw, i
                       column loads of 4 slots can be in flight together (on the H100 the gain was
                       within the spread between runs, docs/gpu.md) */
 #endif
-  for (int k = 0; k < len; k++) {
+  for (int k = 0; k < nz; k++) {
     const long s = (long)k * bw + lane;
     slot_mult<BS, V>(bin_val + (long)k * bw * bs2 + lane, bw, bs, x + (long)bin_col[s] * bs, acc);
   }
@@ -143,13 +145,14 @@ BINBCSR_HD void lane_mult_transpose(const V *bin_val, const I *bin_col, int nz, 
 /* Symmetric storage (upper triangle; see binbcsr.h): one lane of a bin, len slots, all of them (real
    and padding). For every slot of block column c: acc += block x_c, and when c != own (an
    off-diagonal block (r, c), c > r): y_c += block^T xr, the product with the lower block that is not
-   stored. Padding slots hold zeros and own as their column, the diagonal block has c == own: neither
-   scatters. The caller zeroes y first and adds acc to y_r after the lane. Lanes of one bin may run
+   stored. Padding slots hold zeros and own as their column, the diagonal block (slot group kd, -1:
+   none) has c == own: neither scatters, and padding adds nothing to acc (it is not read: zero times a
+   NaN or Inf of x_own would be a NaN the row does not have). The caller zeroes y first and adds acc to y_r after the lane. Lanes of one bin may run
    in any order or in lock step per slot (SIMD lanes, a warp): the layout build colours the slots so
    that no two lanes of one slot group scatter to the same column, so no atomics are needed (a GPU
    must keep the lanes of a bin in step per slot, e.g. one warp per bin with __syncwarp per k). */
 template <int BS, typename V, typename I>
-BINBCSR_HD void sym_lane_mult(const V *bin_val, const I *bin_col, int len, int bw, int bs_rt, int lane, I own, const double *x, const double *xr, double *y, double *acc)
+BINBCSR_HD void sym_lane_mult(const V *bin_val, const I *bin_col, int len, int bw, int bs_rt, int lane, I own, int kd, const double *x, const double *xr, double *y, double *acc)
 {
   const int bs  = BS ? BS : bs_rt;
   const int bs2 = bs * bs;
@@ -157,8 +160,10 @@ BINBCSR_HD void sym_lane_mult(const V *bin_val, const I *bin_col, int len, int b
     const long s = (long)k * bw + lane;
     const I    c = bin_col[s];
     const V   *t = bin_val + (long)k * bw * bs2 + lane;
-    slot_mult<BS, V>(t, bw, bs, x + (long)c * bs, acc);
-    if (c != own) slot_mult_transpose<BS, V>(t, bw, bs, xr, y + (long)c * bs);
+    if (c != own) {
+      slot_mult<BS, V>(t, bw, bs, x + (long)c * bs, acc);
+      slot_mult_transpose<BS, V>(t, bw, bs, xr, y + (long)c * bs);
+    } else if (k == kd) slot_mult<BS, V>(t, bw, bs, x + (long)c * bs, acc);
   }
 }
 
@@ -183,16 +188,18 @@ BINBCSR_HD bool unit_stride(const I *c)
    acc += block x_c and, with SCATTER, y_c += block^T x_r, by unit-stride loads and stores. The
    branch is a template argument: a run-time test inside the lane loop stops GCC from vectorising it. */
 template <int BS, int BW, typename V, bool SCATTER>
-BINBCSR_HD void sym_unit_group_mult(const V *t, const double *xs, const double (*xr)[BW], double *ys, double (*acc)[BW])
+BINBCSR_HD void sym_unit_group_mult(const V *t, const double *xs, const double (*xr)[BW], double *ys, double (*acc)[BW], int k, const int *kd)
 {
   constexpr int BS2 = BS * BS;
 #pragma omp simd
   for (int l = 0; l < BW; l++) {
-    double v[BS2];
+    double     v[BS2], xc[BS];
+    const bool real = SCATTER || k == kd[l]; /* without scatters: the diagonal block or padding */
     for (int e = 0; e < BS2; e++) v[e] = (double)t[e * BW + l];
+    for (int j = 0; j < BS; j++) xc[j] = real ? xs[l * BS + j] : 0.0;
     for (int i = 0; i < BS; i++) {
       double s = acc[i][l];
-      for (int j = 0; j < BS; j++) s += v[i * BS + j] * xs[l * BS + j];
+      for (int j = 0; j < BS; j++) s += v[i * BS + j] * xc[j];
       acc[i][l] = s;
     }
     if constexpr (SCATTER)
@@ -204,26 +211,29 @@ BINBCSR_HD void sym_unit_group_mult(const V *t, const double *xs, const double (
   }
 }
 
-/* One slot group of sym_bins_mult (BW lanes in lock step, the lane loop is the SIMD loop): acc +=
-   block x_c, and a masked scatter-add of block^T x_r into y_c (conflict-free by the colouring). */
+/* One slot group (number k) of sym_bins_mult (BW lanes in lock step, the lane loop is the SIMD loop):
+   acc += block x_c for the real slots (x_c of a padding slot reads as zero: kd[l] is the group of lane
+   l's diagonal block), and a masked scatter-add of block^T x_r into y_c (conflict-free by the
+   colouring). */
 template <int BS, int BW, typename V, typename I>
-BINBCSR_HD void sym_group_mult(const V *t, const I *c, I r0, const I *own, const double (*xr)[BW], const double *x, double *y, double (*acc)[BW])
+BINBCSR_HD void sym_group_mult(const V *t, const I *c, I r0, const I *own, const double (*xr)[BW], const double *x, double *y, double (*acc)[BW], int k, const int *kd)
 {
   constexpr int BS2 = BS * BS;
   prefetch_values(t, BW * BS2 * (int)sizeof(V));
   if (unit_stride<BW>(c)) { /* contiguous x_c and y_c: plain loads and stores instead of gathers and scatters */
     const I c0 = c[0];
     /* c0 == r0: the diagonal blocks or padding of every lane, nothing to scatter */
-    if (c0 == r0) sym_unit_group_mult<BS, BW, V, false>(t, x + (long)c0 * BS, xr, nullptr, acc);
-    else sym_unit_group_mult<BS, BW, V, true>(t, x + (long)c0 * BS, xr, y + (long)c0 * BS, acc);
+    if (c0 == r0) sym_unit_group_mult<BS, BW, V, false>(t, x + (long)c0 * BS, xr, nullptr, acc, k, kd);
+    else sym_unit_group_mult<BS, BW, V, true>(t, x + (long)c0 * BS, xr, y + (long)c0 * BS, acc, k, kd);
     return;
   }
 #pragma omp simd
   for (int l = 0; l < BW; l++) {
-    const I   cl = c[l];
-    const int ci = (int)cl * BS; /* 32-bit offsets: vgatherdpd, fewer index instructions */
-    double    xc[BS], v[BS2];
-    for (int j = 0; j < BS; j++) xc[j] = x[ci + j];
+    const I    cl   = c[l];
+    const int  ci   = (int)cl * BS; /* 32-bit offsets: vgatherdpd, fewer index instructions */
+    const bool real = cl != own[l] || k == kd[l];
+    double     xc[BS], v[BS2];
+    for (int j = 0; j < BS; j++) xc[j] = real ? x[ci + j] : 0.0;
     for (int e = 0; e < BS2; e++) v[e] = (double)t[e * BW + l];
     for (int i = 0; i < BS; i++) {
       double s = acc[i][l];
@@ -243,11 +253,12 @@ BINBCSR_HD void sym_group_mult(const V *t, const I *c, I r0, const I *own, const
 /* The symmetric product of K whole bins of BW lanes (BW, BS compile-time), swept together: the slot
    groups of the K bins in turn (several streams for the prefetcher, as the whole-storage bins_sweep),
    each group through sym_group_mult. Lanes whose row is >= mbs are phantom: their slots are padding
-   (zeros, column own = mbs - 1, masked out) and their acc is dropped. On exit y_r += acc for the real
+   (zeros, column own = mbs - 1, masked out) and their acc is dropped. kd[q][l]: the slot group of
+   the diagonal block of lane l of bin q (-1: none), which tells padding from the diagonal block. On exit y_r += acc for the real
    lanes of every bin. Scatters of one bin may land in the rows of another bin of the sweep: all are
    additions into y, and a bin's own rows are added only at its end. */
 template <int K, int BS, int BW, typename V, typename I>
-BINBCSR_HD void sym_bins_mult(const V *const *bin_val, const I *const *bin_col, const int *len, const I *r0, I mbs, const double *x, double *y)
+BINBCSR_HD void sym_bins_mult(const V *const *bin_val, const I *const *bin_col, const int *len, const I *r0, I mbs, const int (*kd)[BW], const double *x, double *y)
 {
   constexpr int BS2 = BS * BS;
   double        acc[K][BS][BW], xr[K][BS][BW];
@@ -262,7 +273,7 @@ BINBCSR_HD void sym_bins_mult(const V *const *bin_val, const I *const *bin_col, 
       }
     }
   }
-  interleave_groups<K>(len, [&](int q, int k) { sym_group_mult<BS, BW, V, I>(bin_val[q] + (long)k * BW * BS2, bin_col[q] + (long)k * BW, r0[q], own[q], xr[q], x, y, acc[q]); });
+  interleave_groups<K>(len, [&](int q, int k) { sym_group_mult<BS, BW, V, I>(bin_val[q] + (long)k * BW * BS2, bin_col[q] + (long)k * BW, r0[q], own[q], xr[q], x, y, acc[q], k, kd[q]); });
   for (int q = 0; q < K; q++)
     for (int l = 0; l < BW; l++)
       if (r0[q] + l < mbs)

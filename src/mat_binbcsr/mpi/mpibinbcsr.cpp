@@ -232,7 +232,6 @@ static PetscErrorCode MatSetFromOptions_MPIBinBCSR(Mat mat, PetscOptionItems *Pe
     PetscCall(PetscStrncpy(b->inner_type, inner, sizeof(b->inner_type)));
   }
   PetscCall(MatBinBCSRReadOptions_Private(mat, PetscOptionsObject)); /* the -mat_binbcsr_* options, forwarded to both parts */
-  PetscCall(MatBinBCSRKernelFromOptions_Private(PetscOptionsObject, mat, b->kernel));
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }

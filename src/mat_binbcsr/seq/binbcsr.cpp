@@ -141,7 +141,6 @@ static PetscErrorCode MatSetFromOptions_SeqBinBCSR(Mat A, PetscOptionItems *Pets
   PetscFunctionBegin;
   PetscOptionsHeadBegin(PetscOptionsObject, "MATSEQBINBCSR options");
   PetscCall(MatBinBCSRReadOptions_Private(A, PetscOptionsObject));
-  PetscCall(MatBinBCSRKernelFromOptions_Private(PetscOptionsObject, A, ((Mat_SeqBinBCSR *)A->data)->kernel));
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }

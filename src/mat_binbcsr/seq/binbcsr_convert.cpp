@@ -398,8 +398,8 @@ PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
       const PetscInt groups = a->nslots / a->bw, unit = MatSeqBinBCSRCountUnitStrideGroups(a);
       PetscCall(PetscViewerASCIIPrintf(viewer, "slot groups over consecutive block columns (x%s read without gathers): %" PetscInt_FMT " of %" PetscInt_FMT " (%.1f%%)\n", a->sym ? " and y" : "", unit, groups, groups ? 100.0 * (double)unit / (double)groups : 0.0));
       PetscCall(PetscViewerASCIIPrintf(viewer, "product: %" PetscInt_FMT " run(s) of bins swept side by side (-mat_binbcsr_streams)\n", a->streams));
-      PetscCall(PetscViewerASCIIPrintf(viewer, "product body: %s (-mat_binbcsr_kernel %s)\n", binbcsr::body_set_name(MatSeqBinBCSRSelectBody(a).set), MatBinBCSRKernels[a->kernel]));
     }
+    PetscCall(PetscViewerASCIIPrintf(viewer, "product body: %s (-mat_binbcsr_kernel %s)\n", binbcsr::body_set_name(MatSeqBinBCSRSelectBody(a).set), MatBinBCSRKernels[a->kernel]));
     if (a->coo_jmap || a->coo_mirror) {
       const char *refill = a->coo_slot_state == 1 ? "by whole blocks" : a->coo_slot_state == -1 ? "value by value (the list is not made of whole blocks)" : "path chosen at the first refill";
       if (a->coo_jmap) PetscCall(PetscViewerASCIIPrintf(viewer, "COO: %" PetscCount_FMT " entries, refill %s%s\n", a->coo_n, refill, a->coo_mirror ? "; mirror on (entries of off-diagonal blocks also fill the transposed place)" : ""));

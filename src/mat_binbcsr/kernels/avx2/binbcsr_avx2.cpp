@@ -4,14 +4,13 @@
 #define BINBCSR_BODY_SET avx2
 #include "../binbcsr_bin_drivers.h"
 
+#if defined(__AVX2__) && defined(__FMA__)
+  #define BINBCSR_TARGETED true
+#else
+  #define BINBCSR_TARGETED false
+#endif
+
 bool binbcsr::bodies_avx2(const Shape &s, Body &b)
 {
-#if defined(__AVX2__) && defined(__FMA__)
-  b.set = BodySet::AVX2;
-  return drivers::bodies(s, b, true);
-#else
-  (void)s;
-  (void)b;
-  return false;
-#endif
+  return drivers::simd_bodies(s, b, BodySet::AVX2, BINBCSR_TARGETED);
 }

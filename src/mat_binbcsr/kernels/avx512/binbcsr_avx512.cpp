@@ -7,14 +7,13 @@
 #endif
 #include "../binbcsr_bin_drivers.h"
 
+#if defined(BINBCSR_HAND_AVX512)
+  #define BINBCSR_TARGETED true
+#else
+  #define BINBCSR_TARGETED false
+#endif
+
 bool binbcsr::bodies_avx512(const Shape &s, Body &b)
 {
-#if defined(BINBCSR_HAND_AVX512)
-  b.set = BodySet::AVX512;
-  return drivers::bodies(s, b, true);
-#else
-  (void)s;
-  (void)b;
-  return false;
-#endif
+  return drivers::simd_bodies(s, b, BodySet::AVX512, BINBCSR_TARGETED);
 }

@@ -47,9 +47,10 @@ inline void add_xyz(double *ys, __m512d s0, __m512d s1, __m512d s2)
 
 /* One slot group of the whole-storage product (3x3 blocks, 8 lanes): a[i] (lane l in element l) +=
    block(i, j) x_c(j). Consecutive-column groups load x (split_xyz); the others gather it with 32-bit
-   offsets. */
+   offsets. real: the lanes whose slot is a real block; x_c of the others is zero (a masked gather
+   reads nothing for them): zero times a NaN or Inf of x would be a NaN the row does not have. */
 template <typename V, typename I>
-inline void group_mult_3x8(const V *t, const I *c, const double *x, __m512d *a)
+inline void group_mult_3x8(const V *t, const I *c, const double *x, __m512d *a, __mmask8 real)
 {
   static_assert(sizeof(I) == 4, "32-bit column indices");
   const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
@@ -57,12 +58,16 @@ inline void group_mult_3x8(const V *t, const I *c, const double *x, __m512d *a)
   const __m256i ci = _mm256_loadu_si256((const __m256i *)c);
   __m512d       x0, x1, x2;
   /* unit_stride<8>(c) as one vector compare: the indices are in a register already */
-  if (_mm256_cmpeq_epi32_mask(ci, _mm256_add_epi32(_mm256_set1_epi32((int)c[0]), iota)) == 0xFF) split_xyz(x + (long)c[0] * 3, x0, x1, x2);
-  else {
+  if (_mm256_cmpeq_epi32_mask(ci, _mm256_add_epi32(_mm256_set1_epi32((int)c[0]), iota)) == 0xFF) {
+    split_xyz(x + (long)c[0] * 3, x0, x1, x2);
+    x0 = _mm512_maskz_mov_pd(real, x0);
+    x1 = _mm512_maskz_mov_pd(real, x1);
+    x2 = _mm512_maskz_mov_pd(real, x2);
+  } else {
     const __m256i off = _mm256_add_epi32(ci, _mm256_add_epi32(ci, ci)); /* 3 c */
-    x0                = _mm512_i32gather_pd(off, x, 8);
-    x1                = _mm512_i32gather_pd(off, x + 1, 8);
-    x2                = _mm512_i32gather_pd(off, x + 2, 8);
+    x0                = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), real, off, x, 8);
+    x1                = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), real, off, x + 1, 8);
+    x2                = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), real, off, x + 2, 8);
   }
   a[0] = _mm512_fmadd_pd(load8(t + 16), x2, _mm512_fmadd_pd(load8(t + 8), x1, _mm512_fmadd_pd(load8(t), x0, a[0])));
   a[1] = _mm512_fmadd_pd(load8(t + 40), x2, _mm512_fmadd_pd(load8(t + 32), x1, _mm512_fmadd_pd(load8(t + 24), x0, a[1])));
@@ -74,12 +79,15 @@ inline void group_mult_3x8(const V *t, const I *c, const double *x, __m512d *a)
    in turn; the accumulators stay in registers for the whole sweep. K bins far apart in memory are K
    streams for the hardware prefetcher (bins_sweep in binbcsr_bin_drivers.h says why). */
 template <int K, typename V, typename I>
-inline void bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, const int *len, const double *x, double (*const *acc)[8])
+inline void bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, const int *len, const int (*nz)[8], const double *x, double (*const *acc)[8])
 {
   __m512d a[K][3];
-  for (int q = 0; q < K; q++)
+  __m256i n[K]; /* the lanes' real blocks: slot group k of lane l is real when k < n[l] */
+  for (int q = 0; q < K; q++) {
+    n[q] = _mm256_loadu_si256((const __m256i *)nz[q]);
     for (int i = 0; i < 3; i++) a[q][i] = _mm512_loadu_pd(acc[q][i]);
-  interleave_groups<K>(len, [&](int q, int k) { group_mult_3x8(bin_val[q] + (long)k * 72, bin_col[q] + (long)k * 8, x, a[q]); });
+  }
+  interleave_groups<K>(len, [&](int q, int k) { group_mult_3x8(bin_val[q] + (long)k * 72, bin_col[q] + (long)k * 8, x, a[q], _mm256_cmpgt_epi32_mask(n[q], _mm256_set1_epi32(k))); });
   for (int q = 0; q < K; q++)
     for (int i = 0; i < 3; i++) _mm512_storeu_pd(acc[q][i], a[q][i]);
 }
@@ -96,18 +104,20 @@ struct SymBin3x8 {
   const V *t;
   const I *c;
   I        r0;
-  int      nreal;
-  __m256i  own;
+  int      nreal, k; /* k: the next slot group */
+  __m256i  own, kd;  /* kd: the slot group of each lane's diagonal block (-1: none) */
   __m512d  r[3], a[3];
 };
 
 template <typename V, typename I>
-inline void sym_bin_begin_3x8(SymBin3x8<V, I> &b, const V *bin_val, const I *bin_col, I r0, I mbs, const double *x)
+inline void sym_bin_begin_3x8(SymBin3x8<V, I> &b, const V *bin_val, const I *bin_col, I r0, I mbs, const int *kd, const double *x)
 {
   const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   b.t                = bin_val;
   b.c                = bin_col;
   b.r0               = r0;
+  b.k                = 0;
+  b.kd               = _mm256_loadu_si256((const __m256i *)kd);
   b.nreal            = mbs - r0 < 8 ? (int)(mbs - r0) : 8;
   b.own              = _mm256_mask_blend_epi32((__mmask8)((1u << b.nreal) - 1), _mm256_set1_epi32((int)mbs - 1), _mm256_add_epi32(_mm256_set1_epi32((int)r0), iota));
   for (int i = 0; i < 3; i++) b.a[i] = _mm512_setzero_pd();
@@ -133,13 +143,18 @@ inline void sym_bin_group_3x8(SymBin3x8<V, I> &b, const double *x, double *y)
   const __m256i ci = _mm256_loadu_si256((const __m256i *)c);
   __m512d       v[9], xc[3], s[3];
   for (int e = 0; e < 9; e++) v[e] = load8(t + e * 8);
-  const bool unit = _mm256_cmpeq_epi32_mask(ci, _mm256_add_epi32(_mm256_set1_epi32((int)c[0]), iota)) == 0xFF;
-  __m256i    off  = _mm256_add_epi32(ci, _mm256_add_epi32(ci, ci)); /* 3 c */
-  if (unit) split_xyz(x + (long)c[0] * 3, xc[0], xc[1], xc[2]);
-  else
-    for (int j = 0; j < 3; j++) xc[j] = _mm512_i32gather_pd(off, x + j, 8);
+  const bool     unit    = _mm256_cmpeq_epi32_mask(ci, _mm256_add_epi32(_mm256_set1_epi32((int)c[0]), iota)) == 0xFF;
+  __m256i        off     = _mm256_add_epi32(ci, _mm256_add_epi32(ci, ci)); /* 3 c */
+  const __mmask8 scatter = _mm256_cmpneq_epi32_mask(ci, b.own);            /* not the diagonal block, not padding */
+  /* real blocks: the off-diagonal ones and the diagonal block; padding's x_c reads as zero (zero times a
+     NaN or Inf of x_own would be a NaN the row does not have) */
+  const __mmask8 real = scatter | _mm256_cmpeq_epi32_mask(b.kd, _mm256_set1_epi32(b.k++));
+  if (unit) {
+    split_xyz(x + (long)c[0] * 3, xc[0], xc[1], xc[2]);
+    for (int j = 0; j < 3; j++) xc[j] = _mm512_maskz_mov_pd(real, xc[j]);
+  } else
+    for (int j = 0; j < 3; j++) xc[j] = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), real, off, x + j, 8);
   for (int i = 0; i < 3; i++) b.a[i] = _mm512_fmadd_pd(v[3 * i + 2], xc[2], _mm512_fmadd_pd(v[3 * i + 1], xc[1], _mm512_fmadd_pd(v[3 * i], xc[0], b.a[i])));
-  const __mmask8 scatter = _mm256_cmpneq_epi32_mask(ci, b.own); /* not the diagonal block, not padding */
   if (!scatter) return;
   for (int j = 0; j < 3; j++) s[j] = _mm512_fmadd_pd(v[6 + j], b.r[2], _mm512_fmadd_pd(v[3 + j], b.r[1], _mm512_mul_pd(v[j], b.r[0])));
   if (unit) add_xyz(y + (long)c[0] * 3, s[0], s[1], s[2]); /* all lanes scatter: c0 != r0 */
@@ -163,14 +178,14 @@ inline void sym_bin_end_3x8(const SymBin3x8<V, I> &b, double *y)
 }
 
 template <int K, typename V, typename I>
-inline void sym_bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, const int *len, const I *r0, I mbs, const double *x, double *y)
+inline void sym_bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, const int *len, const I *r0, I mbs, const int (*kd)[8], const double *x, double *y)
 {
   /* interleave_groups' order written out: through its lambda this body ran slower (upper double at
      48^3, three alternations: 7.0-7.6 ms against 6.5-6.9) */
   SymBin3x8<V, I> b[K];
   int             common = len[0];
   for (int q = 0; q < K; q++) {
-    sym_bin_begin_3x8(b[q], bin_val[q], bin_col[q], r0[q], mbs, x);
+    sym_bin_begin_3x8(b[q], bin_val[q], bin_col[q], r0[q], mbs, kd[q], x);
     common = len[q] < common ? len[q] : common;
   }
   for (int k = 0; k < common; k++)

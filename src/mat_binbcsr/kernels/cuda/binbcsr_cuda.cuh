@@ -68,7 +68,7 @@ __global__ void __launch_bounds__(block_threads) bin_mult(const V *__restrict__ 
   const int s0 = bin_start[b], len = (bin_start[b + 1] - s0) / bw;
   double    acc[BS];
   for (int i = 0; i < BS; i++) acc[i] = 0.0;
-  lane_mult<BS, V, int>(val + (long)s0 * BS * BS, col + s0, len, bw, BS, lane, x, acc);
+  lane_mult<BS, V, int>(val + (long)s0 * BS * BS, col + s0, len, bw, BS, lane, x, acc); /* len: padding read (no row lengths here) */
   for (int i = 0; i < BS; i++) y[(long)r * BS + i] = acc[i];
 }
 
@@ -149,7 +149,7 @@ __global__ void __launch_bounds__(block_threads) bin_mult_dot_split8(const V *__
    the colouring makes the scatters of one slot group conflict-free, not those of different groups.
    Compiled (tests/cuda/kernels_device.cu), not yet run on a GPU. */
 template <int BS, typename V>
-__global__ void sym_bin_mult(const V *val, const int *col, const int *bin_start, int nbins, int mbs, int bw, const double *x, double *y)
+__global__ void sym_bin_mult(const V *val, const int *col, const int *bin_start, const int *diag_slot, int nbins, int mbs, int bw, const double *x, double *y)
 {
   const int b = blockIdx.x, lane = threadIdx.x, r = b * bw + lane;
   if (b >= nbins || lane >= bw) return;
@@ -159,7 +159,8 @@ __global__ void sym_bin_mult(const V *val, const int *col, const int *bin_start,
     acc[i] = 0.0;
     xr[i]  = r < mbs ? x[(long)r * BS + i] : 0.0;
   }
-  sym_lane_mult<BS, V, int>(val + (long)s0 * BS * BS, col + s0, len, bw, BS, lane, own, x, xr, y, acc);
+  const int kd = r < mbs && diag_slot[r] >= 0 ? (diag_slot[r] - s0) / bw : -1;
+  sym_lane_mult<BS, V, int>(val + (long)s0 * BS * BS, col + s0, len, bw, BS, lane, own, kd, x, xr, y, acc);
   if (r < mbs)
     for (int i = 0; i < BS; i++) atomicAdd(&y[(long)r * BS + i], acc[i]);
 }

@@ -1,7 +1,7 @@
 /* MatBinBCSRSetKernel / GetKernel and the -mat_binbcsr_kernel option: the PETSc face of the body sets
    of src/mat_binbcsr/kernels/ (binbcsr_dispatch.h). The choice itself is select_body's. */
-#include "seq/binbcsr.h"
-#include "mpi/mpibinbcsr.h"
+#include "../seq/binbcsr.h"
+#include "../mpi/mpibinbcsr.h"
 
 const char *const MatBinBCSRKernels[] = {"auto", "portable", "avx2", "avx512", "MatBinBCSRKernel", "MAT_BINBCSR_KERNEL_", nullptr};
 
@@ -51,16 +51,5 @@ PetscErrorCode MatBinBCSRGetKernel(Mat A, MatBinBCSRKernel *kernel)
     if (b->A) PetscCall(MatBinBCSRGetKernel(b->A, kernel)); /* the diagonal part: the bulk of the work */
     else *kernel = (MatBinBCSRKernel)binbcsr::select_body({A->rmap->bs, b->bin_width ? (int)b->bin_width : (int)BinBCSRDefaultBinWidth(A->rmap->bs), b->streams ? (int)b->streams : BINBCSR_DEFAULT_STREAMS, b->precision == MAT_BINBCSR_PRECISION_SINGLE, b->sym ? true : false}, (binbcsr::BodySet)b->kernel).set;
   }
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode MatBinBCSRKernelFromOptions_Private(PetscOptionItems *PetscOptionsObject, Mat A, MatBinBCSRKernel current)
-{
-  PetscBool        set;
-  MatBinBCSRKernel k = current;
-
-  PetscFunctionBegin;
-  PetscCall(PetscOptionsEnum("-mat_binbcsr_kernel", "Body set of the products (auto: the best this CPU has)", "MatBinBCSRSetKernel", MatBinBCSRKernels, (PetscEnum)k, (PetscEnum *)&k, &set));
-  if (set) PetscCall(MatBinBCSRSetKernel(A, k));
   PetscFunctionReturn(0);
 }
