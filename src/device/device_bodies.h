@@ -46,6 +46,7 @@ struct MCGState {
   double rr;                                 /* r.r of the last reduction (breakdown test) */
   double anorm, xnorm, sum_x, sum_r, floor_; /* rounding drift and precision floor estimates */
   double last_true, true_rnorm;
+  double norm_ratio; /* KSP norm / 2-norm of the latest nonzero residual (precision floor test) */
 };
 
 constexpr double mcg_eps          = 2.220446049250313e-16; /* PETSC_MACHINE_EPSILON */
@@ -122,6 +123,7 @@ BINBCSR_HD void mcg_start_step(MCGState &s, const double *dots, double *hist)
   s.sum_x += s.xnorm;
   s.sum_r += sqrt(mcg_abs(dots[MCG_DOT_RR]));
   s.rnorm = mcg_norm(s, dots);
+  if (dots[MCG_DOT_RR] > 0) s.norm_ratio = s.rnorm / sqrt(dots[MCG_DOT_RR]);
   if (hist) hist[0] = s.rnorm;
   s.nhist = 1;
 }
@@ -169,7 +171,8 @@ BINBCSR_HD void mcg_step(MCGState &s, const double *dots, double *hist)
   if (s.roundoff > 0 && (s.reason == 0 || mcg_claim(s.reason))) {
     const double r_un = sqrt(mcg_abs(dots[MCG_DOT_RR]));
     s.floor_          = s.roundoff * s.anorm * s.xnorm;
-    if (r_un <= s.floor_) {
+    if (r_un > 0) s.norm_ratio = dp / r_un;
+    if (r_un <= s.floor_ && !mcg_floor_below_tolerance(s.floor_, s.norm_ratio, s.ttol)) {
       s.reason    = 0; /* the claim is withheld */
       s.floor_hit = 1;
     }

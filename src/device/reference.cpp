@@ -54,7 +54,15 @@ void sym_mult(const Layout &L, const V *val, const double *x, double *y)
       const bool real = r < L.mbs;
       double     acc[BS ? BS : 8] = {0}, xr[BS ? BS : 8] = {0};
       for (int i = 0; i < bs && real; i++) xr[i] = x[r * bs + i];
-      sym_lane_mult<BS, V, int>(val + (long)s0 * bs2, L.col + s0, len, L.bw, bs, lane, real ? (int)r : L.mbs - 1, x, xr, y, acc);
+      const int  own  = real ? (int)r : L.mbs - 1;
+      /* The device layout carries no diagonal-slot map: the diagonal block is the lane's first slot of
+         column own (padding follows the real slots and also names own). A row without a diagonal
+         block then multiplies one padding slot by x_own (zero unless x_own is not finite): the device
+         products are not yet NaN-exact (docs/gpu.md). */
+      int kd = -1;
+      for (int k = 0; k < len && kd < 0; k++)
+        if (L.col[s0 + (long)k * L.bw + lane] == own) kd = k;
+      sym_lane_mult<BS, V, int>(val + (long)s0 * bs2, L.col + s0, len, L.bw, bs, lane, own, kd, x, xr, y, acc);
       for (int i = 0; i < bs && real; i++) y[r * bs + i] += acc[i];
     }
   }

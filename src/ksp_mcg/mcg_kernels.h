@@ -131,4 +131,15 @@ BINBCSR_HD void mcg_dots_index(long i, const Scalar *r, const Scalar *u, Scalar 
   uu += ui * ui;
 }
 
+/* Precision floor (single-precision storage): b - A x for the assembled double values differs from
+   the residual of the rounded operator by up to floor = u ||A|| ||x|| (2-norm). A tolerance claim
+   with the recursive 2-norm residual at or below the floor is still honest when the floor, carried
+   into the KSP's norm by ratio (KSP norm / 2-norm of the latest nonzero residual), lies below the
+   tolerance ttol the claim was made against; otherwise it is withheld. ttol <= 0 (a convergence test
+   that does not say) or no ratio yet (0) withholds. */
+BINBCSR_HD bool mcg_floor_below_tolerance(double floor, double ratio, double ttol)
+{
+  return ttol > 0 && ratio > 0 && floor * ratio < ttol;
+}
+
 #endif

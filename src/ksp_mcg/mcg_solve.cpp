@@ -338,6 +338,7 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
   PetscScalar gamma, gamma_old = 1.0, delta, pAp = 0.0, alpha, beta;
   PetscReal   dp, last_true = PETSC_MAX_REAL;
   PetscReal   anorm = 0, sum_x = 0, sum_r = 0, xnorm = 0; /* for the rounding-drift estimate */
+  PetscReal   norm_ratio = 0;                             /* KSP norm / 2-norm of the latest nonzero r */
   PetscBool   fresh = PETSC_TRUE; /* p and s start from zero: first iteration or after a restart */
   PetscInt    i, max_its;
   PetscBool   defer_product; /* one process, convergence tested: the next w = A u after the test */
@@ -398,6 +399,7 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
   MCGTrackDrift(dots, &anorm, &sum_x, &sum_r, &xnorm);
 
   dp = MCGNorm(ksp, dots);
+  if (PetscRealPart(dots[MCG_DOT_RR]) > 0) norm_ratio = dp / PetscSqrtReal(PetscAbsScalar(dots[MCG_DOT_RR]));
   PetscCall(KSPLogResidualHistory(ksp, dp));
   PetscCall(KSPMonitor(ksp, 0, dp));
   ksp->rnorm = dp;
@@ -490,8 +492,8 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
     /* Precision floor. When the operator's products are rounded at relative u (single-precision
        storage), b - A x against the values the user assembled differs from the residual MCG
        iterates on by up to about u ||A|| ||x|| (||A|| from the largest Rayleigh quotient seen,
-       ||x|| from the reduced x.x: both free). A tolerance met at or below that floor cannot be
-       claimed honestly, so the claim is withheld; the iteration goes on until the residual of the
+       ||x|| from the reduced x.x: both free). A claim whose residual is below that floor, against a tolerance that is not above it
+       (mcg_floor_below_tolerance), cannot be made honestly, so it is withheld; the iteration goes on until the residual of the
        rounded system is MCG_FLOOR_DEPTH below the floor (the solution is then as good as the
        rounded operator allows: the estimate is a bound, the actual plateau is usually a few times
        lower) and stops with KSP_DIVERGED_BREAKDOWN, reporting the floor as the residual norm. */
@@ -500,7 +502,8 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
       mcg->floor       = mcg->roundoff * anorm * xnorm;
       mcg->floor_anorm = anorm;
       mcg->floor_xnorm = xnorm;
-      if (r_un <= mcg->floor) {
+      if (r_un > 0) norm_ratio = dp / r_un;
+      if (r_un <= mcg->floor && !mcg_floor_below_tolerance(mcg->floor, norm_ratio, ksp->converged == KSPConvergedDefault ? ksp->ttol : 0)) {
         if (ksp->reason) {
           if (!mcg->floor_hit) PetscCall(PetscInfo(ksp, "Tolerance met at residual norm %g, at or below the precision floor u ||A|| ||x|| = %g (u %g, ||A|| >= %g, ||x|| %g): claim withheld\n", (double)r_un, (double)mcg->floor, (double)mcg->roundoff, (double)anorm, (double)xnorm));
           ksp->reason = KSP_CONVERGED_ITERATING;

@@ -176,3 +176,33 @@ TEST_CASE("extremes: single storage on an ill-conditioned system reports its flo
   MatDestroy(&A);
   VecDestroy(&b);
 }
+
+TEST_CASE("precision floor: a residual that reaches zero below the floor, tolerance far above it, converges",
+          "[ksp_mcg][floor]")
+{
+  // A scaled identity with Jacobi: the first iteration solves the system exactly, so the recursive
+  // residual drops to zero, below the floor u ||A|| ||x||, while rtol 1e-6 lies far above that floor:
+  // the claim is honest (b - A x is at most the floor) and must stand, not end as a breakdown.
+  Mat A = diagonal(std::vector<PetscScalar>(60, 2.0));
+  Vec b = rhs(A);
+  PetscInt m, n, M, N;
+  Mat      S;
+  MatGetLocalSize(A, &m, &n);
+  MatGetSize(A, &M, &N);
+  REQUIRE(MatCreateShell(PETSC_COMM_WORLD, m, n, M, N, A, &S) == 0);
+  MatShellSetOperation(S, MATOP_MULT, (void (*)(void))ShellMult);
+  for (KSPNormType nt : {KSP_NORM_PRECONDITIONED, KSP_NORM_UNPRECONDITIONED, KSP_NORM_NATURAL}) {
+    Result r = solve(S, b, Solve{KSPMCG, PCNONE, nt, 1e-6, 1000, 0, "-ksp_mcg_precision_floor 6e-8"});
+    CHECK(r.reason > 0);
+    CHECK(r.its <= 2);
+  }
+  if (Mat B = to_binbcsr(A, MAT_BINBCSR_PRECISION_SINGLE)) {
+    Result r = solve(B, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_PRECONDITIONED, 1e-6});
+    CHECK(r.reason > 0);
+    CHECK(r.its <= 2);
+    MatDestroy(&B);
+  }
+  MatDestroy(&S);
+  MatDestroy(&A);
+  VecDestroy(&b);
+}
