@@ -39,6 +39,35 @@ void gather(const FemModel &model, int e, int l, const double *x, const double *
   b.vol[l] = model.volume[e];
 }
 
+// Asks for the cache lines batch [start, start + m) will touch: its nodes' entries of x, v, X and rhs and
+// its COO blocks. The write-out adds into blocks spread over several MB (6.7 MB of values for
+// linear_38k): one batch ahead took the loop from 12-14 to 10.3-10.7 ms there (further ahead: no
+// better).
+template <int N, bool Blocks>
+void prefetch_batch(const FemModel &model, const std::vector<int> &elements, size_t start, int m, const double *x, const double *v,
+                    const double *rhs, const BlockPattern *pattern, const double *values)
+{
+  const double *X = model.mesh.nodes.data();
+  for (int l = 0; l < m; ++l) {
+    const int *nodes = &model.mesh.elements[static_cast<size_t>(elements[start + l]) * N];
+    for (int a = 0; a < N; ++a) {
+      const size_t n = 3 * static_cast<size_t>(nodes[a]);
+      __builtin_prefetch(x + n);
+      __builtin_prefetch(v + n);
+      __builtin_prefetch(X + n);
+      __builtin_prefetch(rhs + n, 1);
+    }
+    if (!Blocks) continue;
+    const int *slot = &pattern->element_slots[(start + l) * N * N];
+    for (int k = 0; k < N * N; ++k) {
+      if (slot[k] < 0) continue;
+      const double *out = values + 9 * static_cast<size_t>(slot[k] & kSlotIndexMask);
+      __builtin_prefetch(out, 1);
+      __builtin_prefetch(out + 8, 1);
+    }
+  }
+}
+
 // Adds the row-major 3x3 block B (entry j at B[j * W]) into COO block s, or stores it where s is the
 // block's first write (kFirstContribution); transposed: B^T.
 inline void write_block(double *values, int s, const double *B, bool transposed)
@@ -70,6 +99,9 @@ long long assemble_batched(const FemModel &model, const std::vector<int> &elemen
   const size_t n = elements.size();
   for (size_t start = 0; start < n; start += W) {
     const int m = static_cast<int>(std::min<size_t>(W, n - start));
+    if (start + W < n)
+      prefetch_batch<N, Blocks>(model, elements, start + W, static_cast<int>(std::min<size_t>(W, n - start - W)), x, v, rhs, pattern,
+                                values);
     // Lanes past the end repeat the last element; nothing of theirs is written out.
     for (int l = 0; l < W; ++l) gather<N>(model, elements[start + std::min(l, m - 1)], l, x, v, b);
     if (corotational) {
