@@ -17,6 +17,7 @@ struct alignas(64) Batch {
   double               x[3 * N * W], v[3 * N * W], X[3 * N * W];
   double               Dinv[9 * W], F[9 * W], R[9 * W], vol[W];
   double               rhs[3 * N * W], blocks[NB * 9 * W];
+  double               Q[N == 10 ? 16 * 9 * W : 1]; // P2: the rotated gradient pairs
   double               ok[W]; // polar_rotation's acceptance per lane
 };
 
@@ -126,8 +127,15 @@ long long assemble_batched(const FemModel &model, const std::vector<int> &elemen
     } else {
 #pragma omp simd
       for (int l = 0; l < W; ++l)
-        kernels::p2_element<W, Blocks, MassDamping>(b.x + l, b.v + l, b.X + l, b.Dinv + l, b.R + l, b.vol[l], k, Mref,
-                                                    b.rhs + l, b.blocks + l);
+        kernels::p2_forces<W, MassDamping>(b.x + l, b.v + l, b.X + l, b.Dinv + l, b.R + l, b.vol[l], k, Mref, b.rhs + l);
+      if (Blocks) {
+#pragma omp simd
+        for (int l = 0; l < W; ++l) kernels::p2_gradient_pairs<W>(b.Dinv + l, b.R + l, b.vol[l], k, b.Q + l);
+        for (int p = 0; p < 55; ++p) {
+#pragma omp simd
+          for (int l = 0; l < W; ++l) kernels::p2_block<W>(p, b.Q + l, b.vol[l], k, Mref, b.blocks + 9 * p * W + l);
+        }
+      }
     }
     // Out in element order, lane after lane: the first-write marks of the slot map follow that order.
     for (int l = 0; l < m; ++l) {

@@ -24,21 +24,47 @@ namespace kernels {
 constexpr int kP2EdgeCorners[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
 constexpr int kP2EdgeOf[4][4]      = {{-1, 0, 2, 3}, {0, -1, 1, 4}, {2, 1, -1, 5}, {3, 4, 5, -1}};
 
-// B += coef Q_cd, with Q_dc = Q_cd^T and only c <= d stored (Q[packed (c, d)], row-major).
-BINBCSR_PHYS_HD void add_gradient_pair(double B[9], const double Q[10][9], int c, int d, double coef)
-{
-  const int lo = c < d ? c : d, hi = c < d ? d : c, q = lo * 4 - lo * (lo - 1) / 2 + (hi - lo);
-  BINBCSR_PHYS_UNROLL
-  for (int i = 0; i < 3; ++i)
-    BINBCSR_PHYS_UNROLL
-    for (int j = 0; j < 3; ++j) B[3 * i + j] += coef * (c <= d ? Q[q][3 * i + j] : Q[q][3 * j + i]);
-}
+// The terms of block p (packed upper pair (a, b) of the 10 nodes): B_ab = sum_t coef_t Q_(cd_t) with
+// Q_cd at cd = 4 c + d (all 16 pairs stored, Q_dc = Q_cd^T); blocks with fewer than 4 terms are padded
+// with zero coefficients, so every block runs the same code (the lane loop is then one body for all
+// blocks with the block number uniform across the lanes: a fully unrolled 55-block body was left
+// scalar by GCC).
+struct P2BlockTerms {
+  int    a[55], b[55], cd[55][4];
+  double coef[55][4];
+  constexpr P2BlockTerms() : a(), b(), cd(), coef()
+  {
+    int p = 0;
+    for (int i = 0; i < 10; ++i)
+      for (int j = i; j < 10; ++j, ++p) {
+        a[p] = i, b[p] = j;
+        int n = 0;
+        auto add = [&](int c, int d, double w) { cd[p][n] = 4 * c + d, coef[p][n] = w, ++n; };
+        if (j < 4) { // corner-corner
+          add(i, j, i == j ? 3.0 / 5 : -1.0 / 5);
+        } else if (i < 4) { // corner-edge
+          const int e0 = kP2EdgeCorners[j - 4][0], e1 = kP2EdgeCorners[j - 4][1];
+          add(i, e0, i == e1 ? 3.0 / 5 : -1.0 / 5);
+          add(i, e1, i == e0 ? 3.0 / 5 : -1.0 / 5);
+        } else { // edge-edge
+          const int e0 = kP2EdgeCorners[i - 4][0], e1 = kP2EdgeCorners[i - 4][1];
+          const int f0 = kP2EdgeCorners[j - 4][0], f1 = kP2EdgeCorners[j - 4][1];
+          add(e0, f0, e1 == f1 ? 8.0 / 5 : 4.0 / 5);
+          add(e0, f1, e1 == f0 ? 8.0 / 5 : 4.0 / 5);
+          add(e1, f0, e0 == f1 ? 8.0 / 5 : 4.0 / 5);
+          add(e1, f1, e0 == f0 ? 8.0 / 5 : 4.0 / 5);
+        }
+        while (n < 4) add(0, 0, 0.0);
+      }
+  }
+};
+constexpr P2BlockTerms kP2Blocks{};
 
-// One quadratic tetrahedron: rhs (30) = -R sum_b K0_ab z_b - a_M m sum_b Mref_ab v_b, blocks (55 x 9,
-// when Blocks) = c_K R K0_ab R^T + c_M m Mref_ab I, m = rho V; Mref: 10 x 10 reference mass.
-template <int S, bool Blocks, bool MassDamping>
-BINBCSR_PHYS_HD void p2_element(const double *x, const double *v, const double *X, const double *Dinv, const double *R,
-                                double vol, const ElementConstants &k, const double *Mref, double *rhs, double *blocks)
+// One quadratic tetrahedron's forces: rhs (30) = -R sum_b K0_ab z_b - a_M m sum_b Mref_ab v_b, m = rho V;
+// Mref: 10 x 10 reference mass.
+template <int S, bool MassDamping>
+BINBCSR_PHYS_HD void p2_forces(const double *x, const double *v, const double *X, const double *Dinv, const double *R, double vol,
+                               const ElementConstants &k, const double *Mref, double *rhs)
 {
   double g[4][3], z[10][3];
   barycentric_gradients<S>(Dinv, g);
@@ -92,47 +118,57 @@ BINBCSR_PHYS_HD void p2_element(const double *x, const double *v, const double *
       rhs[(3 * a + d) * S] = -vol * f[d] - k.mass_rhs * m * mv;
     }
   }
-  if (!Blocks) return;
-  // Rotated Q_cd, c <= d, scaled by c_K V.
-  double rg[4][3], Q[10][9];
+}
+
+// Its rotated gradient pairs Q_cd (16 x 9, row-major, at (9 (4 c + d) + e) S), scaled by c_K V.
+template <int S>
+BINBCSR_PHYS_HD void p2_gradient_pairs(const double *Dinv, const double *R, double vol, const ElementConstants &k, double *Q)
+{
+  double g[4][3], rg[4][3];
+  barycentric_gradients<S>(Dinv, g);
   BINBCSR_PHYS_UNROLL
   for (int c = 0; c < 4; ++c) rotate<S>(R, g[c], rg[c]);
   const double kv = k.stiffness_matrix * vol, kl = kv * k.lambda, km = kv * k.mu;
-  int          q  = 0;
   BINBCSR_PHYS_UNROLL
   for (int c = 0; c < 4; ++c)
     BINBCSR_PHYS_UNROLL
-    for (int d = c; d < 4; ++d, ++q) {
+    for (int d = 0; d < 4; ++d) {
       const double diag = km * (g[c][0] * g[d][0] + g[c][1] * g[d][1] + g[c][2] * g[d][2]);
       BINBCSR_PHYS_UNROLL
       for (int i = 0; i < 3; ++i)
         BINBCSR_PHYS_UNROLL
-        for (int j = 0; j < 3; ++j) Q[q][3 * i + j] = kl * rg[c][i] * rg[d][j] + km * rg[d][i] * rg[c][j] + (i == j ? diag : 0.0);
+        for (int j = 0; j < 3; ++j)
+          Q[(9 * (4 * c + d) + 3 * i + j) * S] = kl * rg[c][i] * rg[d][j] + km * rg[d][i] * rg[c][j] + (i == j ? diag : 0.0);
     }
-  int p = 0;
+}
+
+// Block p of its 55 upper blocks: c_K R K0_ab R^T + c_M m Mref_ab I, m = rho V, from the pairs Q.
+template <int S>
+BINBCSR_PHYS_HD void p2_block(int p, const double *Q, double vol, const ElementConstants &k, const double *Mref, double *block)
+{
+  double B[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
   BINBCSR_PHYS_UNROLL
-  for (int a = 0; a < 10; ++a)
+  for (int t = 0; t < 4; ++t) {
+    const double  w = kP2Blocks.coef[p][t];
+    const double *q = Q + 9 * kP2Blocks.cd[p][t] * S;
     BINBCSR_PHYS_UNROLL
-    for (int b = a; b < 10; ++b, ++p) {
-      double B[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-      if (b < 4) { // corner-corner
-        add_gradient_pair(B, Q, a, b, a == b ? 3.0 / 5 : -1.0 / 5);
-      } else if (a < 4) { // corner-edge
-        const int i = kP2EdgeCorners[b - 4][0], j = kP2EdgeCorners[b - 4][1];
-        add_gradient_pair(B, Q, a, i, a == j ? 3.0 / 5 : -1.0 / 5);
-        add_gradient_pair(B, Q, a, j, a == i ? 3.0 / 5 : -1.0 / 5);
-      } else { // edge-edge
-        const int i = kP2EdgeCorners[a - 4][0], j = kP2EdgeCorners[a - 4][1];
-        const int e = kP2EdgeCorners[b - 4][0], f = kP2EdgeCorners[b - 4][1];
-        add_gradient_pair(B, Q, i, e, j == f ? 8.0 / 5 : 4.0 / 5);
-        add_gradient_pair(B, Q, i, f, j == e ? 8.0 / 5 : 4.0 / 5);
-        add_gradient_pair(B, Q, j, e, i == f ? 8.0 / 5 : 4.0 / 5);
-        add_gradient_pair(B, Q, j, f, i == e ? 8.0 / 5 : 4.0 / 5);
-      }
-      const double mass = k.mass_matrix * m * Mref[10 * a + b];
-      BINBCSR_PHYS_UNROLL
-      for (int j = 0; j < 9; ++j) blocks[(9 * p + j) * S] = B[j] + (j % 4 == 0 ? mass : 0.0);
-    }
+    for (int e = 0; e < 9; ++e) B[e] += w * q[e * S];
+  }
+  const double mass = k.mass_matrix * k.density * vol * Mref[10 * kP2Blocks.a[p] + kP2Blocks.b[p]];
+  BINBCSR_PHYS_UNROLL
+  for (int e = 0; e < 9; ++e) block[e * S] = B[e] + (e % 4 == 0 ? mass : 0.0);
+}
+
+// Both, for a caller that owns one element (S = 1, a GPU thread).
+template <int S, bool Blocks, bool MassDamping>
+BINBCSR_PHYS_HD void p2_element(const double *x, const double *v, const double *X, const double *Dinv, const double *R,
+                                double vol, const ElementConstants &k, const double *Mref, double *rhs, double *blocks)
+{
+  p2_forces<S, MassDamping>(x, v, X, Dinv, R, vol, k, Mref, rhs);
+  if (!Blocks) return;
+  double Q[16 * 9 * S];
+  p2_gradient_pairs<S>(Dinv, R, vol, k, Q);
+  for (int p = 0; p < 55; ++p) p2_block<S>(p, Q, vol, k, Mref, blocks + 9 * p * S);
 }
 
 } // namespace kernels
