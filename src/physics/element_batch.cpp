@@ -186,12 +186,12 @@ long long assemble_elements_batched(const FemModel &model, const std::vector<int
 
 double element_kernel_flops(int order, bool with_blocks)
 {
-  // Counted from the kernels (a multiply-add as 2): deformation gradient 63, 6 Newton steps of about
-  // 110 each; P1 forces about 330 and 10 blocks of 30; P2 forces about 1,100 and 142 gradient pairs of
-  // 18 plus 10 rotated pairs of 40.
-  const double rotation = 63 + 6 * 110;
-  if (order == 1) return rotation + 330 + (with_blocks ? 300 + 80 : 0);
-  return rotation + 1100 + (with_blocks ? 142 * 18 + 400 + 120 : 0);
+  // Counted from the kernels, a multiply-add as 2: deformation gradient 63; Newton 2 scaled steps of
+  // about 110 and 3 plain ones of about 80. P1: forces about 360, blocks 670. P2: forces about 1,650;
+  // blocks: 16 rotated gradient pairs of 40, 55 blocks of 4 (padded) terms of 18, and the mass.
+  const double rotation = 63 + 2 * 110 + 3 * 80;
+  if (order == 1) return rotation + 360 + (with_blocks ? 670 : 0);
+  return rotation + 1650 + (with_blocks ? 16 * 40 + 55 * (4 * 18 + 10) : 0);
 }
 
 } // namespace physics
