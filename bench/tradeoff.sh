@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# bench/tradeoff.sh BUILD OUT QUICK: the speed/accuracy study of issue 7 over examples/fem.
+# bench/tradeoff.sh BUILD OUT QUICK: the speed/accuracy study over examples/fem (the cantilever), then the
+# solver trade of the cloth and linear_38k scenes (at the end of the file).
 #
 # Two scenes, one knob changed at a time from a base point; every run reports its time per step
 # (the driver's summary ms_per_step) and its error against a reference:
@@ -151,3 +152,91 @@ do for [s in "static dynamic"] {
 unset multiplot
 EOF
 echo "  wrote $csv, $out/tradeoff.png"
+
+# ---- The scenes' solver trade: the cloth (options/cloth.opts) and linear_38k (options/linear_38k.opts),
+# error against ms per step over the solver settings. Error after T_SCENE of simulated time against a
+# tightly converged reference run of the same scene: the cloth, rms position difference over all
+# particles (-reference_positions); linear_38k, the distance between the tip displacements. Settings:
+# Jacobi fixed 10/30/100 iterations from zero, Jacobi to rtol 1e-2..1e-6, pbjacobi (fused), multigrid
+# (GAMG: rigid body modes for the FE body, translations for the cloth; set up every step, and once and
+# reused, which only the FE body stands: the cloth's turns indefinite), single and
+# double storage. -quick: the cloth at 40 x 40, 0.25 s; linear_38k left out (its mesh takes minutes).
+scene_csv=$out/tradeoff_scenes.csv
+echo "scene,setting,ms_per_step,error,cg_its,ksp_reason" >"$scene_csv"
+# -pc_gamg_use_sa_esteig 0: with GAMG's smoothed-aggregation estimate the cloth's Chebyshev smoother is
+# indefinite from the third step on (DIVERGED_INDEFINITE_PC at iteration 0); with the smoother's own CG
+# estimate it stays SPD
+gamg=(-pc_type gamg -pc_gamg_esteig_ksp_type cg -mg_levels_ksp_type chebyshev -mg_levels_pc_type jacobi
+      -mg_levels_esteig_ksp_type cg -pc_gamg_use_sa_esteig 0)
+settings=("jacobi_fixed10|-pc_type jacobi -ksp_mcg_fixed_iterations 10 -ksp_max_it 10 -ksp_initial_guess_nonzero 0"
+          "jacobi_fixed30|-pc_type jacobi -ksp_mcg_fixed_iterations 30 -ksp_max_it 30 -ksp_initial_guess_nonzero 0"
+          "jacobi_fixed100|-pc_type jacobi -ksp_mcg_fixed_iterations 100 -ksp_max_it 100 -ksp_initial_guess_nonzero 0")
+for t in 1e-2 1e-3 1e-4 1e-5 1e-6; do settings+=("jacobi_rtol$t|-pc_type jacobi -ksp_mcg_fixed_iterations 0 -ksp_rtol $t"); done
+for t in 1e-2 1e-4 1e-6; do settings+=("pbjacobi_rtol$t|-pc_type pbjacobi -ksp_mcg_fixed_iterations 0 -ksp_rtol $t"); done
+settings+=("pbjacobi_rtol1e-4_single|-pc_type pbjacobi -ksp_mcg_fixed_iterations 0 -ksp_rtol 1e-4 -mat_binbcsr_precision single -ksp_mcg_precision_floor 0"
+           "gamg_rtol1e-4|${gamg[*]} -ksp_mcg_fixed_iterations 0 -ksp_rtol 1e-4"
+           "gamg_rtol1e-6|${gamg[*]} -ksp_mcg_fixed_iterations 0 -ksp_rtol 1e-6"
+           "gamg_reused_rtol1e-6|${gamg[*]} -ksp_reuse_preconditioner -ksp_mcg_fixed_iterations 0 -ksp_rtol 1e-6")
+
+# scene_point SCENE NAME ARGS...: one run, one CSV line
+scene_point() {
+  local scene=$1 name=$2 log
+  shift 2
+  log=$out/tradeoff_${scene}_$name.log
+  if ! "$@" >"$log" 2>&1 && ! grep -q '^summary' "$log"; then note "$scene $name failed (see $log)"; return; fi
+  awk -v sc="$scene" -v nm="$name" -v ref="${scene_ref:-}" '/^summary/ {
+      for (i = 2; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] }
+      if (sc == "cloth") err = v["rms_position_diff"]
+      else { split(ref, q, " "); err = sqrt((v["tip_dx"] - q[1]) ^ 2 + (v["tip_dy"] - q[2]) ^ 2 + (v["tip_dz"] - q[3]) ^ 2) }
+      r = v["ksp_reason"]; if (r == "") r = v["diverged_solves"] > 0 ? "diverged_solves=" v["diverged_solves"] : "ok"
+      printf "%s,%s,%s,%.4e,%s,%s\n", sc, nm, v["ms_per_step"], err, v["cg_its"], r }' "$log" >>"$scene_csv"
+}
+
+clothx=$b/examples/cloth
+if [ -x "$clothx" ]; then
+  if [ "$quick" = 1 ]; then cn=40 csteps=15; else cn=160 csteps=60; fi # dt 1/60 s: 1 s is 60 steps
+  cbase=("$clothx" -options_file options/cloth.opts -cloth_n $cn -steps $csteps -progress_every 100000 -cloth_timer cpu)
+  if "${cbase[@]}" -pc_type pbjacobi -ksp_rtol 1e-10 -ksp_max_it 20000 -write_positions "$out/tradeoff_cloth_reference.txt" \
+       >"$out/tradeoff_cloth_reference.log" 2>&1; then
+    for s in "${settings[@]}"; do
+      IFS='|' read -r name args <<<"$s"
+      scene_point cloth "$name" "${cbase[@]}" -ksp_max_it 5000 $args -reference_positions "$out/tradeoff_cloth_reference.txt"
+    done
+  else
+    note "cloth reference run failed (see $out/tradeoff_cloth_reference.log)"
+  fi
+fi
+if [ "$quick" != 1 ]; then
+  fbase=("$fem" -options_file options/linear_38k.opts -steps 100 -fem_timer cpu -mat_binbcsr_precision double)
+  scene_ref=$(run linear_38k_reference "${fbase[@]}" -ksp_rtol 1e-10 | awk '{ print $2, $3, $4 }')
+  if [ -n "$scene_ref" ] && [ "$scene_ref" != failed ]; then
+    for s in "${settings[@]}"; do
+      IFS='|' read -r name args <<<"$s"
+      # linear_38k's file reuses its GAMG set-up: off unless the setting turns it on again
+      scene_point linear_38k "$name" "${fbase[@]}" -ksp_max_it 5000 -ksp_reuse_preconditioner 0 $args
+    done
+  fi
+fi
+column -s, -t <"$scene_csv" | sed 's/^/  /'
+for sc in cloth linear_38k; do
+  awk -F, -v s=$sc 'NR > 1 && $1 == s && $4 > 0 { split($2, p, "_"); print $3, $4, p[1] (p[2] ~ /fixed/ ? "_fixed" : "") (p[3] == "single" ? "_single" : "") }' "$scene_csv" >"$out/tradeoff_$sc.dat"
+done
+plots=()
+[ -s "$out/tradeoff_cloth.dat" ] && plots+=("cloth|cloth (options/cloth.opts): rms position difference to a converged run, m")
+[ -s "$out/tradeoff_linear_38k.dat" ] && plots+=("linear_38k|linear_38k: tip displacement difference to a converged run, m")
+if [ ${#plots[@]} -gt 0 ]; then
+  {
+    echo 'set terminal pngcairo size 1300,520 font ",10"'
+    echo "set output \"$out/tradeoff_scenes.png\""
+    echo "set multiplot layout 1,${#plots[@]} title \"Solver settings: error after the simulated time against ms per step (binbcsr + mcg, one rank)\""
+    echo 'set logscale xy'; echo 'set grid'; echo 'set xlabel "ms per step"'
+    echo 'set key outside right top noenhanced'; echo 'set format y "10^{%L}"'
+    for p in "${plots[@]}"; do
+      IFS='|' read -r sc title <<<"$p"
+      echo "set title \"$title\""
+      echo "plot for [k in \"jacobi_fixed jacobi pbjacobi pbjacobi_single gamg\"] \"$out/tradeoff_$sc.dat\" using (strcol(3) eq k ? \$1 : NaN):2 with points pt 7 ps 1.3 title k"
+    done
+    echo 'unset multiplot'
+  } | gnuplot 2>&1 | grep -v "Skipping data file with no valid points" || true
+fi
+echo "  wrote $scene_csv, $out/tradeoff_scenes.png"

@@ -9,6 +9,7 @@
 // -velocity_stabilisation, -joint_warm_start (previous step's impulses as initial guesses). Output: a progress
 // line every -progress_every steps, -vtk PREFIX (.vtu per -vtk_every steps plus PREFIX.pvd), -dump_matrix FILE
 // (J M^-1 J^T of the first step, PETSc binary), and a final `summary key=value ...` line.
+#include "sim/run_guard.h"
 #include "sim/sim_driver.h"
 #include "physics/articulated_scenes.hpp"
 #include "physics/articulated_step.hpp"
@@ -208,14 +209,34 @@ int main(int argc, char **argv)
   double e0;
   bool   finite0;
   PetscCall(SceneState(comm, solver.split, scene, &e0, &finite0));
+  RunGuard guard;
+  {
+    // The scene's energy scale: its weight over its extent, plus the kinetic energy it starts with.
+    double          m = 0, ke0 = 0;
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+    for (size_t i = 0; i < scene.bodies.size(); ++i) {
+      const physics::RigidBody &b = scene.bodies[i];
+      m += b.mass;
+      ke0 += physics::mechanical_energy(b, Eigen::Vector3d::Zero());
+      const double r = 0.5 * scene.body_sizes[i].norm();
+      lo = lo.cwiseMin(b.position - Eigen::Vector3d::Constant(r));
+      hi = hi.cwiseMax(b.position + Eigen::Vector3d::Constant(r));
+    }
+    HealthBounds hb;
+    hb.energy_scale  = m * scene.gravity.norm() * (hi - lo).norm() + ke0;
+    hb.energy_growth = 0.1;
+    PetscCall(RunGuardFromOptions(comm, hb, &guard));
+    RunGuardStart(&guard, e0, NAN);
+  }
   double       e_max = e0, worst_error = 0, worst_velocity = 0, step_ms_total = 0;
-  long long    corrections = 0, halvings = 0, max_corrections_seen = 0, unconverged = 0, stalled = 0, singular_steps = 0, nan_steps = 0;
+  long long    done = 0, corrections = 0, halvings = 0, max_corrections_seen = 0, unconverged = 0, stalled = 0, singular_steps = 0, nan_steps = 0;
   for (PetscInt n = 1; n <= out.steps; ++n) {
-    const long long its0 = rs.iterations, solves0 = rs.solves;
+    const long long its0 = rs.iterations, solves0 = rs.solves, diverged0 = rs.diverged_solves;
     const double    solve0 = rs.solve_ms, t0 = WallTime();
     const physics::ArticulatedStepReport r = physics::articulated_step(scene, solver, params, linear);
     const double step_ms = 1e3 * (WallTime() - t0);
     PetscCall(rs.error);
+    ++done;
     step_ms_total += step_ms;
     double energy;
     bool   finite;
@@ -237,7 +258,15 @@ int main(int argc, char **argv)
     if (n == 1 && out.dump) PetscCall(BlockSystemDumpMatrix(&rs.sys, out.dump_path));
     if (out.vtk && n % out.vtk_every == 0) PetscCall(SyncScene(comm, solver.split, scene));
     PetscCall(write_frame(n));
-    if (!finite) break;
+    StepHealth health;
+    // A breakdown that switched the step to the regularised matrix is the physics' own recovery; any
+    // other failed solve leaves the impulses it produced (or zeros) in the step.
+    if (rs.diverged_solves - diverged0 > (r.singular_detected ? 1 : 0)) health.solver_reason = rs.worst_reason;
+    health.energy = energy;
+    health.finite = finite && std::isfinite(energy);
+    bool stop;
+    PetscCall(RunGuardCheckStep(comm, &guard, n, health, &stop));
+    if (stop) break;
   }
   PetscCall(SyncScene(comm, solver.split, scene)); // every body's state on every rank for the summary
 
@@ -252,14 +281,14 @@ int main(int argc, char **argv)
   s.add("loops", (long long)loops);
   s.add("mat_type", std::string(mat_type));
   s.add("ksp_type", std::string(ksp_type));
-  s.add("steps", (long long)out.steps);
+  s.add("steps", done);
   s.add("dt", params.dt);
-  DriverAddSolverSummary(s, rs, out.steps, step_ms_total);
+  DriverAddSolverSummary(s, rs, done, step_ms_total);
   s.add("solves", rs.solves);
-  s.add("cg_its_per_step", out.steps ? (double)rs.iterations / out.steps : 0.0);
-  s.add("corrections_per_step", out.steps ? (double)corrections / out.steps : 0.0);
+  s.add("cg_its_per_step", done ? (double)rs.iterations / done : 0.0);
+  s.add("corrections_per_step", done ? (double)corrections / done : 0.0);
   s.add("corrections_max", max_corrections_seen);
-  s.add("halvings_per_step", out.steps ? (double)halvings / out.steps : 0.0);
+  s.add("halvings_per_step", done ? (double)halvings / done : 0.0);
   s.add("unconverged_steps", unconverged);
   s.add("stalled_steps", stalled);
   s.add("regularised", (long long)solver.regularised);
@@ -271,9 +300,10 @@ int main(int argc, char **argv)
   s.add("energy_final", physics::total_energy(scene));
   s.add("energy_growth_max", e_max - e0);
   s.add("nan", nan_steps);
+  RunGuardAddSummary(s, guard);
   PetscCall(PrintSummary(comm, s));
 
   PetscCall(ReplicatedSolverDestroy(&rs));
   PetscCall(PetscFinalize());
-  return 0;
+  return guard.exit_code;
 }

@@ -5,16 +5,21 @@
 //
 // Scene: -cloth_n, -cloth_size (m), -cloth_mass (kg), -cloth_k_stretch, -cloth_k_shear, -cloth_k_bend (N/m),
 // -cloth_damping (N s/m), -cloth_pins corners|four|top|none, -cloth_hanging, -sphere (drape over a sphere;
-// -sphere_radius, -sphere_centre x,y,z). Time: -dt, -steps, -cloth_exact_jacobian (drop Choi-Ko). Output:
+// -sphere_radius, -sphere_centre x,y,z), -cloth_strain_limit S (stretch springs kept within (1 + S) x rest length,
+// Provot; 0: off) and -cloth_strain_limit_sweeps N. Time: -dt, -steps, -cloth_exact_jacobian (drop Choi-Ko). Output:
 // a progress line every -progress_every steps, -vtk PREFIX (triangle surface per -vtk_every steps),
-// -dump_matrix FILE (first step's matrix), and a final `summary key=value ...` line; -cloth_timer cpu times
+// -dump_matrix FILE (first step's matrix), -write_positions / -reference_positions FILE (rms and largest
+// position difference against another run, sim/position_file.h), and a final `summary key=value ...` line; -cloth_timer cpu times
 // in process CPU time instead of wall time (a shared machine).
+#include "sim/run_guard.h"
+#include "sim/position_file.h"
 #include "sim/sim_driver.h"
 #include "physics/cloth_step.hpp"
 #include "physics/vtk_writer.hpp"
 
 #include <petscbinbcsr.h>
 
+#include <cmath>
 #include <cstring>
 
 static bool WriteFrame(const std::string &path, const physics::Cloth &cloth)
@@ -70,6 +75,12 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetRealArray(nullptr, nullptr, "-sphere_centre", centre, &ncentre, &set));
   PetscCheck(!set || ncentre == 3, comm, PETSC_ERR_ARG_SIZ, "-sphere_centre needs 3 numbers, got %" PetscInt_FMT, ncentre);
   PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-cloth_exact_jacobian", &exact, nullptr));
+  {
+    PetscInt sweeps = params.strain_limit.max_sweeps;
+    PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-cloth_strain_limit", &params.strain_limit.max_strain, nullptr));
+    PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-cloth_strain_limit_sweeps", &sweeps, nullptr));
+    params.strain_limit.max_sweeps = (int)sweeps;
+  }
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-dt", &params.dt, nullptr));
   {
     const char *timers[] = {"wall", "cpu"};
@@ -87,7 +98,7 @@ int main(int argc, char **argv)
   else if (!std::strcmp(pins, "none")) opt.pins = physics::ClothPins::None;
   else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "unknown -cloth_pins %s (corners, four, top, none)", pins);
   const std::string bad = physics::validate_params(params);
-  PetscCheck(bad.empty(), comm, PETSC_ERR_ARG_OUTOFRANGE, "%s (-dt %g)", bad.c_str(), (double)params.dt);
+  PetscCheck(bad.empty(), comm, PETSC_ERR_ARG_OUTOFRANGE, "%s (-dt %g, -cloth_strain_limit %g, -cloth_strain_limit_sweeps %d)", bad.c_str(), (double)params.dt, (double)params.strain_limit.max_strain, params.strain_limit.max_sweeps);
   PetscCheck(!sphere || radius > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-sphere_radius must be positive, got %g", (double)radius);
 
   physics::Cloth cloth;
@@ -129,6 +140,21 @@ int main(int argc, char **argv)
   PetscCall(write_frame(0));
 
   const double e0 = physics::cloth_energy(cloth);
+  RunGuard     guard;
+  {
+    // The scene's energy scale: its weight over its size, plus the kinetic energy it starts with. The
+    // sphere's contact projection adds spring energy (7 J, 1.5 x the scale, for 20 x 20 particles
+    // draped for 20 steps), so the bound is 4 x the scale; a spring at twice its rest length is no
+    // cloth any more.
+    double m = 0, ke0 = 0;
+    for (int p = 0; p < cloth.particle_count(); ++p) m += cloth.mass[p], ke0 += 0.5 * cloth.mass[p] * cloth.velocity[p].squaredNorm();
+    HealthBounds hb;
+    hb.energy_scale  = m * cloth.gravity.norm() * opt.size + ke0;
+    hb.energy_growth = 4.0;
+    hb.max_stretch   = 2.0;
+    PetscCall(RunGuardFromOptions(comm, hb, &guard));
+    RunGuardStart(&guard, e0, NAN);
+  }
   const auto   now = cpu_timer ? ProcessCpuTime : WallTime;
   double       step_ms_total = 0, max_stretch = 0;
   long long    nan_steps = 0, unconverged = 0, contacts = 0, done = 0;
@@ -155,7 +181,15 @@ int main(int argc, char **argv)
     }
     if (step == 1 && out.dump) PetscCall(BlockSystemDumpMatrix(&rs.sys, out.dump_path));
     PetscCall(write_frame(step));
-    if (!finite) break;
+    StepHealth health;
+    health.solver_reason = rs.last.reason;
+    health.energy        = physics::cloth_energy(cloth);
+    health.finite        = finite && std::isfinite(health.energy);
+    health.max_stretch   = r.max_stretch;
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &health.max_stretch, 1, MPI_DOUBLE, MPI_MAX, comm));
+    bool stop;
+    PetscCall(RunGuardCheckStep(comm, &guard, step, health, &stop));
+    if (stop) break;
   }
 
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &max_stretch, 1, MPI_DOUBLE, MPI_MAX, comm));
@@ -181,9 +215,15 @@ int main(int argc, char **argv)
   s.add("energy_final", physics::cloth_energy(cloth));
   s.add("kinetic_final", ke);
   s.add("nan", nan_steps);
+  {
+    std::vector<double> xyz;
+    for (const Eigen::Vector3d &x : cloth.position) xyz.insert(xyz.end(), {x[0], x[1], x[2]});
+    PetscCall(DriverComparePositions(comm, xyz, s));
+  }
+  RunGuardAddSummary(s, guard);
   PetscCall(PrintSummary(comm, s));
 
   PetscCall(ReplicatedSolverDestroy(&rs));
   PetscCall(PetscFinalize());
-  return 0;
+  return guard.exit_code;
 }

@@ -14,6 +14,7 @@
 // right-hand side is 0, so dv = 0 there, the matrix stays SPD and the pattern never changes.
 #include <petscbinbcsr.h>
 
+#include "sim/fem_health.h"
 #include "sim/fem_simulation.h"
 #include "sim/summary.h"
 #include "physics/box_mesh.hpp"
@@ -27,6 +28,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <sys/stat.h>
@@ -144,6 +147,11 @@ PetscErrorCode GetOptions(Options &o)
                                   &n, nullptr));
   PetscOptionsEnd();
   PetscCheck(o.dt > 0 && std::isfinite(o.dt), PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-dt must be positive");
+  for (int d = 0; d < 3; ++d)
+    PetscCheck(std::isfinite(o.gravity[d]) && std::isfinite(o.v0[d]) && std::isfinite(o.spin[d]), PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+               "-gravity, -initial_velocity and -initial_spin must be finite");
+  PetscCheck(std::isfinite(o.rayleigh[0]) && std::isfinite(o.rayleigh[1]) && std::isfinite(o.stretch), PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+             "-rayleigh and -initial_stretch must be finite");
   PetscCheck(o.steps >= 0, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-steps must be >= 0");
   PetscCheck(o.vtk_every >= 1, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-vtk_every must be >= 1");
   PetscFunctionReturn(0);
@@ -153,6 +161,14 @@ bool file_exists(const std::string &p)
 {
   struct stat st;
   return stat(p.c_str(), &st) == 0;
+}
+
+// FNV-1a, 64 bits: a stable digest of the cache key (std::hash may differ between builds).
+unsigned long long Fnv1a64(const std::string &text)
+{
+  unsigned long long h = 1469598103934665603ull;
+  for (unsigned char c : text) h = (h ^ c) * 1099511628211ull;
+  return h;
 }
 
 // Meshes a .geo with gmsh into a cache next to the program (build/meshes), on rank 0.
@@ -169,14 +185,25 @@ PetscErrorCode MeshGeo(MPI_Comm comm, const std::string geo, double size, std::s
   std::string base  = geo.substr(geo.find_last_of('/') + 1);
   base              = base.substr(0, base.find_last_of('.'));
   char sz[64];
-  std::snprintf(sz, sizeof sz, "%g", size);
-  *msh = dir + "/" + base + (size > 0 ? std::string("_h") + sz : std::string()) + ".msh";
-  int failed = 0;
-  if (!rank && !file_exists(*msh)) {
+  std::snprintf(sz, sizeof sz, "%.17g", size);
+  const std::string options = "-3 -format msh41 -v 1 -nt 1 " + (size > 0 ? "-clmax " + std::string(sz) + " " : std::string());
+  // The cache entry is named by what decides the mesh: the .geo file's contents and the meshing options
+  // (the base name alone would hand an edited file, or another folder's file of that name, a stale mesh).
+  // A .geo that includes other files (Merge, Include) is keyed on its own text only.
+  int         failed = 0;
+  char        key[17] = "";
+  if (!rank) {
+    std::ifstream in(geo, std::ios::binary);
+    std::string   text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    failed = !in.good() && !in.eof();
+    std::snprintf(key, sizeof key, "%016llx", (unsigned long long)Fnv1a64(text + '\0' + options));
+  }
+  PetscCallMPI(MPI_Bcast(key, sizeof key, MPI_CHAR, 0, comm));
+  *msh = dir + "/" + base + "_" + key + ".msh";
+  if (!rank && !failed && !file_exists(*msh)) {
     mkdir(dir.c_str(), 0755);
     const std::string tmp = *msh + ".tmp." + std::to_string(getpid()) + ".msh";
-    std::string       cmd = "gmsh -3 -format msh41 -v 1 -nt 1 " + (size > 0 ? "-clmax " + std::string(sz) + " " : std::string()) +
-                      "'" + geo + "' -o '" + tmp + "' > /dev/null 2>&1";
+    std::string       cmd = "gmsh " + options + "'" + geo + "' -o '" + tmp + "' > /dev/null 2>&1";
     failed = std::system(cmd.c_str()) != 0 || std::rename(tmp.c_str(), msh->c_str()) != 0;
   }
   PetscCallMPI(MPI_Bcast(&failed, 1, MPI_INT, 0, comm));
@@ -321,6 +348,11 @@ int main(int argc, char **argv)
       r = std::min(r, physics::element_signed_volume(model.mesh, x.data(), e) / model.volume[e]);
     return r;
   };
+  auto inverted_fraction = [&] { return FemInvertedFraction(sim); };
+  auto total_energy      = [&] { return FemTotalEnergy(sim); };
+  RunGuard guard;
+  PetscCall(RunGuardFromOptions(comm, FemHealthBounds(sim), &guard));
+  RunGuardStart(&guard, total_energy(), inverted_fraction());
   PetscInt    nnz;
   const char *mat_type, *ksp_type;
   PetscCall(BlockSystemGetInfo(&sim.sys, &nnz, &mat_type, &ksp_type));
@@ -364,7 +396,6 @@ int main(int argc, char **argv)
   double             t_element = 0, t_setvalues = 0, t_solve = 0, t_comm = 0, t_total = 0;
   long long          its_total  = 0, svd_rotations = 0;
   int                steps_done = 0;
-  std::string        status     = "ok";
   KSPConvergedReason last_reason = KSP_CONVERGED_ITERATING;
   for (int step = 1; step <= o.steps; ++step) {
     FemStepInfo info;
@@ -383,18 +414,14 @@ int main(int argc, char **argv)
       PetscCall(PetscPrintf(comm, "step %d its %" PetscInt_FMT " res %.3e reason %s assembly_ms %.2f solve_ms %.2f\n", step,
                             info.stats.iterations, (double)info.stats.residual_norm, KSPConvergedReasons[info.stats.reason],
                             info.element_ms + info.setvalues_ms, info.solve_ms));
-    if (!info.finite) {
-      status = "nan";
-      PetscCall(PetscPrintf(comm, "fem: step %d produced a non-finite velocity change (KSP reason %s); stopping\n", step,
-                            KSPConvergedReasons[info.stats.reason]));
-      break;
-    }
-    if (info.stats.reason < 0 && info.stats.reason != KSP_DIVERGED_ITS) {
-      status = "ksp_diverged";
-      PetscCall(PetscPrintf(comm, "fem: the linear solve diverged at step %d (%s); stopping\n", step,
-                            KSPConvergedReasons[info.stats.reason]));
-      break;
-    }
+    StepHealth health;
+    health.solver_reason     = info.stats.reason;
+    health.energy            = total_energy();
+    health.finite            = info.finite && std::isfinite(health.energy);
+    health.inverted_fraction = inverted_fraction();
+    bool stop;
+    PetscCall(RunGuardCheckStep(comm, &guard, step, health, &stop));
+    if (stop) break;
     if (step % o.vtk_every == 0) write_frame(step);
   }
   if (o.element_bench > 0) {
@@ -479,11 +506,14 @@ int main(int argc, char **argv)
     PetscCallMPI(MPI_Allreduce(&svd_rotations, &all, 1, MPI_LONG_LONG, MPI_SUM, comm));
     s.add("svd_rotations", all);
   }
+  s.add("inverted_fraction", inverted_fraction());
+  s.add("energy_initial", guard.energy0);
+  s.add("energy_final", total_energy());
   s.add("ksp_reason", std::string(KSPConvergedReasons[last_reason]));
-  s.add("status", status);
+  RunGuardAddSummary(s, guard);
   PetscCall(PrintSummary(comm, s));
 
   PetscCall(FemSimulationDestroy(&sim));
   PetscCall(PetscFinalize());
-  return 0;
+  return guard.exit_code;
 }

@@ -8,35 +8,67 @@ set(OPTS ${CMAKE_SOURCE_DIR}/options)
 add_test(NAME cloth_drape_sphere
          COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && max_stretch<1.3 && contacts>0 && unknowns==1200"
                  -- ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 20 -steps 60 -progress_every 1000)
+# The scene as options/cloth.opts sets it (strain limit 5%), at a resolution a test affords: every stretch
+# spring stays within a few percent of its rest length over 30 steps that hang it from its corners and
+# drop it on the sphere (the thesis's setting, options/cloth_thesis.opts, stretches the corners far).
+add_test(NAME cloth_scene_stretch_bounded
+         COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && max_stretch<1.08 && contacts>0 && diverged_solves==0"
+                 -- ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 40 -steps 30 -progress_every 1000)
 add_test(NAME cloth_stiff_dt30
          COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && max_stretch<1.1"
                  -- ${CLOTH} -cloth_n 10 -cloth_k_stretch 1e6 -cloth_k_shear 1e5 -cloth_k_bend 1e4 -dt 0.0333333 -steps 30
                     -ksp_rtol 1e-8 -ksp_max_it 5000 -progress_every 1000)
 set(CLOTH_SAME "${CLOTH} -cloth_n 12 -steps 30 -sphere -ksp_rtol 1e-12 -progress_every 1000")
 add_test(NAME cloth_same_result_mat_types
-         COMMAND ${SUMMARY_SAME} "energy_final max_stretch contacts" 1e-6
+         COMMAND ${SUMMARY_SAME} "energy_final:1e-9 max_stretch:1e-9 contacts:0" 1e-6
                  "${CLOTH_SAME} -mat_type aij" "${CLOTH_SAME} -mat_type baij" "${CLOTH_SAME} -mat_type aij -ksp_type pipecg"
                  "${CLOTH_SAME} -mat_type binbcsr" "${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg"
                  "${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg -mat_binbcsr_symmetric_storage")
-add_test(NAME cloth_bad_dt COMMAND ${CLOTH} -cloth_n 4 -dt 0)
-set_tests_properties(cloth_bad_dt PROPERTIES PASS_REGULAR_EXPRESSION "time step must be positive")
-add_test(NAME cloth_bad_n COMMAND ${CLOTH} -cloth_n 1)
-set_tests_properties(cloth_bad_n PROPERTIES PASS_REGULAR_EXPRESSION "at least 2 x 2")
-add_test(NAME cloth_bad_pins COMMAND ${CLOTH} -cloth_n 4 -cloth_pins elbows)
-set_tests_properties(cloth_bad_pins PROPERTIES PASS_REGULAR_EXPRESSION "unknown -cloth_pins elbows")
-add_test(NAME cloth_bad_stiffness COMMAND ${CLOTH} -cloth_n 4 -cloth_k_bend -5)
-set_tests_properties(cloth_bad_stiffness PROPERTIES PASS_REGULAR_EXPRESSION "non-negative")
-set_tests_properties(cloth_drape_sphere cloth_stiff_dt30 cloth_same_result_mat_types cloth_bad_dt cloth_bad_n cloth_bad_pins
+add_test(NAME cloth_bad_dt COMMAND ${EXPECT_RUN} nonzero "time step must be positive" -- ${CLOTH} -cloth_n 4 -dt 0)
+add_test(NAME cloth_bad_n COMMAND ${EXPECT_RUN} nonzero "at least 2 x 2" -- ${CLOTH} -cloth_n 1)
+add_test(NAME cloth_bad_pins COMMAND ${EXPECT_RUN} nonzero "unknown -cloth_pins elbows" -- ${CLOTH} -cloth_n 4 -cloth_pins elbows)
+add_test(NAME cloth_bad_stiffness COMMAND ${EXPECT_RUN} nonzero "non-negative" -- ${CLOTH} -cloth_n 4 -cloth_k_bend -5)
+set_tests_properties(cloth_drape_sphere cloth_scene_stretch_bounded cloth_stiff_dt30 cloth_same_result_mat_types cloth_bad_dt cloth_bad_n cloth_bad_pins
                      cloth_bad_stiffness PROPERTIES LABELS "cloth" TIMEOUT 60)
 
 add_test(NAME cloth_mpi_np2
-         COMMAND ${SUMMARY_SAME} "energy_final max_stretch contacts" 1e-6
+         COMMAND ${SUMMARY_SAME} "energy_final:1e-9 max_stretch:1e-9 contacts:0" 1e-6
                  "${CLOTH_SAME}" "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME}" "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg"
                  "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg -mat_binbcsr_symmetric_storage"
                  "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type sbaij"
                  "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg -mat_binbcsr_coo_mirror")
 set_tests_properties(cloth_mpi_np2 PROPERTIES LABELS "cloth;mpi" TIMEOUT 60)
 
+# The error measure of bench/tradeoff.sh: a run against its own positions differs by exactly 0, against a
+# loosely converged run by more; a reference of another size is an error.
+add_test(NAME cloth_reference_positions
+         COMMAND sh -c "${CLOTH} -cloth_n 6 -steps 3 -progress_every 10 -ksp_rtol 1e-10 -write_positions cloth_ref_positions.txt >/dev/null && ${SUMMARY_CHECK} 'rms_position_diff==0 && max_position_diff==0' -- ${CLOTH} -cloth_n 6 -steps 3 -progress_every 10 -ksp_rtol 1e-10 -reference_positions cloth_ref_positions.txt && ${SUMMARY_CHECK} 'rms_position_diff>1e-5' -- ${CLOTH} -cloth_n 6 -steps 3 -progress_every 10 -ksp_rtol 1e-2 -reference_positions cloth_ref_positions.txt && ${CLOTH} -cloth_n 7 -steps 1 -reference_positions cloth_ref_positions.txt 2>&1 | grep -q 'this run has 49 positions'")
+set_tests_properties(cloth_reference_positions PROPERTIES LABELS "cloth" TIMEOUT 60)
 add_test(NAME cloth_vtk_dump
          COMMAND sh -c "rm -rf cloth_out && mkdir cloth_out && ${CLOTH} -cloth_n 6 -steps 2 -sphere -vtk cloth_out/c -dump_matrix cloth_out/A.bin -progress_every 10 && grep -q 'NumberOfCells=\"50\"' cloth_out/c_00002.vtu && grep -q c_00001.vtu cloth_out/c.pvd && test -s cloth_out/A.bin")
 set_tests_properties(cloth_vtk_dump PROPERTIES LABELS "cloth" TIMEOUT 60)
+
+# When the physics or the solver breaks the run says so (src/sim/run_guard.h). Springs of
+# 1e12 N/m (energy 2.9e8 J from 0 in 5 steps) and a time step of 1 s (a spring at 1108 x its rest
+# length) are `unstable` with a warning; -on_unstable stop ends the run with exit code 4. With GAMG
+# the 160 x 160 cloth's CG fails from step 3 on: the run stops there with exit code 2.
+add_test(NAME cloth_stiff_springs_unstable
+         COMMAND ${EXPECT_RUN} 0 "warning: unstable at step [0-9]+: energy grew.*ended=completed status=unstable"
+                 -- ${CLOTH} -cloth_n 20 -cloth_k_stretch 1e12 -steps 5 -progress_every 1000)
+add_test(NAME cloth_stiff_springs_stop
+         COMMAND ${EXPECT_RUN} 4 "error: unstable at step [0-9]+: .*ended=unstable@step[0-9]+ status=unstable"
+                 -- ${CLOTH} -cloth_n 20 -cloth_k_stretch 1e12 -steps 5 -progress_every 1000 -on_unstable stop)
+add_test(NAME cloth_large_dt_stop
+         COMMAND ${EXPECT_RUN} 4 "error: unstable at step [0-9]+: .*ended=unstable@step[0-9]+ status=unstable"
+                 -- ${CLOTH} -cloth_n 20 -dt 1 -steps 5 -progress_every 1000 -on_unstable stop)
+add_test(NAME cloth_large_dt_stop_np2
+         COMMAND ${EXPECT_RUN} 4 "ranks=2 .*ended=unstable@step[0-9]+ status=unstable"
+                 -- ${MPIEXEC_CMD} -n 2 ${CLOTH} -cloth_n 20 -dt 1 -steps 5 -progress_every 1000 -on_unstable stop)
+add_test(NAME cloth_gamg_solver_failure_stop
+         COMMAND ${EXPECT_RUN} 2 "error: the linear solve of step [0-9]+ failed \\(DIVERGED_.*ended=solver_failure@step[0-9]+ status=solver_failed"
+                 -- ${CLOTH} -options_file ${OPTS}/cloth.opts -pc_type gamg -steps 6 -progress_every 1000)
+add_test(NAME cloth_drape_completes
+         COMMAND ${EXPECT_RUN} 0 "ended=completed status=ok" -- ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 20 -steps 20 -progress_every 1000)
+set_tests_properties(cloth_stiff_springs_unstable cloth_stiff_springs_stop cloth_large_dt_stop cloth_gamg_solver_failure_stop cloth_drape_completes
+                     PROPERTIES LABELS "cloth" TIMEOUT 120)
+set_tests_properties(cloth_large_dt_stop_np2 PROPERTIES LABELS "cloth;mpi" PROCESSORS 2 TIMEOUT 60)

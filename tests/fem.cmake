@@ -4,37 +4,37 @@ set(FEM $<TARGET_FILE:fem>)
 set(FEM_SRC ${CMAKE_SOURCE_DIR})
 set(FEM_SMALL -mesh_box 1,0.1,0.1,8,2,2 -fix xmin -steps 3 -fem_quiet)
 
-function(fem_test name regex)
-  add_test(NAME ${name} COMMAND ${ARGN})
-  set_tests_properties(${name} PROPERTIES LABELS "fem" PASS_REGULAR_EXPRESSION "${regex}" TIMEOUT 60
-                                          WORKING_DIRECTORY ${FEM_SRC})
+# fem_test(NAME EXIT REGEX COMMAND...): EXIT is the exit status expected (0, a number or nonzero)
+function(fem_test name exit regex)
+  add_test(NAME ${name} COMMAND ${EXPECT_RUN} ${exit} "${regex}" -- ${ARGN})
+  set_tests_properties(${name} PROPERTIES LABELS "fem" TIMEOUT 60 WORKING_DIRECTORY ${FEM_SRC})
 endfunction()
 
-fem_test(fem_p1_aij_cg "status=ok" ${FEM} ${FEM_SMALL} -mat_type aij -ksp_type cg)
-fem_test(fem_p2_binbcsr_mcg "order=2.*status=ok" ${FEM} ${FEM_SMALL} -fem_order 2 -mat_type binbcsr -ksp_type mcg)
-fem_test(fem_p2_baij_pipecg "mat_type=seqbaij.*status=ok" ${FEM} ${FEM_SMALL} -fem_order 2 -mat_type baij -ksp_type pipecg)
-fem_test(fem_p2_sell_linear "mat_type=seqsell.*status=ok" ${FEM} ${FEM_SMALL} -fem_order 2 -mat_type sell -fem_corotational 0
+fem_test(fem_p1_aij_cg 0 "status=ok" ${FEM} ${FEM_SMALL} -mat_type aij -ksp_type cg)
+fem_test(fem_p2_binbcsr_mcg 0 "order=2.*status=ok" ${FEM} ${FEM_SMALL} -fem_order 2 -mat_type binbcsr -ksp_type mcg)
+fem_test(fem_p2_baij_pipecg 0 "mat_type=seqbaij.*status=ok" ${FEM} ${FEM_SMALL} -fem_order 2 -mat_type baij -ksp_type pipecg)
+fem_test(fem_p2_sell_linear 0 "mat_type=seqsell.*status=ok" ${FEM} ${FEM_SMALL} -fem_order 2 -mat_type sell -fem_corotational 0
          -fem_mass_lumped)
-fem_test(fem_fixed_iterations "timer=cpu .*cg_its=30 .*status=ok" ${FEM} ${FEM_SMALL} -fem_timer cpu -mat_type binbcsr -ksp_type mcg
+fem_test(fem_fixed_iterations 0 "timer=cpu .*cg_its=30 .*status=ok" ${FEM} ${FEM_SMALL} -fem_timer cpu -mat_type binbcsr -ksp_type mcg
          -ksp_mcg_fixed_iterations 30 -ksp_max_it 30)
-fem_test(fem_static_cantilever "status=ok" ${FEM} -options_file options/cantilever.opts -static -steps 3)
-fem_test(fem_scene_files "mat_type=seqaij ksp_type=cg .*cg_its=30 .*status=ok" ${FEM} -options_file options/cantilever.opts
+fem_test(fem_static_cantilever 0 "status=ok" ${FEM} -options_file options/cantilever.opts -static -steps 3)
+fem_test(fem_scene_files 0 "mat_type=seqaij ksp_type=cg .*cg_its=30 .*status=ok" ${FEM} -options_file options/cantilever.opts
          -options_file options/compare_aij_cg.opts -ksp_max_it 30 -steps 2)
-fem_test(fem_vtk_and_dump "status=ok" ${FEM} ${FEM_SMALL} -fem_order 2 -vtk ${CMAKE_CURRENT_BINARY_DIR}/fem_vtk_test
+fem_test(fem_vtk_and_dump 0 "status=ok" ${FEM} ${FEM_SMALL} -fem_order 2 -vtk ${CMAKE_CURRENT_BINARY_DIR}/fem_vtk_test
          -vtk_every 2 -dump_matrix ${CMAKE_CURRENT_BINARY_DIR}/fem_dump_test.bin)
-fem_test(fem_inverted_start "initial min volume ratio -.*status=ok" ${FEM} -mesh_box 1,0.2,0.2,6,1,1 -fix xmin -gravity 0,0,0 -initial_perturb 27,0,-0.3,-0.35
+fem_test(fem_inverted_start 0 "initial min volume ratio -.*status=ok" ${FEM} -mesh_box 1,0.2,0.2,6,1,1 -fix xmin -gravity 0,0,0 -initial_perturb 27,0,-0.3,-0.35
          -rayleigh 1,0 -steps 40 -fem_quiet -ksp_rtol 1e-10)
-fem_test(fem_geo_mesh "elements=.*status=ok" ${FEM} -mesh examples/meshes/bunny.geo -mesh_size 0.06 -fix zmin:0.05 -steps 2
+fem_test(fem_geo_mesh 0 "elements=.*status=ok" ${FEM} -mesh examples/meshes/bunny.geo -mesh_size 0.06 -fix zmin:0.05 -steps 2
          -fem_quiet)
-fem_test(fem_aijcusparse_error "needs a PETSc configured with CUDA" ${FEM} ${FEM_SMALL} -options_file options/compare_aijcusparse.opts)
-fem_test(fem_bad_mesh_error "cannot open mesh file" ${FEM} -mesh /nonexistent/mesh.msh)
-fem_test(fem_bad_option_error "-fix .*expected none" ${FEM} ${FEM_SMALL} -fix middle)
-fem_test(fem_bad_material_error "Poisson" ${FEM} ${FEM_SMALL} -poisson 0.5)
-fem_test(fem_mpi2_aij "ranks=2 .*status=ok" ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_SMALL} -fem_order 2 -mat_type aij)
+fem_test(fem_aijcusparse_error nonzero "needs a PETSc configured with CUDA" ${FEM} ${FEM_SMALL} -options_file options/compare_aijcusparse.opts)
+fem_test(fem_bad_mesh_error nonzero "cannot open mesh file" ${FEM} -mesh /nonexistent/mesh.msh)
+fem_test(fem_bad_option_error nonzero "-fix .*expected none" ${FEM} ${FEM_SMALL} -fix middle)
+fem_test(fem_bad_material_error nonzero "Poisson" ${FEM} ${FEM_SMALL} -poisson 0.5)
+fem_test(fem_mpi2_aij 0 "ranks=2 .*status=ok" ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_SMALL} -fem_order 2 -mat_type aij)
 set_tests_properties(fem_mpi2_aij PROPERTIES LABELS "fem;mpi")
 # The COO mirror on 2 ranks (upper blocks only, lower ones filled by the Mat, also across ranks) and
 # the matrix dump of such a system.
-fem_test(fem_mpi2_binbcsr_mirror "mat_type=mpibinbcsr .*ranks=2 .*status=ok" ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_SMALL} -fem_order 2
+fem_test(fem_mpi2_binbcsr_mirror 0 "mat_type=mpibinbcsr .*ranks=2 .*status=ok" ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_SMALL} -fem_order 2
          -mat_type binbcsr -mat_binbcsr_coo_mirror -ksp_type mcg -dump_matrix ${CMAKE_CURRENT_BINARY_DIR}/fem_mirror_dump.bin)
 set_tests_properties(fem_mpi2_binbcsr_mirror PROPERTIES LABELS "fem;mpi")
 add_test(NAME unit_fem_mpi2 COMMAND ${MPIEXEC_CMD} -n 2 $<TARGET_FILE:test_fem> "[mpi]")
@@ -42,7 +42,41 @@ set_tests_properties(unit_fem_mpi2 PROPERTIES LABELS "fem;mpi;unit" TIMEOUT 60)
 # GAMG with the rest shape's rigid body modes as near null space (the driver's default): a slender beam
 # that GAMG's default translations-only space leaves at 43-45 CG iterations per solve takes about 22 with them.
 set(FEM_BEAM_GAMG -mesh_box 1,0.1,0.1,16,3,3 -fix xmin -steps 3 -fem_quiet -mat_type binbcsr -ksp_type cg -pc_type gamg -ksp_rtol 1e-8)
-fem_test(fem_gamg_rigid_body_modes "cg_its=(1[0-9]|2[0-5])[. ].*status=ok" ${FEM} ${FEM_BEAM_GAMG})
-fem_test(fem_mpi2_gamg_rigid_body_modes "ranks=2 .*cg_its=(1[0-9]|2[0-5])[. ].*status=ok" ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_BEAM_GAMG})
+fem_test(fem_gamg_rigid_body_modes 0 "cg_its=(1[0-9]|2[0-5])[. ].*status=ok" ${FEM} ${FEM_BEAM_GAMG})
+fem_test(fem_mpi2_gamg_rigid_body_modes 0 "ranks=2 .*cg_its=(1[0-9]|2[0-5])[. ].*status=ok" ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_BEAM_GAMG})
 set_tests_properties(fem_mpi2_gamg_rigid_body_modes PROPERTIES LABELS "fem;mpi")
-fem_test(fem_gamg_translations_only "cg_its=(3[5-9]|4[0-9]|5[0-5])[. ].*status=ok" ${FEM} ${FEM_BEAM_GAMG} -fem_rigid_body_modes 0)
+fem_test(fem_gamg_translations_only 0 "cg_its=(3[5-9]|4[0-9]|5[0-5])[. ].*status=ok" ${FEM} ${FEM_BEAM_GAMG} -fem_rigid_body_modes 0)
+
+# When the physics or the solver breaks the run says so (src/sim/run_guard.h). A body that
+# gravity crushes through itself (min volume ratio -1.8e10 by step 5) is `unstable`, with a warning,
+# and -on_unstable stop ends the run there with exit code 4; serial and on 2 ranks.
+set(FEM_CRUSHED -mesh_box 1,0.1,0.1,6,2,2 -fem_order 1 -fix xmin -gravity 0,0,-1e6 -dt 0.1 -steps 5 -fem_quiet)
+fem_test(fem_crushed_body_unstable 0 "warning: unstable at step [0-9]+: .*inverted.*ended=completed status=unstable" ${FEM} ${FEM_CRUSHED})
+fem_test(fem_crushed_body_stop 4 "error: unstable at step [0-9]+: .*ended=unstable@step[0-9]+ status=unstable" ${FEM} ${FEM_CRUSHED} -on_unstable stop)
+fem_test(fem_mpi2_crushed_body_stop 4 "ranks=2 .*ended=unstable@step[0-9]+ status=unstable" ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_CRUSHED} -on_unstable stop)
+set_tests_properties(fem_mpi2_crushed_body_stop PROPERTIES LABELS "fem;mpi")
+# A negative KSPConvergedReason (here DIVERGED_ITS) stops the run with exit code 2 and one line;
+# -on_solver_failure continue integrates on and the summary still says the solves failed.
+fem_test(fem_solver_failure_stop 2 "error: the linear solve of step 1 failed \\(DIVERGED_ITS\\).*steps=1 .*ended=solver_failure@step1 status=solver_failed"
+         ${FEM} ${FEM_SMALL} -ksp_type cg -ksp_max_it 2 -ksp_rtol 1e-12)
+fem_test(fem_mpi2_solver_failure_stop 2 "ranks=2 .*steps=1 .*ended=solver_failure@step1 status=solver_failed"
+         ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_SMALL} -ksp_type cg -ksp_max_it 2 -ksp_rtol 1e-12)
+set_tests_properties(fem_mpi2_solver_failure_stop PROPERTIES LABELS "fem;mpi")
+fem_test(fem_solver_failure_continue 0 "steps=3 .*solver_failures=3 .*ended=completed status=solver_failed"
+         ${FEM} ${FEM_SMALL} -ksp_type cg -ksp_max_it 2 -ksp_rtol 1e-12 -on_solver_failure continue)
+# A state that stops being finite ends the run with exit code 3 (the kinetic energy of 1e200 m/s overflows).
+fem_test(fem_nonfinite_stop 3 "error: step 1 left a nonfinite state.*ended=nonfinite_state@step1 status=nonfinite"
+         ${FEM} ${FEM_SMALL} -initial_velocity 0,0,1e200)
+# A NaN in the scene is bad input.
+fem_test(fem_nan_gravity_error nonzero "-gravity, -initial_velocity and -initial_spin must be finite" ${FEM} ${FEM_SMALL} -gravity 0,0,nan)
+fem_test(fem_bad_on_solver_failure_error nonzero "-on_solver_failure must be stop or continue" ${FEM} ${FEM_SMALL} -on_solver_failure maybe)
+# The .geo mesh cache is keyed on the file's contents and the meshing options: two files of the same
+# base name in different folders, one of them edited, get their own meshes (a box twice as long meshes to another element count).
+add_test(NAME fem_geo_cache_keyed_on_contents
+         COMMAND sh -c "set -e; d=${CMAKE_CURRENT_BINARY_DIR}/fem_geo_cache; rm -rf $d; mkdir -p $d/a $d/b
+           printf 'SetFactory(\"OpenCASCADE\");\\nBox(1) = {0,0,0,1,0.2,0.2};\\nMesh.CharacteristicLengthMax = 0.2;\\n' > $d/a/box.geo
+           sed 's/0,0,0,1,/0,0,0,2,/' $d/a/box.geo > $d/b/box.geo
+           na=$(${FEM} -mesh $d/a/box.geo -steps 0 -fix xmin | sed -n 's/.* elements=\\([0-9]*\\) .*/\\1/p')
+           nb=$(${FEM} -mesh $d/b/box.geo -steps 0 -fix xmin | sed -n 's/.* elements=\\([0-9]*\\) .*/\\1/p')
+           echo elements a=$na b=$nb; test -n \"$na\" && test -n \"$nb\" && test $nb -ne $na")
+set_tests_properties(fem_geo_cache_keyed_on_contents PROPERTIES LABELS "fem" TIMEOUT 60)

@@ -19,6 +19,10 @@ static PetscErrorCode KSPReset_MCG(KSP ksp)
   PetscCall(VecDestroy(&mcg->dinv));
   mcg->dinv_id    = 0;
   mcg->dinv_state = 0;
+  PetscCall(PetscFree(mcg->binv));
+  mcg->binv_n     = 0;
+  mcg->binv_id    = 0;
+  mcg->binv_state = 0;
   PetscFunctionReturn(0);
 }
 
@@ -44,11 +48,14 @@ static PetscErrorCode KSPView_MCG(KSP ksp, PetscViewer viewer)
   if (mcg->fixed_its > 0) PetscCall(PetscViewerASCIIPrintf(viewer, "  fixed iterations: %" PetscInt_FMT " per solve, no convergence test (tolerances ignored)\n", mcg->fixed_its));
   else PetscCall(PetscViewerASCIIPrintf(viewer, "  fixed iterations: off (tolerances decide); true-residual check before claiming convergence: %s\n", mcg->verify ? "on" : "off"));
   if (ksp->setupstage == KSP_SETUP_NEW && !mcg->dinv && !mcg->why_generic[0]) {
-    PetscCall(PetscViewerASCIIPrintf(viewer, "  fused preconditioner (jacobi/none in the vector pass): %s; decided at the first solve\n", mcg->allow_fused ? "allowed" : "off"));
+    PetscCall(PetscViewerASCIIPrintf(viewer, "  fused preconditioner (jacobi/pbjacobi/none in the vector pass): %s; decided at the first solve\n", mcg->allow_fused ? "allowed" : "off"));
   } else {
     switch (mcg->how) {
     case MCG_PC_JACOBI:
       PetscCall(PetscViewerASCIIPrintf(viewer, "  fast path: on, Jacobi fused into the vector pass (own D^-1 from MatGetDiagonal%s)\n", mcg->dinv_zeros ? ", zero diagonal entries replaced as PCJACOBI does" : ""));
+      break;
+    case MCG_PC_PBJACOBI:
+      PetscCall(PetscViewerASCIIPrintf(viewer, "  fast path: on, point-block Jacobi fused into the vector pass (own 3x3 block inverses from MatInvertBlockDiagonal)\n"));
       break;
     case MCG_PC_NONE:
       PetscCall(PetscViewerASCIIPrintf(viewer, "  fast path: on, no preconditioner, one fused vector pass\n"));
@@ -97,7 +104,7 @@ static PetscErrorCode KSPSetFromOptions_MCG(KSP ksp, PetscOptionItems *PetscOpti
   PetscOptionsHeadBegin(PetscOptionsObject, "KSP MCG (merged CG) options");
   PetscCall(PetscOptionsInt("-ksp_mcg_fixed_iterations", "Run exactly this many iterations per solve, no convergence test (0: off)", "KSPMCGSetFixedIterations", n, &n, &flg));
   if (flg) PetscCall(KSPMCGSetFixedIterations(ksp, n));
-  PetscCall(PetscOptionsBool("-ksp_mcg_fused_pc", "Apply PCJACOBI/PCNONE inside the fused vector pass", "", mcg->allow_fused, &mcg->allow_fused, nullptr));
+  PetscCall(PetscOptionsBool("-ksp_mcg_fused_pc", "Apply PCJACOBI/PCPBJACOBI/PCNONE inside the fused vector pass", "", mcg->allow_fused, &mcg->allow_fused, nullptr));
   PetscCall(PetscOptionsBool("-ksp_mcg_verify_residual", "Confirm convergence on the true residual b - A x, restarting if it fails", "", mcg->verify, &mcg->verify, nullptr));
   PetscCall(PetscOptionsReal("-ksp_mcg_stagnation", "Each restart must shrink the true residual by this factor", "", mcg->stagnation, &mcg->stagnation, nullptr));
   PetscCall(PetscOptionsReal("-ksp_mcg_precision_floor", "Relative rounding u of the operator's products: stop at u ||A|| ||x|| instead of claiming a tolerance below it (-1: from the matrix, 0: off)", "", mcg->floor_set, &mcg->floor_set, nullptr));
@@ -139,7 +146,7 @@ static PetscErrorCode KSPConvergedReasonView_MCGFloor(KSP ksp, void *)
 
    Options Database Keys:
 +  -ksp_mcg_fixed_iterations <n>   - exactly n iterations per solve, no convergence test (0: off), see `KSPMCGSetFixedIterations()`
-.  -ksp_mcg_fused_pc <bool>        - apply `PCJACOBI` or `PCNONE` inside the fused vector pass (default true)
+.  -ksp_mcg_fused_pc <bool>        - apply `PCJACOBI`, `PCPBJACOBI` (block size 3) or `PCNONE` inside the fused vector pass (default true)
 .  -ksp_mcg_verify_residual <bool> - confirm convergence on the true residual b - A x, restarting if it fails (default true)
 .  -ksp_mcg_stagnation <f>         - each restart from the true residual must shrink it by f (default 0.5)
 -  -ksp_mcg_precision_floor <u>    - relative rounding of the operator's products: the solve stops with
@@ -163,8 +170,8 @@ static PetscErrorCode KSPConvergedReasonView_MCGFloor(KSP ksp, void *)
 .ve
    It is CG in exact arithmetic (s = A p is carried by a recurrence instead of a second product), so
    iterates and iteration counts match `KSPCG` up to rounding; the residual norm of iteration k is
-   known at the end of iteration k, as in `KSPCG`. With `PCJACOBI` or `PCNONE` pass 1 is one fused
-   loop; other preconditioners go through `PCApply()`. On a `MATBINBCSR` matrix pass 2 is one sweep
+   known at the end of iteration k, as in `KSPCG`. With `PCJACOBI`, `PCPBJACOBI` (block size 3: its own
+   inverses of the 3x3 diagonal blocks, rebuilt on a refill) or `PCNONE` pass 1 is one fused loop; other preconditioners go through `PCApply()`. On a `MATBINBCSR` matrix pass 2 is one sweep
    over the bins. docs/ksp_mcg.md has the derivation, the restarts and the measurements.
 
 .seealso: `KSPCG`, `KSPCreate()`, `KSPSetType()`, `KSPMCGSetFixedIterations()`, `MatMultDotLocal()`, `MATBINBCSR`

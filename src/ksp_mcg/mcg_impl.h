@@ -9,7 +9,8 @@
 typedef enum {
   MCG_PC_GENERIC = 0, /* PCApply between two vector passes */
   MCG_PC_JACOBI  = 1, /* fused: z = D^-1 r with D^-1 built by KSPMCG exactly as PCJACOBI builds it */
-  MCG_PC_NONE    = 2  /* fused: z = r */
+  MCG_PC_NONE    = 2, /* fused: z = r */
+  MCG_PC_PBJACOBI = 3 /* fused: z_b = D_b^-1 r_b with the inverses of the 3x3 diagonal blocks (MatInvertBlockDiagonal) */
 } MCGPreconditioning;
 
 typedef struct {
@@ -34,6 +35,12 @@ typedef struct {
   PetscObjectState dinv_state;
   PetscInt         dinv_zeros; /* global number of zero diagonal entries found at the last build */
 
+  /* point-block Jacobi: inverses of the 3x3 diagonal blocks (column-major), rebuilt likewise */
+  PetscScalar     *binv;
+  PetscInt         binv_n; /* number of local block rows binv holds */
+  PetscObjectId    binv_id;
+  PetscObjectState binv_state;
+
   /* what the last solve did (for KSPView and PetscInfo) */
   PetscInt  restarts;        /* residual replacements after a failed true-residual check */
   PetscReal true_rnorm;      /* norm of b - A x at the last check, -1 when none was made */
@@ -55,5 +62,9 @@ typedef struct {
 #define MCG_FLOOR_DEPTH 0.1
 
 PETSC_INTERN PetscErrorCode KSPSolve_MCG(KSP);
+PETSC_INTERN PetscErrorCode MCGUpdateBlockDiagonal(KSP);
+/* Whether KSPMCG's own preconditioner data (built from the Pmat with id/state built_id/built_state; built:
+   it exists) must be rebuilt: the Pmat changed and the PC is not told to reuse its preconditioner. */
+PETSC_INTERN PetscErrorCode MCGPreconditionerStale(KSP, PetscBool built, PetscObjectId built_id, PetscObjectState built_state, Mat *Pmat, PetscObjectId *id, PetscObjectState *state, PetscBool *stale);
 
 #endif

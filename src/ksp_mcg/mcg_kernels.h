@@ -45,6 +45,59 @@ MCG_HOST_DEVICE inline void mcg_update_index(long i, Scalar alpha, Scalar beta, 
   xx += xi * xi;
 }
 
+/* y = B x for one 3x3 block B stored column-major (the order of MatInvertBlockDiagonal()). */
+template <typename Scalar>
+MCG_HOST_DEVICE inline void mcg_block3_apply(const Scalar *B, Scalar x0, Scalar x1, Scalar x2, Scalar &y0, Scalar &y1, Scalar &y2)
+{
+  y0 = B[0] * x0 + B[3] * x1 + B[6] * x2;
+  y1 = B[1] * x0 + B[4] * x1 + B[7] * x2;
+  y2 = B[2] * x0 + B[5] * x1 + B[8] * x2;
+}
+
+/* The update of mcg_update_index for the three indices of block row b, with point-block Jacobi:
+   u_b = binv_b r_b, binv_b the inverse of the 3x3 diagonal block of block row b (column-major, 9
+   scalars per block row). */
+template <typename Scalar>
+MCG_HOST_DEVICE inline void mcg_update_block3(long b, Scalar alpha, Scalar beta, Scalar *u, const Scalar *w, Scalar *p, Scalar *s, Scalar *x, Scalar *r, const Scalar *binv, Scalar &ru, Scalar &rr, Scalar &uu, Scalar &xx)
+{
+  Scalar rb[3];
+  for (int c = 0; c < 3; c++) {
+    const long   i  = 3 * b + c;
+    const Scalar pi = u[i] + beta * p[i];
+    const Scalar si = w[i] + beta * s[i];
+    const Scalar xi = x[i] + alpha * pi;
+    rb[c]           = r[i] - alpha * si;
+    p[i]            = pi;
+    s[i]            = si;
+    x[i]            = xi;
+    r[i]            = rb[c];
+    rr += rb[c] * rb[c];
+    xx += xi * xi;
+  }
+  Scalar u0, u1, u2;
+  mcg_block3_apply(binv + 9 * b, rb[0], rb[1], rb[2], u0, u1, u2);
+  u[3 * b] = u0;
+  u[3 * b + 1] = u1;
+  u[3 * b + 2] = u2;
+  ru += rb[0] * u0 + rb[1] * u1 + rb[2] * u2;
+  uu += u0 * u0 + u1 * u1 + u2 * u2;
+}
+
+/* u_b = binv_b r_b and the local dots of r and u for block row b: start of a solve with point-block Jacobi. */
+template <typename Scalar>
+MCG_HOST_DEVICE inline void mcg_precondition_block3(long b, const Scalar *r, const Scalar *binv, Scalar *u, Scalar &ru, Scalar &rr, Scalar &uu)
+{
+  const Scalar r0 = r[3 * b], r1 = r[3 * b + 1], r2 = r[3 * b + 2];
+  Scalar       u0, u1, u2;
+  mcg_block3_apply(binv + 9 * b, r0, r1, r2, u0, u1, u2);
+  u[3 * b]     = u0;
+  u[3 * b + 1] = u1;
+  u[3 * b + 2] = u2;
+  ru += r0 * u0 + r1 * u1 + r2 * u2;
+  rr += r0 * r0 + r1 * r1 + r2 * r2;
+  uu += u0 * u0 + u1 * u1 + u2 * u2;
+}
+
 /* Same update without the preconditioner (generic path: the PC is applied afterwards by PCApply);
    adds x.x of the new x to xx. */
 template <typename Scalar>

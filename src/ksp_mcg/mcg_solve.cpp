@@ -13,7 +13,7 @@
 
    which is CG (Hestenes-Stiefel) in exact arithmetic: s = A p is carried by recurrence instead of
    being a product. The norms r.r and u.u ride along in the same reduction, so every norm type costs
-   the same. With PCJACOBI (diagonal) or PCNONE the preconditioner is applied inside the vector pass
+   the same. With PCJACOBI (diagonal), PCPBJACOBI (3x3 blocks) or PCNONE the preconditioner is applied inside the vector pass
    ("fused" path); any other PC is applied with PCApply between two vector passes ("generic" path),
    still with one reduction per iteration. The product uses MatMultDotLocal(), which runs the matrix
    type's fused product-and-dot kernel when the type composes one (binbcsr does). */
@@ -25,7 +25,7 @@ static PetscErrorCode MCGChoosePath(KSP ksp, Mat Amat)
 {
   KSP_MCG     *mcg = (KSP_MCG *)ksp->data;
   PC           pc  = ksp->pc;
-  PetscBool    isjacobi, isnone;
+  PetscBool    isjacobi, isnone, ispbjacobi;
   MatNullSpace nullsp = nullptr;
   PetscErrorCode (*fused)(Mat, Vec, Vec, PetscScalar *) = nullptr;
 
@@ -36,6 +36,7 @@ static PetscErrorCode MCGChoosePath(KSP ksp, Mat Amat)
   mcg->why_generic[0] = 0;
   PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCJACOBI, &isjacobi));
   PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCNONE, &isnone));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCPBJACOBI, &ispbjacobi));
   PetscCall(MatGetNullSpace(Amat, &nullsp));
   if (!mcg->allow_fused) {
     PetscCall(PetscSNPrintf(mcg->why_generic, sizeof(mcg->why_generic), "turned off (-ksp_mcg_fused_pc 0)"));
@@ -51,6 +52,14 @@ static PetscErrorCode MCGChoosePath(KSP ksp, Mat Amat)
     PetscCall(PCJacobiGetType(pc, &type));
     if (type == PC_JACOBI_DIAGONAL) mcg->how = MCG_PC_JACOBI;
     else PetscCall(PetscSNPrintf(mcg->why_generic, sizeof(mcg->why_generic), "jacobi type %s is applied with PCApply", PCJacobiTypes[type]));
+  } else if (ispbjacobi) {
+    Mat      Pmat;
+    PetscInt bs, n;
+    PetscCall(PCGetOperators(pc, nullptr, &Pmat));
+    PetscCall(MatGetBlockSize(Pmat, &bs));
+    PetscCall(MatGetLocalSize(Pmat, &n, nullptr));
+    if (bs == 3 && n % 3 == 0) mcg->how = MCG_PC_PBJACOBI;
+    else PetscCall(PetscSNPrintf(mcg->why_generic, sizeof(mcg->why_generic), "pbjacobi is fused for block size 3, the matrix has %" PetscInt_FMT ": applied with PCApply", bs));
   } else {
     PetscCall(PetscSNPrintf(mcg->why_generic, sizeof(mcg->why_generic), "PC type %s is applied with PCApply", ((PetscObject)pc)->type_name ? ((PetscObject)pc)->type_name : "(unset)"));
   }
@@ -61,6 +70,19 @@ static PetscErrorCode MCGChoosePath(KSP ksp, Mat Amat)
    zero), absolute value if -pc_jacobi_abs, and zeros replaced by 1 when -pc_jacobi_fixdiagonal (the
    default) unless the matrix is known to be SPD. Rebuilt when the preconditioning matrix or its state
    changes, except when the PC is told to reuse its preconditioner. */
+PetscErrorCode MCGPreconditionerStale(KSP ksp, PetscBool built, PetscObjectId built_id, PetscObjectState built_state, Mat *Pmat, PetscObjectId *id, PetscObjectState *state, PetscBool *stale)
+{
+  PetscBool reuse;
+
+  PetscFunctionBegin;
+  PetscCall(PCGetOperators(ksp->pc, nullptr, Pmat));
+  PetscCall(PetscObjectGetId((PetscObject)*Pmat, id));
+  PetscCall(PetscObjectStateGet((PetscObject)*Pmat, state));
+  PetscCall(PCGetReusePreconditioner(ksp->pc, &reuse));
+  *stale = (PetscBool)!(built && (reuse || (*id == built_id && *state == built_state)));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MCGUpdateDiagonal(KSP ksp)
 {
   KSP_MCG         *mcg = (KSP_MCG *)ksp->data;
@@ -68,16 +90,13 @@ static PetscErrorCode MCGUpdateDiagonal(KSP ksp)
   Mat              Pmat;
   PetscObjectId    id;
   PetscObjectState state;
-  PetscBool        reuse, useabs, fixdiag, isset = PETSC_FALSE, isspd = PETSC_FALSE; /* MatIsSPDKnown leaves isspd unset when unknown */
+  PetscBool        stale, useabs, fixdiag, isset = PETSC_FALSE, isspd = PETSC_FALSE; /* MatIsSPDKnown leaves isspd unset when unknown */
   PetscInt         n, zeros = 0;
   PetscScalar     *d;
 
   PetscFunctionBegin;
-  PetscCall(PCGetOperators(pc, nullptr, &Pmat));
-  PetscCall(PetscObjectGetId((PetscObject)Pmat, &id));
-  PetscCall(PetscObjectStateGet((PetscObject)Pmat, &state));
-  PetscCall(PCGetReusePreconditioner(pc, &reuse));
-  if (mcg->dinv && (reuse || (id == mcg->dinv_id && state == mcg->dinv_state))) PetscFunctionReturn(0);
+  PetscCall(MCGPreconditionerStale(ksp, (PetscBool)!!mcg->dinv, mcg->dinv_id, mcg->dinv_state, &Pmat, &id, &state, &stale));
+  if (!stale) PetscFunctionReturn(0);
   if (mcg->dinv) {
     PetscInt nd, nm;
     PetscCall(VecGetLocalSize(mcg->dinv, &nd));
@@ -168,6 +187,9 @@ static PetscErrorCode MCGPrecondition(KSP ksp, Vec R, Vec U, PetscScalar *dots)
 #pragma omp simd reduction(+ : ru, rr, uu)
       for (PetscInt i = 0; i < n; i++) mcg_precondition_index<true, PetscScalar>(i, r, dinv, u, ru, rr, uu);
       PetscCall(VecRestoreArrayRead(mcg->dinv, &dinv));
+    } else if (mcg->how == MCG_PC_PBJACOBI) {
+      const PetscScalar *binv = mcg->binv;
+      for (PetscInt b = 0; b < n / 3; b++) mcg_precondition_block3<PetscScalar>(b, r, binv, u, ru, rr, uu);
     } else {
 #pragma omp simd reduction(+ : ru, rr, uu)
       for (PetscInt i = 0; i < n; i++) mcg_precondition_index<false, PetscScalar>(i, r, nullptr, u, ru, rr, uu);
@@ -209,6 +231,9 @@ static PetscErrorCode MCGUpdate(KSP ksp, PetscScalar alpha, PetscScalar beta, Ve
 #pragma omp simd reduction(+ : ru, rr, uu, xx)
     for (PetscInt i = 0; i < n; i++) mcg_update_index<true, PetscScalar>(i, alpha, beta, u, w, p, s, x, r, dinv, ru, rr, uu, xx);
     PetscCall(VecRestoreArrayRead(mcg->dinv, &dinv));
+  } else if (mcg->how == MCG_PC_PBJACOBI) {
+    const PetscScalar *binv = mcg->binv;
+    for (PetscInt b = 0; b < n / 3; b++) mcg_update_block3<PetscScalar>(b, alpha, beta, u, w, p, s, x, r, binv, ru, rr, uu, xx);
   } else {
 #pragma omp simd reduction(+ : ru, rr, uu, xx)
     for (PetscInt i = 0; i < n; i++) mcg_update_index<false, PetscScalar>(i, alpha, beta, u, w, p, s, x, r, nullptr, ru, rr, uu, xx);
@@ -219,7 +244,7 @@ static PetscErrorCode MCGUpdate(KSP ksp, PetscScalar alpha, PetscScalar beta, Ve
   PetscCall(VecRestoreArray(U, &u));
   PetscCall(VecRestoreArray(R, &r));
   PetscCall(VecRestoreArray(X, &x));
-  PetscCall(PetscLogFlops((mcg->how == MCG_PC_GENERIC ? 10.0 : 17.0) * n));
+  PetscCall(PetscLogFlops((mcg->how == MCG_PC_GENERIC ? 10.0 : mcg->how == MCG_PC_PBJACOBI ? 26.0 : 17.0) * n));
   PetscCall(PetscLogEventEnd(KSP_MCG_FusedUpdate, ksp, 0, 0, 0));
   if (mcg->how == MCG_PC_GENERIC) {
     /* the PC is applied to the new r, then one more pass for the local dots */
@@ -248,11 +273,24 @@ static PetscReal MCGNorm(KSP ksp, const PetscScalar *dots)
   }
 }
 
+/* The residual norm to report when a reduced dot is NaN or Inf: the KSP's norm when that is
+   nonfinite itself, else the nonfinite dot's magnitude (KSPCG reports its NaN norm the same way;
+   the last finite norm would tell KSPGetResidualNorm() that a NaN solve was small). */
+static PetscReal MCGNonfiniteNorm(KSP ksp, const PetscScalar *dots, int k)
+{
+  const PetscReal dp = MCGNorm(ksp, dots);
+  return PetscIsInfOrNanReal(dp) ? dp : PetscAbsScalar(dots[k]);
+}
+
 /* NaN or Inf in any reduced dot: KSP_DIVERGED_NANORINF (or KSP_DIVERGED_PC_FAILED when the PC
-   reports a failure), as KSPCG reports it. A macro because KSPCheckDot() returns from the solve. */
+   reports a failure), as KSPCG reports it, with the nonfinite norm as the residual norm. A macro
+   because KSPCheckDot() returns from the solve. */
 #define MCGCheckDots(ksp, dots) \
   do { \
-    for (int k_ = 0; k_ < MCG_NDOTS; k_++) KSPCheckDot(ksp, (dots)[k_]); \
+    for (int k_ = 0; k_ < MCG_NDOTS; k_++) { \
+      if (PetscIsInfOrNanScalar((dots)[k_])) ksp->rnorm = MCGNonfiniteNorm(ksp, dots, k_); \
+      KSPCheckDot(ksp, (dots)[k_]); \
+    } \
   } while (0)
 
 /* r = b - A x computed from scratch, u = M^-1 r, and the reduced r.u, r.r, u.u (no product yet). */
@@ -325,6 +363,7 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
     if (mcg->roundoff > 0) PetscCall(PetscInfo(ksp, "operator products rounded at u = %g%s: no tolerance is claimed below u ||A|| ||x||\n", (double)mcg->roundoff, mcg->single_storage ? " (single-precision storage)" : ""));
   }
   if (mcg->how == MCG_PC_JACOBI) PetscCall(MCGUpdateDiagonal(ksp));
+  if (mcg->how == MCG_PC_PBJACOBI) PetscCall(MCGUpdateBlockDiagonal(ksp));
   max_its           = mcg->fixed_its > 0 ? mcg->fixed_its : ksp->max_it;
   mcg->restarts     = 0;
   mcg->true_checks  = 0;
@@ -371,6 +410,20 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
     if (i >= max_its) {
       ksp->reason = mcg->fixed_its > 0 ? KSP_CONVERGED_ITS : KSP_DIVERGED_ITS;
       break;
+    }
+    /* Without a tolerance (fixed iterations, norm none) the iteration goes on after the residual
+       has converged: the recursive residual keeps shrinking geometrically until r.M^-1 r or p.Ap
+       underflow or lose their sign to rounding. Once it is below the rounding drift it no longer
+       measures anything (b - A x is at its attainable accuracy), so a breakdown there is the end of
+       a converged solve, reported as KSPCG reports r.z = 0: KSP_CONVERGED_ATOL. */
+    if (mcg->fixed_its > 0 || ksp->normtype == KSP_NORM_NONE) {
+      const PetscReal drift = PETSC_MACHINE_EPSILON * (anorm * sum_x + sum_r);
+      const PetscReal r_un  = PetscSqrtReal(PetscAbsScalar(dots[MCG_DOT_RR]));
+      if (i > 0 && r_un <= drift && (!(PetscRealPart(gamma) > 0.0) || !(PetscRealPart(delta) > 0.0) || !(PetscRealPart(delta - (gamma / gamma_old) * (gamma / gamma_old) * pAp) > 0.0))) {
+        ksp->reason = KSP_CONVERGED_ATOL;
+        PetscCall(PetscInfo(ksp, "Converged: recursive residual %g below its rounding drift %g at iteration %" PetscInt_FMT " (r.M^-1 r or p.Ap lost to rounding)\n", (double)r_un, (double)drift, i));
+        break;
+      }
     }
     /* breakdowns are reported, never divided by */
     if (gamma == (PetscScalar)0.0) {
@@ -510,6 +563,7 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
     if (ksp->reason) break;
     if (defer_product && !fresh && i < max_its) {
       PetscCall(MCGMatMultDot(ksp, Amat, U, W, &dots[MCG_DOT_UW]));
+      if (PetscIsInfOrNanScalar(dots[MCG_DOT_UW])) ksp->rnorm = PetscAbsScalar(dots[MCG_DOT_UW]);
       KSPCheckDot(ksp, dots[MCG_DOT_UW]);
       delta = dots[MCG_DOT_UW];
       MCGTrackNorm(dots, &anorm);

@@ -21,6 +21,10 @@ static RigidBody bar_between(const Eigen::Vector3d &p, const Eigen::Vector3d &q,
 ArticulatedScene make_chain(const ChainOptions &opt)
 {
   if (opt.links < 1) throw std::invalid_argument("a chain needs at least one link");
+  // checked here, where the option is named: a zero-length bar would surface later as a degenerate body
+  if (!(opt.link_length > 0) || !std::isfinite(opt.link_length) || !(opt.link_width > 0) || !std::isfinite(opt.link_width))
+    throw std::invalid_argument("the chain's link length and width must be positive and finite");
+  if (!std::isfinite(opt.angle)) throw std::invalid_argument("the chain's angle must be finite");
   ArticulatedScene scene;
   const Eigen::Vector3d down(std::sin(opt.angle), -std::cos(opt.angle), 0);
   Eigen::Vector3d       top = Eigen::Vector3d::Zero();

@@ -46,7 +46,7 @@ ClothSystem make_cloth_system(const Cloth &cloth, const std::vector<char> &own, 
 std::string validate_params(const ClothParams &p)
 {
   if (!(p.dt > 0) || !std::isfinite(p.dt)) return "time step must be positive and finite";
-  return "";
+  return validate_strain_limit(p.strain_limit);
 }
 
 namespace {
@@ -168,6 +168,9 @@ ClothStepReport cloth_step(Cloth &cloth, ClothSystem &sys, const ClothParams &pa
     if (cloth.fixed[p]) continue;
     cloth.velocity[p] += Eigen::Vector3d(sys.dv[3 * p], sys.dv[3 * p + 1], sys.dv[3 * p + 2]);
     cloth.position[p] += h * cloth.velocity[p];
+  }
+  for (int p = 0; p < sys.n_particles; ++p) {
+    if (cloth.fixed[p]) continue;
     if (cloth.sphere.enabled) {
       const Eigen::Vector3d d    = cloth.position[p] - cloth.sphere.centre;
       const double          dist = d.norm();
@@ -180,7 +183,8 @@ ClothStepReport cloth_step(Cloth &cloth, ClothSystem &sys, const ClothParams &pa
       }
     }
   }
-  report.max_stretch = max_stretch_ratio(cloth, sys.stretch_springs);
+  report.strain_sweeps = limit_strain(cloth, params.strain_limit, h).sweeps;
+  report.max_stretch   = max_stretch_ratio(cloth, sys.stretch_springs);
   return report;
 }
 

@@ -2,12 +2,13 @@
 // every spring (cloth_springs.hpp),
 //   (M + h D + h^2 K) dv = h (f - h K v),   v += dv,   x += h v,
 // then particles inside the sphere collider are projected to its surface and lose their inward normal
-// velocity. Pinned particles keep dv = 0: their rows and columns hold only M, so the matrix stays SPD.
+// velocity; then, if asked, the stretch springs are strain-limited (cloth_strain_limit.hpp). Pinned particles keep dv = 0: their rows and columns hold only M, so the matrix stays SPD.
 // The 3x3-block pattern (one diagonal block per particle, one or two blocks per spring) is built once; values
 // are refilled in place every step.
 #pragma once
 #include "physics/block_solver.hpp"
 #include "physics/cloth_model.hpp"
+#include "physics/cloth_strain_limit.hpp"
 
 #include <functional>
 #include <vector>
@@ -17,6 +18,7 @@ namespace physics {
 struct ClothParams {
   double dt      = 1.0 / 60.0;
   bool   choi_ko = true; // false keeps the exact (possibly indefinite) Jacobian of compressed springs
+  StrainLimit strain_limit; // off by default: applied after the position update and the sphere
 };
 
 // The blocks one process assembles. On one process: every row and both triangles. With replicated state
@@ -38,6 +40,7 @@ struct ClothStepReport {
   bool   breakdown  = false;
   int    contacts   = 0; // particles projected out of the sphere
   double max_stretch = 0; // over the stretch springs this process assembles (all of them on one process)
+  int    strain_sweeps = 0; // strain-limiting sweeps made (0 when off)
 };
 
 // Every row, both triangles.

@@ -55,9 +55,10 @@ public:
   void skip_section(const std::string &section)
   {
     std::string line;
+    const int   start = line_no_;
     while (next_line(line))
       if (line.rfind("$End" + section, 0) == 0) return;
-    fail("section $" + section + " is not terminated");
+    fail("section $" + section + " opened at line " + std::to_string(start) + " is not terminated (no $End" + section + ")");
   }
 
   TetMesh parse()
@@ -69,6 +70,9 @@ public:
       if (line[0] != '$') fail("expected a section header, found '" + line + "'");
       const std::string section = line.substr(1, line.find_first_of(" \t") == std::string::npos ? std::string::npos
                                                                                                  : line.find_first_of(" \t") - 1);
+      // gmsh files open with $MeshFormat: anything else (a misspelt header) is named here, not
+      // skipped to the end of the file as an unknown section
+      if (!have_format && section != "MeshFormat") fail("expected $MeshFormat as the first section, found '" + line + "'");
       if (section == "MeshFormat") {
         auto s  = data_line("$MeshFormat");
         version = get<double>(s, "format version");
@@ -171,6 +175,7 @@ private:
     }
     if (n == 10) std::swap(v[8], v[9]); // gmsh: 30 32 31 -> ours: 03 13 23 (same pair, flipped ends)
     tets_.insert(tets_.end(), v, v + n);
+    tet_tags_.push_back(element_tag);
   }
 
   static bool is_tet(int type) { return type == 4 || type == 11; }
@@ -214,7 +219,7 @@ private:
       v = new_index[v];
     }
     m.elements = std::move(tets_);
-    validate_mesh(m, name_);
+    validate_mesh(m, name_, tet_tags_);
     return m;
   }
 
@@ -225,6 +230,7 @@ private:
   std::vector<double>                     coords_;
   std::unordered_map<long long, int>      node_index_;
   std::vector<int>                        tets_;
+  std::vector<long long>                  tet_tags_; // the file's tag of each tetrahedron, for messages
 };
 
 } // namespace

@@ -75,9 +75,12 @@ void sort_elements_by_lowest_node(TetMesh &mesh)
   mesh.elements.swap(sorted);
 }
 
-void validate_mesh(const TetMesh &mesh, const std::string &what)
+void validate_mesh(const TetMesh &mesh, const std::string &what, const std::vector<long long> &element_tags)
 {
   const int n = mesh.node_count(), npe = mesh.nodes_per_element();
+  auto      name = [&](size_t e) {
+    return (int)element_tags.size() == mesh.element_count() ? "element with tag " + std::to_string(element_tags[e]) : "element " + std::to_string(e);
+  };
   if (mesh.order != 1 && mesh.order != 2) throw std::runtime_error(what + ": element order must be 1 or 2");
   if (mesh.element_count() == 0) throw std::runtime_error(what + ": mesh has no tetrahedra");
   if (mesh.elements.size() % npe) throw std::runtime_error(what + ": element list length is not a multiple of the element size");
@@ -85,7 +88,7 @@ void validate_mesh(const TetMesh &mesh, const std::string &what)
   for (size_t k = 0; k < mesh.elements.size(); ++k) {
     const int v = mesh.elements[k];
     if (v < 0 || v >= n)
-      throw std::runtime_error(what + ": element " + std::to_string(k / npe) + " refers to node " + std::to_string(v) +
+      throw std::runtime_error(what + ": " + name(k / npe) + " refers to node " + std::to_string(v) +
                                ", outside [0, " + std::to_string(n) + ")");
     used[v] = 1;
   }
@@ -112,8 +115,8 @@ void validate_mesh(const TetMesh &mesh, const std::string &what)
     }
   }
   if (bad)
-    throw std::runtime_error(what + ": " + std::to_string(bad) + " element(s) inverted or of zero volume; first: element " +
-                             std::to_string(first_bad) + " with signed volume " + std::to_string(first_volume));
+    throw std::runtime_error(what + ": " + std::to_string(bad) + " element(s) inverted or of zero volume; first: " +
+                             name(first_bad) + " with signed volume " + std::to_string(first_volume));
 }
 
 std::vector<int> nodes_in_box(const TetMesh &mesh, const std::array<double, 3> &lo, const std::array<double, 3> &hi,

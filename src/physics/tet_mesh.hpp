@@ -41,8 +41,10 @@ void renumber_nodes(TetMesh &mesh, const std::vector<int> &new_of_old);
 void sort_elements_by_lowest_node(TetMesh &mesh);
 
 // Throws std::runtime_error naming the first offending element when an element's rest volume is not
-// positive (inverted or flat) or a node index is out of range, and when nodes are unused.
-void validate_mesh(const TetMesh &mesh, const std::string &what);
+// positive (inverted or flat) or a node index is out of range, and when nodes are unused. With
+// element_tags (one per element, e.g. the tags of a .msh file) elements are named by their tag, so
+// that the user finds them in the file; otherwise by their index.
+void validate_mesh(const TetMesh &mesh, const std::string &what, const std::vector<long long> &element_tags = {});
 
 // Nodes whose rest position lies in the axis-aligned box [lo, hi] (inclusive, tolerance tol).
 std::vector<int> nodes_in_box(const TetMesh &mesh, const std::array<double, 3> &lo, const std::array<double, 3> &hi,

@@ -1,6 +1,7 @@
 /* MATMPIBINBCSR conversion to and from other types, parallel MatLoad, MatView (per-rank info of
    the parts; other formats through an MPIAIJ copy), MatDuplicate and MatCopy. */
 #include "mpibinbcsr.h"
+#include "../common/binbcsr_load.h"
 
 #include <algorithm>
 
@@ -115,21 +116,18 @@ PETSC_INTERN PetscErrorCode MatConvertFrom_MPIBinBCSR(Mat src, MatType newtype, 
   PetscFunctionReturn(0);
 }
 
-/* Reads with PETSc's own parallel MPIAIJ reader, then fills this matrix from it. */
+/* Reads this rank's rows with the reader the serial loader uses (same checks on every rank, repeated
+   entries summed: mpiaij's own reader would drop a negative column and keep only the last of a
+   repeated one), makes them an MPIAIJ matrix and fills this matrix from it. */
 PETSC_INTERN PetscErrorCode MatLoad_MPIBinBCSR(Mat mat, PetscViewer viewer)
 {
-  Mat      T;
-  PetscInt bs, cbs;
+  Mat                      T;
+  std::vector<PetscInt>    rowptr, cols;
+  std::vector<PetscScalar> vals;
 
   PetscFunctionBegin;
-  PetscCall(MatCreate(PetscObjectComm((PetscObject)mat), &T));
-  PetscCall(MatSetSizes(T, mat->rmap->n, mat->cmap->n, mat->rmap->N, mat->cmap->N));
-  PetscCall(MatGetBlockSizes(mat, &bs, &cbs));
-  if (bs > 1 || cbs > 1) PetscCall(MatSetBlockSizes(T, bs, cbs));
-  PetscCall(MatSetType(T, MATMPIAIJ));
-  PetscCall(MatLoad(T, viewer));
-  PetscCall(MatSetSizes(mat, T->rmap->n, T->cmap->n, T->rmap->N, T->cmap->N));
-  PetscCall(MatSetBlockSizesFromMats(mat, T, T));
+  PetscCall(MatBinBCSRReadBinaryRows_Private(mat, viewer, rowptr, cols, vals));
+  PetscCall(MatCreateMPIAIJWithArrays(PetscObjectComm((PetscObject)mat), mat->rmap->n, mat->cmap->n, mat->rmap->N, mat->cmap->N, rowptr.data(), cols.data(), vals.data(), &T));
   PetscCall(MatBinBCSRPreallocateAndFill_Private(T, mat));
   PetscCall(MatDestroy(&T));
   PetscFunctionReturn(0);

@@ -137,10 +137,20 @@ PETSC_INTERN PetscErrorCode MatDiagonalSet_MPIBinBCSR(Mat mat, Vec d, InsertMode
   PetscFunctionReturn(0);
 }
 
+/* As MPIAIJ, the zero pivot the diagonal part met is reported on the matrix (PCPBJACOBI and KSPMCG's
+   fused point-block Jacobi look for it there), its row as a global row. */
 PETSC_INTERN PetscErrorCode MatInvertBlockDiagonal_MPIBinBCSR(Mat mat, const PetscScalar **values)
 {
+  Mat A = MPIBinBCSR(mat)->A;
+
   PetscFunctionBegin;
-  PetscCall(MatInvertBlockDiagonal(MPIBinBCSR(mat)->A, values));
+  PetscCall(MatFactorClearError(A));
+  PetscCall(MatInvertBlockDiagonal(A, values));
+  mat->factorerrortype = A->factorerrortype;
+  if (A->factorerrortype) {
+    mat->factorerror_zeropivot_row   = A->factorerror_zeropivot_row + mat->rmap->rstart;
+    mat->factorerror_zeropivot_value = A->factorerror_zeropivot_value;
+  }
   PetscFunctionReturn(0);
 }
 

@@ -26,18 +26,7 @@ TEST_CASE("mcg matches cg on binbcsr, double and single storage", "[ksp_mcg][bin
       const char *floor_off = "-ksp_mcg_precision_floor 0";
       for (const char *pc : {PCJACOBI, PCNONE}) {
         INFO("pc " << pc);
-        const Result cg = solve(B, b, Solve{KSPCG, pc, KSP_NORM_UNPRECONDITIONED, 1e-10});
-        const Result mcg = solve(B, b, Solve{KSPMCG, pc, KSP_NORM_UNPRECONDITIONED, 1e-10, 1000, 0, floor_off});
-        REQUIRE(mcg.err == 0);
-        CHECK(cg.reason > 0);
-        CHECK(mcg.reason == cg.reason);
-        CHECK(std::abs(mcg.its - cg.its) <= 1);
-        CHECK(rel_diff(mcg.x, cg.x) < 1e-7);
-        for (size_t k = 0; k < 15 && k < cg.history.size() && k < mcg.history.size() && cg.history[k] > 1e-9 * cg.history[0]; k++) CHECK(mcg.history[k] == Approx(cg.history[k]).epsilon(1e-8));
-        // k iterates equal to round-off
-        const Result cg5 = solve(B, b, Solve{KSPCG, pc, KSP_NORM_UNPRECONDITIONED, 1e-30, 5});
-        const Result mcg5 = solve(B, b, Solve{KSPMCG, pc, KSP_NORM_UNPRECONDITIONED, 1e-30, 5, 0, floor_off});
-        CHECK(rel_diff(mcg5.x, cg5.x) < 1e-12);
+        check_mcg_same_as_cg(B, b, pc, floor_off);
       }
       // binbcsr double storage is the same operator as aij: same iterates as mcg on aij
       if (precision == MAT_BINBCSR_PRECISION_DOUBLE) {

@@ -154,6 +154,22 @@ Mat to_binbcsr(Mat aij, MatBinBCSRPrecision precision)
   return B;
 }
 
+void check_mcg_same_as_cg(Mat A, Vec b, const char *pc, const char *options)
+{
+  const Result cg  = solve(A, b, Solve{KSPCG, pc, KSP_NORM_UNPRECONDITIONED, 1e-10});
+  const Result mcg = solve(A, b, Solve{KSPMCG, pc, KSP_NORM_UNPRECONDITIONED, 1e-10, 1000, 0, options});
+  REQUIRE(mcg.err == 0);
+  CHECK(cg.reason > 0);
+  CHECK(mcg.reason == cg.reason);
+  CHECK(std::abs(mcg.its - cg.its) <= 1);
+  CHECK(rel_diff(mcg.x, cg.x) < 1e-7);
+  for (size_t k = 0; k < 15 && k < cg.history.size() && k < mcg.history.size() && cg.history[k] > 1e-9 * cg.history[0]; k++) CHECK(mcg.history[k] == Approx(cg.history[k]).epsilon(1e-8));
+  // k iterates equal to round-off
+  const Result cg5  = solve(A, b, Solve{KSPCG, pc, KSP_NORM_UNPRECONDITIONED, 1e-30, 5});
+  const Result mcg5 = solve(A, b, Solve{KSPMCG, pc, KSP_NORM_UNPRECONDITIONED, 1e-30, 5, 0, options});
+  CHECK(rel_diff(mcg5.x, cg5.x) < 1e-12);
+}
+
 PetscReal rel_residual(Mat A, Vec b, const std::vector<PetscScalar> &x)
 {
   Vec       xv, r;

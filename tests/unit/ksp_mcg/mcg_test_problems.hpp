@@ -44,6 +44,10 @@ PetscReal rel_diff(const std::vector<PetscScalar> &a, const std::vector<PetscSca
 // The aij test matrix converted to binbcsr with the given value storage; nullptr where binbcsr is not
 // available on this communicator (required, checked, on one rank).
 Mat to_binbcsr(Mat aij, MatBinBCSRPrecision precision);
+// KSPMCG with the given PC and extra options against KSPCG with the PC on A x = b (unpreconditioned
+// norm): same reason, iterations +-1, solutions to 1e-7 at rtol 1e-10, residual histories to 1e-8 over
+// the first 15 iterations, and the iterates after 5 iterations equal to rounding (1e-12). Catch checks.
+void check_mcg_same_as_cg(Mat A, Vec b, const char *pc, const char *options);
 // ||b - A x|| / ||b|| with the gathered x.
 PetscReal rel_residual(Mat A, Vec b, const std::vector<PetscScalar> &x);
 

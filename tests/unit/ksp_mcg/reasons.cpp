@@ -149,3 +149,62 @@ TEST_CASE("errors on bad setter input", "[ksp_mcg]")
   CHECK(n == 30);
   KSPDestroy(&ksp);
 }
+
+TEST_CASE("fixed iterations far past convergence end converged, not in a breakdown", "[ksp_mcg][reasons]")
+{
+  // 1000 iterations on systems that converge in a few dozen: the recursive residual goes on shrinking
+  // until r.M^-1 r or p.Ap are lost to rounding; that is a converged solve (KSPCG with norm none and
+  // no convergence test says CONVERGED_ATOL), whatever the rounding does on 1 or 2 ranks
+  for (PetscInt n : {6, 10, 16}) {
+    Mat A = block_laplacian(n, n);
+    Vec b = rhs(A);
+    for (const char *pc : {PCJACOBI, PCNONE, PCPBJACOBI}) {
+      INFO("grid " << n << ", pc " << pc);
+      const Result r = solve(A, b, Solve{KSPMCG, pc, KSP_NORM_DEFAULT, 1e-10, 1000, 1000});
+      REQUIRE(r.err == 0);
+      CHECK(r.reason > 0);
+      CHECK(rel_residual(A, b, r.x) < 1e-12);
+      const Result none = solve(A, b, Solve{KSPMCG, pc, KSP_NORM_NONE, 1e-10, 1000, 0, "-ksp_convergence_test skip"});
+      REQUIRE(none.err == 0);
+      CHECK(none.reason > 0);
+      CHECK(rel_residual(A, b, none.x) < 1e-12);
+    }
+    MatDestroy(&A);
+    VecDestroy(&b);
+  }
+}
+
+TEST_CASE("a NaN in the matrix or the right-hand side is reported as a NaN residual norm", "[ksp_mcg][reasons]")
+{
+  const PetscScalar nan = PETSC_MAX_REAL * 10.0 - PETSC_MAX_REAL * 10.0;
+  PetscMPIInt       rank;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  Mat A = block_laplacian(4, 3);
+  Vec b = rhs(A);
+  Vec bn;
+  VecDuplicate(b, &bn);
+  VecCopy(b, bn);
+  VecSetValue(bn, 5, nan, INSERT_VALUES);
+  VecAssemblyBegin(bn);
+  VecAssemblyEnd(bn);
+  Mat An;
+  MatDuplicate(A, MAT_COPY_VALUES, &An);
+  if (!rank) MatSetValue(An, 4, 4, nan, INSERT_VALUES);
+  MatAssemblyBegin(An, MAT_FINAL_ASSEMBLY);
+  MatAssemblyEnd(An, MAT_FINAL_ASSEMBLY);
+  for (const char *pc : {PCJACOBI, PCNONE, PCBJACOBI}) {
+    for (PetscInt fixed : {0, 10}) {
+      INFO("pc " << pc << ", fixed iterations " << fixed);
+      const Result rb = solve(A, bn, Solve{KSPMCG, pc, KSP_NORM_DEFAULT, 1e-10, 1000, fixed});
+      CHECK(rb.reason == KSP_DIVERGED_NANORINF);
+      CHECK(PetscIsInfOrNanReal(rb.rnorm));
+      const Result ra = solve(An, b, Solve{KSPMCG, pc, KSP_NORM_DEFAULT, 1e-10, 1000, fixed});
+      CHECK(ra.reason < 0);
+      CHECK(PetscIsInfOrNanReal(ra.rnorm));
+    }
+  }
+  MatDestroy(&An);
+  MatDestroy(&A);
+  VecDestroy(&bn);
+  VecDestroy(&b);
+}

@@ -305,3 +305,20 @@ TEST_CASE("work split over processes: own joints partition, every body counted o
   for (int j = 0; j < nj; ++j) CHECK(owned[j] == 1);
   CHECK_THROWS_AS(split_articulated_work(scene, std::vector<int>(nj - 1, 0), 0), std::invalid_argument);
 }
+
+TEST_CASE("chain options: a zero or nonfinite link length or width is refused by name", "[articulated]")
+{
+  for (double bad : {0.0, -1.0, std::nan("")}) {
+    ChainOptions length, width;
+    length.link_length = bad;
+    width.link_width   = bad;
+    for (const ChainOptions *o : {&length, &width}) {
+      try {
+        make_chain(*o);
+        FAIL("accepted a link length/width of " << bad);
+      } catch (const std::invalid_argument &e) {
+        CHECK(std::string(e.what()).find("link length and width must be positive") != std::string::npos);
+      }
+    }
+  }
+}

@@ -109,10 +109,15 @@ TEST_CASE("malformed msh files give clear errors", "[fem][msh]")
   CHECK_THAT(error_of(replace(good, "2 4 2 1 1 1 2 3 4", "2 2 2 1 1 1 2 3")), Catch::Contains("no tetrahedra"));
   CHECK_THAT(error_of(replace(good, "2 4 2 1 1 1 2 3 4", "2 4 2 1 1 1 3 2 4")), Catch::Contains("inverted or of zero volume"));
   CHECK_THAT(error_of(replace(good, "4 0 0 1", "4 1 1 0")), Catch::Contains("inverted or of zero volume"));
+  // The inverted element is named by its tag in the file (2), not by its index in the mesh (0).
+  CHECK_THAT(error_of(replace(good, "2 4 2 1 1 1 2 3 4", "2 4 2 1 1 1 3 2 4")), Catch::Contains("first: element with tag 2 "));
+  // A misspelt header is named where it stands, not skipped to the end of the file.
+  CHECK_THAT(error_of(replace(good, "$MeshFormat\n", "$MeshFmt\n")), Catch::Contains("test.msh:1: expected $MeshFormat as the first section, found '$MeshFmt'"));
   CHECK_THAT(error_of(replace(good, "$EndElements\n", "")), Catch::Contains("missing $EndElements"));
   const std::string no_elements = good.substr(0, good.find("$Elements"));
   CHECK_THAT(error_of(no_elements), Catch::Contains("no $Elements"));
   CHECK_THAT(error_of(replace(good, "$EndPhysicalNames\n", "")), Catch::Contains("not terminated"));
+  CHECK_THAT(error_of(replace(good, "$EndPhysicalNames\n", "")), Catch::Contains("opened at line"));
   // Mixed orders.
   std::string mixed = replace(good, "$Elements\n2", "$Elements\n3");
   mixed             = replace(mixed, "$EndElements", "3 11 2 1 1 1 2 3 4 1 2 3 4 1 2\n$EndElements");
