@@ -67,6 +67,7 @@ struct Options {
   PetscBool   quiet   = PETSC_FALSE;
   PetscInt    element_bench = 0;
   PetscBool   cpu_timer = PETSC_FALSE;
+  PetscBool   scalar_elements = PETSC_FALSE;
   PetscBool   is_static = PETSC_FALSE;
   PetscReal   v0[3] = {0, 0, 0};
   PetscReal   spin[3] = {0, 0, 0};
@@ -125,6 +126,13 @@ PetscErrorCode GetOptions(Options &o)
     PetscCall(PetscOptionsEList("-fem_timer", "per-step timings in wall time or process CPU time (a shared machine)", "", timers, 2,
                                 timers[t], &t, nullptr));
     o.cpu_timer = t == 1 ? PETSC_TRUE : PETSC_FALSE;
+  }
+  {
+    const char *kernels[] = {"batched", "scalar"};
+    PetscInt    k         = o.scalar_elements ? 1 : 0;
+    PetscCall(PetscOptionsEList("-fem_element_kernel", "element loop: batched over SIMD lanes, or the scalar reference", "",
+                                kernels, 2, kernels[k], &k, nullptr));
+    o.scalar_elements = k == 1 ? PETSC_TRUE : PETSC_FALSE;
   }
   PetscCall(PetscOptionsBool("-fem_quiet", "no progress line per step", "", o.quiet, &o.quiet, nullptr));
   PetscCall(PetscOptionsBool("-static", "solve K(x) dx = f(x) + f_ext by Newton steps instead of time steps", "", o.is_static,
@@ -307,6 +315,7 @@ int main(int argc, char **argv)
   FemSimulation sim;
   PetscCall(FemSimulationCreate(comm, scene, &sim));
   sim.cpu_timer = o.cpu_timer;
+  sim.element_kernel = o.scalar_elements ? physics::ElementKernel::Scalar : physics::ElementKernel::Batched;
   const physics::FemModel &model = sim.model;
   const int n_nodes = model.node_count(), npe = model.npe, tip = sim.new_of_old[tip_input];
   const std::vector<double> &X = model.mesh.nodes;
@@ -385,7 +394,7 @@ int main(int argc, char **argv)
 
   // ---- time loop ----------------------------------------------------------------------------
   double             t_element = 0, t_setvalues = 0, t_solve = 0, t_comm = 0, t_total = 0;
-  long long          its_total  = 0;
+  long long          its_total  = 0, svd_rotations = 0;
   int                steps_done = 0;
   KSPConvergedReason last_reason = KSP_CONVERGED_ITERATING;
   for (int step = 1; step <= o.steps; ++step) {
@@ -398,6 +407,7 @@ int main(int argc, char **argv)
     t_solve += info.solve_ms;
     t_total += info.total_ms;
     its_total += info.stats.iterations;
+    svd_rotations += info.svd_rotations;
     last_reason = info.stats.reason;
     steps_done  = step;
     if (!o.quiet)
@@ -424,7 +434,7 @@ int main(int argc, char **argv)
       std::fill(sim.rhs_full.begin(), sim.rhs_full.end(), 0.0);
       const double c1 = cpu_ms();
       physics::assemble_elements(model, sim.elements, x.data(), v.data(), sim.coefficients, &sim.pattern, sim.values.data(),
-                                 sim.rhs_full.data());
+                                 sim.rhs_full.data(), nullptr, sim.element_kernel);
       const double c2 = cpu_ms();
       reset_ms.push_back(c1 - c0);
       loop_ms.push_back(c2 - c1);
@@ -491,6 +501,11 @@ int main(int argc, char **argv)
   s.add("momentum_y", P[1]);
   s.add("momentum_z", P[2]);
   s.add("min_volume_ratio", min_vol_ratio);
+  {
+    long long all = 0; // summed over the ranks: each counts the elements it assembles
+    PetscCallMPI(MPI_Allreduce(&svd_rotations, &all, 1, MPI_LONG_LONG, MPI_SUM, comm));
+    s.add("svd_rotations", all);
+  }
   s.add("inverted_fraction", inverted_fraction());
   s.add("energy_initial", guard.energy0);
   s.add("energy_final", total_energy());

@@ -1,4 +1,5 @@
 #include "physics/corotational_assembly.hpp"
+#include "physics/element_batch.hpp"
 #include "physics/polar_decomposition.hpp"
 
 #include <algorithm>
@@ -236,16 +237,19 @@ void assemble_kernel_p1(const FemModel &model, const std::vector<int> &elements,
 
 } // namespace
 
-void assemble_elements(const FemModel &model, const std::vector<int> &elements, const double *x, const double *v,
-                       const StepCoefficients &c, const BlockPattern *pattern, double *block_values, double *rhs,
-                       Eigen::Matrix3d *rotations)
+long long assemble_elements(const FemModel &model, const std::vector<int> &elements, const double *x, const double *v,
+                            const StepCoefficients &c, const BlockPattern *pattern, double *block_values, double *rhs,
+                            Eigen::Matrix3d *rotations, ElementKernel kernel)
 {
   if (block_values && !pattern) throw std::invalid_argument("assemble_elements: block values need a pattern");
   if (pattern && pattern->element_slots.size() != elements.size() * model.npe * model.npe)
     throw std::invalid_argument("assemble_elements: pattern was built for another element list");
+  if (kernel == ElementKernel::Batched)
+    return assemble_elements_batched(model, elements, x, v, c, block_values ? pattern : nullptr, block_values, rhs, rotations);
   if (model.npe == 4 && !model.gradients.empty()) assemble_kernel_p1(model, elements, x, v, c, pattern, block_values, rhs, rotations);
   else if (model.npe == 4) assemble_kernel<4>(model, elements, x, v, c, pattern, block_values, rhs, rotations);
   else assemble_kernel<10>(model, elements, x, v, c, pattern, block_values, rhs, rotations);
+  return 0;
 }
 
 std::vector<double> elastic_forces(const FemModel &model, const double *x)

@@ -72,13 +72,20 @@ BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &e
 // loop does not write. Call before assemble_elements (once is enough while the array is kept).
 void reset_block_values(const BlockPattern &pattern, std::vector<double> &block_values);
 
+// Which element loop runs: Batched (element_batch.hpp: the kernels of element_kernels.hpp over SIMD
+// lanes, P2 from the barycentric gradients) or Scalar (one element at a time, P2 from the stored K0:
+// the reference the batched kernels are tested against).
+enum class ElementKernel { Batched, Scalar };
+
 // The element loop. x, v: 3 per node (all nodes). rhs: 3 per node, accumulated (+=). block_values:
 // 9 per COO block of `pattern`, row-major: every element block is overwritten with the sum of its
 // element contributions (the identity blocks are left as they are); may be null (forces only;
-// pattern may then be null too). rotations (optional): one per listed element.
-void assemble_elements(const FemModel &model, const std::vector<int> &elements, const double *x, const double *v,
-                       const StepCoefficients &c, const BlockPattern *pattern, double *block_values, double *rhs,
-                       Eigen::Matrix3d *rotations = nullptr);
+// pattern may then be null too). rotations (optional): one per listed element. Returns the number of
+// elements whose rotation took the scalar SVD path (inverted or flat; Batched also counts elements
+// that the fixed Newton steps did not converge; Scalar returns 0).
+long long assemble_elements(const FemModel &model, const std::vector<int> &elements, const double *x, const double *v,
+                            const StepCoefficients &c, const BlockPattern *pattern, double *block_values, double *rhs,
+                            Eigen::Matrix3d *rotations = nullptr, ElementKernel kernel = ElementKernel::Batched);
 
 // Elastic forces only (a_f = 1): f = sum_e f_e over all elements, 3 per node, overwritten.
 std::vector<double> elastic_forces(const FemModel &model, const double *x);

@@ -1,5 +1,6 @@
 #include "sim/fem_simulation.h"
 #include "sim/summary.h"
+#include "physics/element_batch.hpp"
 #include "physics/partition.hpp"
 #include "physics/row_order.hpp"
 
@@ -7,12 +8,27 @@
 #include <cmath>
 #include <stdexcept>
 
+static PetscLogEvent FEM_Elements = 0;
+
+/* -log_view events of the driver layer (the physics library has no PETSc): the element loop, i.e. the
+   batched kernels (rotations, rotated blocks, forces) with their gather and write-out. */
+static PetscErrorCode FemRegisterEvents(void)
+{
+  static PetscClassId classid = 0;
+  PetscFunctionBegin;
+  if (classid) PetscFunctionReturn(0);
+  PetscCall(PetscClassIdRegister("FEM", &classid));
+  PetscCall(PetscLogEventRegister("FemElements", classid, &FEM_Elements));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode FemSimulationCreate(MPI_Comm comm, const FemScene &scene, FemSimulation *sim)
 {
   PetscMPIInt rank, size;
   std::string error;
 
   PetscFunctionBegin;
+  PetscCall(FemRegisterEvents());
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   PetscCallMPI(MPI_Comm_size(comm, &size));
   sim->comm = comm;
@@ -111,8 +127,11 @@ PetscErrorCode FemSimulationStep(FemSimulation *sim, FemStepInfo *info)
   const double t0  = now();
   physics::reset_block_values(sim->pattern, sim->values);
   std::fill(sim->rhs_full.begin(), sim->rhs_full.end(), 0.0);
-  physics::assemble_elements(sim->model, sim->elements, sim->x.data(), sim->v.data(), sim->coefficients, &sim->pattern,
-                             sim->values.data(), sim->rhs_full.data());
+  PetscCall(PetscLogEventBegin(FEM_Elements, 0, 0, 0, 0));
+  info->svd_rotations = physics::assemble_elements(sim->model, sim->elements, sim->x.data(), sim->v.data(), sim->coefficients,
+                                                   &sim->pattern, sim->values.data(), sim->rhs_full.data(), nullptr, sim->element_kernel);
+  PetscCall(PetscLogFlops(physics::element_kernel_flops(sim->model.mesh.order, true) * (PetscLogDouble)sim->elements.size()));
+  PetscCall(PetscLogEventEnd(FEM_Elements, 0, 0, 0, 0));
   const double t1 = now();
   if (sim->size > 1)
     PetscCallMPI(MPI_Reduce_scatter(sim->rhs_full.data(), sim->rhs_local.data(), sim->counts.data(), MPI_DOUBLE, MPI_SUM, sim->comm));

@@ -34,6 +34,7 @@ struct FemStepInfo {
   SolveStats stats;
   bool       finite = true; // dv had no NaN/Inf (else the state was left unchanged)
   double     element_ms = 0, setvalues_ms = 0, comm_ms = 0, solve_ms = 0, total_ms = 0;
+  long long  svd_rotations = 0; // this rank's elements whose rotation took the scalar SVD path (inverted, flat)
 };
 
 struct FemSimulation {
@@ -53,6 +54,7 @@ struct FemSimulation {
   double                dt = 0, rhs_gravity_scale = 0;
   bool                  is_static = false;
   bool                  cpu_timer = false; // FemStepInfo times in process CPU time instead of wall time
+  physics::ElementKernel element_kernel = physics::ElementKernel::Batched; // Scalar: the reference loop
   // work arrays
   std::vector<double>   values, rhs_full, rhs_local, dv_local, dv_full;
   std::vector<int>      counts, displs;

@@ -288,8 +288,8 @@ TEST_CASE("P1 fast kernel (rotated gradients) equals the generic K0 kernel", "[f
   std::vector<double> va, vb, ra(x.size(), 0.0), rb(x.size(), 0.0);
   reset_block_values(p, va);
   reset_block_values(p, vb);
-  assemble_elements(fast, elements, x.data(), v.data(), c, &p, va.data(), ra.data());
-  assemble_elements(generic, elements, x.data(), v.data(), c, &p, vb.data(), rb.data());
+  assemble_elements(fast, elements, x.data(), v.data(), c, &p, va.data(), ra.data(), nullptr, ElementKernel::Scalar);
+  assemble_elements(generic, elements, x.data(), v.data(), c, &p, vb.data(), rb.data(), nullptr, ElementKernel::Scalar);
   double dv = 0, sv = 0, dr = 0, sr = 0;
   for (size_t k = 0; k < va.size(); ++k) dv = std::max(dv, std::fabs(va[k] - vb[k])), sv = std::max(sv, std::fabs(vb[k]));
   for (size_t k = 0; k < ra.size(); ++k) dr = std::max(dr, std::fabs(ra[k] - rb[k])), sr = std::max(sr, std::fabs(rb[k]));

@@ -1,0 +1,238 @@
+// Corotational tetrahedron kernels as per-element functions over plain arrays: the deformation
+// gradient, the rotation (polar factor) by a fixed number of Newton steps, and the P1 / P2 element
+// (rotated stiffness blocks and corotational forces). No allocation, no Eigen, no STL, no PETSc, so
+// that a GPU can run one element per thread (BINBCSR_PHYS_HD becomes __host__ __device__ under nvcc).
+//
+// Layout: entry k of an element's array is at p[k * S]. The CPU (element_batch.cpp) keeps a batch of
+// S elements as structure of arrays and calls the functions from an `omp simd` loop over the lanes,
+// with the pointers offset by the lane, so every access is a contiguous vector across the lanes; a
+// thread that owns one element calls them with S = 1. The bodies have no data-dependent branches
+// (selects only) and fixed trip counts, which the compiler unrolls inside the lane loop.
+//
+// Conventions: 3x3 matrices F, R, Dm^-1 column-major (Eigen's order: (r, c) at 3 c + r); nodal
+// vectors node-major (node b, component d at 3 b + d); output blocks row-major ((r, c) at 3 r + c),
+// block (a, b), a <= b, at 9 * packed index (row by row over the upper triangle, fem_model.hpp).
+#pragma once
+#include <cmath>
+
+#if defined(__CUDACC__)
+#define BINBCSR_PHYS_HD __host__ __device__ __forceinline__
+#define BINBCSR_PHYS_UNROLL _Pragma("unroll")
+#else
+#define BINBCSR_PHYS_HD inline __attribute__((always_inline))
+#define BINBCSR_PHYS_UNROLL _Pragma("GCC unroll 64")
+#endif
+
+namespace physics {
+namespace kernels {
+
+// What every element of a call shares: the integrator's coefficients (corotational_assembly.hpp) and
+// the material.
+struct ElementConstants {
+  double force, stiffness_rhs, mass_rhs, mass_matrix, stiffness_matrix; // a_f, a_K, a_M, c_M, c_K
+  double lambda, mu, density;
+};
+
+// ---- deformation gradient -------------------------------------------------------------------------
+
+// F = Ds Dm^-1, Ds = (x1 - x0, x2 - x0, x3 - x0) from the corner positions xc (node-major, 12 entries).
+template <int S>
+BINBCSR_PHYS_HD void deformation_gradient(const double *xc, const double *Dinv, double *F)
+{
+  double Ds[9];
+  BINBCSR_PHYS_UNROLL
+  for (int k = 0; k < 3; ++k)
+    BINBCSR_PHYS_UNROLL
+    for (int r = 0; r < 3; ++r) Ds[3 * k + r] = xc[(3 * (k + 1) + r) * S] - xc[r * S];
+  BINBCSR_PHYS_UNROLL
+  for (int c = 0; c < 3; ++c)
+    BINBCSR_PHYS_UNROLL
+    for (int r = 0; r < 3; ++r)
+      F[(3 * c + r) * S] = Ds[r] * Dinv[(3 * c) * S] + Ds[3 + r] * Dinv[(3 * c + 1) * S] + Ds[6 + r] * Dinv[(3 * c + 2) * S];
+}
+
+// ---- rotation -------------------------------------------------------------------------------------
+
+// The limits of polar_decomposition.cpp's Newton iteration (the scalar reference): an iterate is
+// accepted when its last step changed it by less than 1e-7 (so it is within ~1e-14 of the limit) and
+// |det - 1| < 1e-8; a start with det(F / |F| sqrt 3) <= 5.2e-6 (inverted, flat) is not iterated.
+constexpr double kPolarMinStartDet  = 5.2e-6;
+constexpr double kPolarConverged2   = 1e-14;
+constexpr double kPolarDetTolerance = 1e-8;
+// Newton steps, all lanes alike, the first kPolarScaledSteps with Higham's Frobenius scaling (two
+// square roots and a division more, on the lanes' latency chain). Steps needed to pass the acceptance
+// test (20,000 random F per row): singular value ratios up to 1.02: 3; 1.5: 4; 4: 5; 10: 6, so 5 steps
+// pass every element stretched up to 4:1 and most at 10:1; the rest take the scalar path. Steps
+// after convergence keep the iterate (a rotation is a fixed point).
+constexpr int kPolarSteps       = 5;
+constexpr int kPolarScaledSteps = 2;
+
+// Columns of cof(X) = det(X) X^-T (cross products of X's other two columns) and det X.
+BINBCSR_PHYS_HD void cofactor3(const double *X, double *C, double &det)
+{
+  C[0] = X[4] * X[8] - X[5] * X[7];
+  C[1] = X[5] * X[6] - X[3] * X[8];
+  C[2] = X[3] * X[7] - X[4] * X[6];
+  C[3] = X[7] * X[2] - X[8] * X[1];
+  C[4] = X[8] * X[0] - X[6] * X[2];
+  C[5] = X[6] * X[1] - X[7] * X[0];
+  C[6] = X[1] * X[5] - X[2] * X[4];
+  C[7] = X[2] * X[3] - X[0] * X[5];
+  C[8] = X[0] * X[4] - X[1] * X[3];
+  det  = X[0] * C[0] + X[1] * C[1] + X[2] * C[2];
+}
+
+// R = polar factor of F by kPolarSteps scaled Newton steps X <- (g X + cof(X) / (g det X)) / 2, without
+// branches. Returns 1 where R passed the acceptance test, 0 where the caller must take the scalar
+// path (rotation_from_deformation: inverted or flat elements get the sign-corrected SVD rotation,
+// broken F the identity). R is then the identity, and no lane divides by zero or makes NaN on the way.
+// (A double, not a flag type: in the lane loop a 32-bit result would halve the vector width.)
+template <int S>
+BINBCSR_PHYS_HD double polar_rotation(const double *F, double *R)
+{
+  double X[9], C[9], det, s2 = 0;
+  BINBCSR_PHYS_UNROLL
+  for (int j = 0; j < 9; ++j) s2 += F[j * S] * F[j * S];
+  const bool   finite = s2 > 0 && s2 < 1e300; // false for 0, Inf and NaN
+  const double k      = std::sqrt(3.0 / (finite ? s2 : 3.0));
+  BINBCSR_PHYS_UNROLL
+  for (int j = 0; j < 9; ++j) X[j] = finite ? F[j * S] * k : (j % 4 == 0 ? 1.0 : 0.0);
+  cofactor3(X, C, det);
+  bool ok = finite && det > kPolarMinStartDet;
+  BINBCSR_PHYS_UNROLL
+  for (int j = 0; j < 9; ++j) { // lanes that cannot start run on the identity, which stays put
+    X[j] = ok ? X[j] : (j % 4 == 0 ? 1.0 : 0.0);
+    C[j] = ok ? C[j] : (j % 4 == 0 ? 1.0 : 0.0);
+  }
+  det           = ok ? det : 1.0;
+  double change = 0;
+  BINBCSR_PHYS_UNROLL
+  for (int it = 0; it < kPolarSteps; ++it) {
+    double g = 1;
+    if (it < kPolarScaledSteps) { // a constant condition: resolved when the loop is unrolled
+      double x2 = 0, c2 = 0;
+      BINBCSR_PHYS_UNROLL
+      for (int j = 0; j < 9; ++j) x2 += X[j] * X[j], c2 += C[j] * C[j];
+      g = std::sqrt(std::sqrt(c2 / (det * det * x2))); // (|X^-1| / |X|)^(1/2), |X^-1| = |cof X| / |det X|
+    }
+    const double a = 0.5 * g, b = 0.5 / (g * det);
+    change         = 0;
+    BINBCSR_PHYS_UNROLL
+    for (int j = 0; j < 9; ++j) {
+      const double next = a * X[j] + b * C[j];
+      change += (next - X[j]) * (next - X[j]);
+      X[j] = next;
+    }
+    cofactor3(X, C, det);
+    ok  = ok && det > 0 && det < 1e300;
+    det = ok ? det : 1.0; // the lane is lost; keep its arithmetic finite
+  }
+  ok = ok && change < kPolarConverged2 && std::fabs(det - 1.0) < kPolarDetTolerance;
+  BINBCSR_PHYS_UNROLL
+  for (int j = 0; j < 9; ++j) R[j * S] = ok ? X[j] : (j % 4 == 0 ? 1.0 : 0.0);
+  return ok ? 1.0 : 0.0;
+}
+
+// ---- shared element pieces ------------------------------------------------------------------------
+
+// Barycentric gradients g_a (4 x 3, node-major) from Dm^-1: g_{k+1} = row k, g_0 = -(g_1 + g_2 + g_3).
+template <int S>
+BINBCSR_PHYS_HD void barycentric_gradients(const double *Dinv, double g[4][3])
+{
+  BINBCSR_PHYS_UNROLL
+  for (int d = 0; d < 3; ++d) {
+    BINBCSR_PHYS_UNROLL
+    for (int k = 0; k < 3; ++k) g[k + 1][d] = Dinv[(3 * d + k) * S];
+    g[0][d] = -(g[1][d] + g[2][d] + g[3][d]);
+  }
+}
+
+// z_b = R^T (a_f x_b + a_K v_b) - a_f X_b for n nodes: the displacement in the element's rest frame
+// (plus the stiffness-damping velocity term), so that rhs_a = -R sum_b K0_ab z_b in one pass.
+template <int S, int N>
+BINBCSR_PHYS_HD void rest_frame_displacements(const double *x, const double *v, const double *X, const double *R,
+                                              const ElementConstants &k, double z[N][3])
+{
+  BINBCSR_PHYS_UNROLL
+  for (int b = 0; b < N; ++b) {
+    double y[3];
+    BINBCSR_PHYS_UNROLL
+    for (int d = 0; d < 3; ++d) y[d] = k.force * x[(3 * b + d) * S] + k.stiffness_rhs * v[(3 * b + d) * S];
+    BINBCSR_PHYS_UNROLL
+    for (int i = 0; i < 3; ++i)
+      z[b][i] = R[(3 * i) * S] * y[0] + R[(3 * i + 1) * S] * y[1] + R[(3 * i + 2) * S] * y[2] - k.force * X[(3 * b + i) * S];
+  }
+}
+
+// r = R g (R column-major at stride S).
+template <int S>
+BINBCSR_PHYS_HD void rotate(const double *R, const double g[3], double r[3])
+{
+  BINBCSR_PHYS_UNROLL
+  for (int i = 0; i < 3; ++i) r[i] = R[i * S] * g[0] + R[(3 + i) * S] * g[1] + R[(6 + i) * S] * g[2];
+}
+
+// sigma = lambda tr(G) I + mu (G + G^T): the stress of the displacement gradient G (row-major).
+BINBCSR_PHYS_HD void linear_stress(const double G[9], double lambda, double mu, double sigma[9])
+{
+  const double tr = G[0] + G[4] + G[8];
+  BINBCSR_PHYS_UNROLL
+  for (int i = 0; i < 3; ++i)
+    BINBCSR_PHYS_UNROLL
+    for (int j = 0; j < 3; ++j) sigma[3 * i + j] = mu * (G[3 * i + j] + G[3 * j + i]) + (i == j ? lambda * tr : 0.0);
+}
+
+// ---- P1 -------------------------------------------------------------------------------------------
+
+// One linear tetrahedron (corotational_assembly.cpp's scalar P1 kernel, same formulas): with r = R g,
+//   blocks (a <= b): c_K V (lambda r_a r_b^T + mu r_b r_a^T + mu (g_a . g_b) I) + [a = b] c_M m I
+//   rhs_a = -V R sigma g_a - a_M m v_a,   sigma = stress of G = sum_b z_b g_b^T,   m = rho V / 4.
+// x, v, X: 12 entries; rhs: 12; blocks: 10 x 9 (written only when Blocks).
+template <int S, bool Blocks, bool MassDamping>
+BINBCSR_PHYS_HD void p1_element(const double *x, const double *v, const double *X, const double *Dinv, const double *R,
+                                double vol, const ElementConstants &k, double *rhs, double *blocks)
+{
+  double g[4][3], z[4][3];
+  barycentric_gradients<S>(Dinv, g);
+  rest_frame_displacements<S, 4>(x, v, X, R, k, z);
+  double G[9];
+  BINBCSR_PHYS_UNROLL
+  for (int i = 0; i < 3; ++i)
+    BINBCSR_PHYS_UNROLL
+    for (int j = 0; j < 3; ++j) G[3 * i + j] = z[0][i] * g[0][j] + z[1][i] * g[1][j] + z[2][i] * g[2][j] + z[3][i] * g[3][j];
+  double sigma[9];
+  linear_stress(G, k.lambda, k.mu, sigma);
+  const double m = k.density * vol * 0.25; // lumped: reference_mass = I / 4
+  BINBCSR_PHYS_UNROLL
+  for (int a = 0; a < 4; ++a) {
+    double sg[3];
+    BINBCSR_PHYS_UNROLL
+    for (int i = 0; i < 3; ++i) sg[i] = sigma[3 * i] * g[a][0] + sigma[3 * i + 1] * g[a][1] + sigma[3 * i + 2] * g[a][2];
+    double f[3];
+    rotate<S>(R, sg, f);
+    BINBCSR_PHYS_UNROLL
+    for (int d = 0; d < 3; ++d) rhs[(3 * a + d) * S] = -vol * f[d] - (MassDamping ? k.mass_rhs * m * v[(3 * a + d) * S] : 0.0);
+  }
+  if (!Blocks) return;
+  double rg[4][3];
+  BINBCSR_PHYS_UNROLL
+  for (int a = 0; a < 4; ++a) rotate<S>(R, g[a], rg[a]);
+  const double kv = k.stiffness_matrix * vol, kl = kv * k.lambda, km = kv * k.mu;
+  int          p  = 0;
+  BINBCSR_PHYS_UNROLL
+  for (int a = 0; a < 4; ++a)
+    BINBCSR_PHYS_UNROLL
+    for (int b = a; b < 4; ++b, ++p) {
+      const double diag = km * (g[a][0] * g[b][0] + g[a][1] * g[b][1] + g[a][2] * g[b][2]) + (a == b ? k.mass_matrix * m : 0.0);
+      BINBCSR_PHYS_UNROLL
+      for (int i = 0; i < 3; ++i)
+        BINBCSR_PHYS_UNROLL
+        for (int j = 0; j < 3; ++j)
+          blocks[(9 * p + 3 * i + j) * S] = kl * rg[a][i] * rg[b][j] + km * rg[b][i] * rg[a][j] + (i == j ? diag : 0.0);
+    }
+}
+
+} // namespace kernels
+} // namespace physics
+
+#include "physics/element_kernels_p2.hpp"

@@ -1,0 +1,230 @@
+// The batched element kernels (element_kernels.hpp over SIMD lanes, element_batch.cpp) against the
+// scalar reference loop, element by element: random, strongly stretched, rigidly rotated, inverted,
+// nearly flat, flat and collapsed elements, P1 and P2, with and without blocks, damping, fixed nodes
+// and corotation; and the fixed-step polar kernel against the scalar polar decomposition.
+#include <catch2/catch.hpp>
+
+#include "physics/corotational_assembly.hpp"
+#include "physics/element_batch.hpp"
+#include "physics/element_kernels.hpp"
+#include "physics/polar_decomposition.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+
+using namespace physics;
+
+namespace {
+
+Eigen::Matrix3d random_rotation(std::mt19937 &rng)
+{
+  std::normal_distribution<double> normal(0, 1);
+  Eigen::Quaterniond               q(normal(rng), normal(rng), normal(rng), normal(rng));
+  return q.normalized().toRotationMatrix();
+}
+
+// Kinds of current shape, drawn per element.
+enum Kind { Small, Large, Rigid, Inverted, NearlyFlat, Flat, Collapsed, kKinds };
+
+struct Elements {
+  TetMesh           mesh; // disjoint elements: element e owns nodes npe e .. npe e + npe - 1
+  std::vector<double> x, v;
+  std::vector<int>    kind;
+};
+
+// n disjoint elements with random rest shapes (positive volume) and current shapes of every kind.
+Elements make_elements(int order, int n, unsigned seed)
+{
+  std::mt19937                           rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Elements                               s;
+  TetMesh                                lin;
+  lin.order = 1;
+  for (int e = 0; e < n; ++e) {
+    Eigen::Vector3d c[4];
+    // Near the origin like a mesh's (they may overlap: no node is shared). Far from it, z = R^T x - X
+    // would lose the digits of the rounding of R times |x|, in both kernels alike.
+    const Eigen::Vector3d base(0.5 * u(rng), 0.5 * u(rng), 0.5 * u(rng));
+    for (int a = 0; a < 4; ++a) c[a] = base + Eigen::Vector3d(u(rng), u(rng), u(rng));
+    if ((c[1] - c[0]).cross(c[2] - c[0]).dot(c[3] - c[0]) < 0) std::swap(c[1], c[2]);
+    if (std::fabs((c[1] - c[0]).cross(c[2] - c[0]).dot(c[3] - c[0])) < 0.05) c[3] += Eigen::Vector3d(0.3, 0.4, 0.5) * 2;
+    if ((c[1] - c[0]).cross(c[2] - c[0]).dot(c[3] - c[0]) < 0) std::swap(c[1], c[2]);
+    for (int a = 0; a < 4; ++a) {
+      for (int d = 0; d < 3; ++d) lin.nodes.push_back(c[a][d]);
+      lin.elements.push_back(4 * e + a);
+    }
+  }
+  s.mesh = order == 2 ? promote_to_quadratic(lin) : lin;
+  const int npe = s.mesh.nodes_per_element();
+  s.x.assign(s.mesh.nodes.size(), 0.0);
+  s.v.resize(s.x.size());
+  for (double &w : s.v) w = u(rng);
+  for (int e = 0; e < n; ++e) {
+    const int  kind = e % kKinds;
+    const int *nd   = &s.mesh.elements[static_cast<size_t>(e) * npe];
+    s.kind.push_back(kind);
+    const Eigen::Matrix3d Q = random_rotation(rng);
+    Eigen::Matrix3d       A = Eigen::Matrix3d::Identity();
+    if (kind == Small || kind == Inverted || kind == NearlyFlat || kind == Flat)
+      for (int j = 0; j < 9; ++j) A.data()[j] += 0.01 * u(rng);
+    if (kind == Large)
+      for (int j = 0; j < 9; ++j) A.data()[j] += 0.4 * u(rng);
+    const Eigen::Vector3d t(u(rng), u(rng), u(rng));
+    for (int a = 0; a < npe; ++a) {
+      const Eigen::Vector3d X = Eigen::Vector3d::Map(&s.mesh.nodes[3 * nd[a]]);
+      Eigen::Vector3d::Map(&s.x[3 * nd[a]]) = Q * A * X + t;
+    }
+    // Corner 3 moved onto the plane of the other corners (Flat), just off it (NearlyFlat), through it
+    // (Inverted), or all corners onto corner 0 (Collapsed).
+    Eigen::Vector3d c[4];
+    for (int a = 0; a < 4; ++a) c[a] = Eigen::Vector3d::Map(&s.x[3 * nd[a]]);
+    const Eigen::Vector3d normal = (c[1] - c[0]).cross(c[2] - c[0]).normalized();
+    const double          h      = (c[3] - c[0]).dot(normal);
+    if (kind == Flat) c[3] -= h * normal;
+    if (kind == NearlyFlat) c[3] -= (h - 1e-7 * std::fabs(h)) * normal;
+    if (kind == Inverted) c[3] -= 1.5 * h * normal;
+    if (kind == Collapsed) c[1] = c[2] = c[3] = c[0];
+    for (int a = 0; a < 4; ++a) Eigen::Vector3d::Map(&s.x[3 * nd[a]]) = c[a];
+    if (order == 2) // edge nodes: midpoints of the moved corners, then bent a little (curved current edges)
+      for (int k = 0; k < 6; ++k)
+        for (int d = 0; d < 3; ++d)
+          s.x[3 * nd[4 + k] + d] = 0.5 * (c[kTetEdges[k][0]][d] + c[kTetEdges[k][1]][d]) + (kind == Collapsed ? 0 : 0.01 * u(rng));
+  }
+  return s;
+}
+
+double max_abs(const double *p, size_t n)
+{
+  double m = 0;
+  for (size_t k = 0; k < n; ++k) m = std::max(m, std::fabs(p[k]));
+  return m;
+}
+
+} // namespace
+
+TEST_CASE("batched element kernels equal the scalar ones element by element", "[fem][kernel][batch]")
+{
+  for (int order : {1, 2})
+    for (bool corotational : {true, false})
+      for (int variant = 0; variant < 4; ++variant) {
+        // 0: step with damping (a_M != 0), 1: step without, 2: static Newton step, 3: forces only
+        INFO("order " << order << " corotational " << corotational << " variant " << variant);
+        const int      n = 203; // not a multiple of the lane count
+        const Elements s = make_elements(order, n, 17 + order);
+        FemSettings    settings;
+        settings.young        = 3e5;
+        settings.poisson      = 0.45;
+        settings.corotational = corotational;
+        settings.mass         = variant == 1 ? MassLumping::Lumped : MassLumping::Consistent;
+        const FemModel   m = make_fem_model(s.mesh, settings);
+        std::vector<int> elements(n);
+        for (int e = 0; e < n; ++e) elements[e] = (e * 37) % n; // a permuted element list
+        std::vector<char> fixed(m.node_count(), 0);
+        fixed[3] = fixed[m.node_count() - 1] = 1; // some slots dropped
+        const BlockPattern p = make_block_pattern(m, elements, fixed, 0, m.node_count(), false); // one COO block per element block
+        const StepCoefficients c = variant == 0   ? implicit_euler_coefficients(0.01, 0.5, 0.002)
+                                   : variant == 1 ? implicit_euler_coefficients(0.01)
+                                                  : StepCoefficients{1, 0, 0, 0, 1};
+        const bool          blocks = variant != 3;
+        std::vector<double> vs, vb, rs(s.x.size(), 0.0), rb(s.x.size(), 0.0);
+        reset_block_values(p, vs);
+        reset_block_values(p, vb);
+        std::vector<Eigen::Matrix3d> Rs(n), Rb(n);
+        assemble_elements(m, elements, s.x.data(), s.v.data(), c, blocks ? &p : nullptr, blocks ? vs.data() : nullptr, rs.data(),
+                          Rs.data(), ElementKernel::Scalar);
+        const long long scalar_path = assemble_elements(m, elements, s.x.data(), s.v.data(), c, blocks ? &p : nullptr,
+                                                        blocks ? vb.data() : nullptr, rb.data(), Rb.data(), ElementKernel::Batched);
+        // Every inverted, flat or collapsed element takes the scalar SVD path, regular ones do not.
+        if (corotational) {
+          long long expected_min = 0, expected_max = 0;
+          for (int e = 0; e < n; ++e) {
+            const int k = s.kind[e];
+            expected_min += (k == Inverted || k == Flat || k == Collapsed);
+            expected_max += (k == Inverted || k == Flat || k == Collapsed || k == NearlyFlat || k == Large);
+          }
+          CHECK(scalar_path >= expected_min);
+          CHECK(scalar_path <= expected_max);
+        } else {
+          CHECK(scalar_path == 0);
+        }
+        const int npe = m.npe;
+        double    worst_block = 0, worst_rhs = 0, worst_R = 0;
+        int       compared    = 0;
+        for (int i = 0; i < n; ++i) {
+          const int e  = elements[i];
+          worst_R      = std::max(worst_R, (Rs[i] - Rb[i]).norm());
+          const int *nd = &m.mesh.elements[static_cast<size_t>(e) * npe];
+          // This element's nodes are its own: compare its forces, scaled by their largest entry, or
+          // for a rigidly moved element (forces of round-off) by those of a 0.1% strain.
+          double scale = 1e-3 * settings.young * std::cbrt(m.volume[e] * m.volume[e]), diff = 0;
+          for (int a = 0; a < npe; ++a) scale = std::max(scale, max_abs(&rs[3 * nd[a]], 3));
+          for (int a = 0; a < npe; ++a)
+            for (int d = 0; d < 3; ++d) {
+              REQUIRE(std::isfinite(rb[3 * nd[a] + d]));
+              diff = std::max(diff, std::fabs(rb[3 * nd[a] + d] - rs[3 * nd[a] + d]));
+            }
+          worst_rhs = std::max(worst_rhs, diff / std::max(scale, 1e-300));
+          if (!blocks) continue;
+          scale = diff = 0;
+          for (int k = 0; k < npe * npe; ++k) {
+            const int slot = p.element_slots[static_cast<size_t>(i) * npe * npe + k];
+            if (slot < 0) continue;
+            const size_t at = 9 * static_cast<size_t>(slot & kSlotIndexMask);
+            scale           = std::max(scale, max_abs(&vs[at], 9));
+            for (int j = 0; j < 9; ++j) {
+              REQUIRE(std::isfinite(vb[at + j]));
+              diff = std::max(diff, std::fabs(vb[at + j] - vs[at + j]));
+            }
+          }
+          worst_block = std::max(worst_block, diff / std::max(scale, 1e-300));
+          ++compared;
+        }
+        CHECK(worst_R < 1e-12);
+        // The scalar reference stops its Newton iteration within ~1e-14 of the rotation; a nearly rigid
+        // element's forces (a difference of two large terms) amplify that to ~1e-11 of the floor.
+        CHECK(worst_rhs < 1e-10);
+        CHECK(worst_block < 1e-12);
+        CHECK((!blocks || compared == n));
+        // The identity blocks of the fixed nodes are left alone, and nothing else changes.
+        if (blocks)
+          for (int slot : p.identity_slots) CHECK(vb[9 * slot] == 1.0);
+      }
+}
+
+TEST_CASE("fixed-step polar kernel: the scalar rotation where it accepts, the fallback flag elsewhere", "[fem][polar][batch]")
+{
+  std::mt19937                           rng(23);
+  std::normal_distribution<double>       normal(0, 1);
+  std::uniform_real_distribution<double> uniform(0, 1);
+  double                                 worst    = 0;
+  int                                    accepted = 0;
+  for (int k = 0; k < 4000; ++k) {
+    // Singular values 1 +- 1% or with ratios up to 4:1 (3:1 stretch), overall scale 1e-3..1e3.
+    Eigen::Vector3d sv;
+    for (int d = 0; d < 3; ++d) sv[d] = k % 2 ? std::pow(4.0, -0.5 + uniform(rng)) : 1.0 + 0.01 * normal(rng);
+    const Eigen::Matrix3d F = std::pow(10.0, -3 + 6 * uniform(rng)) * random_rotation(rng) * sv.asDiagonal() * random_rotation(rng);
+    double                R[9];
+    const double          ok = kernels::polar_rotation<1>(F.data(), R);
+    accepted += ok != 0;
+    REQUIRE(ok != 0);
+    worst = std::max(worst, (Eigen::Matrix3d::Map(R) - rotation_from_deformation(F)).norm());
+  }
+  CHECK(accepted == 4000);
+  CHECK(worst < 1e-12);
+  // Refused (identity returned, no NaN): inverted, flat, collapsed, zero, NaN, Inf.
+  const Eigen::Matrix3d Q   = random_rotation(rng);
+  Eigen::Matrix3d       nan = Eigen::Matrix3d::Identity(), inf = Eigen::Matrix3d::Identity();
+  nan(1, 2)                 = std::nan("");
+  inf(0, 1)                 = std::numeric_limits<double>::infinity();
+  for (const Eigen::Matrix3d &F :
+       {Eigen::Matrix3d(-Q), Eigen::Matrix3d(Q * Eigen::DiagonalMatrix<double, 3>(1.0, 1.0, -0.2)),
+        Eigen::Matrix3d(Q * Eigen::DiagonalMatrix<double, 3>(1.0, 2.0, 0.0)),
+        Eigen::Matrix3d(Q * Eigen::DiagonalMatrix<double, 3>(1.0, 0.0, 0.0)), Eigen::Matrix3d(Eigen::Matrix3d::Zero()), nan, inf}) {
+    double R[9];
+    CHECK(kernels::polar_rotation<1>(F.data(), R) == 0);
+    CHECK((Eigen::Matrix3d::Map(R) - Eigen::Matrix3d::Identity()).norm() == 0);
+  }
+}
