@@ -512,7 +512,36 @@ static PetscErrorCode MatBinBCSRGetCOOMirror_SeqBinBCSR(Mat A, PetscBool *flg)
 static PetscErrorCode MatBinBCSRSetStreams_SeqBinBCSR(Mat A, PetscInt streams)
 {
   PetscFunctionBegin;
-  ((Mat_SeqBinBCSR *)A->data)->streams = streams;
+  ((Mat_SeqBinBCSR *)A->data)->streams     = streams;
+  ((Mat_SeqBinBCSR *)A->data)->streams_set = PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRSetTune_SeqBinBCSR(Mat A, MatBinBCSRTune t)
+{
+  PetscFunctionBegin;
+  ((Mat_SeqBinBCSR *)A->data)->tune = (PetscInt)t;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRGetTune_SeqBinBCSR(Mat A, MatBinBCSRTune *t)
+{
+  PetscFunctionBegin;
+  *t = ((Mat_SeqBinBCSR *)A->data)->tune == (PetscInt)MAT_BINBCSR_TUNE_OFF ? MAT_BINBCSR_TUNE_OFF : MAT_BINBCSR_TUNE_AUTO;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRSetTuneCache_SeqBinBCSR(Mat A, PetscBool flg)
+{
+  PetscFunctionBegin;
+  ((Mat_SeqBinBCSR *)A->data)->tune_cache = flg ? 1 : 0;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRGetTuneCache_SeqBinBCSR(Mat A, PetscBool *flg)
+{
+  PetscFunctionBegin;
+  *flg = ((Mat_SeqBinBCSR *)A->data)->tune_cache == 0 ? PETSC_FALSE : PETSC_TRUE;
   PetscFunctionReturn(0);
 }
 
@@ -544,6 +573,14 @@ static PetscErrorCode MatSetFromOptions_SeqBinBCSR(Mat A, PetscOptionItems *Pets
   PetscCall(PetscOptionsBool("-mat_binbcsr_coo_mirror", "COO entries of off-diagonal blocks also fill the transposed place (give one triangle of a symmetric matrix)", "MatBinBCSRSetCOOMirror", a->coo_mirror, &a->coo_mirror, nullptr));
   PetscCall(PetscOptionsInt("-mat_binbcsr_streams", "Runs of bins the product sweeps side by side (1, 2, 4, 8)", "MatBinBCSRSetStreams", streams, &streams, &set));
   if (set) PetscCall(MatBinBCSRSetStreams(A, streams));
+  {
+    PetscEnum t = (PetscEnum)(a->tune == (PetscInt)MAT_BINBCSR_TUNE_OFF ? MAT_BINBCSR_TUNE_OFF : MAT_BINBCSR_TUNE_AUTO);
+    PetscBool c = a->tune_cache == 0 ? PETSC_FALSE : PETSC_TRUE;
+    PetscCall(PetscOptionsEnum("-mat_binbcsr_tune", "Time bin widths and stream counts on this machine at the layout build and keep the fastest", "MatBinBCSRSetTune", MatBinBCSRTunes, t, &t, &set));
+    if (set) a->tune = (PetscInt)t;
+    PetscCall(PetscOptionsBool("-mat_binbcsr_tune_cache", "Read and write the tuner's cache file ($XDG_CACHE_HOME/petscbinbcsr/)", "MatBinBCSRSetTuneCache", c, &c, &set));
+    if (set) a->tune_cache = c ? 1 : 0;
+  }
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }
@@ -566,7 +603,7 @@ static PetscErrorCode MatGetInfo_SeqBinBCSR_Basic(Mat A, MatInfoType flag, MatIn
   PetscFunctionReturn(0);
 }
 
-static const char *const composed_names[] = {"MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatBinBCSRSetCOOMirror_C", "MatBinBCSRGetCOOMirror_C", "MatBinBCSRSetStreams_C", "MatBinBCSRGetStreams_C", "MatSeqAIJSetPreallocation_C", "MatSeqBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatConvert_seqbinbcsr_seqaij_C", "MatConvert_seqbinbcsr_seqbaij_C", "MatProductSetFromOptions_anytype_C", "MatAXPYGetPreallocation_C"};
+static const char *const composed_names[] = {"MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatBinBCSRSetCOOMirror_C", "MatBinBCSRGetCOOMirror_C", "MatBinBCSRSetStreams_C", "MatBinBCSRGetStreams_C", "MatBinBCSRSetTune_C", "MatBinBCSRGetTune_C", "MatBinBCSRSetTuneCache_C", "MatBinBCSRGetTuneCache_C", "MatSeqAIJSetPreallocation_C", "MatSeqBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatConvert_seqbinbcsr_seqaij_C", "MatConvert_seqbinbcsr_seqbaij_C", "MatProductSetFromOptions_anytype_C", "MatAXPYGetPreallocation_C"};
 
 static PetscErrorCode MatDestroy_SeqBinBCSR(Mat A)
 {
@@ -596,6 +633,8 @@ PetscErrorCode MatCreate_SeqBinBCSR(Mat A)
   a->bw          = BinBCSRDefaultBinWidth(1);
   a->precision   = MAT_BINBCSR_PRECISION_DOUBLE;
   a->streams     = BINBCSR_DEFAULT_STREAMS;
+  a->tune        = -1;
+  a->tune_cache  = -1;
   a->roworiented = PETSC_TRUE;
   a->bs          = 1;
   a->bs2         = 1;
@@ -639,6 +678,10 @@ PetscErrorCode MatCreate_SeqBinBCSR(Mat A)
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRGetCOOMirror_C", MatBinBCSRGetCOOMirror_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRSetStreams_C", MatBinBCSRSetStreams_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRGetStreams_C", MatBinBCSRGetStreams_SeqBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRSetTune_C", MatBinBCSRSetTune_SeqBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRGetTune_C", MatBinBCSRGetTune_SeqBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRSetTuneCache_C", MatBinBCSRSetTuneCache_SeqBinBCSR));
+  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRGetTuneCache_C", MatBinBCSRGetTuneCache_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatSeqAIJSetPreallocation_C", MatSeqAIJSetPreallocation_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatSeqBAIJSetPreallocation_C", MatSeqBAIJSetPreallocation_SeqBinBCSR));
   PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatSetPreallocationCOO_C", MatSetPreallocationCOO_SeqBinBCSR));
