@@ -84,6 +84,56 @@ PETSC_EXTERN PetscErrorCode MatBinBCSRGetTune(Mat, MatBinBCSRTune *);
    -mat_binbcsr_tune_cache (default true); false neither reads nor writes the file. */
 PETSC_EXTERN PetscErrorCode MatBinBCSRSetTuneCache(Mat, PetscBool);
 PETSC_EXTERN PetscErrorCode MatBinBCSRGetTuneCache(Mat, PetscBool *);
+
+/* The body set that runs the products (the same results up to rounding; speed differs by CPU). */
+typedef enum {
+  MAT_BINBCSR_KERNEL_AUTO     = 0, /* the best set this CPU has (the default) */
+  MAT_BINBCSR_KERNEL_PORTABLE = 1, /* plain C++ compiled for the build's baseline target: the reference */
+  MAT_BINBCSR_KERNEL_AVX2     = 2, /* AVX2 + FMA */
+  MAT_BINBCSR_KERNEL_AVX512   = 3  /* AVX-512, with hand-written bodies for 3x3 blocks at bin width 8 */
+} MatBinBCSRKernel;
+PETSC_EXTERN const char *const MatBinBCSRKernels[];
+/*@
+   MatBinBCSRSetKernel - Chooses the body set of the products of a MATBINBCSR matrix.
+
+   Logically collective
+
+   Input Parameters:
++  A - the matrix (a no-op on matrices of other types)
+-  kernel - MAT_BINBCSR_KERNEL_AUTO (the best this CPU has), _PORTABLE, _AVX2 or _AVX512
+
+   Options Database Key:
+.  -mat_binbcsr_kernel <auto,portable,avx2,avx512> - the body set
+
+   Notes:
+   A set the CPU (or this build) lacks is an error. A set without a specialised body for the matrix's
+   shape (block size, bin width, streams) runs the portable body there; MatBinBCSRGetKernel() and
+   -mat_view ::ascii_info name the set in use. May change at any time: the layout is not touched.
+
+   Level: advanced
+
+.seealso: MatBinBCSRGetKernel(), MatBinBCSRSetStreams(), MatBinBCSRSetBinWidth()
+@*/
+PETSC_EXTERN PetscErrorCode MatBinBCSRSetKernel(Mat, MatBinBCSRKernel);
+/*@
+   MatBinBCSRGetKernel - The body set that runs the products of a MATBINBCSR matrix now (AUTO
+   resolved; the portable set where the chosen one has no body for the matrix's shape).
+
+   Not collective
+
+   Input Parameter:
+.  A - the matrix
+
+   Output Parameter:
+.  kernel - the set in use (MAT_BINBCSR_KERNEL_PORTABLE on matrices of other types)
+
+   Level: advanced
+
+.seealso: MatBinBCSRSetKernel()
+@*/
+PETSC_EXTERN PetscErrorCode MatBinBCSRGetKernel(Mat, MatBinBCSRKernel *);
+/* Whether this build and CPU can run a body set (AUTO and PORTABLE: always). */
+PETSC_EXTERN PetscErrorCode MatBinBCSRKernelAvailable(MatBinBCSRKernel, PetscBool *);
 /* The -mat_binbcsr_* options of the options database (under the matrix's prefix) applied to a matrix
    whose type the program chose with MatSetType: MatSetFromOptions would also let -mat_type replace
    that type. A no-op on matrices of other types. */

@@ -13,6 +13,8 @@
 PETSC_EXTERN PetscErrorCode MatCreate_SeqBinBCSR(Mat);
 PETSC_EXTERN PetscErrorCode MatCreate_MPIBinBCSR(Mat);
 PETSC_EXTERN PetscErrorCode KSPCreate_MCG(KSP);
+/* -mat_binbcsr_kernel (seq and mpi readers): binbcsr_kernel_api.cpp */
+PETSC_INTERN PetscErrorCode MatBinBCSRKernelFromOptions_Private(PetscOptionItems *, Mat, MatBinBCSRKernel);
 /* ICC, Cholesky (through seqsbaij), ILU, LU (through seqbaij) for MATSOLVERPETSC: seq/binbcsr_factor.cpp */
 PETSC_INTERN PetscErrorCode MatGetFactor_SeqBinBCSR_Petsc(Mat, MatFactorType, Mat *);
 

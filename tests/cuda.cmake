@@ -1,4 +1,4 @@
-# The lane kernels of src/mat_binbcsr/binbcsr_kernels.h compiled as CUDA device code (tests/cuda/):
+# The lane kernels of src/mat_binbcsr/kernels/binbcsr_kernels.h compiled as CUDA device code (tests/cuda/):
 # a compile check that the header stays callable from a CUDA backend. No GPU here, so nothing runs on
 # one. Added only where nvcc is found (Debian 12's PETSc has no CUDA; the toolkit is optional).
 find_program(BINBCSR_NVCC nvcc PATHS /usr/local/cuda/bin)

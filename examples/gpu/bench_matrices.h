@@ -1,8 +1,8 @@
 // Host-side matrices of the GPU benchmark (examples/gpu/binbcsr_gpu_bench.cu): the 27-point block
 // stencil, PETSc binary files, the scalar CSR every cuSPARSE format starts from, and the bins of
-// src/mat_binbcsr/binbcsr_layout.h. Plain C++17; a failed read exits with a message.
+// src/mat_binbcsr/kernels/binbcsr_layout.h. Plain C++17; a failed read exits with a message.
 #pragma once
-#include "mat_binbcsr/binbcsr_layout.h"
+#include "mat_binbcsr/kernels/binbcsr_layout.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,8 +1,8 @@
 // BIN-(B)CSR and the merged CG on a GPU, against cuSPARSE and a stock CG (cuSPARSE + cuBLAS): the
 // seed's Fig. 2.42 (SpMV GFlop/s per format and matrix) and Fig. 2.43 (CG speed-up over matrix size)
 // with this project's matrices. Standalone (no PETSc: Debian's PETSc has no CUDA): it builds the bins
-// with src/mat_binbcsr/binbcsr_layout.h and runs the lane kernels of binbcsr_kernels.h through
-// src/mat_binbcsr/cuda/binbcsr_cuda.cuh. Every product is checked against a double-precision product
+// with src/mat_binbcsr/kernels/binbcsr_layout.h and runs the lane kernels of binbcsr_kernels.h through
+// src/mat_binbcsr/kernels/cuda/binbcsr_cuda.cuh. Every product is checked against a double-precision product
 // on the host, every CG against the stock CG's residual history; a failed check exits non-zero.
 //
 //   binbcsr_gpu_bench [-stencil 16,32,64] [-f A.bin [-f B.bin ...]] [-bs 3] [-cg_its 1000] [-no_cg] [-no_triad] [-check_only]
@@ -12,7 +12,7 @@
 // blocks. Stencil matrices are 27-point block stencils on n^3 nodes, symmetric and diagonally dominant.
 // Build: scripts/gpu_bench (nvcc; links cuSPARSE and cuBLAS).
 #include "bench_matrices.h"
-#include "mat_binbcsr/cuda/binbcsr_cuda.cuh"
+#include "ksp_mcg/mcg_device.cuh" /* the merged CG; includes the matrix kernels, mat_binbcsr/kernels/cuda/binbcsr_cuda.cuh */
 
 #include <cublas_v2.h>
 #include <cuda_runtime.h>
@@ -455,8 +455,8 @@ CGResult merged_cg(const Bins<V> &B, const std::vector<double> &dinv_h, const st
     bc::mcg_start<<<vb, bc::block_threads, 0, st>>>(n, dinv, b, x, r, z, p, partials, s, hist);
     for (int it = 0; it < its; it++) {
       const int cur = it % 2;
-      if (B.bw == 8) bc::mcg_spmv_dot_split8<3, V><<<sb, bc::block_threads, 0, st>>>(dv, dc, ds, B.mbs, p, q, partials, s);
-      else bc::mcg_spmv_dot<3, V><<<sb, bc::block_threads, 0, st>>>(dv, dc, ds, B.mbs, B.bw, p, q, partials, s);
+      if (B.bw == 8) bc::bin_mult_dot_split8<3, V><<<sb, bc::block_threads, 0, st>>>(dv, dc, ds, B.mbs, p, q, partials, &s->ticket, &s->pq);
+      else bc::bin_mult_dot<3, V><<<sb, bc::block_threads, 0, st>>>(dv, dc, ds, B.mbs, B.bw, p, q, partials, &s->ticket, &s->pq);
       bc::mcg_update<<<vb, bc::block_threads, 0, st>>>(n, cur, dinv, p, q, x, r, z, partials, s, hist + it + 1);
       bc::mcg_direction<<<vb, bc::block_threads, 0, st>>>(n, cur, z, p, s);
     }

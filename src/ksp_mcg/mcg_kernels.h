@@ -9,11 +9,7 @@
 #ifndef BINBCSR_MCG_KERNELS_H
 #define BINBCSR_MCG_KERNELS_H
 
-#if defined(__CUDACC__) || defined(__HIPCC__)
-  #define MCG_HOST_DEVICE __host__ __device__
-#else
-  #define MCG_HOST_DEVICE
-#endif
+#include "../binbcsr_hd.h"
 
 /* Order matters: it is the layout of the buffer handed to the global reduction. */
 enum { MCG_DOT_RU = 0, MCG_DOT_UW = 1, MCG_DOT_RR = 2, MCG_DOT_UU = 3, MCG_DOT_XX = 4, MCG_NDOTS = 5 };
@@ -27,7 +23,7 @@ enum { MCG_DOT_RU = 0, MCG_DOT_UW = 1, MCG_DOT_RR = 2, MCG_DOT_UU = 3, MCG_DOT_X
    shared memory). x.x feeds the estimate of the rounding drift of r (see mcg_solve.cpp).
    u is read (old value) before it is written (new value), so it is updated in place. */
 template <bool Jacobi, typename Scalar>
-MCG_HOST_DEVICE inline void mcg_update_index(long i, Scalar alpha, Scalar beta, Scalar *u, const Scalar *w, Scalar *p, Scalar *s, Scalar *x, Scalar *r, const Scalar *dinv, Scalar &ru, Scalar &rr, Scalar &uu, Scalar &xx)
+BINBCSR_HD void mcg_update_index(long i, Scalar alpha, Scalar beta, Scalar *u, const Scalar *w, Scalar *p, Scalar *s, Scalar *x, Scalar *r, const Scalar *dinv, Scalar &ru, Scalar &rr, Scalar &uu, Scalar &xx)
 {
   const Scalar pi = u[i] + beta * p[i];
   const Scalar si = w[i] + beta * s[i];
@@ -48,7 +44,7 @@ MCG_HOST_DEVICE inline void mcg_update_index(long i, Scalar alpha, Scalar beta, 
 /* Same update without the preconditioner (generic path: the PC is applied afterwards by PCApply);
    adds x.x of the new x to xx. */
 template <typename Scalar>
-MCG_HOST_DEVICE inline void mcg_update_index_nopc(long i, Scalar alpha, Scalar beta, const Scalar *u, const Scalar *w, Scalar *p, Scalar *s, Scalar *x, Scalar *r, Scalar &xx)
+BINBCSR_HD void mcg_update_index_nopc(long i, Scalar alpha, Scalar beta, const Scalar *u, const Scalar *w, Scalar *p, Scalar *s, Scalar *x, Scalar *r, Scalar &xx)
 {
   const Scalar pi = u[i] + beta * p[i];
   const Scalar si = w[i] + beta * s[i];
@@ -62,7 +58,7 @@ MCG_HOST_DEVICE inline void mcg_update_index_nopc(long i, Scalar alpha, Scalar b
 
 /* u = dinv * r (or u = r) and the local dots of r and u: the start of a solve or a restart. */
 template <bool Jacobi, typename Scalar>
-MCG_HOST_DEVICE inline void mcg_precondition_index(long i, const Scalar *r, const Scalar *dinv, Scalar *u, Scalar &ru, Scalar &rr, Scalar &uu)
+BINBCSR_HD void mcg_precondition_index(long i, const Scalar *r, const Scalar *dinv, Scalar *u, Scalar &ru, Scalar &rr, Scalar &uu)
 {
   const Scalar ri = r[i];
   const Scalar ui = Jacobi ? dinv[i] * ri : ri;
@@ -74,7 +70,7 @@ MCG_HOST_DEVICE inline void mcg_precondition_index(long i, const Scalar *r, cons
 
 /* Local dots of r and u only (generic path, after PCApply). */
 template <typename Scalar>
-MCG_HOST_DEVICE inline void mcg_dots_index(long i, const Scalar *r, const Scalar *u, Scalar &ru, Scalar &rr, Scalar &uu)
+BINBCSR_HD void mcg_dots_index(long i, const Scalar *r, const Scalar *u, Scalar &ru, Scalar &rr, Scalar &uu)
 {
   const Scalar ri = r[i], ui = u[i];
   ru += ri * ui;

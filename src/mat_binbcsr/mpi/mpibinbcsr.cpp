@@ -295,6 +295,7 @@ static PetscErrorCode MatSetFromOptions_MPIBinBCSR(Mat mat, PetscOptionItems *Pe
     PetscCall(PetscOptionsBool("-mat_binbcsr_tune_cache", "Read and write the tuner's cache file ($XDG_CACHE_HOME/petscbinbcsr/)", "MatBinBCSRSetTuneCache", c, &c, &flg));
     if (flg) PetscCall(MatBinBCSRSetTuneCache_MPIBinBCSR(mat, c));
   }
+  PetscCall(MatBinBCSRKernelFromOptions_Private(PetscOptionsObject, mat, b->kernel));
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }
@@ -359,6 +360,7 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRCreatePart(Mat mat, PetscInt m, PetscIn
   if (b->streams) PetscCall(MatBinBCSRSetStreams(*part, b->streams));
   if (b->tune >= 0) PetscCall(MatBinBCSRSetTune(*part, (MatBinBCSRTune)b->tune));
   if (b->tune_cache >= 0) PetscCall(MatBinBCSRSetTuneCache(*part, b->tune_cache ? PETSC_TRUE : PETSC_FALSE));
+  if (b->kernel) PetscCall(MatBinBCSRSetKernel(*part, b->kernel));
   if (b->sym && part == &b->A) PetscCall(MatBinBCSRSetSymmetricStorage(*part, PETSC_TRUE)); /* B stays full */
   for (const auto &[op, flg] : b->part_options) {
     const bool wholematrix = op == MAT_SYMMETRIC || op == MAT_SPD || op == MAT_HERMITIAN || op == MAT_STRUCTURALLY_SYMMETRIC || op == MAT_SYMMETRY_ETERNAL || op == MAT_STRUCTURAL_SYMMETRY_ETERNAL || op == MAT_SPD_ETERNAL;

@@ -192,6 +192,7 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRCopyConfig(Mat from, Mat to)
   c->streams            = b->streams;
   c->tune               = b->tune;
   c->tune_cache         = b->tune_cache;
+  c->kernel             = b->kernel;
   c->sym                = b->sym;
   c->coo_mirror         = b->coo_mirror;
   PetscFunctionReturn(0);

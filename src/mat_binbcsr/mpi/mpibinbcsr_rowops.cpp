@@ -3,7 +3,7 @@
    PETSc's MPIAIJ, each works through the parts' own operations where the split A (owned columns) /
    B (ghost columns, compressed through garray) allows it; the rest goes through whole rows. */
 #include "mpibinbcsr.h"
-#include "../binbcsr_value_kernels.h"
+#include "../kernels/binbcsr_value_kernels.h"
 
 #include <algorithm>
 #include <vector>

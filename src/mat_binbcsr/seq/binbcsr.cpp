@@ -581,6 +581,7 @@ static PetscErrorCode MatSetFromOptions_SeqBinBCSR(Mat A, PetscOptionItems *Pets
     PetscCall(PetscOptionsBool("-mat_binbcsr_tune_cache", "Read and write the tuner's cache file ($XDG_CACHE_HOME/petscbinbcsr/)", "MatBinBCSRSetTuneCache", c, &c, &set));
     if (set) a->tune_cache = c ? 1 : 0;
   }
+  PetscCall(MatBinBCSRKernelFromOptions_Private(PetscOptionsObject, A, a->kernel));
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }

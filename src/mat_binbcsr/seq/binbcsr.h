@@ -46,7 +46,8 @@
 #define BINBCSR_SEQ_H
 
 #include "binbcsr_impl.h"
-#include "../binbcsr_layout.h"
+#include "../kernels/binbcsr_layout.h"
+#include "../kernels/binbcsr_dispatch.h"
 #include <petsc/private/matimpl.h>
 #include <vector>
 
@@ -70,6 +71,7 @@ typedef struct {
   PetscInt            tune;        /* MatBinBCSRTune; -1: not set (the option, else auto, at the layout build) */
   PetscInt            tune_cache;  /* MatBinBCSRSetTuneCache: 1 on, 0 off, -1 not set (the option, else on) */
   char                tune_info[768]; /* what the tuner tried and chose at the last layout build (MatView) */
+  MatBinBCSRKernel    kernel;      /* MatBinBCSRSetKernel: the body set asked for (AUTO: the best the CPU has) */
   PetscBool           sym;         /* symmetric storage: only blocks with block column >= block row
                                       are stored; entries below the block diagonal are ignored. The
                                       slots of a bin are ordered by an edge colouring (below). */
@@ -137,6 +139,9 @@ typedef struct {
 /* Default bin width, measured on this project's AVX-512 machine (docs/mat_binbcsr.md): 8 block rows
    for blocks (3x3: 24 scalar rows per bin), 16 rows for scalars. */
 static inline PetscInt BinBCSRDefaultBinWidth(PetscInt bs) { return bs == 1 ? 16 : 8; }
+
+/* The product body for a's shape and body set (binbcsr_mult.cpp; the choice is select_body's). */
+binbcsr::Body MatSeqBinBCSRSelectBody(const Mat_SeqBinBCSR *a);
 
 /* Lane of slot s, and the index into val/valf of entry e of slot s. */
 static inline PetscInt BinBCSRLane(PetscInt s, PetscInt bw) { return s % bw; }

@@ -1,6 +1,6 @@
 /* MATSEQBINBCSR rows, copies, conversions and ASCII views. */
 #include "binbcsr.h"
-#include "../binbcsr_kernels.h"
+#include "../kernels/binbcsr_kernels.h"
 #include <petscviewer.h>
 #include <algorithm>
 #include <vector>
@@ -78,6 +78,7 @@ static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues
   b->tune        = a->tune;
   b->tune_cache  = a->tune_cache;
   PetscCall(PetscStrncpy(b->tune_info, a->tune_info, sizeof(b->tune_info)));
+  b->kernel      = a->kernel;
   b->sym         = a->sym;
   b->bs          = a->bs;
   b->bs2         = a->bs2;
@@ -400,6 +401,7 @@ PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
       const PetscInt groups = a->nslots / a->bw, unit = MatSeqBinBCSRCountUnitStrideGroups(a);
       PetscCall(PetscViewerASCIIPrintf(viewer, "slot groups over consecutive block columns (x%s read without gathers): %" PetscInt_FMT " of %" PetscInt_FMT " (%.1f%%)\n", a->sym ? " and y" : "", unit, groups, groups ? 100.0 * (double)unit / (double)groups : 0.0));
       PetscCall(PetscViewerASCIIPrintf(viewer, "product: %" PetscInt_FMT " run(s) of bins swept side by side (-mat_binbcsr_streams)\n", a->streams));
+      PetscCall(PetscViewerASCIIPrintf(viewer, "product body: %s (-mat_binbcsr_kernel %s)\n", binbcsr::body_set_name(MatSeqBinBCSRSelectBody(a).set), MatBinBCSRKernels[a->kernel]));
     }
     if (a->tune_info[0]) PetscCall(PetscViewerASCIIPrintf(viewer, "tuning (-mat_binbcsr_tune): %s\n", a->tune_info));
     if (a->coo_jmap || a->coo_mirror) {

@@ -9,7 +9,7 @@
    places in coo_perm then name the entry they mirror, so the refill reads the caller's value twice
    and needs no copy. */
 #include "binbcsr.h"
-#include "../binbcsr_kernels.h"
+#include "../kernels/binbcsr_kernels.h"
 #include <algorithm>
 #include <cstdint>
 #include <vector>

@@ -8,7 +8,7 @@
 */
 #include "binbcsr.h"
 #include "binbcsr_ops.h"
-#include "../binbcsr_value_kernels.h"
+#include "../kernels/binbcsr_value_kernels.h"
 
 #include <algorithm>
 #include <vector>

@@ -15,7 +15,7 @@
    applies D (PCEISENSTAT's diagonal scaling). D is the block diagonal, so for bs 3 this is the point-block
    Eisenstat that AIJ's inodes give for 3-row nodes. */
 #include "binbcsr.h"
-#include "../binbcsr_kernels.h"
+#include "../kernels/binbcsr_kernels.h"
 
 #include <type_traits>
 

@@ -1,7 +1,7 @@
-// The layout rule of src/mat_binbcsr/binbcsr_layout.h (the CPU Mat and the CUDA benchmark both build
+// The layout rule of src/mat_binbcsr/kernels/binbcsr_layout.h (the CPU Mat and the CUDA benchmark both build
 // their bins with it) on the worked example of seq/binbcsr.h, docs/mat_binbcsr.md and the README, and
 // the value index of 3x3 tiles.
-#include "mat_binbcsr/binbcsr_layout.h"
+#include "mat_binbcsr/kernels/binbcsr_layout.h"
 
 #include <catch2/catch.hpp>
 #include <vector>

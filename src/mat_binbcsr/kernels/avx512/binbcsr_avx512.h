@@ -1,9 +1,9 @@
 /*
    AVX-512 bodies of the two products of 3x3 blocks at bin width 8 (one zmm register of doubles per
    block entry), the shape of the cloth, the stencils and the FE scenes: whole bins of the whole-storage
-   product (bins_mult_3x8) and of the symmetric one (sym_bins_mult_3x8). CPU only: binbcsr_kernels.h
-   includes this header when the compiler targets AVX-512; the portable per-lane kernels stay the
-   definition (and the CUDA path), and the unit tests compare both with seqaij.
+   product (bins_mult_3x8) and of the symmetric one (sym_bins_mult_3x8). CPU only: the AVX-512 body set
+   (binbcsr_avx512.cpp, compiled with AVX-512 flags) plugs them into the bin drivers; the portable
+   per-lane kernels stay the definition (and the CUDA path), and the unit tests compare both.
 
    Why by hand: where the 8 lanes read consecutive block columns, x_c is 24 consecutive doubles (x, y, z
    of 8 nodes), and so is the y_c that the transposed blocks update. GCC vectorises the portable loop with
@@ -12,8 +12,8 @@
    transposed blocks, and 6 permutes interleave the result back (add_xyz). The accumulators stay in
    registers for the whole bin.
 */
-#ifndef BINBCSR_KERNELS_AVX512_H
-#define BINBCSR_KERNELS_AVX512_H
+#ifndef BINBCSR_AVX512_H
+#define BINBCSR_AVX512_H
 
 #include <immintrin.h>
 
@@ -72,7 +72,7 @@ inline void group_mult_3x8(const V *t, const I *c, const double *x, __m512d *a)
 /* The whole-storage product of K bins swept together (3x3 blocks, 8 lanes): acc[q][i] (lane l in
    element l) += block row i of bin q times x over its len[q] slot groups, the groups of the K bins taken
    in turn; the accumulators stay in registers for the whole sweep. K bins far apart in memory are K
-   streams for the hardware prefetcher (bins_sweep in binbcsr_mult.cpp says why). */
+   streams for the hardware prefetcher (bins_sweep in binbcsr_bin_drivers.h says why). */
 template <int K, typename V, typename I>
 inline void bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, const int *len, const double *x, double (*const *acc)[8])
 {

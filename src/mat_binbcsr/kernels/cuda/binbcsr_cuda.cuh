@@ -1,5 +1,5 @@
 /*
-   CUDA kernels of BIN-(B)CSR and of the merged CG (KSPMCG's iteration) over device arrays. They call
+   The CUDA body set of BIN-(B)CSR: kernels over device arrays. They call
    the lane bodies of binbcsr_kernels.h with one thread per lane, so the GPU runs the arithmetic the
    CPU kernels are tested with. No PETSc here (Debian's PETSc has no CUDA): examples/gpu/ drives them
    directly, and a MATBINBCSRCUDA type would call the same kernels.
@@ -7,13 +7,11 @@
    Thread mapping: global thread t is lane t % bw of bin t / bw; with bw = 32 a warp is a bin, so the
    column indices and each entry plane of the values are read as one coalesced 128/256-byte line.
 
-   The merged CG (Jacobi preconditioner) takes 3 launches per iteration and no host synchronisation:
-     1. q = A p and the partial sums of p.q           (mcg_spmv_dot)
-     2. x += a p, r -= a q, z = D^-1 r, partial r.z   (mcg_update; a = rz / pq read on the device)
-     3. p = z + b p                                    (mcg_direction; b = rz_new / rz)
-   Each reduction is finished by the last block to arrive (a ticket counter), which sums the blocks'
-   partials in block order: the result does not depend on the order the blocks ran in, so two runs
-   give the same bits and every block reads the same scalar.
+   The merged CG's vector updates that go with these products are the KSP's: src/ksp_mcg/mcg_device.cuh.
+
+   Reductions (bin_mult_dot) are finished by the last block to arrive (a ticket counter), which sums
+   the blocks' partials in block order: the result does not depend on the order the blocks ran in, so
+   two runs give the same bits and every block reads the same scalar.
 */
 #ifndef BINBCSR_CUDA_CUH
 #define BINBCSR_CUDA_CUH
@@ -116,16 +114,10 @@ inline long split_threads(int mbs, int bs) { return (long)((mbs + 7) / 8) * 32 *
 /* Threads bin_mult_rows needs for mbs block rows: BS per lane of every bin, phantom lanes included. */
 inline long rows_threads(int mbs, int bw, int bs) { return (long)((mbs + bw - 1) / bw) * bw * bs; }
 
-/* Scalars of one merged-CG solve, on the device. */
-struct MCGScalars {
-  double   rz[2];    /* r.z of the current and the next iteration (parity of the iteration picks) */
-  double   pq;       /* p.A p of this iteration */
-  unsigned ticket;   /* finish_sum's counter */
-};
-
-/* 1. q = A p; p.q into s->pq. Launch rows_threads(mbs, bw, BS) threads. */
+/* q = A p and p.q, finished into *out by the last block (finish_sum; ticket: its counter): the product
+   of a merged CG iteration. Launch rows_threads(mbs, bw, BS) threads. */
 template <int BS, typename V>
-__global__ void __launch_bounds__(block_threads) mcg_spmv_dot(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start, int mbs, int bw, const double *__restrict__ p, double *__restrict__ q, double *partials, MCGScalars *s)
+__global__ void __launch_bounds__(block_threads) bin_mult_dot(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start, int mbs, int bw, const double *__restrict__ p, double *__restrict__ q, double *partials, unsigned *ticket, double *out)
 {
   const int t = blockIdx.x * blockDim.x + threadIdx.x, b = t / (BS * bw), i = t / bw % BS, lane = t % bw, r = b * bw + lane;
   double    d = 0.0;
@@ -135,12 +127,12 @@ __global__ void __launch_bounds__(block_threads) mcg_spmv_dot(const V *__restric
     q[(long)r * BS + i] = qi;
     d = p[(long)r * BS + i] * qi;
   }
-  finish_sum(block_sum(d), partials, &s->ticket, &s->pq, nullptr);
+  finish_sum(block_sum(d), partials, ticket, out, nullptr);
 }
 
-/* 1 for bin width 8, the bin_mult_split8 mapping. Launch split_threads(mbs, BS) threads. */
+/* bin_mult_dot for bin width 8, the bin_mult_split8 mapping. Launch split_threads(mbs, BS) threads. */
 template <int BS, typename V>
-__global__ void __launch_bounds__(block_threads) mcg_spmv_dot_split8(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start, int mbs, const double *__restrict__ p, double *__restrict__ q, double *partials, MCGScalars *s)
+__global__ void __launch_bounds__(block_threads) bin_mult_dot_split8(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start, int mbs, const double *__restrict__ p, double *__restrict__ q, double *partials, unsigned *ticket, double *out)
 {
   int          row;
   const double qi = bin_row_split8<BS, V>(val, col, bin_start, mbs, p, &row);
@@ -149,45 +141,27 @@ __global__ void __launch_bounds__(block_threads) mcg_spmv_dot_split8(const V *__
     q[row] = qi;
     d      = p[row] * qi;
   }
-  finish_sum(block_sum(d), partials, &s->ticket, &s->pq, nullptr);
+  finish_sum(block_sum(d), partials, ticket, out, nullptr);
 }
 
-/* 2. With a = rz / pq: x += a p, r -= a q, z = dinv r; r.z of the new residual into s->rz[1 - cur]
-   (and hist). Grid-stride over the n entries. */
-__global__ void __launch_bounds__(block_threads) mcg_update(int n, int cur, const double *__restrict__ dinv, const double *__restrict__ p, const double *__restrict__ q, double *__restrict__ x, double *__restrict__ r, double *__restrict__ z, double *partials, MCGScalars *s, double *hist)
+/* Symmetric storage: one warp per bin (bw <= 32), y += A x with y zeroed first. A backend that runs
+   this must also keep the lanes in step per slot (__syncwarp between slot groups, see sym_lane_mult):
+   the colouring makes the scatters of one slot group conflict-free, not those of different groups.
+   Compiled (tests/cuda/kernels_device.cu), not yet run on a GPU. */
+template <int BS, typename V>
+__global__ void sym_bin_mult(const V *val, const int *col, const int *bin_start, int nbins, int mbs, int bw, const double *x, double *y)
 {
-  const double a = s->pq > 0.0 ? s->rz[cur] / s->pq : 0.0; /* p = 0: converged exactly, stay */
-  double       d = 0.0;
-  for (int i = blockIdx.x * blockDim.x + threadIdx.x; i < n; i += gridDim.x * blockDim.x) {
-    const double ri = r[i] - a * q[i], zi = dinv[i] * ri;
-    x[i] += a * p[i];
-    r[i] = ri;
-    z[i] = zi;
-    d += ri * zi;
+  const int b = blockIdx.x, lane = threadIdx.x, r = b * bw + lane;
+  if (b >= nbins || lane >= bw) return;
+  const int own = r < mbs ? r : mbs - 1, s0 = bin_start[b], len = (bin_start[b + 1] - s0) / bw;
+  double    acc[BS], xr[BS];
+  for (int i = 0; i < BS; i++) {
+    acc[i] = 0.0;
+    xr[i]  = r < mbs ? x[(long)r * BS + i] : 0.0;
   }
-  finish_sum(block_sum(d), partials, &s->ticket, &s->rz[1 - cur], hist);
-}
-
-/* Start from x = 0: r = b, z = dinv b, p = z, r.z into s->rz[0] (and hist). */
-__global__ void __launch_bounds__(block_threads) mcg_start(int n, const double *__restrict__ dinv, const double *__restrict__ rhs, double *__restrict__ x, double *__restrict__ r, double *__restrict__ z, double *__restrict__ p, double *partials, MCGScalars *s, double *hist)
-{
-  double d = 0.0;
-  for (int i = blockIdx.x * blockDim.x + threadIdx.x; i < n; i += gridDim.x * blockDim.x) {
-    const double zi = dinv[i] * rhs[i];
-    x[i] = 0.0;
-    r[i] = rhs[i];
-    z[i] = zi;
-    p[i] = zi;
-    d += rhs[i] * zi;
-  }
-  finish_sum(block_sum(d), partials, &s->ticket, &s->rz[0], hist);
-}
-
-/* 3. p = z + b p with b = rz[next] / rz[cur]. */
-__global__ void __launch_bounds__(block_threads) mcg_direction(int n, int cur, const double *__restrict__ z, double *__restrict__ p, const MCGScalars *s)
-{
-  const double beta = s->rz[cur] > 0.0 ? s->rz[1 - cur] / s->rz[cur] : 0.0;
-  for (int i = blockIdx.x * blockDim.x + threadIdx.x; i < n; i += gridDim.x * blockDim.x) p[i] = z[i] + beta * p[i];
+  sym_lane_mult<BS, V, int>(val + (long)s0 * BS * BS, col + s0, len, bw, BS, lane, own, x, xr, y, acc);
+  if (r < mbs)
+    for (int i = 0; i < BS; i++) atomicAdd(&y[(long)r * BS + i], acc[i]);
 }
 
 } // namespace cuda

@@ -10,7 +10,7 @@
      - a "tile lane pointer" points at entry 0 of one slot's block for one lane: entry e of the block
        (row-major, e = i*bs + j) is at tile[e * bw].
 
-   CPU drivers (binbcsr_mult.cpp) run slot_mult for k = 0..len-1 in the outer loop and over the lanes of
+   CPU drivers (binbcsr_bin_drivers.h) run slot_mult for k = 0..len-1 in the outer loop and over the lanes of
    a bin in the inner `omp simd` loop, so the lanes map onto SIMD lanes and every load of values and
    column indices is contiguous; a GPU runs lane_mult with one thread per lane, which reads the same
    addresses coalesced across the threads of a warp.
@@ -18,17 +18,18 @@
 #ifndef BINBCSR_KERNELS_H
 #define BINBCSR_KERNELS_H
 
-#if defined(__CUDACC__)
-  #define BINBCSR_HD __host__ __device__ __forceinline__
-#else
-  #define BINBCSR_HD inline
-#endif
+#include "../../binbcsr_hd.h"
 
-#if !defined(__CUDACC__) && defined(__AVX512F__)
-  #define BINBCSR_AVX512 1 /* hand-written bodies for the common shape, binbcsr_kernels_avx512.h */
+/* Every body set (kernels/portable, avx2, avx512) compiles these templates with its own target flags in
+   its own translation unit: the inline namespace gives each set its own symbols, so the linker never
+   merges an AVX-512 instance into the portable code (the one-definition rule across TUs). */
+#if !defined(BINBCSR_BODY_SET)
+  #define BINBCSR_BODY_SET baseline
 #endif
 
 namespace binbcsr
+{
+inline namespace BINBCSR_BODY_SET
 {
 
 /* Software prefetch of the value stream, CPU only. One core streaming one array out of cache is
@@ -51,7 +52,7 @@ BINBCSR_HD void prefetch_values(const V *tile, int nbytes)
 /* The slot groups of K bins swept together (len[q]: the groups of bin q): group(q, k) for group k of
    bin q, one group of each bin in turn while every bin has one left, then the rest of each bin. The
    products sweep several bins at once because the bins are then several streams for the hardware
-   prefetcher (binbcsr_mult.cpp's bins_sweep says why). */
+   prefetcher (bins_sweep in binbcsr_bin_drivers.h says why). */
 template <int K, class G>
 BINBCSR_HD void interleave_groups(const int *len, G &&group)
 {
@@ -177,14 +178,6 @@ BINBCSR_HD bool unit_stride(const I *c)
   return unit_stride(c, BW);
 }
 
-} // namespace binbcsr
-
-#if defined(BINBCSR_AVX512)
-  #include "binbcsr_kernels_avx512.h" /* uses prefetch_values above */
-#endif
-
-namespace binbcsr
-{
 
 /* One slot group of sym_bins_mult whose lanes read the consecutive block columns xs, xs + BS, ...:
    acc += block x_c and, with SCATTER, y_c += block^T x_r, by unit-stride loads and stores. The
@@ -256,12 +249,6 @@ BINBCSR_HD void sym_group_mult(const V *t, const I *c, I r0, const I *own, const
 template <int K, int BS, int BW, typename V, typename I>
 BINBCSR_HD void sym_bins_mult(const V *const *bin_val, const I *const *bin_col, const int *len, const I *r0, I mbs, const double *x, double *y)
 {
-#if defined(BINBCSR_AVX512)
-  if constexpr (BS == 3 && BW == 8 && sizeof(I) == 4) {
-    avx512::sym_bins_mult_3x8<K>(bin_val, bin_col, len, r0, mbs, x, y);
-    return;
-  }
-#endif
   constexpr int BS2 = BS * BS;
   double        acc[K][BS][BW], xr[K][BS][BW];
   I             own[K][BW];
@@ -297,6 +284,7 @@ BINBCSR_HD double coo_gather(const double *coo_v, long n, const double *recv, co
   return s;
 }
 
+} // namespace BINBCSR_BODY_SET
 } // namespace binbcsr
 
 #endif
