@@ -10,11 +10,11 @@
 // -streams 1,2,4,8 times each matrix with each stream count (one matrix per width and precision:
 // the stream count is a traversal order, set before each batch).
 //
-// -sweep: every (bin width 4/8/16(/32 for bs 1), streams 1/2/4/8) against the autotuned default
+// -sweep: every (bin width 4/8/16(/32 for bs 1), streams 1/2/4/8, body set the CPU has) against the autotuned default
 // (nothing set, -mat_binbcsr_tune auto) for whole and symmetric storage in double and single precision,
 // on the stencils of -stencil_sizes (default 32,48) and on every PETSc binary file of -f (comma list,
 // block size from -bs, default 3; the drivers write them with -dump_matrix FILE). Per matrix and
-// case one line: the sweep's best bw/K and ms, the tuned bw/K and ms, tuned / best, the reference
+// case one line: the sweep's best bw/K/body and ms, the tuned bw/K/body and ms, tuned / best, the reference
 // (seqbaij; seqaij for bs 1) and what the tuning cost. -sweep_verbose prints every variant;
 // -tune_cache 1 lets the tuned matrix use the cache file (default: it measures).
 //

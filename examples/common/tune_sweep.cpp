@@ -38,8 +38,9 @@ namespace
 {
 
 struct Variant {
-  Mat      A       = nullptr;
-  PetscInt bw      = 0, streams = 0; // streams set before each batch (0: the matrix's own)
+  Mat              A       = nullptr;
+  PetscInt         bw      = 0, streams = 0; // streams set before each batch (0: the matrix's own)
+  MatBinBCSRKernel kernel  = MAT_BINBCSR_KERNEL_AUTO; // set before each batch
   bool     owner   = false;
   double   best    = 1e300;
 };
@@ -47,16 +48,21 @@ struct Variant {
 // The "cost X ms" of the tuner's line in -mat_view ::ascii_info, or -1.
 PetscErrorCode TuneCost(Mat A, double *ms, std::string *line)
 {
-  PetscViewer       v;
-  std::vector<char> buf(1 << 16, 0);
+  FILE       *f = tmpfile();
+  PetscViewer v;
+  std::string s;
+  char        buf[4096];
 
   PetscFunctionBeginUser;
-  PetscCall(PetscViewerStringOpen(PETSC_COMM_SELF, buf.data(), buf.size() - 1, &v));
+  PetscCheck(f, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "no temporary file");
+  PetscCall(PetscViewerASCIIOpenWithFILE(PETSC_COMM_SELF, f, &v));
   PetscCall(PetscViewerPushFormat(v, PETSC_VIEWER_ASCII_INFO));
   PetscCall(MatView(A, v));
   PetscCall(PetscViewerPopFormat(v));
   PetscCall(PetscViewerDestroy(&v));
-  std::string s = buf.data();
+  rewind(f);
+  for (size_t n; (n = fread(buf, 1, sizeof buf, f)) > 0;) s.append(buf, n);
+  fclose(f);
   const size_t t = s.find("tuning (-mat_binbcsr_tune): ");
   *line          = t == std::string::npos ? "" : s.substr(t + 28, s.find('\n', t) - t - 28);
   *ms            = -1;
@@ -96,24 +102,31 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
     tuned.owner = true;
     PetscCall(MatBinBCSRGetBinWidth(tuned.A, &tuned.bw));
     PetscCall(MatBinBCSRGetStreams(tuned.A, &tuned.streams));
+    PetscCall(MatBinBCSRGetKernel(tuned.A, &tuned.kernel));
     base.A = ref;
     for (PetscInt bw : widths) {
       Mat A;
       PetscCall(MakeBinBCSR(aij, bs, bw, 0, prec, sym, PETSC_FALSE, &A));
-      for (PetscInt K : {1, 2, 4, 8}) {
-        Variant v;
-        v.A       = A;
-        v.bw      = bw;
-        v.streams = K;
-        v.owner   = K == 1;
-        vars.push_back(v);
-      }
+      for (PetscInt K : {1, 2, 4, 8})
+        for (MatBinBCSRKernel k : {MAT_BINBCSR_KERNEL_PORTABLE, MAT_BINBCSR_KERNEL_AVX2, MAT_BINBCSR_KERNEL_AVX512}) {
+          PetscBool avail;
+          PetscCall(MatBinBCSRKernelAvailable(k, &avail));
+          if (!avail) continue;
+          Variant v;
+          v.A       = A;
+          v.bw      = bw;
+          v.streams = K;
+          v.kernel  = k;
+          v.owner   = vars.empty() || vars.back().A != A;
+          vars.push_back(v);
+        }
     }
     for (PetscInt r = 0; r < s.repeats; r++) {
       std::vector<Variant *> all = {&base, &tuned};
       for (Variant &v : vars) all.push_back(&v);
       for (Variant *v : all) {
         if (v != &tuned && v->streams) PetscCall(MatBinBCSRSetStreams(v->A, v->streams));
+        if (v != &tuned && v != &base) PetscCall(MatBinBCSRSetKernel(v->A, v->kernel));
         PetscCall(MatMult(v->A, x, y)); // warm
         const double a = s.now();
         for (PetscInt b = 0; b < s.batch; b++) PetscCall(MatMult(v->A, x, y));
@@ -128,10 +141,10 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
     PetscCall(TuneCost(tuned.A, &cost, &line));
     const char *storage = sym ? "symmetric" : "whole", *p = prec == MAT_BINBCSR_PRECISION_SINGLE ? "single" : "double";
     if (s.verbose) {
-      for (const Variant &v : vars) PetscCall(PetscPrintf(PETSC_COMM_SELF, "  %-14s %-9s %-6s bw %2" PetscInt_FMT " K %" PetscInt_FMT " %9.4f ms\n", name.c_str(), storage, p, v.bw, v.streams, 1e3 * v.best));
+      for (const Variant &v : vars) PetscCall(PetscPrintf(PETSC_COMM_SELF, "  %-14s %-9s %-6s bw %2" PetscInt_FMT " K %" PetscInt_FMT " %-8s %9.4f ms\n", name.c_str(), storage, p, v.bw, v.streams, MatBinBCSRKernels[v.kernel], 1e3 * v.best));
       PetscCall(PetscPrintf(PETSC_COMM_SELF, "  tuner: %s\n", line.c_str()));
     }
-    PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-14s %-9s %-6s best %2" PetscInt_FMT "/%" PetscInt_FMT " %8.4f   tuned %2" PetscInt_FMT "/%" PetscInt_FMT " %8.4f   tuned/best %5.3f   %s %8.4f  tuned x %s %5.2f   tuning %6.1f ms (build %.0f ms)\n", name.c_str(), storage, p, best->bw, best->streams, 1e3 * best->best, tuned.bw, tuned.streams, 1e3 * tuned.best, tuned.best / best->best, bs > 1 ? "baij" : "aij", 1e3 * base.best, bs > 1 ? "baij" : "aij", base.best / tuned.best, cost, 1e3 * (t1 - t0)));
+    PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-14s %-9s %-6s best %2" PetscInt_FMT "/%" PetscInt_FMT "/%-8s %8.4f   tuned %2" PetscInt_FMT "/%" PetscInt_FMT "/%-8s %8.4f   tuned/best %5.3f   %s %8.4f  tuned x %s %5.2f   tuning %6.1f ms (build %.0f ms)\n", name.c_str(), storage, p, best->bw, best->streams, MatBinBCSRKernels[best->kernel], 1e3 * best->best, tuned.bw, tuned.streams, MatBinBCSRKernels[tuned.kernel], 1e3 * tuned.best, tuned.best / best->best, bs > 1 ? "baij" : "aij", 1e3 * base.best, bs > 1 ? "baij" : "aij", base.best / tuned.best, cost, 1e3 * (t1 - t0)));
     for (Variant &v : vars)
       if (v.owner) PetscCall(MatDestroy(&v.A));
     PetscCall(MatDestroy(&tuned.A));

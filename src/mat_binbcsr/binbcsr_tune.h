@@ -15,6 +15,7 @@
 struct BinBCSRTuneChoice {
   PetscInt bw      = 0;
   PetscInt streams = 0;
+  PetscInt kernel  = 0; /* MatBinBCSRKernel; AUTO: the dispatch's default */
 };
 
 /* The machine part of a cache key: CPU model string, online cores, the kernel bodies compiled in. */

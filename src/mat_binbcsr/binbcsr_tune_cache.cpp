@@ -1,12 +1,13 @@
 /* The tuning cache file of MATSEQBINBCSR: one text line per (machine, matrix class),
 
      # petscbinbcsr tune cache v1
-     <machine key> TAB <matrix class> TAB <bin width> <streams>
+     <machine key> TAB <matrix class> TAB <bin width> <streams> <body set>
 
    read whole and rewritten whole (a temporary file renamed over the old one). The file only saves
    time: whatever is wrong with it makes the tuner measure again, never fail or use a bad layout. */
 #include "binbcsr_tune.h"
 #include "binbcsr_machine.h"
+#include "kernels/binbcsr_dispatch.h"
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -21,13 +22,7 @@ static const char *const cache_header = "# petscbinbcsr tune cache v1";
 
 const std::string &BinBCSRTuneMachineKey(void)
 {
-#if defined(__AVX512F__)
-  static const char *bodies = "avx512";
-#elif defined(__AVX2__)
-  static const char *bodies = "avx2";
-#else
-  static const char *bodies = "portable";
-#endif
+  static const char       *bodies = binbcsr::body_set_name(binbcsr::best_body_set());
   static const std::string key = (binbcsr::cpu_model().empty() ? std::string("unknown cpu") : binbcsr::cpu_model()) + " | " + std::to_string(binbcsr::online_cpus()) + " cores | " + bodies;
   return key;
 }
@@ -61,12 +56,16 @@ static bool ReadCache(const std::string &path, std::map<std::string, BinBCSRTune
     }
     std::istringstream v(line.substr(t2 + 1));
     long               bw = 0, streams = 0;
-    std::string        rest;
-    if (!(v >> bw >> streams) || (v >> rest) || bw < 1 || bw > 1024 || (streams != 1 && streams != 2 && streams != 4 && streams != 8)) {
-      why = "line " + std::to_string(n) + ": choice \"" + line.substr(t2 + 1) + "\" is not a bin width in [1, 1024] and streams 1, 2, 4 or 8";
+    std::string        body, rest;
+    int                kernel = -1;
+    if (v >> bw >> streams >> body)
+      for (int k = 0; k <= (int)binbcsr::BodySet::AVX512; k++)
+        if (body == binbcsr::body_set_name((binbcsr::BodySet)k) && binbcsr::body_set_available((binbcsr::BodySet)k)) kernel = k;
+    if (kernel < 0 || (v >> rest) || bw < 1 || bw > 1024 || (streams != 1 && streams != 2 && streams != 4 && streams != 8)) {
+      why = "line " + std::to_string(n) + ": choice \"" + line.substr(t2 + 1) + "\" is not a bin width in [1, 1024], streams 1, 2, 4 or 8 and a body set this CPU has";
       return false;
     }
-    entries[line.substr(0, t2)] = BinBCSRTuneChoice{(PetscInt)bw, (PetscInt)streams};
+    entries[line.substr(0, t2)] = BinBCSRTuneChoice{(PetscInt)bw, (PetscInt)streams, (PetscInt)kernel};
   }
   return true;
 }
@@ -129,7 +128,7 @@ PetscErrorCode BinBCSRTuneCacheStore(const std::string &key, const BinBCSRTuneCh
   {
     std::ofstream out(tmp, std::ios::trunc);
     out << cache_header << "\n";
-    for (const auto &[k, v] : entries) out << k << "\t" << v.bw << " " << v.streams << "\n";
+    for (const auto &[k, v] : entries) out << k << "\t" << v.bw << " " << v.streams << " " << binbcsr::body_set_name((binbcsr::BodySet)v.kernel) << "\n";
     out.close();
     if (!out) {
       PetscCall(PetscInfo(nullptr, "Cannot write the tuning cache %s\n", tmp.c_str()));

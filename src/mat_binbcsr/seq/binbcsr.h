@@ -72,6 +72,7 @@ typedef struct {
   PetscInt            tune_cache;  /* MatBinBCSRSetTuneCache: 1 on, 0 off, -1 not set (the option, else on) */
   char                tune_info[768]; /* what the tuner tried and chose at the last layout build (MatView) */
   MatBinBCSRKernel    kernel;      /* MatBinBCSRSetKernel: the body set asked for (AUTO: the best the CPU has) */
+  PetscBool           kernel_tuned; /* kernel is the tuner's choice, not the user's (a rebuild may change it) */
   PetscBool           sym;         /* symmetric storage: only blocks with block column >= block row
                                       are stored; entries below the block diagonal are ignored. The
                                       slots of a bin are ordered by an edge colouring (below). */

@@ -79,6 +79,7 @@ static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues
   b->tune_cache  = a->tune_cache;
   PetscCall(PetscStrncpy(b->tune_info, a->tune_info, sizeof(b->tune_info)));
   b->kernel      = a->kernel;
+  b->kernel_tuned = a->kernel_tuned;
   b->sym         = a->sym;
   b->bs          = a->bs;
   b->bs2         = a->bs2;

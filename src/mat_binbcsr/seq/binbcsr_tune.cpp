@@ -11,13 +11,17 @@
    Candidates, in the order the budget (about 30 products or 50 ms of products) admits them:
    streams 1, 2, 4, 8 at the default width; the other widths (4, 8, 16, and 32 for bs 1) at the best
    stream count; then the other stream counts at the best width. A width or stream count set
-   explicitly (option or MatBinBCSRSet*) is kept and only the other parameter is tuned. */
+   explicitly (option or MatBinBCSRSet*) is kept and only the other parameter is tuned. Last, the
+   other kernel body sets the CPU has (kernels/binbcsr_dispatch.h) at the best width and streams,
+   unless -mat_binbcsr_kernel / MatBinBCSRSetKernel chose one. Products are timed in this thread's
+   CPU time (the budget too); the cost reported is wall time. */
 #include "binbcsr.h"
 #include "../binbcsr_tune.h"
 #include "../binbcsr_machine.h"
 #include <petsctime.h>
 #include <algorithm>
 #include <cmath>
+#include <ctime>
 #include <vector>
 
 namespace
@@ -30,7 +34,7 @@ constexpr PetscInt min_tune_kib    = 512; /* smaller matrices live in L2: any la
 /* The matrix class of a cache key: block size, precision, storage, size bucket (log2 of the value
    bytes), mean row length bucket (log2) and row-length spread (coefficient of variation in quarters),
    plus the parameters set explicitly (their values are part of the question). */
-std::string MatrixClass(const Mat_SeqBinBCSR *a, size_t vbytes, double mean, double cv, PetscBool bw_fixed, PetscBool k_fixed)
+std::string MatrixClass(const Mat_SeqBinBCSR *a, size_t vbytes, double mean, double cv, PetscBool bw_fixed, PetscBool k_fixed, PetscBool body_fixed)
 {
   std::string c = "bs " + std::to_string(a->bs) + " " + (a->precision == MAT_BINBCSR_PRECISION_SINGLE ? "single" : "double") + (a->sym ? " symmetric" : " whole");
   c += " size 2^" + std::to_string((int)std::lround(std::log2((double)std::max<size_t>(vbytes, 1))));
@@ -38,6 +42,7 @@ std::string MatrixClass(const Mat_SeqBinBCSR *a, size_t vbytes, double mean, dou
   c += " spread " + std::to_string(std::min(16, (int)(cv * 4.0)));
   if (bw_fixed) c += " bw=" + std::to_string(a->bw);
   if (k_fixed) c += " streams=" + std::to_string(a->streams);
+  if (body_fixed) c += std::string(" kernel=") + MatBinBCSRKernels[a->kernel];
   return c;
 }
 
@@ -81,6 +86,7 @@ PetscErrorCode SampleMatrix(const Mat_SeqBinBCSR *a, const Sample &s, PetscInt b
   t->bw_set    = PETSC_TRUE;
   t->precision = a->precision;
   t->sym       = a->sym;
+  t->kernel    = a->kernel; /* a set chosen explicitly is the one timed */
   PetscCall(MatSeqBinBCSRBuildLayout(*T, s.bi.data(), s.bj.data()));
   if (t->val) std::fill(t->val, t->val + (size_t)t->nslots * t->bs2, (MatScalar)1e-3);
   else std::fill(t->valf, t->valf + (size_t)t->nslots * t->bs2, 1e-3f);
@@ -94,17 +100,22 @@ struct Timer {
   PetscInt products = 0;
   double   seconds  = 0; /* time in timed products */
 
+  /* CPU seconds of this thread: on a machine shared with other work the wall clock also counts the
+     time the process waits for a core, which would decide the choice by chance */
+  static double Now()
+  {
+    timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+  }
   /* Seconds of one product of T with K streams (the product op itself: no log events, no checks). */
   PetscErrorCode Time(Mat T, PetscInt K, double *sec)
   {
-    PetscLogDouble t0, t1;
-
     PetscFunctionBegin;
     ((Mat_SeqBinBCSR *)T->data)->streams = K;
-    PetscCall(PetscTime(&t0));
+    const double t0 = Now();
     PetscCall(MatMult_SeqBinBCSR(T, x, y));
-    PetscCall(PetscTime(&t1));
-    *sec = t1 - t0;
+    *sec = Now() - t0;
     products++;
     seconds += *sec;
     PetscFunctionReturn(0);
@@ -115,6 +126,7 @@ struct Timer {
 struct Tried {
   PetscInt bw, K;
   double   sec;
+  PetscInt kernel; /* MatBinBCSRKernel; AUTO: the dispatch's default body */
 };
 
 } // namespace
@@ -168,13 +180,18 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
 
   PetscFunctionBegin;
   a->tune_info[0] = 0;
+  if (a->kernel_tuned) { /* the last build's choice, not the user's: free again */
+    a->kernel       = MAT_BINBCSR_KERNEL_AUTO;
+    a->kernel_tuned = PETSC_FALSE;
+  }
+  const PetscBool body_free = a->kernel == MAT_BINBCSR_KERNEL_AUTO ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(TuneSettings(A, &tune, &use_cache, &min_bytes));
   if (!tune) {
     SetInfo(a, "off (-mat_binbcsr_tune off)");
     PetscFunctionReturn(0);
   }
-  if (a->bw_set && a->streams_set) {
-    SetInfo(a, "nothing to tune: bin width and streams set explicitly");
+  if (a->bw_set && a->streams_set && !body_free) {
+    SetInfo(a, "nothing to tune: bin width, streams and kernel set explicitly");
     PetscFunctionReturn(0);
   }
   if (bs != 1 && bs != 3) {
@@ -205,15 +222,19 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
     PetscCall(PetscLogEventEnd(MAT_BinBCSR_Tune, A, 0, 0, 0));
     PetscFunctionReturn(0);
   }
-  const std::string key = BinBCSRTuneMachineKey() + "\t" + MatrixClass(a, vbytes, mean, cv, a->bw_set, a->streams_set);
+  const std::string key = BinBCSRTuneMachineKey() + "\t" + MatrixClass(a, vbytes, mean, cv, a->bw_set, a->streams_set, body_free ? PETSC_FALSE : PETSC_TRUE);
   if (use_cache) {
     BinBCSRTuneChoice c;
     PetscCall(BinBCSRTuneCacheLookup(key, &c, &found));
-    if (found && (!a->bw_set || c.bw == a->bw) && (!a->streams_set || c.streams == a->streams) && (c.bw == 4 || c.bw == 8 || c.bw == 16 || (c.bw == 32 && bs == 1))) {
+    if (found && (!a->bw_set || c.bw == a->bw) && (!a->streams_set || c.streams == a->streams) && (body_free || c.kernel == (PetscInt)a->kernel) && (c.bw == 4 || c.bw == 8 || c.bw == 16 || (c.bw == 32 && bs == 1))) {
       a->bw      = c.bw;
       a->streams = c.streams;
+      if (body_free && c.kernel != (PetscInt)MAT_BINBCSR_KERNEL_AUTO) {
+        a->kernel       = (MatBinBCSRKernel)c.kernel;
+        a->kernel_tuned = PETSC_TRUE;
+      }
       PetscCall(PetscTime(&t_end));
-      SetInfo(a, "bin width " + std::to_string(c.bw) + ", streams " + std::to_string(c.streams) + " from the cache " + BinBCSRTuneCachePath() + " (" + Fmt("%.3f", 1e3 * (t_end - t_start)) + " ms)");
+      SetInfo(a, "bin width " + std::to_string(c.bw) + ", streams " + std::to_string(c.streams) + ", kernel " + MatBinBCSRKernels[c.kernel] + " from the cache " + BinBCSRTuneCachePath() + " (" + Fmt("%.3f", 1e3 * (t_end - t_start)) + " ms)");
       PetscCall(PetscInfo(A, "Tuning: %s\n", a->tune_info));
       PetscCall(PetscLogEventEnd(MAT_BinBCSR_Tune, A, 0, 0, 0));
       PetscFunctionReturn(0);
@@ -244,7 +265,7 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
   std::vector<Tried> tried;
   PetscInt           skipped = 0;
   Mat                best_T  = nullptr;
-  Tried              best    = {widths[0], counts[0], 1e30};
+  Tried              best    = {widths[0], counts[0], 1e30, (PetscInt)a->kernel};
   PetscCall(VecCreateSeq(PETSC_COMM_SELF, s.nc * bs, &tm.x));
   PetscCall(VecCreateSeq(PETSC_COMM_SELF, s.nr * bs, &tm.y));
   PetscCall(VecSet(tm.x, 1.0));
@@ -266,7 +287,7 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
       }
     bool kept = false;
     for (size_t i = 0; i < ks.size(); i++) {
-      tried.push_back({bw, ks[i], sec[i]});
+      tried.push_back({bw, ks[i], sec[i], (PetscInt)((Mat_SeqBinBCSR *)T->data)->kernel});
       if (sec[i] < best.sec) {
         best = tried.back();
         if (best_T != T) {
@@ -277,6 +298,33 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
       }
     }
     if (!kept && T != best_T) PetscCall(MatDestroy(&T));
+    PetscFunctionReturn(0);
+  };
+  /* the other body sets at the best width and streams, where their body differs from the default's */
+  auto time_bodies = [&]() -> PetscErrorCode {
+    Mat_SeqBinBCSR      *t = (Mat_SeqBinBCSR *)best_T->data;
+    const binbcsr::Shape sh = {(int)bs, (int)best.bw, (int)best.K, a->precision == MAT_BINBCSR_PRECISION_SINGLE, a->sym ? true : false};
+    std::vector<binbcsr::MultBody> seen = {binbcsr::select_body(sh, binbcsr::BodySet::Auto).mult};
+    PetscFunctionBegin;
+    for (int k = (int)MAT_BINBCSR_KERNEL_PORTABLE; k <= (int)MAT_BINBCSR_KERNEL_AVX512; k++) {
+      if (!binbcsr::body_set_available((binbcsr::BodySet)k)) continue;
+      const binbcsr::Body b = binbcsr::select_body(sh, (binbcsr::BodySet)k);
+      if (std::find(seen.begin(), seen.end(), b.mult) != seen.end() || b.set != (binbcsr::BodySet)k) continue; /* the same body, or a fallback */
+      seen.push_back(b.mult);
+      if (!tm.Admits(2, best.sec)) {
+        skipped++;
+        continue;
+      }
+      double sec = 1e30, s1;
+      t->kernel  = (MatBinBCSRKernel)k;
+      for (int round = 0; round < 2; round++) {
+        PetscCall(tm.Time(best_T, best.K, &s1));
+        sec = std::min(sec, s1);
+      }
+      tried.push_back({best.bw, best.K, sec, (PetscInt)k});
+      if (sec < best.sec) best = tried.back();
+    }
+    t->kernel = (MatBinBCSRKernel)best.kernel;
     PetscFunctionReturn(0);
   };
   PetscCall(time_width(widths[0], counts, nullptr));
@@ -295,24 +343,29 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
     if (tm.Admits(2 * (PetscInt)rest.size(), best.sec)) PetscCall(time_width(best.bw, rest, best_T));
     else skipped += (PetscInt)rest.size();
   }
+  if (body_free) PetscCall(time_bodies());
   PetscCall(MatDestroy(&best_T));
   PetscCall(VecDestroy(&tm.x));
   PetscCall(VecDestroy(&tm.y));
   a->bw      = best.bw;
   a->streams = best.K;
-  if (use_cache) PetscCall(BinBCSRTuneCacheStore(key, BinBCSRTuneChoice{best.bw, best.K}));
+  if (body_free && best.kernel != (PetscInt)MAT_BINBCSR_KERNEL_AUTO) {
+    a->kernel       = (MatBinBCSRKernel)best.kernel;
+    a->kernel_tuned = PETSC_TRUE;
+  }
+  if (use_cache) PetscCall(BinBCSRTuneCacheStore(key, BinBCSRTuneChoice{best.bw, best.K, best.kernel}));
   PetscCall(PetscTime(&t_end));
 
   /* the report: what was tried, the choice against the untuned default, what it cost */
   double      t_default = -1;
   std::string list;
   for (const Tried &t : tried) {
-    list += (list.empty() ? "" : ", ") + std::to_string(t.bw) + "/" + std::to_string(t.K) + " " + Fmt("%.3g", 1e3 * t.sec);
-    if (t.bw == (a->bw_set ? a->bw : bw_default) && t.K == (a->streams_set ? a->streams : BINBCSR_DEFAULT_STREAMS)) t_default = t.sec;
+    list += (list.empty() ? "" : ", ") + std::to_string(t.bw) + "/" + std::to_string(t.K) + (t.kernel != (body_free ? (PetscInt)MAT_BINBCSR_KERNEL_AUTO : (PetscInt)a->kernel) ? std::string("/") + MatBinBCSRKernels[t.kernel] : std::string("")) + " " + Fmt("%.3g", 1e3 * t.sec);
+    if (t.bw == (a->bw_set ? a->bw : bw_default) && t.K == (a->streams_set ? a->streams : BINBCSR_DEFAULT_STREAMS) && (!body_free || t.kernel == (PetscInt)MAT_BINBCSR_KERNEL_AUTO)) t_default = t.sec;
   }
-  std::string info = "bin width " + std::to_string(best.bw) + ", streams " + std::to_string(best.K) + " measured on block rows " + std::to_string(r0) + ".." + std::to_string(r0 + nr - 1) + " of " + std::to_string(mbs) + " (ms per sample product, width/streams: " + list + (skipped ? "; " + std::to_string(skipped) + " left out by the budget" : "") + ")";
+  std::string info = "bin width " + std::to_string(best.bw) + ", streams " + std::to_string(best.K) + ", kernel " + MatBinBCSRKernels[best.kernel] + " measured on block rows " + std::to_string(r0) + ".." + std::to_string(r0 + nr - 1) + " of " + std::to_string(mbs) + " (ms per sample product, width/streams[/kernel]: " + list + (skipped ? "; " + std::to_string(skipped) + " left out by the budget" : "") + ")";
   const double cost = t_end - t_start;
-  info += "; cost " + Fmt("%.1f", 1e3 * cost) + " ms";
+  info += "; cost " + Fmt("%.1f", 1e3 * cost) + " ms (" + Fmt("%.1f", 1e3 * tm.seconds) + " ms CPU in " + std::to_string(tm.products) + " sample products)";
   if (t_default > 0) {
     const double gain = (t_default - best.sec) * (double)mbs / (double)nr; /* per product of the whole matrix */
     info += "; " + Fmt("%.2f", t_default / best.sec) + "x the default";

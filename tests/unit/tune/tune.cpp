@@ -151,6 +151,9 @@ TEST_CASE("tuning chooses among the candidates; products and values stay exact",
         CHECK(txt.find("left out by the budget") == std::string::npos);
         CHECK(txt.find(" 4/") != std::string::npos);
         CHECK(txt.find(" 16/") != std::string::npos);
+        PetscBool avx2;
+        REQUIRE(MatBinBCSRKernelAvailable(MAT_BINBCSR_KERNEL_AVX2, &avx2) == 0);
+        if (avx2) CHECK(txt.find("/portable ") != std::string::npos); // the other body sets were timed too
         check_same(A, R, p);
         Mat D;
         REQUIRE(MatDuplicate(A, MAT_COPY_VALUES, &D) == 0);
@@ -205,6 +208,16 @@ TEST_CASE("tuning: explicit settings win", "[tune]")
     Mat A = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO, 0, 2);
     CHECK(streams(A) == 2);
     CHECK(info_view(A).find("/1 ") == std::string::npos); // only the widths, at streams 2
+    MatDestroy(&A);
+  }
+  {
+    // the kernel set explicitly: kept, and only it is timed
+    o.set("-mat_binbcsr_kernel", "portable");
+    Mat A = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
+    MatBinBCSRKernel k;
+    REQUIRE(MatBinBCSRGetKernel(A, &k) == 0);
+    CHECK(k == MAT_BINBCSR_KERNEL_PORTABLE);
+    CHECK(info_view(A).find("/avx") == std::string::npos);
     MatDestroy(&A);
   }
   {
