@@ -66,9 +66,9 @@ PetscErrorCode TuneCost(Mat A, double *ms, std::string *line)
   const size_t t = s.find("tuning (-mat_binbcsr_tune): ");
   *line          = t == std::string::npos ? "" : s.substr(t + 28, s.find('\n', t) - t - 28);
   *ms            = -1;
-  const size_t c = line->find("cost "), f = line->find(" ms)");
+  const size_t c = line->find("cost "), e = line->find(" ms)");
   if (c != std::string::npos) *ms = atof(line->c_str() + c + 5);
-  else if (f != std::string::npos) *ms = atof(line->c_str() + line->rfind('(', f) + 1); // from the cache (X ms)
+  else if (e != std::string::npos) *ms = atof(line->c_str() + line->rfind('(', e) + 1); // from the cache (X ms)
   PetscFunctionReturn(0);
 }
 

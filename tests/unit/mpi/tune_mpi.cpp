@@ -74,7 +74,9 @@ TEST_CASE("mpi: each rank tunes its parts; the matrix and its products stay MPIA
   PCHK(PetscOptionsSetValue(nullptr, "-mat_binbcsr_tune_cache", "0"));
   const FemProblem fem(9, 8, 7, true);
   Mat              A = coo_matrix(fem, MATMPIBINBCSR), R = coo_matrix(fem, MATMPIAIJ);
-  CHECK(all_ranks(mat_rel_diff(A, R) == 0.0));
+  // each stored value is a sum of up to 8 element entries, summed in another order than MPIAIJ's
+  const double sum_tol = 16 * PETSC_MACHINE_EPSILON;
+  CHECK(all_ranks(mat_rel_diff(A, R) < sum_tol));
   Vec x, y, yr;
   PCHK(MatCreateVecs(R, &x, &y));
   PCHK(VecDuplicate(y, &yr));
@@ -97,17 +99,24 @@ TEST_CASE("mpi: each rank tunes its parts; the matrix and its products stay MPIA
   // a duplicate keeps every rank's choice and values
   Mat D;
   PCHK(MatDuplicate(A, MAT_COPY_VALUES, &D));
-  CHECK(all_ranks(mat_rel_diff(D, R) == 0.0));
+  CHECK(all_ranks(mat_rel_diff(D, R) < sum_tol));
   MatDestroy(&D);
-  MatDestroy(&A);
-  // off and explicit values reach the parts
+  // off reaches the parts; the untuned matrix gives bit-identical products (same values, same order
+  // of summation in each row)
   PCHK(PetscOptionsSetValue(nullptr, "-mat_binbcsr_tune", "off"));
-  A = coo_matrix(fem, MATMPIBINBCSR);
+  Mat U = coo_matrix(fem, MATMPIBINBCSR);
+  Vec yu;
+  PCHK(VecDuplicate(y, &yu));
+  PCHK(MatMult(U, x, yu));
+  CHECK(all_ranks(vec_rel_diff(y, yu) == 0.0));
+  VecDestroy(&yu);
+  MatDestroy(&A);
+  A = U;
   MatBinBCSRTune t;
   PCHK(MatBinBCSRGetTune(A, &t));
   CHECK(t == MAT_BINBCSR_TUNE_OFF);
   CHECK(all_ranks(info_text(A).find("measured on block rows") == std::string::npos));
-  CHECK(all_ranks(mat_rel_diff(A, R) == 0.0));
+  CHECK(all_ranks(mat_rel_diff(A, R) < sum_tol));
   MatDestroy(&A);
   PCHK(PetscOptionsClearValue(nullptr, "-mat_binbcsr_tune"));
   PCHK(PetscOptionsClearValue(nullptr, "-mat_binbcsr_tune_min_kib"));
