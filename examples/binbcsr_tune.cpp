@@ -25,9 +25,9 @@
 // both precisions) with the COO list of trilinear hexahedra on the same node grid (24x24 element
 // matrices, every entry listed once per element).
 #include <petscbinbcsr.h>
-#include "common/stencil.h"
-#include "common/bench_util.h"
-#include "common/tune_sweep.h"
+#include "sim/stencil.h"
+#include "sim/bench_util.h"
+#include "sim/tune_sweep.h"
 #include <ctime>
 #include <string>
 #include <vector>

@@ -7,7 +7,7 @@
 //              [-save_dir DIR] (also write each stencil matrix to DIR/stencilN.bin, PETSc binary)
 //              [-timer wall|cpu] (cpu: process CPU time, for a machine shared with other work)
 //
-// Matrices: the 27-point 3x3-block stencil (examples/common/stencil.h) on an n^3 node grid for each
+// Matrices: the 27-point 3x3-block stencil (src/sim/stencil.h) on an n^3 node grid for each
 // n of -stencil_sizes (0 = none), and every PETSc binary file given with -f (repeatable, or a comma
 // list; the block size comes from the file's .info, -matload_block_size, or -bs).
 // Under mpiexec the same types are used in their mpi forms (rows split by PETSc's default layout).
@@ -15,7 +15,7 @@
 // Timing: the formats are timed round-robin (one batch of MatMults per format per round, -repeats
 // rounds) so that load from other processes hits them alike; a batch is long enough to last
 // -min_batch_ms. Per MatMult: min and median over the rounds. Each round also runs one STREAM triad
-// pass and one pass of the best read pattern (common/read_bw.h: one array read as 1, 2, 4, 8
+// pass and one pass of the best read pattern (sim/read_bw.h: one array read as 1, 2, 4, 8
 // interleaved streams and with AVX-512 / AVX2 sums, measured at the start). %read is relative to the
 // best read bandwidth of all those passes: the physical limit of a product that reads its matrix
 // once. %triad is relative to the best triad pass (two reads and a write: not that limit).
@@ -35,10 +35,10 @@
 //   + 8 N (x) + 8 N (y)
 #include <petscbinbcsr.h>
 
-#include "common/bench_util.h"
-#include "common/stencil.h"
-#include "common/read_bw.h"
-#include "common/stream.h"
+#include "sim/bench_util.h"
+#include "sim/stencil.h"
+#include "sim/read_bw.h"
+#include "sim/stream.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,6 @@
 /* MATSEQBINBCSR rows, copies, conversions and ASCII views. */
 #include "binbcsr.h"
+#include "binbcsr_ops.h"
 #include "../kernels/binbcsr_kernels.h"
 #include <petscviewer.h>
 #include <algorithm>
@@ -75,11 +76,11 @@ static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues
   b->roworiented = a->roworiented;
   b->streams     = a->streams;
   b->streams_set = a->streams_set;
+  b->kernel      = a->kernel;
+  b->kernel_tuned = a->kernel_tuned;
   b->tune        = a->tune;
   b->tune_cache  = a->tune_cache;
   PetscCall(PetscStrncpy(b->tune_info, a->tune_info, sizeof(b->tune_info)));
-  b->kernel      = a->kernel;
-  b->kernel_tuned = a->kernel_tuned;
   b->sym         = a->sym;
   b->bs          = a->bs;
   b->bs2         = a->bs2;
@@ -440,19 +441,11 @@ PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
 
 PetscErrorCode MatView_SeqBinBCSR(Mat A, PetscViewer viewer)
 {
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-  PetscBool       isascii;
+  PetscBool isascii;
 
   PetscFunctionBegin;
   PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &isascii));
   if (isascii) PetscCall(MatView_SeqBinBCSR_ASCII(A, viewer));
-  else if (a->view_other) PetscCall(a->view_other(A, viewer));
-  else {
-    /* any other viewer: through an AIJ copy */
-    Mat B;
-    PetscCall(MatConvert(A, MATSEQAIJ, MAT_INITIAL_MATRIX, &B));
-    PetscCall(MatView(B, viewer));
-    PetscCall(MatDestroy(&B));
-  }
+  else PetscCall(MatView_SeqBinBCSR_Other(A, viewer)); /* binary natively, the rest through a seqaij copy */
   PetscFunctionReturn(0);
 }
