@@ -10,12 +10,24 @@
 // -streams 1,2,4,8 times each matrix with each stream count (one matrix per width and precision:
 // the stream count is a traversal order, set before each batch).
 //
+// -sweep: every (bin width 4/8/16(/32 for bs 1), streams 1/2/4/8, body set the CPU has) against the autotuned default
+// (nothing set, -mat_binbcsr_tune auto) for whole and symmetric storage in double and single precision,
+// on the stencils of -stencil_sizes (default 32,48) and on every PETSc binary file of -f (comma list,
+// block size from -bs, default 3; the drivers write them with -dump_matrix FILE). Per matrix and
+// case one line: the sweep's best bw/K/body and ms, the tuned bw/K/body and ms, tuned / best, the reference
+// (seqbaij; seqaij for bs 1) and what the tuning cost. -sweep_verbose prints every variant;
+// -tune_cache 1 lets the tuned matrix use the cache file (default: it measures).
+//
+// The fixed variants are built with -mat_binbcsr_tune off semantics (MatBinBCSRSetTune).
+//
 // -bs 1 measures BIN-CSR on the same stencil seen as a scalar matrix.
 // -coo also times the COO refill (MatSetValuesCOO, INSERT) of seqaij and binbcsr (default bin width,
 // both precisions) with the COO list of trilinear hexahedra on the same node grid (24x24 element
 // matrices, every entry listed once per element).
 #include <petscbinbcsr.h>
 #include "sim/stencil.h"
+#include "sim/bench_util.h"
+#include "sim/tune_sweep.h"
 #include <ctime>
 #include <string>
 #include <vector>
@@ -41,31 +53,6 @@ struct Variant {
   double      best    = 1e300;
 };
 
-PetscErrorCode MakeBinBCSR(Mat src, PetscInt bs, PetscInt bw, MatBinBCSRPrecision prec, Mat *A)
-{
-  PetscInt m, n;
-
-  PetscFunctionBeginUser;
-  PetscCall(MatGetLocalSize(src, &m, &n));
-  PetscCall(MatCreate(PETSC_COMM_SELF, A));
-  PetscCall(MatSetSizes(*A, m, n, m, n));
-  PetscCall(MatSetBlockSize(*A, bs));
-  PetscCall(MatSetType(*A, MATSEQBINBCSR));
-  PetscCall(MatBinBCSRSetBinWidth(*A, bw));
-  PetscCall(MatBinBCSRSetPrecision(*A, prec));
-  PetscCall(MatSetUp(*A));
-  for (PetscInt r = 0; r < m; r++) {
-    PetscInt           nc;
-    const PetscInt    *cols;
-    const PetscScalar *vals;
-    PetscCall(MatGetRow(src, r, &nc, &cols, &vals));
-    PetscCall(MatSetValues(*A, 1, &r, nc, cols, vals, INSERT_VALUES));
-    PetscCall(MatRestoreRow(src, r, &nc, &cols, &vals));
-  }
-  PetscCall(MatAssemblyBegin(*A, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(*A, MAT_FINAL_ASSEMBLY));
-  PetscFunctionReturn(0);
-}
 /* COO refill of the hexahedral element list on the grid: seqaij against binbcsr (both precisions). */
 PetscErrorCode TimeCOO(const StencilGrid &g, PetscInt repeats)
 {
@@ -147,6 +134,47 @@ int main(int argc, char **argv)
     PetscCall(PetscStrcmp(timer, "wall", &use_wall));
   }
 
+  {
+    PetscBool sweep = PETSC_FALSE;
+    PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-sweep", &sweep, nullptr));
+    if (sweep) {
+      SweepSettings s;
+      char          buf[4096] = "";
+      PetscBool     flg;
+      PetscInt      sizes[8] = {32, 48}, nsizes = 8;
+      s.now = Now;
+      PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-repeats", &s.repeats, nullptr));
+      PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-batch", &s.batch, nullptr));
+      PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-tune_cache", &s.tune_cache, nullptr));
+      PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-sweep_verbose", &s.verbose, nullptr));
+      PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-stencil_sizes", sizes, &nsizes, &flg));
+      if (!flg) nsizes = 2;
+      PetscCall(PetscPrintf(PETSC_COMM_SELF, "binbcsr_tune -sweep: ms per MatMult, minimum of %" PetscInt_FMT " rounds of %" PetscInt_FMT " (%s time); best/tuned as bin width/streams\n", s.repeats, s.batch, use_wall ? "wall" : "process CPU"));
+      for (PetscInt i = 0; i < nsizes; i++) {
+        if (sizes[i] <= 0) continue;
+        StencilGrid g;
+        g.nx = g.ny = g.nz = sizes[i];
+        PetscCall(CreateStencilMatrix(PETSC_COMM_SELF, g, MATSEQAIJ, nullptr, &aij));
+        if (bs == 1) PetscCall(MatSetBlockSize(aij, 1));
+        PetscCall(TuneSweep("stencil" + std::to_string(sizes[i]), aij, s));
+        PetscCall(MatDestroy(&aij));
+      }
+      PetscCall(PetscOptionsGetString(nullptr, nullptr, "-f", buf, sizeof buf, &flg));
+      for (const std::string &f : flg ? SplitList(buf) : std::vector<std::string>{}) {
+        PetscViewer v;
+        PetscCall(PetscViewerBinaryOpen(PETSC_COMM_SELF, f.c_str(), FILE_MODE_READ, &v));
+        PetscCall(MatCreate(PETSC_COMM_SELF, &aij));
+        PetscCall(MatSetType(aij, MATSEQAIJ));
+        PetscCall(MatSetBlockSize(aij, bs));
+        PetscCall(MatLoad(aij, v));
+        PetscCall(PetscViewerDestroy(&v));
+        PetscCall(TuneSweep(f.substr(f.find_last_of('/') == std::string::npos ? 0 : f.find_last_of('/') + 1), aij, s));
+        PetscCall(MatDestroy(&aij));
+      }
+      PetscCall(PetscFinalize());
+      return 0;
+    }
+  }
   PetscCall(CreateStencilMatrix(PETSC_COMM_SELF, grid, MATSEQAIJ, nullptr, &aij));
   PetscCall(CreateStencilMatrix(PETSC_COMM_SELF, grid, MATSEQBAIJ, nullptr, &baij));
   if (bs == 1) PetscCall(MatSetBlockSize(aij, 1));
@@ -155,7 +183,7 @@ int main(int argc, char **argv)
   for (PetscInt w = 0; w < nw; w++)
     for (int p = 0; p < 2; p++) {
       Mat A;
-      PetscCall(MakeBinBCSR(aij, bs, widths[w], p ? MAT_BINBCSR_PRECISION_SINGLE : MAT_BINBCSR_PRECISION_DOUBLE, &A));
+      PetscCall(MakeBinBCSR(aij, bs, widths[w], 0, p ? MAT_BINBCSR_PRECISION_SINGLE : MAT_BINBCSR_PRECISION_DOUBLE, PETSC_FALSE, PETSC_FALSE, &A));
       for (PetscInt k = 0; k < ns; k++) {
         Variant v;
         v.name    = std::string(p ? "single" : "double") + " bw " + std::to_string(widths[w]) + (ns > 1 ? " K " + std::to_string(streams[k]) : "");

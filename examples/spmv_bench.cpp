@@ -15,7 +15,10 @@
 // Timing: the formats are timed round-robin (one batch of MatMults per format per round, -repeats
 // rounds) so that load from other processes hits them alike; a batch is long enough to last
 // -min_batch_ms. Per MatMult: min and median over the rounds. Each round also runs one STREAM triad
-// pass; %triad is relative to the best of those (the bandwidth available in the same rounds).
+// pass and one pass of the best read pattern (sim/read_bw.h: one array read as 1, 2, 4, 8
+// interleaved streams and with AVX-512 / AVX2 sums, measured at the start). %read is relative to the
+// best read bandwidth of all those passes: the physical limit of a product that reads its matrix
+// once. %triad is relative to the best triad pass (two reads and a write: not that limit).
 // GFlop/s = 2 nnz / t with nnz the nonzeros of the full matrix (also for sbaij, which stores half).
 // Bytes model (GB/s): the matrix's stored arrays read once (values, column indices, row/bin offsets,
 // padding included) + x read once + y written once; no cache reuse of x beyond that and no halo.
@@ -34,6 +37,7 @@
 
 #include "sim/bench_util.h"
 #include "sim/stencil.h"
+#include "sim/read_bw.h"
 #include "sim/stream.h"
 
 #include <algorithm>
@@ -227,6 +231,7 @@ struct Settings {
   PetscBool               stats_only   = PETSC_FALSE;
   FILE                   *csv          = nullptr;
   TriadArrays            *triad        = nullptr; // one triad pass per round, beside the MatMults
+  ReadArray              *read         = nullptr; // one pass of the best read pattern per round
   PetscInt                file_bs      = 0;
   std::string             save_dir; // -save_dir: write each stencil matrix (aij) as a PETSc binary file
   PetscBool               cpu_clock = PETSC_FALSE; // -timer cpu: process CPU time instead of wall time
@@ -337,6 +342,10 @@ PetscErrorCode BenchMatrix(MPI_Comm comm, const MatrixSource &src, const Setting
       PetscCall(TriadArraysRun(comm, set.triad, &t));
       triad_seconds.push_back(t);
     }
+    if (set.read) {
+      double g;
+      PetscCall(ReadArrayRun(comm, set.read, ReadArrayBest(set.read), &g));
+    }
     for (Candidate &c : cands) {
       if (!c.A || !c.note.empty()) continue;
       PetscCallMPI(MPI_Barrier(comm));
@@ -355,34 +364,36 @@ PetscErrorCode BenchMatrix(MPI_Comm comm, const MatrixSource &src, const Setting
   {
     double aij_bytes = 12.0 * st.nnz;
     const double llc = (double)LastLevelCacheBytes();
-    if (llc > 0 && aij_bytes < 2 * llc) PetscCall(PetscPrintf(comm, "   (aij values+indices %.0f MB vs %.0f MB last-level cache: partly cache-resident, %%triad may exceed 100)\n", aij_bytes * 1e-6, llc * 1e-6));
+    if (llc > 0 && aij_bytes < 2 * llc) PetscCall(PetscPrintf(comm, "   (aij values+indices %.0f MB vs %.0f MB last-level cache: partly cache-resident, %%read and %%triad may exceed 100)\n", aij_bytes * 1e-6, llc * 1e-6));
   }
   const double triad_GBs = (set.triad && !triad_seconds.empty()) ? set.triad->bytes / Min(triad_seconds) * 1e-9 : 0;
   if (triad_GBs > 0) PetscCall(PetscPrintf(comm, "   STREAM triad in the same rounds: %.2f GB/s (best of %d)\n", triad_GBs, (int)triad_seconds.size()));
+  const double read_GBs = set.read ? set.read->patterns[ReadArrayBest(set.read)].best_GBs : 0;
+  if (read_GBs > 0) PetscCall(PetscPrintf(comm, "   read bandwidth (best pattern, %s, so far): %.2f GB/s\n", set.read->patterns[ReadArrayBest(set.read)].name.c_str(), read_GBs));
   double t_aij = 0, t_baij = 0, b_baij = 0;
   for (const Candidate &c : cands) {
     if (c.spec.label == "aij" && !c.per_mult.empty()) t_aij = Min(c.per_mult);
     if (c.spec.label == "baij" && !c.per_mult.empty()) t_baij = Min(c.per_mult);
     if (c.spec.label == "baij" && c.A) b_baij = c.bytes;
   }
-  PetscCall(PetscPrintf(comm, "%-15s %-11s %9s %9s %8s %8s %7s %9s %7s %7s %7s %7s %9s\n", "format", "type", "ms(min)", "ms(med)", "GFlop/s", "GB/s", "%triad", "MB", "/baijB", "x aij", "x baij", "pad%", "rel.err"));
+  PetscCall(PetscPrintf(comm, "%-15s %-11s %9s %9s %8s %8s %7s %7s %9s %7s %7s %7s %7s %9s\n", "format", "type", "ms(min)", "ms(med)", "GFlop/s", "GB/s", "%read", "%triad", "MB", "/baijB", "x aij", "x baij", "pad%", "rel.err"));
   for (const Candidate &c : cands) {
     if (!c.A || !c.note.empty()) {
       PetscCall(PetscPrintf(comm, "%-15s skipped: %s\n", c.spec.label.c_str(), c.note.empty() ? "not created" : c.note.c_str()));
-      if (set.csv) PetscCall(PetscFPrintf(comm, set.csv, "%s,%s,%" PetscInt_FMT ",%.0f,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%.2f,%d,,,,,,,,,,,,,%.3f,skipped\n", src.name.c_str(), c.spec.label.c_str(), st.rows, st.nnz, st.bs, st.max_row, st.min_row, st.avg_row, size, triad_GBs));
+      if (set.csv) PetscCall(PetscFPrintf(comm, set.csv, "%s,%s,%" PetscInt_FMT ",%.0f,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%.2f,%d,,,,,,,,,,,,,%.3f,,%.3f,skipped\n", src.name.c_str(), c.spec.label.c_str(), st.rows, st.nnz, st.bs, st.max_row, st.min_row, st.avg_row, size, triad_GBs, read_GBs));
       continue;
     }
     const double tmin = Min(c.per_mult), tmed = Median(c.per_mult);
     const double gflops = tmin > 0 ? 2.0 * st.nnz / tmin * 1e-9 : 0, gbs = tmin > 0 ? c.bytes / tmin * 1e-9 : 0;
-    const double frac = triad_GBs > 0 ? 100.0 * gbs / triad_GBs : 0;
+    const double frac = triad_GBs > 0 ? 100.0 * gbs / triad_GBs : 0, rfrac = read_GBs > 0 ? 100.0 * gbs / read_GBs : 0;
     char         pad[32] = "-", xa[16] = "-", xb[16] = "-", rb[16] = "-";
     if (c.padding >= 0) std::snprintf(pad, sizeof pad, "%.1f", c.padding);
     if (t_aij > 0 && tmin > 0) std::snprintf(xa, sizeof xa, "%.2f", t_aij / tmin);
     if (t_baij > 0 && tmin > 0) std::snprintf(xb, sizeof xb, "%.2f", t_baij / tmin);
     if (b_baij > 0) std::snprintf(rb, sizeof rb, "%.2f", c.bytes / b_baij);
-    PetscCall(PetscPrintf(comm, "%-15s %-11s %9.4f %9.4f %8.2f %8.2f %7.1f %9.1f %7s %7s %7s %7s %9.1e\n", c.spec.label.c_str(), c.actual_type.c_str(), tmin * 1e3, tmed * 1e3, gflops, gbs, frac, c.bytes * 1e-6, rb, xa, xb, pad, c.rel_err));
+    PetscCall(PetscPrintf(comm, "%-15s %-11s %9.4f %9.4f %8.2f %8.2f %7.1f %7.1f %9.1f %7s %7s %7s %7s %9.1e\n", c.spec.label.c_str(), c.actual_type.c_str(), tmin * 1e3, tmed * 1e3, gflops, gbs, rfrac, frac, c.bytes * 1e-6, rb, xa, xb, pad, c.rel_err));
     if (set.csv)
-      PetscCall(PetscFPrintf(comm, set.csv, "%s,%s,%" PetscInt_FMT ",%.0f,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%.2f,%d,%s,%.6f,%.6f,%.4f,%.4f,%.2f,%.0f,%s,%s,%s,%s,%.3e,%.3f,ok\n", src.name.c_str(), c.spec.label.c_str(), st.rows, st.nnz, st.bs, st.max_row, st.min_row, st.avg_row, size, c.actual_type.c_str(), tmin * 1e3, tmed * 1e3, gflops, gbs, frac, c.bytes, rb, xa, xb, c.padding >= 0 ? pad : "", c.rel_err, triad_GBs));
+      PetscCall(PetscFPrintf(comm, set.csv, "%s,%s,%" PetscInt_FMT ",%.0f,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%.2f,%d,%s,%.6f,%.6f,%.4f,%.4f,%.2f,%.0f,%s,%s,%s,%s,%.3e,%.3f,%.2f,%.3f,ok\n", src.name.c_str(), c.spec.label.c_str(), st.rows, st.nnz, st.bs, st.max_row, st.min_row, st.avg_row, size, c.actual_type.c_str(), tmin * 1e3, tmed * 1e3, gflops, gbs, frac, c.bytes, rb, xa, xb, c.padding >= 0 ? pad : "", c.rel_err, triad_GBs, rfrac, read_GBs));
     if (c.spec.label == "binbcsr") PetscCall(PetscPrintf(comm, "  (binbcsr bin width %" PetscInt_FMT " block rows; -mat_binbcsr_bin_width changes it)\n", c.bin_width));
     if (c.padding >= 0 && c.padding_info >= 0 && std::fabs(c.padding - c.padding_info) > 0.5)
       PetscCall(PetscPrintf(comm, "  note: %s reports %.1f%% padding through MatGetInfo (model above: %.1f%%)\n", c.spec.label.c_str(), c.padding_info, c.padding));
@@ -467,22 +478,32 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-csv", buf, sizeof buf, &flg));
   if (flg) {
     PetscCall(PetscFOpen(comm, buf, "w", &set.csv));
-    PetscCall(PetscFPrintf(comm, set.csv, "matrix,format,rows,nnz,bs,max_row,min_row,avg_row,ranks,type,ms_min,ms_median,gflops,gbs,pct_triad,bytes,bytes_vs_baij,speedup_vs_aij,speedup_vs_baij,padding_pct,rel_err,triad_gbs,status\n"));
+    PetscCall(PetscFPrintf(comm, set.csv, "matrix,format,rows,nnz,bs,max_row,min_row,avg_row,ranks,type,ms_min,ms_median,gflops,gbs,pct_triad,bytes,bytes_vs_baij,speedup_vs_aij,speedup_vs_baij,padding_pct,rel_err,triad_gbs,pct_read,read_gbs,status\n"));
   }
 
   StreamResult stream;
   TriadArrays  triad;
+  ReadArray    read;
   if (!set.stats_only) {
     PetscCall(MeasureStreamTriadFromOptions(comm, &stream));
     PetscCall(TriadArraysCreate(comm, stream.elements_per_rank, &triad));
     triad.cpu_clock = set.cpu_clock;
     set.triad = &triad;
+    PetscCall(ReadArrayCreate(comm, 0, &read));
+    read.cpu_clock = set.cpu_clock;
+    PetscCall(ReadArrayMeasureAll(comm, &read, 5));
+    set.read = &read;
+    PetscCall(PetscPrintf(comm, "Read bandwidth of one %.0f MB array per rank (%d rank(s), best of 5 passes each, GB/s):", 8e-6 * (double)read.n, stream.ranks));
+    for (const ReadPattern &rp : read.patterns) PetscCall(PetscPrintf(comm, "  %s %.2f", rp.name.c_str(), rp.best_GBs));
+    PetscCall(PetscPrintf(comm, "\n  %%read: a format's bytes-model GB/s against the best of these (also passes beside the products); %%triad: against STREAM triad\n"));
+    if (LastLevelCacheBytes() > 0) PetscCall(PetscPrintf(comm, "Last-level cache %.1f MiB (/sys/devices/system/cpu/cpu0/cache)\n", (double)LastLevelCacheBytes() / (1 << 20)));
     PetscCall(PetscPrintf(comm, "STREAM triad: %.2f GB/s best, %.2f GB/s median (%d rank(s), %.0f MB per array in all, %" PetscInt_FMT " repeats)\n", stream.best_GBs, stream.median_GBs, stream.ranks, 8e-6 * (double)stream.elements_per_rank * stream.ranks, stream.repeats));
   }
   PetscCall(PetscPrintf(comm, "Bytes model: stored matrix arrays (padding included) + x + y, each once; GFlop/s = 2 nnz / t; ms per MatMult (%s)\n", set.cpu_clock ? "process CPU time: -timer cpu" : "wall clock"));
   for (const MatrixSource &s : sources) PetscCall(BenchMatrix(comm, s, set));
   if (set.csv) PetscCall(PetscFClose(comm, set.csv));
   if (set.triad) PetscCall(TriadArraysDestroy(set.triad));
+  if (set.read) PetscCall(ReadArrayDestroy(set.read));
   PetscCall(PetscFinalize());
   return 0;
 }

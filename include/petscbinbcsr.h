@@ -64,6 +64,26 @@ PETSC_EXTERN PetscErrorCode MatBinBCSRGetCOOMirror(Mat, PetscBool *);
    -mat_binbcsr_streams. The setter is a no-op and the getter answers 1 on matrices of other types. */
 PETSC_EXTERN PetscErrorCode MatBinBCSRSetStreams(Mat, PetscInt);
 PETSC_EXTERN PetscErrorCode MatBinBCSRGetStreams(Mat, PetscInt *);
+/* Tuning on this machine (option -mat_binbcsr_tune auto|off, default auto): when the layout is built
+   from the final pattern (first final assembly, COO preallocation, conversion, load), the bin width
+   and the stream count that were not set explicitly are chosen by timing products of a sample of the
+   matrix with the candidates (widths 4, 8, 16, and 32 for block size 1; streams 1, 2, 4, 8), within
+   about 30 products or 50 ms. Set before the layout is built. Matrices with under 512 KiB of values
+   keep the defaults. -mat_view ::ascii_info says what was tried and chosen; log event BinBCSRTune.
+   The setters are no-ops and the getters answer off / PETSC_FALSE on matrices of other types. */
+typedef enum {
+  MAT_BINBCSR_TUNE_OFF  = 0,
+  MAT_BINBCSR_TUNE_AUTO = 1
+} MatBinBCSRTune;
+PETSC_EXTERN const char *const MatBinBCSRTunes[];
+PETSC_EXTERN PetscErrorCode MatBinBCSRSetTune(Mat, MatBinBCSRTune);
+PETSC_EXTERN PetscErrorCode MatBinBCSRGetTune(Mat, MatBinBCSRTune *);
+/* The tuner's choices are kept per machine (CPU model, cores, kernel bodies) and matrix class (block
+   size, precision, storage, size, row lengths) in $XDG_CACHE_HOME/petscbinbcsr/tune.txt (else
+   ~/.cache/petscbinbcsr/tune.txt), so a later run takes them without timing. Option
+   -mat_binbcsr_tune_cache (default true); false neither reads nor writes the file. */
+PETSC_EXTERN PetscErrorCode MatBinBCSRSetTuneCache(Mat, PetscBool);
+PETSC_EXTERN PetscErrorCode MatBinBCSRGetTuneCache(Mat, PetscBool *);
 
 /* The body set that runs the products (the same results up to rounding; speed differs by CPU). */
 typedef enum {

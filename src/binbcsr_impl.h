@@ -76,6 +76,7 @@ PETSC_INTERN PetscErrorCode MatBinBCSRCheckVecLocalSize(Vec v, PetscInt n, const
 /* Registered once by PetscBinBCSRRegisterAll(). */
 PETSC_EXTERN PetscLogEvent MAT_BinBCSR_BuildLayout; /* first final assembly: staging -> bins */
 PETSC_EXTERN PetscLogEvent MAT_BinBCSR_SetValuesCOO; /* slot refill by gather */
+PETSC_EXTERN PetscLogEvent MAT_BinBCSR_Tune;         /* the layout tuner (timing a sample's products) */
 PETSC_EXTERN PetscLogEvent MAT_BinBCSR_MultDot;      /* y = A x fused with x.y */
 PETSC_EXTERN PetscLogEvent KSP_MCG_FusedUpdate;      /* x, r, z (Jacobi), p, s updates + local dots */
 PETSC_EXTERN PetscLogEvent KSP_MCG_Reduction;        /* the one global reduction per iteration */

@@ -3,6 +3,7 @@
 PetscLogEvent MAT_BinBCSR_BuildLayout  = 0;
 PetscLogEvent MAT_BinBCSR_SetValuesCOO = 0;
 PetscLogEvent MAT_BinBCSR_MultDot      = 0;
+PetscLogEvent MAT_BinBCSR_Tune         = 0;
 PetscLogEvent KSP_MCG_FusedUpdate      = 0;
 PetscLogEvent KSP_MCG_Reduction        = 0;
 PetscLogEvent MAT_BinBCSR_DeviceMult   = 0;
@@ -11,6 +12,7 @@ PetscLogEvent KSP_MCG_DeviceSolve      = 0;
 
 const char *const MatBinBCSRPrecisions[] = {"double", "single", "MatBinBCSRPrecision", "MAT_BINBCSR_PRECISION_", nullptr};
 const char *const MatBinBCSRDevices[]    = {"none", "reference", "cuda", "MatBinBCSRDevice", "MAT_BINBCSR_DEVICE_", nullptr};
+const char *const MatBinBCSRTunes[]      = {"off", "auto", "MatBinBCSRTune", "MAT_BINBCSR_TUNE_", nullptr};
 
 static PetscBool registered = PETSC_FALSE;
 
@@ -43,6 +45,7 @@ PetscErrorCode PetscBinBCSRRegisterAll(void)
   PetscCall(PetscLogEventRegister("BinBCSRBuildLay", MAT_CLASSID, &MAT_BinBCSR_BuildLayout));
   PetscCall(PetscLogEventRegister("BinBCSRSetCOO", MAT_CLASSID, &MAT_BinBCSR_SetValuesCOO));
   PetscCall(PetscLogEventRegister("BinBCSRMultDot", MAT_CLASSID, &MAT_BinBCSR_MultDot));
+  PetscCall(PetscLogEventRegister("BinBCSRTune", MAT_CLASSID, &MAT_BinBCSR_Tune));
   PetscCall(PetscLogEventRegister("MCGFusedUpdate", KSP_CLASSID, &KSP_MCG_FusedUpdate));
   PetscCall(PetscLogEventRegister("MCGReduction", KSP_CLASSID, &KSP_MCG_Reduction));
   PetscCall(PetscLogEventRegister("BinBCSRDevMult", MAT_CLASSID, &MAT_BinBCSR_DeviceMult));

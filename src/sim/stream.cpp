@@ -1,21 +1,12 @@
 #include "sim/stream.h"
+#include "mat_binbcsr/binbcsr_machine.h"
 
 #include <algorithm>
 #include <ctime>
 #include <unistd.h>
 #include <vector>
 
-size_t LastLevelCacheBytes()
-{
-  long bytes = 0;
-#ifdef _SC_LEVEL3_CACHE_SIZE
-  bytes = sysconf(_SC_LEVEL3_CACHE_SIZE);
-#endif
-#ifdef _SC_LEVEL2_CACHE_SIZE
-  if (bytes <= 0) bytes = sysconf(_SC_LEVEL2_CACHE_SIZE);
-#endif
-  return bytes > 0 ? (size_t)bytes : 0;
-}
+size_t LastLevelCacheBytes() { return (size_t)binbcsr::last_level_cache_bytes(); }
 
 double ProcessCpuSeconds()
 {

@@ -40,5 +40,6 @@ PetscErrorCode MeasureStreamTriadFromOptions(MPI_Comm comm, StreamResult *result
 // cache and memory traffic of the others).
 double ProcessCpuSeconds();
 
-// Last-level cache in bytes as the OS reports it (0 if unknown).
+// Last-level cache in bytes as /sys/devices/system/cpu/cpu0/cache/ reports it (0 if unknown; not
+// sysconf, whose CPUID-derived answer a virtual machine may get wrong).
 size_t LastLevelCacheBytes();

@@ -54,5 +54,7 @@ PetscErrorCode MatBinBCSRReadOptions_Private(Mat A, PetscOptionItems *PetscOptio
   PetscCall(OptionInt(PetscOptionsObject, A, "-mat_binbcsr_streams", "Runs of bins the product sweeps side by side (1, 2, 4, 8)", "MatBinBCSRSetStreams", MatBinBCSRGetStreams, MatBinBCSRSetStreams));
   PetscCall(OptionEnum(PetscOptionsObject, A, "-mat_binbcsr_device", "Device copy: none, reference (host executor), cuda (one process only)", "MatBinBCSRSetDevice", MatBinBCSRDevices, MatBinBCSRGetDevice, MatBinBCSRSetDevice));
   PetscCall(OptionEnum(PetscOptionsObject, A, "-mat_binbcsr_kernel", "Body set of the products (auto: the best this CPU has)", "MatBinBCSRSetKernel", MatBinBCSRKernels, MatBinBCSRGetKernel, MatBinBCSRSetKernel));
+  PetscCall(OptionEnum(PetscOptionsObject, A, "-mat_binbcsr_tune", "Time bin widths, stream counts and body sets on this machine at the layout build and keep the fastest (on several ranks, each rank its parts)", "MatBinBCSRSetTune", MatBinBCSRTunes, MatBinBCSRGetTune, MatBinBCSRSetTune));
+  PetscCall(OptionBool(PetscOptionsObject, A, "-mat_binbcsr_tune_cache", "Read and write the tuner's cache file ($XDG_CACHE_HOME/petscbinbcsr/tune.txt)", "MatBinBCSRSetTuneCache", MatBinBCSRGetTuneCache, MatBinBCSRSetTuneCache));
   PetscFunctionReturn(0);
 }

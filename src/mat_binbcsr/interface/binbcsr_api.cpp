@@ -400,6 +400,58 @@ PetscErrorCode MatBinBCSRGetStreams(Mat A, PetscInt *streams)
 
 .seealso: `MATBINBCSR`, `KSPMCG`, `MatMult()`
 @*/
+/*@
+   MatBinBCSRSetTune - Whether the layout build times the candidate bin widths and stream counts on
+   this machine and keeps the fastest (MAT_BINBCSR_TUNE_AUTO, the default) or takes the defaults
+   (MAT_BINBCSR_TUNE_OFF). A bin width or stream count set explicitly is never changed.
+
+   Logically collective; set before the layout is built. Option: -mat_binbcsr_tune auto|off
+@*/
+PetscErrorCode MatBinBCSRSetTune(Mat A, MatBinBCSRTune t)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidLogicalCollectiveEnum(A, t, 2);
+  PetscCheck(t == MAT_BINBCSR_TUNE_OFF || t == MAT_BINBCSR_TUNE_AUTO, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_OUTOFRANGE, "Unknown tuning mode %d: MAT_BINBCSR_TUNE_OFF or MAT_BINBCSR_TUNE_AUTO", (int)t);
+  PetscTryMethod(A, "MatBinBCSRSetTune_C", (Mat, MatBinBCSRTune), (A, t));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatBinBCSRGetTune(Mat A, MatBinBCSRTune *t)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidPointer(t, 2);
+  *t = MAT_BINBCSR_TUNE_OFF;
+  PetscTryMethod(A, "MatBinBCSRGetTune_C", (Mat, MatBinBCSRTune *), (A, t));
+  PetscFunctionReturn(0);
+}
+
+/*@
+   MatBinBCSRSetTuneCache - Whether the tuner reads and writes its cache file
+   ($XDG_CACHE_HOME/petscbinbcsr/tune.txt, else ~/.cache/petscbinbcsr/tune.txt).
+
+   Logically collective; set before the layout is built. Option: -mat_binbcsr_tune_cache <bool>
+@*/
+PetscErrorCode MatBinBCSRSetTuneCache(Mat A, PetscBool flg)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidLogicalCollectiveBool(A, flg, 2);
+  PetscTryMethod(A, "MatBinBCSRSetTuneCache_C", (Mat, PetscBool), (A, flg));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatBinBCSRGetTuneCache(Mat A, PetscBool *flg)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidBoolPointer(flg, 2);
+  *flg = PETSC_FALSE;
+  PetscTryMethod(A, "MatBinBCSRGetTuneCache_C", (Mat, PetscBool *), (A, flg));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode MatMultDotLocal(Mat A, Vec x, Vec y, PetscScalar *xdoty)
 {
   PetscErrorCode (*fused)(Mat, Vec, Vec, PetscScalar *) = nullptr;

@@ -148,6 +148,49 @@ static PetscErrorCode MatBinBCSRGetStreams_MPIBinBCSR(Mat mat, PetscInt *streams
   PetscFunctionReturn(0);
 }
 
+/* Each rank tunes its own parts (diagonal and off-diagonal) when their layouts are built. */
+static PetscErrorCode MatBinBCSRSetTune_MPIBinBCSR(Mat mat, MatBinBCSRTune t)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  b->tune = (PetscInt)t;
+  if (b->A) PetscCall(MatBinBCSRSetTune(b->A, t));
+  if (b->B) PetscCall(MatBinBCSRSetTune(b->B, t));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRGetTune_MPIBinBCSR(Mat mat, MatBinBCSRTune *t)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  if (b->A) PetscCall(MatBinBCSRGetTune(b->A, t));
+  else *t = b->tune == (PetscInt)MAT_BINBCSR_TUNE_OFF ? MAT_BINBCSR_TUNE_OFF : MAT_BINBCSR_TUNE_AUTO;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRSetTuneCache_MPIBinBCSR(Mat mat, PetscBool flg)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  b->tune_cache = flg ? 1 : 0;
+  if (b->A) PetscCall(MatBinBCSRSetTuneCache(b->A, flg));
+  if (b->B) PetscCall(MatBinBCSRSetTuneCache(b->B, flg));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRGetTuneCache_MPIBinBCSR(Mat mat, PetscBool *flg)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  if (b->A) PetscCall(MatBinBCSRGetTuneCache(b->A, flg));
+  else *flg = b->tune_cache == 0 ? PETSC_FALSE : PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MatBinBCSRSetPrecision_MPIBinBCSR(Mat mat, MatBinBCSRPrecision p)
 {
   Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
@@ -295,6 +338,8 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRCreatePart(Mat mat, PetscInt m, PetscIn
   if (b->precision_set) PetscCall(MatBinBCSRSetPrecision(*part, b->precision));
   if (b->streams) PetscCall(MatBinBCSRSetStreams(*part, b->streams));
   if (b->kernel) PetscCall(MatBinBCSRSetKernel(*part, b->kernel));
+  if (b->tune >= 0) PetscCall(MatBinBCSRSetTune(*part, (MatBinBCSRTune)b->tune));
+  if (b->tune_cache >= 0) PetscCall(MatBinBCSRSetTuneCache(*part, b->tune_cache ? PETSC_TRUE : PETSC_FALSE));
   if (b->sym && part == &b->A) PetscCall(MatBinBCSRSetSymmetricStorage(*part, PETSC_TRUE)); /* B stays full */
   for (const auto &[op, flg] : b->part_options) {
     const bool wholematrix = op == MAT_SYMMETRIC || op == MAT_SPD || op == MAT_HERMITIAN || op == MAT_STRUCTURALLY_SYMMETRIC || op == MAT_SYMMETRY_ETERNAL || op == MAT_STRUCTURAL_SYMMETRY_ETERNAL || op == MAT_SPD_ETERNAL;
@@ -470,6 +515,10 @@ static const BinBCSRComposed composed[] = {
   BINBCSR_COMPOSED("MatBinBCSRGetCOOMirror_C", MatBinBCSRGetCOOMirror_MPIBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRSetStreams_C", MatBinBCSRSetStreams_MPIBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRGetStreams_C", MatBinBCSRGetStreams_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRSetTune_C", MatBinBCSRSetTune_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRGetTune_C", MatBinBCSRGetTune_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRSetTuneCache_C", MatBinBCSRSetTuneCache_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRGetTuneCache_C", MatBinBCSRGetTuneCache_MPIBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRGetBinWidth_C", MatBinBCSRGetBinWidth_MPIBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRSetPrecision_C", MatBinBCSRSetPrecision_MPIBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRGetPrecision_C", MatBinBCSRGetPrecision_MPIBinBCSR),

@@ -188,6 +188,8 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRCopyConfig(Mat from, Mat to)
   c->precision_set      = b->precision_set;
   c->precision          = b->precision;
   c->streams            = b->streams;
+  c->tune               = b->tune;
+  c->tune_cache         = b->tune_cache;
   c->kernel             = b->kernel;
   c->sym                = b->sym;
   c->coo_mirror         = b->coo_mirror;

@@ -212,6 +212,43 @@ static const struct _MatOps &MatOps_SeqBinBCSR(void)
   return ops;
 }
 
+/* Streams set by the user: the layout build's tuner keeps them. */
+static PetscErrorCode MatBinBCSRSetStreams_SeqBinBCSR(Mat A, PetscInt streams)
+{
+  PetscFunctionBegin;
+  ((Mat_SeqBinBCSR *)A->data)->streams     = streams;
+  ((Mat_SeqBinBCSR *)A->data)->streams_set = PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRSetTune_SeqBinBCSR(Mat A, MatBinBCSRTune t)
+{
+  PetscFunctionBegin;
+  ((Mat_SeqBinBCSR *)A->data)->tune = (PetscInt)t;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRGetTune_SeqBinBCSR(Mat A, MatBinBCSRTune *t)
+{
+  PetscFunctionBegin;
+  *t = ((Mat_SeqBinBCSR *)A->data)->tune == (PetscInt)MAT_BINBCSR_TUNE_OFF ? MAT_BINBCSR_TUNE_OFF : MAT_BINBCSR_TUNE_AUTO;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRSetTuneCache_SeqBinBCSR(Mat A, PetscBool flg)
+{
+  PetscFunctionBegin;
+  ((Mat_SeqBinBCSR *)A->data)->tune_cache = flg ? 1 : 0;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRGetTuneCache_SeqBinBCSR(Mat A, PetscBool *flg)
+{
+  PetscFunctionBegin;
+  *flg = ((Mat_SeqBinBCSR *)A->data)->tune_cache == 0 ? PETSC_FALSE : PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
 /* The composed functions, composed by MatCreate_SeqBinBCSR and cleared by MatDestroy_SeqBinBCSR. */
 static const BinBCSRComposed composed[] = {
   BINBCSR_COMPOSED("MatBinBCSRSetBinWidth_C", MatBinBCSRSetBinWidth_SeqBinBCSR),
@@ -222,8 +259,12 @@ static const BinBCSRComposed composed[] = {
   BINBCSR_COMPOSED("MatBinBCSRGetSymmetricStorage_C", (&MatSeqBinBCSRGetField<PetscBool, &Mat_SeqBinBCSR::sym>)),
   BINBCSR_COMPOSED("MatBinBCSRSetCOOMirror_C", (&MatSeqBinBCSRSetField<PetscBool, &Mat_SeqBinBCSR::coo_mirror>)),
   BINBCSR_COMPOSED("MatBinBCSRGetCOOMirror_C", (&MatSeqBinBCSRGetField<PetscBool, &Mat_SeqBinBCSR::coo_mirror>)),
-  BINBCSR_COMPOSED("MatBinBCSRSetStreams_C", (&MatSeqBinBCSRSetField<PetscInt, &Mat_SeqBinBCSR::streams>)),
+  BINBCSR_COMPOSED("MatBinBCSRSetStreams_C", MatBinBCSRSetStreams_SeqBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRGetStreams_C", (&MatSeqBinBCSRGetField<PetscInt, &Mat_SeqBinBCSR::streams>)),
+  BINBCSR_COMPOSED("MatBinBCSRSetTune_C", MatBinBCSRSetTune_SeqBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRGetTune_C", MatBinBCSRGetTune_SeqBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRSetTuneCache_C", MatBinBCSRSetTuneCache_SeqBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRGetTuneCache_C", MatBinBCSRGetTuneCache_SeqBinBCSR),
   BINBCSR_COMPOSED("MatSeqAIJSetPreallocation_C", MatSeqAIJSetPreallocation_SeqBinBCSR),
   BINBCSR_COMPOSED("MatSeqBAIJSetPreallocation_C", MatSeqBAIJSetPreallocation_SeqBinBCSR),
   BINBCSR_COMPOSED("MatSetPreallocationCOO_C", MatSetPreallocationCOO_SeqBinBCSR),
@@ -263,6 +304,8 @@ PetscErrorCode MatCreate_SeqBinBCSR(Mat A)
   a->bw          = BinBCSRDefaultBinWidth(1);
   a->precision   = MAT_BINBCSR_PRECISION_DOUBLE;
   a->streams     = BINBCSR_DEFAULT_STREAMS;
+  a->tune        = -1;
+  a->tune_cache  = -1;
   a->roworiented = PETSC_TRUE;
   a->bs          = 1;
   a->bs2         = 1;

@@ -67,7 +67,12 @@ typedef struct {
                                     exists a new location is an error unless nonew == 1. */
   PetscBool           roworiented; /* MAT_ROW_ORIENTED for MatSetValues(Blocked) */
   PetscInt            streams;     /* MatBinBCSRSetStreams: runs of bins the product sweeps side by side */
+  PetscBool           streams_set; /* set by the user before the layout build: the tuner keeps it */
+  PetscInt            tune;        /* MatBinBCSRTune; -1: not set (the option, else auto, at the layout build) */
+  PetscInt            tune_cache;  /* MatBinBCSRSetTuneCache: 1 on, 0 off, -1 not set (the option, else on) */
+  char                tune_info[768]; /* what the tuner tried and chose at the last layout build (MatView) */
   MatBinBCSRKernel    kernel;      /* MatBinBCSRSetKernel: the body set asked for (AUTO: the best the CPU has) */
+  PetscBool           kernel_tuned; /* kernel is the tuner's choice, not the user's (a rebuild may change it) */
   PetscBool           sym;         /* symmetric storage: only blocks with block column >= block row
                                       are stored; entries below the block diagonal are ignored. The
                                       slots of a bin are ordered by an edge colouring (below). */
@@ -175,6 +180,10 @@ PETSC_INTERN PetscInt MatSeqBinBCSRFindSlot(const Mat_SeqBinBCSR *, PetscInt bro
    each row. Values are zero, in the current precision. Drops staging and any COO map; increases the
    nonzero state. Used by assembly, COO preallocation, MatConvert and available to MatLoad. */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRBuildLayout(Mat, const PetscInt bi[], const PetscInt bj[]);
+/* Before a layout build from the final pattern bi/bj: chooses a->bw and a->streams where they were not
+   set explicitly, by timing products of a sample on this machine, or from the tuning cache
+   (binbcsr_tune.cpp). A no-op with tuning off. */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRTune(Mat, const PetscInt bi[], const PetscInt bj[]);
 /* Sizes checked, any layout and staging dropped (binbcsr.cpp): where a layout build starts. */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRResetLayout(Mat);
 

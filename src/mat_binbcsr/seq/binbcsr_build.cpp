@@ -110,9 +110,11 @@ PetscErrorCode MatSeqBinBCSRBuildLayout(Mat A, const PetscInt bi[], const PetscI
   PetscInt        bw, mbs, nbins;
 
   PetscFunctionBegin;
-  PetscCall(PetscLogEventBegin(MAT_BinBCSR_BuildLayout, A, 0, 0, 0));
   PetscCall(MatSeqBinBCSRResetLayout(A));
   if (!a->bw_set) a->bw = BinBCSRDefaultBinWidth(a->bs);
+  if (!a->streams_set) a->streams = BINBCSR_DEFAULT_STREAMS;
+  PetscCall(MatSeqBinBCSRTune(A, bi, bj)); /* outside the build's log event: it has its own */
+  PetscCall(PetscLogEventBegin(MAT_BinBCSR_BuildLayout, A, 0, 0, 0));
   bw = a->bw;
   mbs = a->mbs;
   nbins = (mbs + bw - 1) / bw;

@@ -75,7 +75,12 @@ static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues
   b->nonew       = a->nonew;
   b->roworiented = a->roworiented;
   b->streams     = a->streams;
+  b->streams_set = a->streams_set;
   b->kernel      = a->kernel;
+  b->kernel_tuned = a->kernel_tuned;
+  b->tune        = a->tune;
+  b->tune_cache  = a->tune_cache;
+  PetscCall(PetscStrncpy(b->tune_info, a->tune_info, sizeof(b->tune_info)));
   b->sym         = a->sym;
   b->bs          = a->bs;
   b->bs2         = a->bs2;
@@ -400,6 +405,7 @@ PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
       PetscCall(PetscViewerASCIIPrintf(viewer, "product: %" PetscInt_FMT " run(s) of bins swept side by side (-mat_binbcsr_streams)\n", a->streams));
     }
     PetscCall(PetscViewerASCIIPrintf(viewer, "product body: %s (-mat_binbcsr_kernel %s)\n", binbcsr::body_set_name(MatSeqBinBCSRSelectBody(a).set), MatBinBCSRKernels[a->kernel]));
+    if (a->tune_info[0]) PetscCall(PetscViewerASCIIPrintf(viewer, "tuning (-mat_binbcsr_tune): %s\n", a->tune_info));
     if (a->coo_jmap || a->coo_mirror) {
       const char *refill = a->coo_slot_state == 1 ? "by whole blocks" : a->coo_slot_state == -1 ? "value by value (the list is not made of whole blocks)" : "path chosen at the first refill";
       if (a->coo_jmap) PetscCall(PetscViewerASCIIPrintf(viewer, "COO: %" PetscCount_FMT " entries, refill %s%s\n", a->coo_n, refill, a->coo_mirror ? "; mirror on (entries of off-diagonal blocks also fill the transposed place)" : ""));

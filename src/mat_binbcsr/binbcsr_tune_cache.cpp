@@ -1,0 +1,144 @@
+/* The tuning cache file of MATSEQBINBCSR: one text line per (machine, matrix class),
+
+     # petscbinbcsr tune cache v1
+     <machine key> TAB <matrix class> TAB <bin width> <streams> <body set>
+
+   read whole and rewritten whole (a temporary file renamed over the old one). The file only saves
+   time: whatever is wrong with it makes the tuner measure again, never fail or use a bad layout. */
+#include "binbcsr_tune.h"
+#include "binbcsr_machine.h"
+#include "kernels/binbcsr_dispatch.h"
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <sys/stat.h>
+#include <unistd.h>
+
+static const char *const cache_header = "# petscbinbcsr tune cache v1";
+
+const std::string &BinBCSRTuneMachineKey(void)
+{
+  static const char       *bodies = binbcsr::body_set_name(binbcsr::best_body_set());
+  static const std::string key = (binbcsr::cpu_model().empty() ? std::string("unknown cpu") : binbcsr::cpu_model()) + " | " + std::to_string(binbcsr::online_cpus()) + " cores | " + bodies;
+  return key;
+}
+
+std::string BinBCSRTuneCachePath(void)
+{
+  const char *xdg = getenv("XDG_CACHE_HOME"), *home = getenv("HOME");
+  std::string dir;
+  if (xdg && xdg[0] == '/') dir = xdg; /* the XDG rule: a relative value is ignored */
+  else if (home && home[0]) dir = std::string(home) + "/.cache";
+  else return "";
+  return dir + "/petscbinbcsr/tune.txt";
+}
+
+/* Every entry of the file; false when the file exists but does not parse (why says where). */
+static bool ReadCache(const std::string &path, std::map<std::string, BinBCSRTuneChoice> &entries, std::string &why)
+{
+  std::ifstream in(path);
+  std::string   line;
+  if (!in) return true; /* no file yet (or unreadable): nothing cached */
+  if (!std::getline(in, line) || line != cache_header) {
+    why = "first line is not \"" + std::string(cache_header) + "\"";
+    return false;
+  }
+  for (int n = 2; std::getline(in, line); n++) {
+    const size_t t1 = line.find('\t'), t2 = t1 == std::string::npos ? t1 : line.find('\t', t1 + 1);
+    if (line.empty()) continue;
+    if (t2 == std::string::npos || t1 == 0 || t2 == t1 + 1) {
+      why = "line " + std::to_string(n) + " has no machine, class and choice";
+      return false;
+    }
+    std::istringstream v(line.substr(t2 + 1));
+    long               bw = 0, streams = 0;
+    std::string        body, rest;
+    int                kernel = -1;
+    if (v >> bw >> streams >> body)
+      for (int k = 0; k <= (int)binbcsr::BodySet::AVX512; k++)
+        if (body == binbcsr::body_set_name((binbcsr::BodySet)k) && binbcsr::body_set_available((binbcsr::BodySet)k)) kernel = k;
+    if (kernel < 0 || (v >> rest) || bw < 1 || bw > 1024 || (streams != 1 && streams != 2 && streams != 4 && streams != 8)) {
+      why = "line " + std::to_string(n) + ": choice \"" + line.substr(t2 + 1) + "\" is not a bin width in [1, 1024], streams 1, 2, 4 or 8 and a body set this CPU has";
+      return false;
+    }
+    entries[line.substr(0, t2)] = BinBCSRTuneChoice{(PetscInt)bw, (PetscInt)streams, (PetscInt)kernel};
+  }
+  return true;
+}
+
+static PetscErrorCode WarnCorrupt(const std::string &path, const std::string &why)
+{
+  static bool warned = false;
+
+  PetscFunctionBegin;
+  PetscCall(PetscInfo(nullptr, "Ignoring the tuning cache %s: %s\n", path.c_str(), why.c_str()));
+  if (!warned) PetscCall(PetscFPrintf(PETSC_COMM_SELF, PETSC_STDERR, "petscbinbcsr: ignoring the corrupt tuning cache %s (%s); it is rewritten by the next tuning\n", path.c_str(), why.c_str()));
+  warned = true;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode BinBCSRTuneCacheLookup(const std::string &key, BinBCSRTuneChoice *c, PetscBool *found)
+{
+  std::map<std::string, BinBCSRTuneChoice> entries;
+  std::string                              why, path = BinBCSRTuneCachePath();
+
+  PetscFunctionBegin;
+  *found = PETSC_FALSE;
+  if (path.empty()) PetscFunctionReturn(0);
+  if (!ReadCache(path, entries, why)) {
+    PetscCall(WarnCorrupt(path, why));
+    PetscFunctionReturn(0);
+  }
+  auto it = entries.find(key);
+  if (it == entries.end()) PetscFunctionReturn(0);
+  *c     = it->second;
+  *found = PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
+/* mkdir -p of the folders above path; false if one cannot be made. */
+static bool MakeParents(const std::string &path)
+{
+  for (size_t p = path.find('/', 1); p != std::string::npos; p = path.find('/', p + 1)) {
+    const std::string d = path.substr(0, p);
+    if (mkdir(d.c_str(), 0755) != 0 && errno != EEXIST) return false;
+  }
+  return true;
+}
+
+PetscErrorCode BinBCSRTuneCacheStore(const std::string &key, const BinBCSRTuneChoice &c)
+{
+  static unsigned long                     serial = 0;
+  std::map<std::string, BinBCSRTuneChoice> entries;
+  std::string                              why, path = BinBCSRTuneCachePath();
+
+  PetscFunctionBegin;
+  if (path.empty()) PetscFunctionReturn(0);
+  if (!ReadCache(path, entries, why)) entries.clear(); /* a corrupt file is replaced (the lookup warned) */
+  entries[key] = c;
+  if (!MakeParents(path)) {
+    PetscCall(PetscInfo(nullptr, "Cannot create the folder of the tuning cache %s: %s\n", path.c_str(), strerror(errno)));
+    PetscFunctionReturn(0);
+  }
+  const std::string tmp = path + ".tmp." + std::to_string((long)getpid()) + "." + std::to_string(serial++);
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << cache_header << "\n";
+    for (const auto &[k, v] : entries) out << k << "\t" << v.bw << " " << v.streams << " " << binbcsr::body_set_name((binbcsr::BodySet)v.kernel) << "\n";
+    out.close();
+    if (!out) {
+      PetscCall(PetscInfo(nullptr, "Cannot write the tuning cache %s\n", tmp.c_str()));
+      std::remove(tmp.c_str());
+      PetscFunctionReturn(0);
+    }
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    PetscCall(PetscInfo(nullptr, "Cannot rename %s to %s: %s\n", tmp.c_str(), path.c_str(), strerror(errno)));
+    std::remove(tmp.c_str());
+  }
+  PetscFunctionReturn(0);
+}

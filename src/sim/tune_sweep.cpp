@@ -1,0 +1,156 @@
+#include <petscbinbcsr.h>
+#include "sim/tune_sweep.h"
+#include <petsctime.h>
+#include <cstdio>
+#include <cstring>
+#include <vector>
+
+PetscErrorCode MakeBinBCSR(Mat src, PetscInt bs, PetscInt bw, PetscInt streams, MatBinBCSRPrecision prec, PetscBool sym, PetscBool tune, Mat *A)
+{
+  PetscInt m, n;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatGetLocalSize(src, &m, &n));
+  PetscCall(MatCreate(PETSC_COMM_SELF, A));
+  PetscCall(MatSetSizes(*A, m, n, m, n));
+  PetscCall(MatSetBlockSize(*A, bs));
+  PetscCall(MatSetType(*A, MATSEQBINBCSR));
+  PetscCall(MatBinBCSRSetTune(*A, tune ? MAT_BINBCSR_TUNE_AUTO : MAT_BINBCSR_TUNE_OFF));
+  if (bw) PetscCall(MatBinBCSRSetBinWidth(*A, bw));
+  if (streams) PetscCall(MatBinBCSRSetStreams(*A, streams));
+  PetscCall(MatBinBCSRSetPrecision(*A, prec));
+  PetscCall(MatBinBCSRSetSymmetricStorage(*A, sym));
+  PetscCall(MatSetUp(*A));
+  for (PetscInt r = 0; r < m; r++) {
+    PetscInt           nc;
+    const PetscInt    *cols;
+    const PetscScalar *vals;
+    PetscCall(MatGetRow(src, r, &nc, &cols, &vals));
+    PetscCall(MatSetValues(*A, 1, &r, nc, cols, vals, INSERT_VALUES));
+    PetscCall(MatRestoreRow(src, r, &nc, &cols, &vals));
+  }
+  PetscCall(MatAssemblyBegin(*A, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(*A, MAT_FINAL_ASSEMBLY));
+  PetscFunctionReturn(0);
+}
+
+namespace
+{
+
+struct Variant {
+  Mat              A       = nullptr;
+  PetscInt         bw      = 0, streams = 0; // streams set before each batch (0: the matrix's own)
+  MatBinBCSRKernel kernel  = MAT_BINBCSR_KERNEL_AUTO; // set before each batch
+  bool     owner   = false;
+  double   best    = 1e300;
+};
+
+// The "cost X ms" of the tuner's line in -mat_view ::ascii_info, or -1.
+PetscErrorCode TuneCost(Mat A, double *ms, std::string *line)
+{
+  FILE       *f = tmpfile();
+  PetscViewer v;
+  std::string s;
+  char        buf[4096];
+
+  PetscFunctionBeginUser;
+  PetscCheck(f, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "no temporary file");
+  PetscCall(PetscViewerASCIIOpenWithFILE(PETSC_COMM_SELF, f, &v));
+  PetscCall(PetscViewerPushFormat(v, PETSC_VIEWER_ASCII_INFO));
+  PetscCall(MatView(A, v));
+  PetscCall(PetscViewerPopFormat(v));
+  PetscCall(PetscViewerDestroy(&v));
+  rewind(f);
+  for (size_t n; (n = fread(buf, 1, sizeof buf, f)) > 0;) s.append(buf, n);
+  fclose(f);
+  const size_t t = s.find("tuning (-mat_binbcsr_tune): ");
+  *line          = t == std::string::npos ? "" : s.substr(t + 28, s.find('\n', t) - t - 28);
+  *ms            = -1;
+  const size_t c = line->find("cost "), e = line->find(" ms)");
+  if (c != std::string::npos) *ms = atof(line->c_str() + c + 5);
+  else if (e != std::string::npos) *ms = atof(line->c_str() + line->rfind('(', e) + 1); // from the cache (X ms)
+  PetscFunctionReturn(0);
+}
+
+} // namespace
+
+PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &s)
+{
+  PetscInt bs, m;
+  Mat      ref;
+  Vec      x, y;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatGetBlockSize(aij, &bs));
+  PetscCall(MatGetLocalSize(aij, &m, nullptr));
+  PetscCall(MatConvert(aij, bs > 1 ? MATSEQBAIJ : MATSEQAIJ, MAT_INITIAL_MATRIX, &ref));
+  PetscCall(MatCreateVecs(aij, &x, &y));
+  PetscCall(VecSet(x, 1.0));
+  std::vector<PetscInt> widths = {4, 8, 16};
+  if (bs == 1) widths.push_back(32);
+  for (int g = 0; g < 4; g++) {
+    const PetscBool           sym  = g >= 2 ? PETSC_TRUE : PETSC_FALSE;
+    const MatBinBCSRPrecision prec = g % 2 ? MAT_BINBCSR_PRECISION_SINGLE : MAT_BINBCSR_PRECISION_DOUBLE;
+    std::vector<Variant>      vars;
+    Variant                   tuned, base;
+    PetscLogDouble            t0, t1;
+    PetscCall(PetscOptionsSetValue(nullptr, "-mat_binbcsr_tune_cache", s.tune_cache ? "1" : "0"));
+    PetscCall(PetscTime(&t0));
+    PetscCall(MakeBinBCSR(aij, bs, 0, 0, prec, sym, PETSC_TRUE, &tuned.A));
+    PetscCall(PetscTime(&t1));
+    PetscCall(PetscOptionsClearValue(nullptr, "-mat_binbcsr_tune_cache"));
+    tuned.owner = true;
+    PetscCall(MatBinBCSRGetBinWidth(tuned.A, &tuned.bw));
+    PetscCall(MatBinBCSRGetStreams(tuned.A, &tuned.streams));
+    PetscCall(MatBinBCSRGetKernel(tuned.A, &tuned.kernel));
+    base.A = ref;
+    for (PetscInt bw : widths) {
+      Mat A;
+      PetscCall(MakeBinBCSR(aij, bs, bw, 0, prec, sym, PETSC_FALSE, &A));
+      for (PetscInt K : {1, 2, 4, 8})
+        for (MatBinBCSRKernel k : {MAT_BINBCSR_KERNEL_PORTABLE, MAT_BINBCSR_KERNEL_AVX2, MAT_BINBCSR_KERNEL_AVX512}) {
+          PetscBool avail;
+          PetscCall(MatBinBCSRKernelAvailable(k, &avail));
+          if (!avail) continue;
+          Variant v;
+          v.A       = A;
+          v.bw      = bw;
+          v.streams = K;
+          v.kernel  = k;
+          v.owner   = vars.empty() || vars.back().A != A;
+          vars.push_back(v);
+        }
+    }
+    for (PetscInt r = 0; r < s.repeats; r++) {
+      std::vector<Variant *> all = {&base, &tuned};
+      for (Variant &v : vars) all.push_back(&v);
+      for (Variant *v : all) {
+        if (v != &tuned && v->streams) PetscCall(MatBinBCSRSetStreams(v->A, v->streams));
+        if (v != &tuned && v != &base) PetscCall(MatBinBCSRSetKernel(v->A, v->kernel));
+        PetscCall(MatMult(v->A, x, y)); // warm
+        const double a = s.now();
+        for (PetscInt b = 0; b < s.batch; b++) PetscCall(MatMult(v->A, x, y));
+        v->best = PetscMin(v->best, (s.now() - a) / s.batch);
+      }
+    }
+    const Variant *best = &vars[0];
+    for (const Variant &v : vars)
+      if (v.best < best->best) best = &v;
+    double      cost;
+    std::string line;
+    PetscCall(TuneCost(tuned.A, &cost, &line));
+    const char *storage = sym ? "symmetric" : "whole", *p = prec == MAT_BINBCSR_PRECISION_SINGLE ? "single" : "double";
+    if (s.verbose) {
+      for (const Variant &v : vars) PetscCall(PetscPrintf(PETSC_COMM_SELF, "  %-14s %-9s %-6s bw %2" PetscInt_FMT " K %" PetscInt_FMT " %-8s %9.4f ms\n", name.c_str(), storage, p, v.bw, v.streams, MatBinBCSRKernels[v.kernel], 1e3 * v.best));
+      PetscCall(PetscPrintf(PETSC_COMM_SELF, "  tuner: %s\n", line.c_str()));
+    }
+    PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-14s %-9s %-6s best %2" PetscInt_FMT "/%" PetscInt_FMT "/%-8s %8.4f   tuned %2" PetscInt_FMT "/%" PetscInt_FMT "/%-8s %8.4f   tuned/best %5.3f   %s %8.4f  tuned x %s %5.2f   tuning %6.1f ms (build %.0f ms)\n", name.c_str(), storage, p, best->bw, best->streams, MatBinBCSRKernels[best->kernel], 1e3 * best->best, tuned.bw, tuned.streams, MatBinBCSRKernels[tuned.kernel], 1e3 * tuned.best, tuned.best / best->best, bs > 1 ? "baij" : "aij", 1e3 * base.best, bs > 1 ? "baij" : "aij", base.best / tuned.best, cost, 1e3 * (t1 - t0)));
+    for (Variant &v : vars)
+      if (v.owner) PetscCall(MatDestroy(&v.A));
+    PetscCall(MatDestroy(&tuned.A));
+  }
+  PetscCall(MatDestroy(&ref));
+  PetscCall(VecDestroy(&x));
+  PetscCall(VecDestroy(&y));
+  PetscFunctionReturn(0);
+}

@@ -1,0 +1,7 @@
+# The tuner's cache file under concurrent writers: four processes tune matrices of several classes at
+# once on one cache folder (each rewrites the file through a temporary file and a rename), then a
+# fifth checks that the file is whole and well-formed and that a build reads it.
+set(TUNE_CONCURRENT_DIR ${CMAKE_BINARY_DIR}/test-cache/concurrent)
+add_test(NAME tune_cache_concurrent
+         COMMAND sh -c "rm -rf '${TUNE_CONCURRENT_DIR}' && mkdir -p '${TUNE_CONCURRENT_DIR}' && export XDG_CACHE_HOME='${TUNE_CONCURRENT_DIR}' && pids= && for i in 1 2 3 4; do '$<TARGET_FILE:test_tune>' '[.cache_writer]' > /dev/null & pids=\"$pids $!\"; done && for p in $pids; do wait $p || exit 1; done && '$<TARGET_FILE:test_tune>' '[.cache_check]'")
+set_tests_properties(tune_cache_concurrent PROPERTIES LABELS "unit;tune" TIMEOUT 120)

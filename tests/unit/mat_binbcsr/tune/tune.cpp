@@ -1,0 +1,375 @@
+// The layout tuner (-mat_binbcsr_tune): it chooses among the candidates, the products and stored
+// values stay exactly those of a fixed configuration, explicit settings win, the cache file round
+// trips, a corrupt one is ignored, bad values give errors. The cache lives in a folder of the test
+// run (XDG_CACHE_HOME, set by CTest; each case here points it at its own folder).
+#include "support/mat_support.hpp"
+#include <petscviewer.h>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <sys/stat.h>
+#include <unistd.h>
+
+using namespace mat_core;
+
+namespace
+{
+
+// A fresh cache folder for one test case: XDG_CACHE_HOME=<base>/<name>, the file removed.
+std::string fresh_cache(const std::string &name)
+{
+  const char *base = getenv("XDG_CACHE_HOME");
+  std::string root = std::string(base && base[0] == '/' ? base : "/tmp") + "/" + name;
+  mkdir(root.c_str(), 0755);
+  std::remove((root + "/petscbinbcsr/tune.txt").c_str());
+  setenv("XDG_CACHE_HOME", root.c_str(), 1);
+  return root + "/petscbinbcsr/tune.txt";
+}
+
+struct Restore { // puts XDG_CACHE_HOME back at the end of a case
+  std::string old;
+  bool        had;
+  Restore() : had(getenv("XDG_CACHE_HOME") != nullptr) { if (had) old = getenv("XDG_CACHE_HOME"); }
+  ~Restore()
+  {
+    if (had) setenv("XDG_CACHE_HOME", old.c_str(), 1);
+    else unsetenv("XDG_CACHE_HOME");
+  }
+};
+
+// Options for one case; every size is tuned (the patterns here are small, to keep the case fast).
+struct Opts {
+  std::vector<std::string> names;
+  void set(const char *n, const char *v)
+  {
+    REQUIRE(PetscOptionsSetValue(nullptr, n, v) == 0);
+    names.push_back(n);
+  }
+  Opts(bool cache)
+  {
+    set("-mat_binbcsr_tune_min_kib", "0");
+    set("-mat_binbcsr_tune_cache", cache ? "1" : "0");
+  }
+  ~Opts()
+  {
+    for (auto &n : names) PetscOptionsClearValue(nullptr, n.c_str());
+  }
+};
+
+PetscInt bin_width(Mat A)
+{
+  PetscInt bw;
+  REQUIRE(MatBinBCSRGetBinWidth(A, &bw) == 0);
+  return bw;
+}
+
+PetscInt streams(Mat A)
+{
+  PetscInt k;
+  REQUIRE(MatBinBCSRGetStreams(A, &k) == 0);
+  return k;
+}
+
+// Both matrices hold the same values and give the same products: bit-identical with whole storage
+// (the tuner changes only the order of slots and bins, not a row's order of summation); within the
+// rounding of the sums with symmetric storage (the transposed contributions arrive in another order).
+void check_same(Mat A, Mat R, const Pattern &p)
+{
+  Vec       x = make_vec(p.n, 7), y, yr;
+  PetscBool sym;
+  REQUIRE(VecDuplicate(x, &y) == 0);
+  REQUIRE(VecDuplicate(x, &yr) == 0);
+  REQUIRE(MatMult(A, x, y) == 0);
+  REQUIRE(MatMult(R, x, yr) == 0);
+  REQUIRE(MatBinBCSRGetSymmetricStorage(A, &sym) == 0);
+  const auto a = values(y), r = values(yr);
+  if (sym) check_close(a, r, mult_bound(p, values(x), 0.0, false));
+  else {
+    size_t diff = 0;
+    for (size_t i = 0; i < a.size(); i++) diff += a[i] != r[i];
+    CHECK(diff == 0);
+  }
+  check_dense(dense(A), dense(R), 0);
+  VecDestroy(&x);
+  VecDestroy(&y);
+  VecDestroy(&yr);
+}
+
+Mat build_tuned(const Pattern &p, MatBinBCSRPrecision prec, bool sym, MatBinBCSRTune tune, PetscInt bw = 0, PetscInt k = 0)
+{
+  Mat A;
+  REQUIRE(MatCreate(PETSC_COMM_SELF, &A) == 0);
+  REQUIRE(MatSetSizes(A, p.m, p.n, p.m, p.n) == 0);
+  REQUIRE(MatSetBlockSize(A, p.bs) == 0);
+  REQUIRE(MatSetType(A, MATSEQBINBCSR) == 0);
+  REQUIRE(MatBinBCSRSetTune(A, tune) == 0);
+  if (bw) REQUIRE(MatBinBCSRSetBinWidth(A, bw) == 0);
+  if (k) REQUIRE(MatBinBCSRSetStreams(A, k) == 0);
+  REQUIRE(MatBinBCSRSetPrecision(A, prec) == 0);
+  REQUIRE(MatBinBCSRSetSymmetricStorage(A, sym ? PETSC_TRUE : PETSC_FALSE) == 0);
+  REQUIRE(MatSetFromOptions(A) == 0);
+  REQUIRE(MatSetUp(A) == 0);
+  for (const Entry &e : p.entries) REQUIRE(MatSetValue(A, e.i, e.j, e.v, INSERT_VALUES) == 0);
+  REQUIRE(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY) == 0);
+  REQUIRE(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY) == 0);
+  return A;
+}
+
+// A symmetric FEM pattern (values made symmetric so both storages hold the same matrix).
+Pattern sym_pattern(PetscInt n, PetscInt bs)
+{
+  Pattern p = fem_pattern(n, n, n, bs);
+  std::map<std::pair<PetscInt, PetscInt>, PetscScalar> m;
+  for (const Entry &e : p.entries) m[{std::min(e.i, e.j), std::max(e.i, e.j)}] = e.v;
+  for (Entry &e : p.entries) e.v = m[{std::min(e.i, e.j), std::max(e.i, e.j)}];
+  return p;
+}
+
+} // namespace
+
+TEST_CASE("tuning chooses among the candidates; products and values stay exact", "[tune]")
+{
+  Restore r;
+  fresh_cache("tune_exact");
+  Opts o(false);
+  for (PetscInt bs : {1, 3})
+    for (auto prec : {MAT_BINBCSR_PRECISION_DOUBLE, MAT_BINBCSR_PRECISION_SINGLE})
+      for (bool sym : {false, true}) {
+        CAPTURE(bs, (int)prec, sym);
+        const Pattern p   = sym_pattern(bs == 1 ? 12 : 7, bs);
+        Mat           A   = build_tuned(p, prec, sym, MAT_BINBCSR_TUNE_AUTO);
+        Mat           R   = build_tuned(p, prec, sym, MAT_BINBCSR_TUNE_OFF, bs == 1 ? 16 : 8, 4);
+        const auto    txt = info_view(A);
+        CAPTURE(txt);
+        CHECK(txt.find("tuning (-mat_binbcsr_tune): bin width") != std::string::npos);
+        CHECK(txt.find("measured on block rows") != std::string::npos);
+        const PetscInt bw = bin_width(A), k = streams(A);
+        CHECK((bw == 4 || bw == 8 || bw == 16 || (bw == 32 && bs == 1)));
+        CHECK((k == 1 || k == 2 || k == 4 || k == 8));
+        // every candidate was timed (the budget admits them all on a matrix this small)
+        CHECK(txt.find("left out by the budget") == std::string::npos);
+        CHECK(txt.find(" 4/") != std::string::npos);
+        CHECK(txt.find(" 16/") != std::string::npos);
+        PetscBool avx2;
+        REQUIRE(MatBinBCSRKernelAvailable(MAT_BINBCSR_KERNEL_AVX2, &avx2) == 0);
+        if (avx2) CHECK(txt.find("/portable ") != std::string::npos); // the other body sets were timed too
+        check_same(A, R, p);
+        Mat D;
+        REQUIRE(MatDuplicate(A, MAT_COPY_VALUES, &D) == 0);
+        CHECK(bin_width(D) == bw);
+        CHECK(streams(D) == k);
+        check_same(D, R, p);
+        MatDestroy(&D);
+        CHECK(info_view(R).find("tuning (-mat_binbcsr_tune): off") != std::string::npos);
+        MatDestroy(&A);
+        MatDestroy(&R);
+      }
+}
+
+TEST_CASE("tuning through COO assembly keeps the values exact", "[tune]")
+{
+  Restore r;
+  fresh_cache("tune_coo");
+  Opts                  o(false);
+  const Pattern         p = fem_pattern(7, 7, 7, 3);
+  std::vector<PetscInt> ii, jj;
+  std::vector<PetscScalar> vv;
+  for (const Entry &e : p.entries) ii.push_back(e.i), jj.push_back(e.j), vv.push_back(e.v);
+  Mat A, R = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_OFF, 8, 4);
+  REQUIRE(MatCreate(PETSC_COMM_SELF, &A) == 0);
+  REQUIRE(MatSetSizes(A, p.m, p.n, p.m, p.n) == 0);
+  REQUIRE(MatSetBlockSize(A, 3) == 0);
+  REQUIRE(MatSetType(A, MATSEQBINBCSR) == 0);
+  REQUIRE(MatSetFromOptions(A) == 0);
+  REQUIRE(MatSetPreallocationCOO(A, (PetscCount)ii.size(), ii.data(), jj.data()) == 0);
+  REQUIRE(MatSetValuesCOO(A, vv.data(), INSERT_VALUES) == 0);
+  CHECK(info_view(A).find("measured on block rows") != std::string::npos);
+  check_same(A, R, p);
+  MatDestroy(&A);
+  MatDestroy(&R);
+}
+
+TEST_CASE("tuning: explicit settings win", "[tune]")
+{
+  Restore r;
+  fresh_cache("tune_explicit");
+  Opts          o(false);
+  const Pattern p = fem_pattern(7, 7, 7, 3);
+  {
+    Mat A = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO, 16, 0);
+    CHECK(bin_width(A) == 16);
+    const auto txt = info_view(A);
+    CHECK(txt.find(" 16/1 ") != std::string::npos); // only the streams were timed
+    CHECK(txt.find(" 4/") == std::string::npos);
+    MatDestroy(&A);
+  }
+  {
+    Mat A = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO, 0, 2);
+    CHECK(streams(A) == 2);
+    CHECK(info_view(A).find("/1 ") == std::string::npos); // only the widths, at streams 2
+    MatDestroy(&A);
+  }
+  {
+    // the kernel set explicitly: kept, and only it is timed
+    o.set("-mat_binbcsr_kernel", "portable");
+    Mat A = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
+    MatBinBCSRKernel k;
+    REQUIRE(MatBinBCSRGetKernel(A, &k) == 0);
+    CHECK(k == MAT_BINBCSR_KERNEL_PORTABLE);
+    CHECK(info_view(A).find("/avx") == std::string::npos);
+    MatDestroy(&A);
+  }
+  {
+    o.set("-mat_binbcsr_bin_width", "4");
+    o.set("-mat_binbcsr_streams", "8");
+    Mat A = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
+    CHECK(bin_width(A) == 4);
+    CHECK(streams(A) == 8);
+    CHECK(info_view(A).find("nothing to tune") != std::string::npos);
+    MatDestroy(&A);
+  }
+}
+
+TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
+{
+  Restore           r;
+  const std::string file = fresh_cache("tune_cache");
+  Opts              o(true);
+  const Pattern     p = fem_pattern(7, 7, 7, 3);
+  Mat               A = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
+  CHECK(info_view(A).find("measured on block rows") != std::string::npos);
+  std::string content;
+  {
+    std::ifstream in(file);
+    REQUIRE(in.good());
+    std::stringstream ss;
+    ss << in.rdbuf();
+    content = ss.str();
+  }
+  CHECK(content.rfind("# petscbinbcsr tune cache v1\n", 0) == 0);
+  CHECK(content.find("bs 3 double whole") != std::string::npos);
+  // the second matrix of the class takes the choice from the file
+  Mat B = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
+  CHECK(info_view(B).find("from the cache") != std::string::npos);
+  CHECK(bin_width(B) == bin_width(A));
+  CHECK(streams(B) == streams(A));
+  MatDestroy(&B);
+  // another class (single precision) is measured and added
+  B = build_tuned(p, MAT_BINBCSR_PRECISION_SINGLE, false, MAT_BINBCSR_TUNE_AUTO);
+  CHECK(info_view(B).find("measured on block rows") != std::string::npos);
+  MatDestroy(&B);
+  // -mat_binbcsr_tune_cache 0: neither read nor written
+  o.set("-mat_binbcsr_tune_cache", "0");
+  B = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
+  CHECK(info_view(B).find("measured on block rows") != std::string::npos);
+  MatDestroy(&B);
+  o.set("-mat_binbcsr_tune_cache", "1");
+
+  // corrupt files: garbage, a bad choice, a choice the block size cannot take, an empty file
+  const std::string key = content.substr(content.find('\n') + 1, content.rfind('\t') - content.find('\n') - 1);
+  for (const std::string bad : {std::string("garbage\n\x01\x02"), std::string("# petscbinbcsr tune cache v1\n") + key + "\t7 3\n", std::string("# petscbinbcsr tune cache v1\n") + key + "\t32 1\n", std::string("# petscbinbcsr tune cache v1\n") + key + "\tx\n", std::string("")}) {
+    CAPTURE(bad);
+    {
+      std::ofstream out(file, std::ios::trunc);
+      out << bad;
+    }
+    Mat C = nullptr;
+    C     = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
+    CHECK(info_view(C).find("measured on block rows") != std::string::npos);
+    const PetscInt bw = bin_width(C);
+    CHECK((bw == 4 || bw == 8 || bw == 16));
+    check_same(C, A, p);
+    MatDestroy(&C);
+    std::ifstream in(file); // rewritten, valid
+    std::string   first;
+    std::getline(in, first);
+    CHECK(first == "# petscbinbcsr tune cache v1");
+  }
+  // an unreadable cache folder: no file written, no error
+  setenv("XDG_CACHE_HOME", "/proc/no/such/folder", 1);
+  Mat C = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
+  CHECK(info_view(C).find("measured on block rows") != std::string::npos);
+  MatDestroy(&C);
+  MatDestroy(&A);
+}
+
+TEST_CASE("tuning: bad values give clear errors", "[tune]")
+{
+  Restore r;
+  fresh_cache("tune_bad");
+  Mat A;
+  REQUIRE(MatCreate(PETSC_COMM_SELF, &A) == 0);
+  REQUIRE(MatSetSizes(A, 6, 6, 6, 6) == 0);
+  REQUIRE(MatSetType(A, MATSEQBINBCSR) == 0);
+  CHECK(MatBinBCSRSetTune(A, (MatBinBCSRTune)7) == PETSC_ERR_ARG_OUTOFRANGE);
+  REQUIRE(PetscOptionsSetValue(nullptr, "-mat_binbcsr_tune", "sometimes") == 0);
+  CHECK(MatSetFromOptions(A) != 0);
+  REQUIRE(PetscOptionsClearValue(nullptr, "-mat_binbcsr_tune") == 0);
+  REQUIRE(PetscOptionsSetValue(nullptr, "-mat_binbcsr_tune_cache", "perhaps") == 0);
+  CHECK(MatSetFromOptions(A) != 0);
+  REQUIRE(PetscOptionsClearValue(nullptr, "-mat_binbcsr_tune_cache") == 0);
+  MatBinBCSRTune t;
+  REQUIRE(MatBinBCSRGetTune(A, &t) == 0);
+  CHECK(t == MAT_BINBCSR_TUNE_AUTO); // the default
+  MatDestroy(&A);
+  // read at the layout build when MatSetFromOptions was not called
+  const Pattern p = fem_pattern(4, 4, 4, 3);
+  REQUIRE(PetscOptionsSetValue(nullptr, "-mat_binbcsr_tune", "never") == 0);
+  REQUIRE(MatCreate(PETSC_COMM_SELF, &A) == 0);
+  REQUIRE(MatSetSizes(A, p.m, p.n, p.m, p.n) == 0);
+  REQUIRE(MatSetBlockSize(A, 3) == 0);
+  REQUIRE(MatSetType(A, MATSEQBINBCSR) == 0);
+  REQUIRE(MatSetUp(A) == 0);
+  REQUIRE(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY) == 0);
+  CHECK(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY) != 0);
+  REQUIRE(PetscOptionsClearValue(nullptr, "-mat_binbcsr_tune") == 0);
+  MatDestroy(&A);
+  // other types: no-ops
+  REQUIRE(MatCreateSeqAIJ(PETSC_COMM_SELF, 4, 4, 1, nullptr, &A) == 0);
+  CHECK(MatBinBCSRSetTune(A, MAT_BINBCSR_TUNE_AUTO) == 0);
+  REQUIRE(MatBinBCSRGetTune(A, &t) == 0);
+  CHECK(t == MAT_BINBCSR_TUNE_OFF);
+  MatDestroy(&A);
+}
+
+// Run by tests/tune.cmake as several processes at once on one cache folder (hidden from the plain
+// run): each tunes matrices of several classes with the cache on, so they rewrite the file together.
+TEST_CASE("tuning cache writer", "[.cache_writer]")
+{
+  Opts o(true);
+  for (int round = 0; round < 3; round++)
+    for (PetscInt n : {4, 5, 6, 7})
+      for (auto prec : {MAT_BINBCSR_PRECISION_DOUBLE, MAT_BINBCSR_PRECISION_SINGLE}) {
+        Mat A = build_tuned(fem_pattern(n, n, n + round, 3), prec, false, MAT_BINBCSR_TUNE_AUTO);
+        MatDestroy(&A);
+      }
+}
+
+// ... and then this one checks the file they left: the header and only well-formed lines.
+TEST_CASE("tuning cache check", "[.cache_check]")
+{
+  const char   *x = getenv("XDG_CACHE_HOME");
+  std::ifstream in(std::string(x ? x : "") + "/petscbinbcsr/tune.txt");
+  REQUIRE(in.good());
+  std::string line;
+  std::getline(in, line);
+  CHECK(line == "# petscbinbcsr tune cache v1");
+  int n = 0;
+  while (std::getline(in, line)) {
+    CAPTURE(line);
+    const size_t t1 = line.find('\t'), t2 = line.find('\t', t1 + 1);
+    REQUIRE(t2 != std::string::npos);
+    int bw = 0, k = 0;
+    CHECK(sscanf(line.c_str() + t2 + 1, "%d %d", &bw, &k) == 2);
+    CHECK((bw == 4 || bw == 8 || bw == 16));
+    CHECK((k == 1 || k == 2 || k == 4 || k == 8));
+    n++;
+  }
+  CHECK(n >= 1);
+  // the next process reads it without warning and takes the choice
+  Opts o(true);
+  Mat  A = build_tuned(fem_pattern(7, 7, 7, 3), MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
+  CHECK(info_view(A).find("tuning (-mat_binbcsr_tune): bin width") != std::string::npos);
+  MatDestroy(&A);
+}
