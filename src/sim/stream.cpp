@@ -1,5 +1,5 @@
 #include "sim/stream.h"
-#include "mat_binbcsr/binbcsr_machine.h"
+#include "mat_binbcsr/common/binbcsr_machine.h"
 
 #include <algorithm>
 #include <ctime>

@@ -16,8 +16,8 @@
    unless -mat_binbcsr_kernel / MatBinBCSRSetKernel chose one. Products are timed in this thread's
    CPU time (the budget too); the cost reported is wall time. */
 #include "binbcsr.h"
-#include "../binbcsr_tune.h"
-#include "../binbcsr_machine.h"
+#include "../common/binbcsr_tune.h"
+#include "../common/binbcsr_machine.h"
 #include <petsctime.h>
 #include <algorithm>
 #include <cmath>

@@ -7,7 +7,7 @@
    time: whatever is wrong with it makes the tuner measure again, never fail or use a bad layout. */
 #include "binbcsr_tune.h"
 #include "binbcsr_machine.h"
-#include "kernels/binbcsr_dispatch.h"
+#include "../kernels/binbcsr_dispatch.h"
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
