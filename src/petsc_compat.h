@@ -6,6 +6,7 @@
 
 #include <petscversion.h>
 #include <petscmat.h>
+#include <petscvec.h>
 #include <petscviewer.h>
 
 /* MatCreateGraph and its MatOps slot: 3.21 added the index set of the diagonal entries to filter
@@ -21,6 +22,14 @@
   #define BINBCSR_CREATEGRAPH_PASS
   #define BINBCSR_CREATEGRAPH_TYPES
   #define BINBCSR_CREATEGRAPH_NO_INDEX
+#endif
+
+/* Marks a vector as holding the result of a failed operation (Inf): 3.22 replaced VecSetInf by
+   VecFlag (and declares the deprecated VecSetInf without C linkage, so C++ cannot link it). */
+#if PETSC_VERSION_GE(3, 22, 0)
+  #define BinBCSRVecSetInf(v) VecFlag((v), 1)
+#else
+  #define BinBCSRVecSetInf(v) VecSetInf(v)
 #endif
 
 /* 3.22 renamed PetscOptionsGetViewer (the viewer is destroyed with PetscViewerDestroy in both). */
