@@ -9,7 +9,7 @@
 // -velocity_stabilisation, -joint_warm_start (previous step's impulses as initial guesses). Output: a progress
 // line every -progress_every steps, -vtk PREFIX (.vtu per -vtk_every steps plus PREFIX.pvd), -dump_matrix FILE
 // (J M^-1 J^T of the first step, PETSc binary), and a final `summary key=value ...` line.
-#include "common/sim_driver.h"
+#include "sim/sim_driver.h"
 #include "physics/articulated_scenes.hpp"
 #include "physics/articulated_step.hpp"
 #include "physics/kinematic_loops.hpp"

@@ -15,7 +15,7 @@
 // both precisions) with the COO list of trilinear hexahedra on the same node grid (24x24 element
 // matrices, every entry listed once per element).
 #include <petscbinbcsr.h>
-#include "common/stencil.h"
+#include "sim/stencil.h"
 #include <ctime>
 #include <string>
 #include <vector>

@@ -9,7 +9,7 @@
 // a progress line every -progress_every steps, -vtk PREFIX (triangle surface per -vtk_every steps),
 // -dump_matrix FILE (first step's matrix), and a final `summary key=value ...` line; -cloth_timer cpu times
 // in process CPU time instead of wall time (a shared machine).
-#include "common/sim_driver.h"
+#include "sim/sim_driver.h"
 #include "physics/cloth_step.hpp"
 #include "physics/vtk_writer.hpp"
 

@@ -14,8 +14,8 @@
 // right-hand side is 0, so dv = 0 there, the matrix stays SPD and the pattern never changes.
 #include <petscbinbcsr.h>
 
-#include "common/fem_simulation.h"
-#include "common/summary.h"
+#include "sim/fem_simulation.h"
+#include "sim/summary.h"
 #include "physics/box_mesh.hpp"
 #include "physics/corotational_assembly.hpp"
 #include "physics/fem_model.hpp"

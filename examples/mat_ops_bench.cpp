@@ -6,12 +6,12 @@
 // runs of each operation in milliseconds (the machine is shared: the minimum is the least disturbed).
 //
 //   mat_ops_bench [-stencil_n 24] [-repeats 10]
-#include "common/stencil.h"
-#include "common/summary.h"
+#include "sim/stencil.h"
+#include "sim/summary.h"
 
 #include <petscbinbcsr.h>
 
-#include "common/bench_util.h"
+#include "sim/bench_util.h"
 
 #include <algorithm>
 #include <functional>

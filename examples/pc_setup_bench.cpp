@@ -1,7 +1,7 @@
 // pc_setup_bench: what a PC that works on submatrices or a factor costs to set up on binbcsr against
 // aij, first and after a refill of the values (what a simulation pays every step).
 //
-// The matrix: the 27-point block stencil (examples/common/stencil.h), -stencil_n N nodes a side.
+// The matrix: the 27-point block stencil (src/sim/stencil.h), -stencil_n N nodes a side.
 // For each -formats entry and each -pcs entry: KSPSetUp once (the first set-up), then -refills times
 // "scale the values (MatScale, the matrix's state changes) + PCSetUp" (the MAT_REUSE_MATRIX path),
 // timed with a barrier around; prints the minimum over -repeats batches in ms.
@@ -9,8 +9,8 @@
 //   mpiexec -n 2 build/examples/pc_setup_bench -stencil_n 20 -pcs asm,gasm,redundant,fieldsplit,mumps,hypre
 static char help[] = "PC set-up time, first and after a refill, binbcsr against aij.\n";
 
-#include "common/bench_util.h"
-#include "common/stencil.h"
+#include "sim/bench_util.h"
+#include "sim/stencil.h"
 
 #include <petscbinbcsr.h>
 #include <petscksp.h>

@@ -1,5 +1,5 @@
 // reorder_bench: what a locality (bandwidth) reordering buys MatMult on one rank, and what a METIS
-// partition buys on several. The 27-point 3x3-block stencil (examples/common/stencil.h) on an n^3 grid
+// partition buys on several. The 27-point 3x3-block stencil (src/sim/stencil.h) on an n^3 grid
 // is numbered four ways: natural (lexicographic), randomly shuffled (a mesh file from a generator with
 // no locality), shuffled then reverse Cuthill-McKee, shuffled then METIS nested dissection
 // (src/physics/partition.hpp), and MatMult is timed for each numbering and format in the same run.
@@ -10,7 +10,7 @@
 #include <petscbinbcsr.h>
 #include <petsc/private/matimpl.h>
 
-#include "common/stencil.h"
+#include "sim/stencil.h"
 #include "physics/partition.hpp"
 
 #include <algorithm>

@@ -27,9 +27,9 @@
 // updated residual and the true residual against A_ref, both relative to ||b||.
 #include <petscbinbcsr.h>
 
-#include "common/bench_util.h"
-#include "common/stencil.h"
-#include "common/summary.h"
+#include "sim/bench_util.h"
+#include "sim/stencil.h"
+#include "sim/summary.h"
 
 #include <algorithm>
 #include <cmath>

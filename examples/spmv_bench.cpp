@@ -7,7 +7,7 @@
 //              [-save_dir DIR] (also write each stencil matrix to DIR/stencilN.bin, PETSc binary)
 //              [-timer wall|cpu] (cpu: process CPU time, for a machine shared with other work)
 //
-// Matrices: the 27-point 3x3-block stencil (examples/common/stencil.h) on an n^3 node grid for each
+// Matrices: the 27-point 3x3-block stencil (src/sim/stencil.h) on an n^3 node grid for each
 // n of -stencil_sizes (0 = none), and every PETSc binary file given with -f (repeatable, or a comma
 // list; the block size comes from the file's .info, -matload_block_size, or -bs).
 // Under mpiexec the same types are used in their mpi forms (rows split by PETSc's default layout).
@@ -32,9 +32,9 @@
 //   + 8 N (x) + 8 N (y)
 #include <petscbinbcsr.h>
 
-#include "common/bench_util.h"
-#include "common/stencil.h"
-#include "common/stream.h"
+#include "sim/bench_util.h"
+#include "sim/stencil.h"
+#include "sim/stream.h"
 
 #include <algorithm>
 #include <cmath>

@@ -24,7 +24,7 @@ PETSC_INTERN PetscErrorCode MatBinBCSRPreallocateAndFill_Private(Mat src, Mat ds
 /* An empty matrix of the given type with src's sizes and block sizes: a conversion's target (seq and mpi). */
 PETSC_INTERN PetscErrorCode MatBinBCSRCreateLike_Private(Mat src, MatType type, Mat *M);
 
-/* Submatrices (PCASM, PCGASM, PCREDUNDANT, PCFIELDSPLIT) of seq and mpi binbcsr through an AIJ shadow: binbcsr_submat.cpp */
+/* Submatrices (PCASM, PCGASM, PCREDUNDANT, PCFIELDSPLIT) of seq and mpi binbcsr through an AIJ shadow: common/binbcsr_submat.cpp */
 PETSC_INTERN PetscErrorCode MatIncreaseOverlap_BinBCSR(Mat, PetscInt, IS[], PetscInt);
 PETSC_INTERN PetscErrorCode MatCreateSubMatrices_BinBCSR(Mat, PetscInt, const IS[], const IS[], MatReuse, Mat *[]);
 PETSC_INTERN PetscErrorCode MatCreateSubMatricesMPI_BinBCSR(Mat, PetscInt, const IS[], const IS[], MatReuse, Mat *[]);
@@ -35,14 +35,14 @@ PETSC_INTERN PetscErrorCode MatConvert_BinBCSR_HYPRE(Mat, MatType, MatReuse, Mat
 PETSC_INTERN PetscErrorCode MatBinBCSRGetAIJShadow_Private(Mat, Mat *);
 /* and back: the shadow's values written into the matrix (both then in step) */
 PETSC_INTERN PetscErrorCode MatBinBCSRSetValuesFromAIJShadow_Private(Mat);
-/* Finite-difference Jacobians by colouring (MatFDColoring, SNES's default with a DMDA) through that shadow: binbcsr_fdcoloring.cpp */
+/* Finite-difference Jacobians by colouring (MatFDColoring, SNES's default with a DMDA) through that shadow: common/binbcsr_fdcoloring.cpp */
 PETSC_INTERN PetscErrorCode MatFDColoringCreate_BinBCSR(Mat, ISColoring, MatFDColoring);
 PETSC_INTERN PetscErrorCode MatFDColoringSetUp_BinBCSR(Mat, ISColoring, MatFDColoring);
 PETSC_INTERN PetscErrorCode MatFDColoringApply_BinBCSR(Mat, MatFDColoring, Vec, void *);
-/* PCGAMG's needs through that shadow (MatCreateGraph, matrix products with binbcsr operands): binbcsr_shadow_ops.cpp */
+/* PCGAMG's needs through that shadow (MatCreateGraph, matrix products with binbcsr operands): common/binbcsr_shadow_ops.cpp */
 PETSC_INTERN PetscErrorCode MatCreateGraph_BinBCSR(Mat, PetscBool, PetscBool, PetscReal BINBCSR_CREATEGRAPH_TYPES, Mat *);
 PETSC_INTERN PetscErrorCode MatProductSetFromOptions_BinBCSR(Mat); /* also composed as MatProductSetFromOptions_anytype_C */
-/* MUMPS / SuperLU_DIST LU and Cholesky for seq and mpi binbcsr through that shadow: binbcsr_factor_external.cpp */
+/* MUMPS / SuperLU_DIST LU and Cholesky for seq and mpi binbcsr through that shadow: common/binbcsr_factor_external.cpp */
 PETSC_INTERN PetscErrorCode MatBinBCSRRegisterExternalFactors(void);
 
 /* MATSEQBINBCSR parts of MATMPIBINBCSR: after MatSetPreallocationCOO, compose the part's COO map with
@@ -53,21 +53,25 @@ PETSC_INTERN PetscErrorCode MatSetValuesCOOTwoSources_SeqBinBCSR(Mat, const Pets
 
 /* An empty, set-up matrix of A's binbcsr type and configuration (bin width, precision, storage, MPI inner
    type) with the given local sizes and block sizes; and the MatAXPY_Basic hook built on it, composed as
-   "MatAXPYGetPreallocation_C" (binbcsr_permute.cpp) */
+   "MatAXPYGetPreallocation_C" (common/binbcsr_permute.cpp) */
 PETSC_INTERN PetscErrorCode MatBinBCSRCreateEmptyLike_Private(Mat A, PetscInt m, PetscInt n, PetscInt rbs, PetscInt cbs, Mat *C);
 PETSC_INTERN PetscErrorCode MatAXPYGetPreallocation_BinBCSR(Mat Y, Mat X, Mat *B);
-/* MatPermute of seq and mpi binbcsr: a new matrix of the same type and configuration (binbcsr_permute.cpp) */
+/* MatPermute of seq and mpi binbcsr: a new matrix of the same type and configuration (common/binbcsr_permute.cpp) */
 PETSC_INTERN PetscErrorCode MatPermute_BinBCSR(Mat, IS, IS, Mat *);
-/* MatIsSymmetric (through the transpose), MatFindZeroDiagonals, MatFindNonzeroRows of seq and mpi binbcsr (binbcsr_queries.cpp) */
+/* MatIsSymmetric (through the transpose), MatFindZeroDiagonals, MatFindNonzeroRows of seq and mpi binbcsr (common/binbcsr_queries.cpp) */
 PETSC_INTERN PetscErrorCode MatIsSymmetric_BinBCSR(Mat, PetscReal, PetscBool *);
 PETSC_INTERN PetscErrorCode MatFindZeroDiagonals_BinBCSR(Mat, IS *);
 PETSC_INTERN PetscErrorCode MatFindNonzeroRows_BinBCSR(Mat, IS *);
-/* MatSetRandom (the stored pattern), MatRealPart, MatImaginaryPart of seq and mpi binbcsr (binbcsr_value_fill.cpp) */
+/* MatSetRandom (the stored pattern), MatRealPart, MatImaginaryPart of seq and mpi binbcsr (common/binbcsr_value_fill.cpp) */
 PETSC_INTERN PetscErrorCode MatSetRandom_BinBCSR(Mat, PetscRandom);
 PETSC_INTERN PetscErrorCode MatRealPart_BinBCSR(Mat);
 PETSC_INTERN PetscErrorCode MatImaginaryPart_BinBCSR(Mat);
 
-/* A clear error unless v has n local entries (what: the argument's name in the message): binbcsr_api.cpp */
+/* The -mat_binbcsr_* options (one list for seq and mpi), read inside a type's MatSetFromOptions and
+   applied through the public setters: common/binbcsr_options.cpp */
+PETSC_INTERN PetscErrorCode MatBinBCSRReadOptions_Private(Mat, PetscOptionItems *);
+
+/* A clear error unless v has n local entries (what: the argument's name in the message): interface/binbcsr_api.cpp */
 PETSC_INTERN PetscErrorCode MatBinBCSRCheckVecLocalSize(Vec v, PetscInt n, const char *what);
 
 /* Registered once by PetscBinBCSRRegisterAll(). */

@@ -31,6 +31,21 @@ static const char binbcsr_citation[] =
   "}\n";
 static PetscBool binbcsr_cited = PETSC_FALSE;
 
+/*@C
+   PetscBinBCSRRegisterAll - Registers `MATBINBCSR`, `MATSEQBINBCSR`, `MATMPIBINBCSR`, `KSPMCG`, the
+   factorisations of `MATSEQBINBCSR` and the -log_view events of the plug-in
+
+   Not Collective
+
+   Level: beginner
+
+   Notes:
+   A program linked against libpetscbinbcsr calls it once after `PetscInitialize()`; a stock PETSc
+   program gets the same from -dll_append libpetscbinbcsr.so, through
+   `PetscDLLibraryRegister_petscbinbcsr()`. Calling it again does nothing.
+
+.seealso: `MATBINBCSR`, `KSPMCG`, `PetscDLLibraryRegister_petscbinbcsr()`
+@*/
 PetscErrorCode PetscBinBCSRRegisterAll(void)
 {
   PetscFunctionBegin;
@@ -51,7 +66,16 @@ PetscErrorCode PetscBinBCSRRegisterAll(void)
   PetscFunctionReturn(0);
 }
 
-/* Called by PETSc's dynamic library loader (-dll_append libpetscbinbcsr.so). */
+/*@C
+   PetscDLLibraryRegister_petscbinbcsr - The entry point PETSc's dynamic library loader calls for
+   -dll_append or -dll_prepend libpetscbinbcsr.so: registers everything, as `PetscBinBCSRRegisterAll()`
+
+   Not Collective
+
+   Level: developer
+
+.seealso: `PetscBinBCSRRegisterAll()`, `PetscDLLibraryAppend()`
+@*/
 PetscErrorCode PetscDLLibraryRegister_petscbinbcsr(void)
 {
   PetscFunctionBegin;

@@ -1,4 +1,4 @@
-# Row, column and whole-matrix operations (tests/unit/mat_rowops, written for any communicator size):
+# Row, column and whole-matrix operations (tests/unit/mat_binbcsr/mat_rowops, written for any communicator size):
 # unit_mat_rowops runs them on one rank (seqbinbcsr), these on 2 and 3 (mpibinbcsr).
 foreach(np 2 3)
   add_test(NAME unit_mat_rowops_np${np} COMMAND ${MPIEXEC_CMD} -n ${np} $<TARGET_FILE:test_mat_rowops>)

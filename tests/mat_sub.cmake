@@ -8,7 +8,7 @@ endforeach()
 
 # PETSc's stock ksp ex4 (-bs 3) loaded with -dll_append on 2 ranks: each PC that works through
 # submatrices (the unit tests cover the others) or an external factor takes as many CG iterations with -mat_type binbcsr as with aij.
-# (SuperLU_DIST only here, one factor per process: see tests/unit/mat_sub/submatrices.cpp.)
+# (SuperLU_DIST only here, one factor per process: see tests/unit/mat_binbcsr/mat_sub/submatrices.cpp.)
 binbcsr_stock_example(stock_ksp_ex4 ksp/ksp/tutorials/ex4.c)
 set(MAT_SUB_PCS
     "asm_ov1|-pc_type asm -pc_asm_overlap 1"

@@ -8,7 +8,7 @@
 find_program(VALGRIND_EXECUTABLE valgrind)
 set(VALGRIND_AREAS)
 foreach(area mat_core mat_ops mat_sym mat_factor mat_sub mat_rowops)
-  if(IS_DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/unit/${area})
+  if(TARGET test_${area})
     list(APPEND VALGRIND_AREAS ${area})
   endif()
 endforeach()

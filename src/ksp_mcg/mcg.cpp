@@ -134,20 +134,40 @@ static PetscErrorCode KSPConvergedReasonView_MCGFloor(KSP ksp, void *)
 }
 
 /*MC
-   KSPMCG - "mcg": merged preconditioned conjugate gradient for symmetric positive definite systems.
+   KSPMCG - "mcg": merged preconditioned conjugate gradient for symmetric positive definite systems,
+   with one global reduction per iteration whatever the norm type
 
-   Chronopoulos-Gear formulation: one global reduction (of r.z, z.Az, r.r, z.z together) per
-   iteration; the matrix product accumulates z.Az (MatMultDotLocal()); one vector pass updates p, s,
-   x, r, applies PCJACOBI or PCNONE and accumulates the local dots. Other PCs go through PCApply.
+   Options Database Keys:
++  -ksp_mcg_fixed_iterations <n>   - exactly n iterations per solve, no convergence test (0: off), see `KSPMCGSetFixedIterations()`
+.  -ksp_mcg_fused_pc <bool>        - apply `PCJACOBI` or `PCNONE` inside the fused vector pass (default true)
+.  -ksp_mcg_verify_residual <bool> - confirm convergence on the true residual b - A x, restarting if it fails (default true)
+.  -ksp_mcg_stagnation <f>         - each restart from the true residual must shrink it by f (default 0.5)
+-  -ksp_mcg_precision_floor <u>    - relative rounding of the operator's products: the solve stops with
+                                     `KSP_DIVERGED_BREAKDOWN` at u ||A|| ||x|| instead of claiming a tolerance
+                                     below it (default -1: from the matrix, 2^-24 for `MATBINBCSR` single
+                                     storage and none otherwise; 0: off)
 
-   Options:
-+  -ksp_mcg_fixed_iterations <n> - exactly n iterations per solve, no convergence test (0: off)
-.  -ksp_mcg_fused_pc <bool> - fuse jacobi/none into the vector pass (default true)
-.  -ksp_mcg_verify_residual <bool> - confirm convergence on b - A x (default true)
-.  -ksp_mcg_stagnation <f> - a restart from the true residual must shrink it by f (default 0.5)
--  -ksp_mcg_precision_floor <u> - relative rounding of the operator's products; the solve stops with
-   KSP_DIVERGED_BREAKDOWN at u ||A|| ||x|| instead of claiming a tolerance below it (default -1: from
-   the matrix, 2^-24 for binbcsr single storage and none otherwise; 0: off)
+   Level: intermediate
+
+   Notes:
+   The Chronopoulos-Gear formulation of CG. With u = M^-1 r, w = A u, gamma = r.u and delta = u.w,
+   each iteration is
+.vb
+   beta  = gamma_k / gamma_{k-1}                (0 at the start and after a restart)
+   pAp   = delta_k - beta^2 pAp_{k-1}
+   alpha = gamma_k / pAp
+   pass 1 (vectors): p = u + beta p; s = w + beta s; x += alpha p; r -= alpha s; u = M^-1 r;
+                     local r.u, r.r, u.u
+   pass 2 (matrix):  w = A u and the local u.w  (MatMultDotLocal())
+   reduction:        {r.u, u.w, r.r, u.u} in one MPI_Allreduce
+.ve
+   It is CG in exact arithmetic (s = A p is carried by a recurrence instead of a second product), so
+   iterates and iteration counts match `KSPCG` up to rounding; the residual norm of iteration k is
+   known at the end of iteration k, as in `KSPCG`. With `PCJACOBI` or `PCNONE` pass 1 is one fused
+   loop; other preconditioners go through `PCApply()`. On a `MATBINBCSR` matrix pass 2 is one sweep
+   over the bins. docs/ksp_mcg.md has the derivation, the restarts and the measurements.
+
+.seealso: `KSPCG`, `KSPCreate()`, `KSPSetType()`, `KSPMCGSetFixedIterations()`, `MatMultDotLocal()`, `MATBINBCSR`
 M*/
 PetscErrorCode KSPCreate_MCG(KSP ksp)
 {

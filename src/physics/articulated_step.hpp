@@ -49,7 +49,7 @@ struct ArticulatedStepReport {
 };
 
 // How the work of a step is split over processes that each hold the whole scene (the PETSc drivers with
-// several ranks, examples/common/replicated_solver.h). A process advances only its active bodies (those of
+// several ranks, src/sim/replicated_solver.h). A process advances only its active bodies (those of
 // its own joints) and evaluates joint errors only for its own joints; a joint's impulse (the solve returns
 // all of them) is applied to every active end, in joint order, so a body active on two processes gets the
 // same state on both, bit for bit. Bodies that are not active keep stale values. max_over_processes turns

@@ -20,7 +20,7 @@ struct ClothParams {
 };
 
 // The blocks one process assembles. On one process: every row and both triangles. With replicated state
-// on several processes (examples/common/replicated_solver.h) each one assembles only the rows it owns,
+// on several processes (src/sim/replicated_solver.h) each one assembles only the rows it owns,
 // so it visits only the springs that touch them, and lists only the off-diagonal blocks its matrix type
 // stores (one per spring with upper-triangle storage), which is all the COO refill then reads.
 struct ClothSystem {

@@ -32,7 +32,7 @@ struct StepCoefficients {
 //   ((1 + dt alpha) M + (dt^2 + dt beta) K) dv = dt f - (dt^2 + dt beta) K v0 - dt alpha M v0.
 // Without damping: (M + dt^2 K) dv = dt (f - dt K v0). The seed's "dt (f + dt K v)" is the same
 // equation only with K = +df/dx (negative definite), where the matrix would read M - dt^2 K; with
-// an SPD matrix the sign in front of dt K v must be minus (tests/unit/fem checks the residual of
+// an SPD matrix the sign in front of dt K v must be minus (tests/unit/physics/fem checks the residual of
 // backward Euler after one step).
 StepCoefficients implicit_euler_coefficients(double dt, double rayleigh_alpha = 0, double rayleigh_beta = 0);
 

@@ -1,21 +1,13 @@
-/* MATMPIBINBCSR: constructor, destructor, preallocation answers, options and the bin-width /
-   precision setters (forwarded to both parts). The layout is described in mpibinbcsr.h. */
+/* MATMPIBINBCSR as a PETSc type: ops table, composed functions, constructor, destructor, preallocation
+   answers, options and the configuration setters (forwarded to both parts). The layout is described
+   in mpibinbcsr.h. */
 #include "mpibinbcsr.h"
+#include "../common/binbcsr_type.h"
 
 #include <algorithm>
 #include <cstring>
 
-static PetscErrorCode MatDestroy_MPIBinBCSR(Mat mat)
-{
-  PetscFunctionBegin;
-  PetscCall(MatMPIBinBCSRResetParts(mat));
-  delete MPIBinBCSR(mat);
-  mat->data = nullptr;
-  PetscCall(PetscObjectChangeTypeName((PetscObject)mat, nullptr));
-  const char *names[] = {"MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatBinBCSRSetCOOMirror_C", "MatBinBCSRGetCOOMirror_C", "MatBinBCSRSetStreams_C", "MatBinBCSRGetStreams_C", "MatMPIAIJSetPreallocation_C", "MatMPIBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatGetDiagonalBlock_C", "MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatConvert_mpibinbcsr_mpiaij_C", "MatConvert_mpibinbcsr_hypre_C", "MatProductSetFromOptions_anytype_C", "MatAXPYGetPreallocation_C"};
-  for (const char *name : names) PetscCall(PetscObjectComposeFunction((PetscObject)mat, name, (void (*)(void)) nullptr));
-  PetscFunctionReturn(0);
-}
+static PetscErrorCode MatDestroy_MPIBinBCSR(Mat); /* after the composed list, at the end */
 
 PetscErrorCode MatMPIBinBCSRSetUpLayouts(Mat mat)
 {
@@ -101,6 +93,19 @@ static PetscErrorCode MatSetUp_MPIBinBCSR(Mat mat)
   PetscFunctionReturn(0);
 }
 
+/* A setting of the matrix applied to each part that exists (the parts made later get it from the
+   matrix's own copy, MatMPIBinBCSRCreatePart). */
+template <class T>
+static PetscErrorCode MatMPIBinBCSRSetOnParts(Mat mat, PetscErrorCode (*set)(Mat, T), T v)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  if (b->A) PetscCall(set(b->A, v));
+  if (b->B) PetscCall(set(b->B, v));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MatBinBCSRSetBinWidth_MPIBinBCSR(Mat mat, PetscInt bw)
 {
   Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
@@ -108,8 +113,7 @@ static PetscErrorCode MatBinBCSRSetBinWidth_MPIBinBCSR(Mat mat, PetscInt bw)
   PetscFunctionBegin;
   PetscCheck(bw >= 1, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_OUTOFRANGE, "bin width must be >= 1, got %" PetscInt_FMT, bw);
   b->bin_width = bw;
-  if (b->A) PetscCall(MatBinBCSRSetBinWidth(b->A, bw));
-  if (b->B) PetscCall(MatBinBCSRSetBinWidth(b->B, bw));
+  PetscCall(MatMPIBinBCSRSetOnParts(mat, MatBinBCSRSetBinWidth, bw));
   PetscFunctionReturn(0);
 }
 
@@ -130,8 +134,7 @@ static PetscErrorCode MatBinBCSRSetStreams_MPIBinBCSR(Mat mat, PetscInt streams)
 
   PetscFunctionBegin;
   b->streams = streams;
-  if (b->A) PetscCall(MatBinBCSRSetStreams(b->A, streams));
-  if (b->B) PetscCall(MatBinBCSRSetStreams(b->B, streams));
+  PetscCall(MatMPIBinBCSRSetOnParts(mat, MatBinBCSRSetStreams, streams));
   PetscFunctionReturn(0);
 }
 
@@ -152,8 +155,7 @@ static PetscErrorCode MatBinBCSRSetPrecision_MPIBinBCSR(Mat mat, MatBinBCSRPreci
   PetscFunctionBegin;
   b->precision_set = PETSC_TRUE;
   b->precision     = p;
-  if (b->A) PetscCall(MatBinBCSRSetPrecision(b->A, p));
-  if (b->B) PetscCall(MatBinBCSRSetPrecision(b->B, p));
+  PetscCall(MatMPIBinBCSRSetOnParts(mat, MatBinBCSRSetPrecision, p));
   PetscFunctionReturn(0);
 }
 
@@ -218,11 +220,9 @@ static PetscErrorCode MatGetDiagonalBlock_MPIBinBCSR(Mat mat, Mat *a)
 
 static PetscErrorCode MatSetFromOptions_MPIBinBCSR(Mat mat, PetscOptionItems *PetscOptionsObject)
 {
-  Mat_MPIBinBCSR     *b  = MPIBinBCSR(mat);
-  PetscInt            bw = b->bin_width;
-  MatBinBCSRPrecision p  = b->precision;
-  char                inner[64];
-  PetscBool           flg, sym;
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+  char            inner[64];
+  PetscBool       flg;
 
   PetscFunctionBegin;
   PetscOptionsHeadBegin(PetscOptionsObject, "MATMPIBINBCSR options");
@@ -231,19 +231,7 @@ static PetscErrorCode MatSetFromOptions_MPIBinBCSR(Mat mat, PetscOptionItems *Pe
     PetscCheck(!b->A, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONGSTATE, "-mat_mpibinbcsr_inner_type must be set before preallocation");
     PetscCall(PetscStrncpy(b->inner_type, inner, sizeof(b->inner_type)));
   }
-  PetscCall(PetscOptionsInt("-mat_binbcsr_bin_width", "Rows per bin", "MatBinBCSRSetBinWidth", bw, &bw, &flg));
-  if (flg) PetscCall(MatBinBCSRSetBinWidth_MPIBinBCSR(mat, bw));
-  PetscCall(PetscOptionsEnum("-mat_binbcsr_precision", "Value storage", "MatBinBCSRSetPrecision", MatBinBCSRPrecisions, (PetscEnum)p, (PetscEnum *)&p, &flg));
-  if (flg) PetscCall(MatBinBCSRSetPrecision_MPIBinBCSR(mat, p));
-  sym = b->sym;
-  PetscCall(PetscOptionsBool("-mat_binbcsr_symmetric_storage", "Store the upper triangle of the diagonal part only (symmetric matrices; the lower triangle given is ignored)", "MatBinBCSRSetSymmetricStorage", sym, &sym, &flg));
-  if (flg) PetscCall(MatBinBCSRSetSymmetricStorage_MPIBinBCSR(mat, sym));
-  PetscCall(PetscOptionsBool("-mat_binbcsr_coo_mirror", "COO entries of off-diagonal blocks also fill the transposed place (give one triangle of a symmetric matrix)", "MatBinBCSRSetCOOMirror", b->coo_mirror, &b->coo_mirror, nullptr));
-  {
-    PetscInt streams = b->streams ? b->streams : BINBCSR_DEFAULT_STREAMS;
-    PetscCall(PetscOptionsInt("-mat_binbcsr_streams", "Runs of bins the product sweeps side by side (1, 2, 4, 8)", "MatBinBCSRSetStreams", streams, &streams, &flg));
-    if (flg) PetscCall(MatBinBCSRSetStreams(mat, streams));
-  }
+  PetscCall(MatBinBCSRReadOptions_Private(mat, PetscOptionsObject)); /* the -mat_binbcsr_* options, forwarded to both parts */
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }
@@ -399,6 +387,109 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRBuildSendSF(MPI_Comm comm, PetscInt nse
   PetscFunctionReturn(0);
 }
 
+/* The ops table: every operation of the type, one named slot each (slots not named stay NULL).
+   Filled once, copied into each new matrix by MatCreate_MPIBinBCSR; named assignments, so the table
+   reads the same whatever slots a PETSc version adds or drops. */
+static const struct _MatOps &MatOps_MPIBinBCSR(void)
+{
+  static const struct _MatOps ops = [] {
+    struct _MatOps o = {};
+    BinBCSRSetCommonOps(o); /* common/: the same function for seq and mpi */
+    /* values in and out, assembly */
+    o.setvalues      = MatSetValues_MPIBinBCSR;
+    o.getvalues      = MatGetValues_MPIBinBCSR;
+    o.getrow         = MatGetRow_MPIBinBCSR;
+    o.restorerow     = MatRestoreRow_MPIBinBCSR;
+    o.getrowij       = MatGetRowIJ_MPIBinBCSR;
+    o.restorerowij   = MatRestoreRowIJ_MPIBinBCSR;
+    o.assemblybegin  = MatAssemblyBegin_MPIBinBCSR;
+    o.assemblyend    = MatAssemblyEnd_MPIBinBCSR;
+    o.setoption      = MatSetOption_MPIBinBCSR;
+    o.setup          = MatSetUp_MPIBinBCSR;
+    o.setfromoptions = MatSetFromOptions_MPIBinBCSR;
+    o.zeroentries    = MatZeroEntries_MPIBinBCSR;
+    /* products and the diagonal */
+    o.mult                        = MatMult_MPIBinBCSR;
+    o.multadd                     = MatMultAdd_MPIBinBCSR;
+    o.multtranspose               = MatMultTranspose_MPIBinBCSR;
+    o.multtransposeadd            = MatMultTransposeAdd_MPIBinBCSR;
+    o.getdiagonal                 = MatGetDiagonal_MPIBinBCSR;
+    o.getdiagonalblock            = MatGetDiagonalBlock_MPIBinBCSR;
+    o.invertblockdiagonal         = MatInvertBlockDiagonal_MPIBinBCSR;
+    o.invertvariableblockdiagonal = MatInvertVariableBlockDiagonal_MPIBinBCSR;
+    o.sor                         = MatSOR_MPIBinBCSR;
+    o.multdiagonalblock           = MatMultDiagonalBlock_MPIBinBCSR;
+    /* value operations */
+    o.scale           = MatScale_MPIBinBCSR;
+    o.shift           = MatShift_MPIBinBCSR;
+    o.diagonalset     = MatDiagonalSet_MPIBinBCSR;
+    o.axpy            = MatAXPY_MPIBinBCSR;
+    o.zerorows        = MatZeroRows_MPIBinBCSR;
+    o.zerorowscolumns = MatZeroRowsColumns_MPIBinBCSR;
+    o.norm            = MatNorm_MPIBinBCSR;
+    o.getinfo         = MatGetInfo_MPIBinBCSR;
+    /* rows and columns (mpibinbcsr_rowops.cpp) */
+    o.diagonalscale       = MatDiagonalScale_MPIBinBCSR;
+    o.getrowmaxabs        = MatGetRowMaxAbs_MPIBinBCSR;
+    o.getrowmax           = MatGetRowMax_MPIBinBCSR;
+    o.getrowmin           = MatGetRowMin_MPIBinBCSR;
+    o.getrowminabs        = MatGetRowMinAbs_MPIBinBCSR;
+    o.getcolumnreductions = MatGetColumnReductions_MPIBinBCSR;
+    o.missingdiagonal     = MatMissingDiagonal_MPIBinBCSR;
+    o.equal               = MatEqual_MPIBinBCSR;
+    /* new matrices, view, load */
+    o.transpose         = MatTranspose_MPIBinBCSR;
+    o.duplicate         = MatDuplicate_MPIBinBCSR;
+    o.copy              = MatCopy_MPIBinBCSR;
+    o.convertfrom       = MatConvertFrom_MPIBinBCSR;
+    o.destroy           = MatDestroy_MPIBinBCSR;
+    o.view              = MatView_MPIBinBCSR;
+    o.load              = MatLoad_MPIBinBCSR;
+    /* submatrices through the AIJ shadow (common/) */
+    o.createsubmatricesmpi = MatCreateSubMatricesMPI_BinBCSR;
+    o.createsubmatrix      = MatCreateSubMatrix_BinBCSR;
+    return o;
+  }();
+  return ops;
+}
+
+/* The composed functions, composed by MatCreate_MPIBinBCSR and cleared by MatDestroy_MPIBinBCSR. */
+static const BinBCSRComposed composed[] = {
+  BINBCSR_COMPOSED("MatMPIAIJSetPreallocation_C", MatMPIAIJSetPreallocation_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatMPIBAIJSetPreallocation_C", MatMPIBAIJSetPreallocation_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatSetPreallocationCOO_C", MatSetPreallocationCOO_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatSetValuesCOO_C", MatSetValuesCOO_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatMultDotLocal_C", MatMultDotLocal_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatAXPYGetPreallocation_C", MatAXPYGetPreallocation_BinBCSR),
+  BINBCSR_COMPOSED("MatGetDiagonalBlock_C", MatGetDiagonalBlock_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRSetBinWidth_C", MatBinBCSRSetBinWidth_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRSetSymmetricStorage_C", MatBinBCSRSetSymmetricStorage_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRGetSymmetricStorage_C", MatBinBCSRGetSymmetricStorage_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRSetCOOMirror_C", MatBinBCSRSetCOOMirror_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRGetCOOMirror_C", MatBinBCSRGetCOOMirror_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRSetStreams_C", MatBinBCSRSetStreams_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRGetStreams_C", MatBinBCSRGetStreams_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRGetBinWidth_C", MatBinBCSRGetBinWidth_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRSetPrecision_C", MatBinBCSRSetPrecision_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRGetPrecision_C", MatBinBCSRGetPrecision_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatConvert_mpibinbcsr_mpiaij_C", MatConvert_MPIBinBCSR_MPIAIJ),
+  BINBCSR_COMPOSED("MatProductSetFromOptions_anytype_C", MatProductSetFromOptions_BinBCSR),
+#if defined(PETSC_HAVE_HYPRE)
+  BINBCSR_COMPOSED("MatConvert_mpibinbcsr_hypre_C", MatConvert_BinBCSR_HYPRE),
+#endif
+};
+
+static PetscErrorCode MatDestroy_MPIBinBCSR(Mat mat)
+{
+  PetscFunctionBegin;
+  PetscCall(MatMPIBinBCSRResetParts(mat));
+  delete MPIBinBCSR(mat);
+  mat->data = nullptr;
+  PetscCall(PetscObjectChangeTypeName((PetscObject)mat, nullptr));
+  PetscCall(BinBCSRComposeList((PetscObject)mat, composed, PETSC_TRUE));
+  PetscFunctionReturn(0);
+}
+
 /*MC
    MATMPIBINBCSR - "mpibinbcsr": the parallel BIN-CSR / BIN-BCSR matrix. Each rank stores its rows as
    a diagonal part and an off-diagonal part with compressed columns, both MATSEQBINBCSR; the ghost
@@ -415,93 +506,10 @@ PetscErrorCode MatCreate_MPIBinBCSR(Mat mat)
   auto *b = new Mat_MPIBinBCSR();
   PetscCall(PetscStrncpy(b->inner_type, MATSEQBINBCSR, sizeof(b->inner_type)));
   mat->data = b;
-  PetscCall(PetscMemzero(mat->ops, sizeof(struct _MatOps)));
-  mat->ops->destroy             = MatDestroy_MPIBinBCSR;
-  mat->ops->setup               = MatSetUp_MPIBinBCSR;
-  mat->ops->setfromoptions      = MatSetFromOptions_MPIBinBCSR;
-  mat->ops->setoption           = MatSetOption_MPIBinBCSR;
-  mat->ops->setvalues           = MatSetValues_MPIBinBCSR;
-  mat->ops->assemblybegin       = MatAssemblyBegin_MPIBinBCSR;
-  mat->ops->assemblyend         = MatAssemblyEnd_MPIBinBCSR;
-  mat->ops->mult                = MatMult_MPIBinBCSR;
-  mat->ops->multadd             = MatMultAdd_MPIBinBCSR;
-  mat->ops->multtranspose       = MatMultTranspose_MPIBinBCSR;
-  mat->ops->multtransposeadd    = MatMultTransposeAdd_MPIBinBCSR;
-  mat->ops->getdiagonal         = MatGetDiagonal_MPIBinBCSR;
-  mat->ops->diagonalset         = MatDiagonalSet_MPIBinBCSR;
-  mat->ops->invertblockdiagonal = MatInvertBlockDiagonal_MPIBinBCSR;
-  mat->ops->invertvariableblockdiagonal = MatInvertVariableBlockDiagonal_MPIBinBCSR;
-  mat->ops->sor                 = MatSOR_MPIBinBCSR;
-  mat->ops->multdiagonalblock   = MatMultDiagonalBlock_MPIBinBCSR;
-  mat->ops->scale               = MatScale_MPIBinBCSR;
-  mat->ops->shift               = MatShift_MPIBinBCSR;
-  mat->ops->zeroentries         = MatZeroEntries_MPIBinBCSR;
-  mat->ops->zerorows            = MatZeroRows_MPIBinBCSR;
-  mat->ops->zerorowscolumns     = MatZeroRowsColumns_MPIBinBCSR;
-  mat->ops->getrow              = MatGetRow_MPIBinBCSR;
-  mat->ops->restorerow          = MatRestoreRow_MPIBinBCSR;
-  mat->ops->norm                = MatNorm_MPIBinBCSR;
-  mat->ops->getinfo             = MatGetInfo_MPIBinBCSR;
-  mat->ops->diagonalscale       = MatDiagonalScale_MPIBinBCSR;
-  mat->ops->getrowmaxabs        = MatGetRowMaxAbs_MPIBinBCSR;
-  mat->ops->getrowmax           = MatGetRowMax_MPIBinBCSR;
-  mat->ops->getrowmin           = MatGetRowMin_MPIBinBCSR;
-  mat->ops->getrowminabs        = MatGetRowMinAbs_MPIBinBCSR;
-  mat->ops->getcolumnreductions = MatGetColumnReductions_MPIBinBCSR;
-  mat->ops->missingdiagonal     = MatMissingDiagonal_MPIBinBCSR;
-  mat->ops->equal               = MatEqual_MPIBinBCSR;
-  mat->ops->getvalues           = MatGetValues_MPIBinBCSR;
-  mat->ops->axpy                = MatAXPY_MPIBinBCSR;
-  mat->ops->transpose           = MatTranspose_MPIBinBCSR;
-  mat->ops->permute             = MatPermute_BinBCSR;
-  mat->ops->issymmetric         = MatIsSymmetric_BinBCSR;
-  mat->ops->findzerodiagonals   = MatFindZeroDiagonals_BinBCSR;
-  mat->ops->findnonzerorows     = MatFindNonzeroRows_BinBCSR;
-  mat->ops->setrandom           = MatSetRandom_BinBCSR;
-  mat->ops->realpart            = MatRealPart_BinBCSR;
-  mat->ops->imaginarypart       = MatImaginaryPart_BinBCSR;
-  mat->ops->getrowij            = MatGetRowIJ_MPIBinBCSR;
-  mat->ops->restorerowij        = MatRestoreRowIJ_MPIBinBCSR;
-  mat->ops->getdiagonalblock    = MatGetDiagonalBlock_MPIBinBCSR;
-  mat->ops->view                = MatView_MPIBinBCSR;
-  mat->ops->load                = MatLoad_MPIBinBCSR;
-  mat->ops->convertfrom         = MatConvertFrom_MPIBinBCSR;
-  mat->ops->duplicate           = MatDuplicate_MPIBinBCSR;
-  mat->ops->copy                = MatCopy_MPIBinBCSR;
-  mat->ops->increaseoverlap     = MatIncreaseOverlap_BinBCSR;
-  mat->ops->createsubmatrices   = MatCreateSubMatrices_BinBCSR;
-  mat->ops->fdcoloringcreate    = MatFDColoringCreate_BinBCSR;
-  mat->ops->fdcoloringsetup     = MatFDColoringSetUp_BinBCSR;
-  mat->ops->fdcoloringapply     = MatFDColoringApply_BinBCSR;
-  mat->ops->createsubmatricesmpi = MatCreateSubMatricesMPI_BinBCSR;
-  mat->ops->createsubmatrix     = MatCreateSubMatrix_BinBCSR;
-  mat->ops->creategraph         = MatCreateGraph_BinBCSR; /* PCGAMG, through the AIJ shadow */
-  mat->ops->productsetfromoptions = MatProductSetFromOptions_BinBCSR;
-  mat->assembled                = PETSC_FALSE;
-  mat->insertmode               = NOT_SET_VALUES;
-
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatMPIAIJSetPreallocation_C", MatMPIAIJSetPreallocation_MPIBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatMPIBAIJSetPreallocation_C", MatMPIBAIJSetPreallocation_MPIBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatSetPreallocationCOO_C", MatSetPreallocationCOO_MPIBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatSetValuesCOO_C", MatSetValuesCOO_MPIBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatMultDotLocal_C", MatMultDotLocal_MPIBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatAXPYGetPreallocation_C", MatAXPYGetPreallocation_BinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatGetDiagonalBlock_C", MatGetDiagonalBlock_MPIBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetBinWidth_C", MatBinBCSRSetBinWidth_MPIBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetSymmetricStorage_C", MatBinBCSRSetSymmetricStorage_MPIBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetSymmetricStorage_C", MatBinBCSRGetSymmetricStorage_MPIBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetCOOMirror_C", MatBinBCSRSetCOOMirror_MPIBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetCOOMirror_C", MatBinBCSRGetCOOMirror_MPIBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetStreams_C", MatBinBCSRSetStreams_MPIBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetStreams_C", MatBinBCSRGetStreams_MPIBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetBinWidth_C", MatBinBCSRGetBinWidth_MPIBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRSetPrecision_C", MatBinBCSRSetPrecision_MPIBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatBinBCSRGetPrecision_C", MatBinBCSRGetPrecision_MPIBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatConvert_mpibinbcsr_mpiaij_C", MatConvert_MPIBinBCSR_MPIAIJ));
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatProductSetFromOptions_anytype_C", MatProductSetFromOptions_BinBCSR)); /* products with other types */
-#if defined(PETSC_HAVE_HYPRE)
-  PetscCall(PetscObjectComposeFunction((PetscObject)mat, "MatConvert_mpibinbcsr_hypre_C", MatConvert_BinBCSR_HYPRE));
-#endif
+  PetscCall(PetscMemcpy(mat->ops, &MatOps_MPIBinBCSR(), sizeof(struct _MatOps)));
+  mat->assembled  = PETSC_FALSE;
+  mat->insertmode = NOT_SET_VALUES;
+  PetscCall(BinBCSRComposeList((PetscObject)mat, composed, PETSC_FALSE));
   PetscCall(PetscObjectChangeTypeName((PetscObject)mat, MATMPIBINBCSR));
   PetscFunctionReturn(0);
 }

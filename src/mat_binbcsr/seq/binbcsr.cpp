@@ -1,373 +1,10 @@
-/* MATSEQBINBCSR: creation, options, staging, MatSetValues and assembly (the layout build itself:
-   binbcsr_build.cpp). */
+/* MATSEQBINBCSR as a PETSc type: its options, configuration setters, ops table, composed functions,
+   constructor and destructor. The storage is described in binbcsr.h; staging, MatSetValues and
+   assembly: binbcsr_assembly.cpp; the layout build: binbcsr_build.cpp; products: binbcsr_mult.cpp;
+   value operations: binbcsr_ops.cpp. */
 #include "binbcsr.h"
-#include <algorithm>
-#include <vector>
-
-/* Staged pattern and values, per block row: sorted block columns and bs2 values per block
-   (row-major). Kept as vectors because stock programs insert in any order before the first
-   assembly; the bin layout is built once from it. */
-struct BinBCSRStaging {
-  std::vector<std::vector<PetscInt>>  cols;
-  std::vector<std::vector<MatScalar>> vals;
-  std::vector<PetscInt>               prealloc; /* block nonzeros per block row, empty if unknown */
-};
-
-static PetscErrorCode MatSeqBinBCSRFreeLayout(Mat_SeqBinBCSR *a)
-{
-  PetscFunctionBegin;
-  PetscCall(PetscFree(a->bin_start));
-  PetscCall(PetscFree(a->row_nz));
-  PetscCall(PetscFree(a->diag_slot));
-  PetscCall(PetscFree(a->col));
-  PetscCall(PetscFree(a->row_off));
-  PetscCall(PetscFree(a->real_slot));
-  PetscCall(PetscFree(a->lower_off));
-  PetscCall(PetscFree(a->lower_slot));
-  PetscCall(PetscFree(a->val));
-  PetscCall(PetscFree(a->valf));
-  PetscCall(PetscFree2(a->rowbuf_cols, a->rowbuf_vals));
-  PetscCall(PetscFree(a->idiag));
-  PetscCall(PetscFree(a->sor_idiag));
-  a->sor_state = 0;
-  PetscCall(MatSeqBinBCSRDestroyCOO(a));
-  a->built  = PETSC_FALSE;
-  a->nbins  = 0;
-  a->nslots = 0;
-  a->nz     = 0;
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode MatSeqBinBCSRDestroyCOO(Mat_SeqBinBCSR *a)
-{
-  PetscFunctionBegin;
-  PetscCall(PetscFree(a->coo_jmap));
-  PetscCall(PetscFree(a->coo_perm));
-  PetscCall(PetscFree(a->coo_perm_src));
-  PetscCall(PetscFree(a->coo_slot_ptr));
-  PetscCall(PetscFree(a->coo_slot_src));
-  a->coo_slot_state = 0;
-  a->coo_composed = PETSC_FALSE;
-  a->coo_n        = 0;
-  PetscFunctionReturn(0);
-}
-
-/* Block size and block counts from the layouts; the check every entry point shares. */
-static PetscErrorCode MatSeqBinBCSRSetSizes(Mat A)
-{
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-  PetscInt        rbs, cbs;
-
-  PetscFunctionBegin;
-  PetscCall(PetscLayoutSetUp(A->rmap));
-  PetscCall(PetscLayoutSetUp(A->cmap));
-  PetscCall(MatGetBlockSizes(A, &rbs, &cbs));
-  PetscCheck(rbs == cbs, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP, "MATSEQBINBCSR needs equal row and column block sizes, got %" PetscInt_FMT " and %" PetscInt_FMT, rbs, cbs);
-  PetscCheck(A->rmap->n % rbs == 0 && A->cmap->n % rbs == 0, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP, "Matrix sizes %" PetscInt_FMT " x %" PetscInt_FMT " are not multiples of the block size %" PetscInt_FMT, A->rmap->n, A->cmap->n, rbs);
-  a->bs  = rbs;
-  a->bs2 = rbs * rbs;
-  a->mbs = A->rmap->n / rbs;
-  a->nbs = A->cmap->n / rbs;
-  PetscFunctionReturn(0);
-}
-
-/* Sizes checked, any layout and staging dropped: what a new layout build starts from. */
-PetscErrorCode MatSeqBinBCSRResetLayout(Mat A)
-{
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-
-  PetscFunctionBegin;
-  PetscCall(MatSeqBinBCSRSetSizes(A));
-  PetscCall(MatSeqBinBCSRFreeLayout(a));
-  delete a->staging;
-  a->staging = nullptr;
-  PetscFunctionReturn(0);
-}
-
-/* A fresh, empty staging area; drops any layout (preallocation starts a new pattern, as in AIJ). */
-static PetscErrorCode MatSeqBinBCSRResetStaging(Mat A, const PetscInt *block_nnz, PetscInt block_nz)
-{
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-
-  PetscFunctionBegin;
-  PetscCall(MatSeqBinBCSRSetSizes(A));
-  PetscCall(MatSeqBinBCSRFreeLayout(a));
-  delete a->staging;
-  a->staging = new BinBCSRStaging;
-  a->staging->cols.resize(a->mbs);
-  a->staging->vals.resize(a->mbs);
-  if (block_nnz || block_nz > 0) {
-    a->staging->prealloc.resize(a->mbs);
-    for (PetscInt r = 0; r < a->mbs; r++) {
-      const PetscInt n = PetscMin(block_nnz ? block_nnz[r] : block_nz, a->nbs);
-      PetscCheck(n >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Negative preallocation %" PetscInt_FMT " for block row %" PetscInt_FMT, n, r);
-      a->staging->prealloc[r] = n;
-      a->staging->cols[r].reserve(n);
-      a->staging->vals[r].reserve(n * a->bs2);
-    }
-  }
-  A->preallocated = PETSC_TRUE;
-  A->was_assembled = PETSC_FALSE;
-  A->assembled     = PETSC_FALSE;
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode MatSetUp_SeqBinBCSR(Mat A)
-{
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-
-  PetscFunctionBegin;
-  if (!a->staging && !a->built) PetscCall(MatSeqBinBCSRResetStaging(A, nullptr, 0));
-  A->preallocated = PETSC_TRUE;
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode MatSeqAIJSetPreallocation_SeqBinBCSR(Mat A, PetscInt nz, const PetscInt nnz[])
-{
-  PetscInt *bnnz = nullptr, bs;
-
-  PetscFunctionBegin;
-  PetscCall(PetscLayoutSetUp(A->rmap));
-  PetscCall(PetscLayoutSetUp(A->cmap));
-  if (A->rmap->bs != A->cmap->bs) { /* a layout the bins cannot hold (PCGAMG's prolongators, made in the operator's type) */
-    PetscCall(PetscInfo(A, "Row and column block sizes %" PetscInt_FMT " and %" PetscInt_FMT " differ: the matrix becomes %s\n", A->rmap->bs, A->cmap->bs, MATSEQAIJ));
-    PetscCall(MatSetType(A, MATSEQAIJ));
-    PetscCall(MatSeqAIJSetPreallocation(A, nz, nnz));
-    PetscFunctionReturn(0);
-  }
-  bs = PetscMax(A->rmap->bs, 1);
-  if (nnz) { /* point rows -> block rows: the largest point row of a block row, in blocks (upper bound) */
-    const PetscInt mbs = A->rmap->n / bs;
-    PetscCall(PetscMalloc1(mbs, &bnnz));
-    for (PetscInt r = 0; r < mbs; r++) {
-      PetscInt mx = 0;
-      for (PetscInt i = 0; i < bs; i++) mx = PetscMax(mx, nnz[r * bs + i]);
-      bnnz[r] = mx;
-    }
-  }
-  PetscCall(MatSeqBinBCSRResetStaging(A, bnnz, nz == PETSC_DEFAULT || nz == PETSC_DECIDE ? 0 : nz));
-  PetscCall(PetscFree(bnnz));
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode MatSeqBAIJSetPreallocation_SeqBinBCSR(Mat A, PetscInt bs, PetscInt nz, const PetscInt nnz[])
-{
-  PetscFunctionBegin;
-  PetscCall(MatSetBlockSize(A, PetscAbs(bs)));
-  PetscCall(PetscLayoutSetUp(A->rmap));
-  PetscCall(PetscLayoutSetUp(A->cmap));
-  PetscCheck(A->rmap->bs == PetscAbs(bs), PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP, "Block size %" PetscInt_FMT " given to the preallocation differs from the matrix block size %" PetscInt_FMT, bs, A->rmap->bs);
-  PetscCall(MatSeqBinBCSRResetStaging(A, nnz, nz == PETSC_DEFAULT || nz == PETSC_DECIDE ? 0 : nz));
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode MatSeqBinBCSRStagingZeroValues(Mat A)
-{
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-
-  PetscFunctionBegin;
-  if (a->staging)
-    for (auto &v : a->staging->vals) std::fill(v.begin(), v.end(), 0.0);
-  PetscFunctionReturn(0);
-}
-
-/* Symmetric storage chosen after some values were staged: the staged lower triangle goes. */
-PetscErrorCode MatSeqBinBCSRStagingDropLower(Mat A)
-{
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-
-  PetscFunctionBegin;
-  for (PetscInt r = 0; r < (PetscInt)a->staging->cols.size(); r++) {
-    std::vector<PetscInt> &cols = a->staging->cols[r];
-    const size_t           nlow = (size_t)(std::lower_bound(cols.begin(), cols.end(), r) - cols.begin());
-    cols.erase(cols.begin(), cols.begin() + nlow);
-    a->staging->vals[r].erase(a->staging->vals[r].begin(), a->staging->vals[r].begin() + nlow * a->bs2);
-  }
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode MatSeqBinBCSRDuplicateStaging(Mat A, Mat B, PetscBool copyvalues)
-{
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data, *b = (Mat_SeqBinBCSR *)B->data;
-
-  PetscFunctionBegin;
-  delete b->staging;
-  b->staging = a->staging ? new BinBCSRStaging(*a->staging) : nullptr;
-  if (b->staging && !copyvalues) PetscCall(MatSeqBinBCSRStagingZeroValues(B));
-  PetscFunctionReturn(0);
-}
-
-/* Staging -> bins, with the staged values. */
-static PetscErrorCode MatSeqBinBCSRBuildFromStaging(Mat A)
-{
-  Mat_SeqBinBCSR  *a = (Mat_SeqBinBCSR *)A->data;
-  BinBCSRStaging  *st = a->staging;
-  PetscInt        *bi, *bj;
-  const PetscInt   mbs = a->mbs, bs2 = a->bs2;
-
-  PetscFunctionBegin;
-  PetscCall(PetscMalloc1(mbs + 1, &bi));
-  bi[0] = 0;
-  for (PetscInt r = 0; r < mbs; r++) bi[r + 1] = bi[r] + (PetscInt)st->cols[r].size();
-  PetscCall(PetscMalloc1(bi[mbs], &bj));
-  for (PetscInt r = 0; r < mbs; r++) std::copy(st->cols[r].begin(), st->cols[r].end(), bj + bi[r]);
-  a->staging = nullptr; /* keep the values while the layout is built */
-  PetscCall(MatSeqBinBCSRBuildLayout(A, bi, bj));
-  for (PetscInt r = 0; r < mbs; r++) {
-    const std::vector<MatScalar> &v = st->vals[r];
-    for (PetscInt k = 0; k < bi[r + 1] - bi[r]; k++) {
-      const PetscInt s = BinBCSRSlot(a, r, k);
-      for (PetscInt e = 0; e < bs2; e++) BinBCSRSetValue(a, BinBCSRValueIndex(s, e, a->bw, bs2), v[k * bs2 + e]);
-    }
-  }
-  delete st;
-  PetscCall(PetscFree(bi));
-  PetscCall(PetscFree(bj));
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode MatAssemblyEnd_SeqBinBCSR(Mat A, MatAssemblyType type)
-{
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-
-  PetscFunctionBegin;
-  if (type == MAT_FLUSH_ASSEMBLY) PetscFunctionReturn(0);
-  if (!a->built && !a->staging) PetscCall(MatSetUp_SeqBinBCSR(A)); /* assembled without any entry */
-  if (!a->built) PetscCall(MatSeqBinBCSRBuildFromStaging(A));
-  PetscFunctionReturn(0);
-}
-
-/* One value into the staged pattern; `ok` is false when the location is new and ignored. */
-static PetscErrorCode StagingAdd(Mat A, Mat_SeqBinBCSR *a, PetscInt br, PetscInt bc, PetscInt e, PetscScalar v, InsertMode mode, PetscInt prow, PetscInt pcol)
-{
-  BinBCSRStaging        *st   = a->staging;
-  std::vector<PetscInt> &cols = st->cols[br];
-  auto                   it   = std::lower_bound(cols.begin(), cols.end(), bc);
-  const size_t           k    = (size_t)(it - cols.begin());
-
-  PetscFunctionBegin;
-  if (it == cols.end() || *it != bc) {
-    if (a->nonew == 1) PetscFunctionReturn(0);
-    PetscCheck(a->nonew != -1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Inserting a new nonzero at (%" PetscInt_FMT ", %" PetscInt_FMT ") in the matrix (MAT_NEW_NONZERO_LOCATION_ERR is set)", prow, pcol);
-    PetscCheck(!(a->nonew == -2 && !st->prealloc.empty() && (PetscInt)cols.size() >= st->prealloc[br]), PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "New nonzero at (%" PetscInt_FMT ", %" PetscInt_FMT ") exceeds the preallocation (MAT_NEW_NONZERO_ALLOCATION_ERR is set)", prow, pcol);
-    cols.insert(it, bc);
-    st->vals[br].insert(st->vals[br].begin() + k * a->bs2, (size_t)a->bs2, 0.0);
-  }
-  MatScalar &dst = st->vals[br][k * a->bs2 + e];
-  dst            = (mode == ADD_VALUES) ? dst + v : v;
-  (void)A;
-  PetscFunctionReturn(0);
-}
-
-/* One value into the frozen layout. `cache` keeps the last block found: element matrices hit the
-   same block bs times in a row. */
-static inline PetscErrorCode LayoutAdd(Mat_SeqBinBCSR *a, PetscInt br, PetscInt bc, PetscInt e, PetscScalar v, InsertMode mode, PetscInt prow, PetscInt pcol, PetscInt cache[3])
-{
-  PetscInt s;
-
-  PetscFunctionBegin;
-  if (cache[0] == br && cache[1] == bc) s = cache[2];
-  else {
-    s        = MatSeqBinBCSRFindSlot(a, br, bc);
-    cache[0] = br;
-    cache[1] = bc;
-    cache[2] = s;
-  }
-  if (s < 0) {
-    PetscCheck(a->nonew == 1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "New nonzero at (%" PetscInt_FMT ", %" PetscInt_FMT "): the pattern of a MATSEQBINBCSR matrix is frozen at its first final assembly (use MatSetOption(A, MAT_NEW_NONZERO_LOCATIONS, PETSC_FALSE) to ignore new locations)", prow, pcol);
-    PetscFunctionReturn(0);
-  }
-  {
-    const PetscInt vi = BinBCSRValueIndex(s, e, a->bw, a->bs2);
-    if (a->val) a->val[vi] = (mode == ADD_VALUES) ? a->val[vi] + v : v;
-    else a->valf[vi] = (float)((mode == ADD_VALUES) ? (PetscScalar)a->valf[vi] + v : v);
-  }
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode MatSetValues_SeqBinBCSR(Mat A, PetscInt m, const PetscInt im[], PetscInt n, const PetscInt in[], const PetscScalar v[], InsertMode mode)
-{
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-  PetscInt        cache[3] = {-1, -1, -1};
-
-  PetscFunctionBegin;
-  if (!a->built && !a->staging) PetscCall(MatSetUp_SeqBinBCSR(A));
-  PetscCheck(PetscAbs(A->rmap->bs) == a->bs, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP, "Block size changed from %" PetscInt_FMT " to %" PetscInt_FMT " after preallocation", a->bs, A->rmap->bs);
-  for (PetscInt i = 0; i < m; i++) {
-    const PetscInt r = im[i];
-    if (r < 0) continue;
-    PetscCheck(r < A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", r, A->rmap->n);
-    const PetscInt br = r / a->bs, ri = r % a->bs;
-    for (PetscInt j = 0; j < n; j++) {
-      const PetscInt c = in[j];
-      if (c < 0) continue;
-      PetscCheck(c < A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", c, A->cmap->n);
-      const PetscScalar x = v ? (a->roworiented ? v[i * n + j] : v[j * m + i]) : 0.0;
-      const PetscInt    bc = c / a->bs, e = ri * a->bs + c % a->bs;
-      if (a->sym && bc < br) continue; /* symmetric storage: the lower triangle is implied */
-      if (a->built) PetscCall(LayoutAdd(a, br, bc, e, x, mode, r, c, cache));
-      else PetscCall(StagingAdd(A, a, br, bc, e, x, mode, r, c));
-    }
-  }
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode MatSetValuesBlocked_SeqBinBCSR(Mat A, PetscInt m, const PetscInt im[], PetscInt n, const PetscInt in[], const PetscScalar v[], InsertMode mode)
-{
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-  PetscInt        cache[3] = {-1, -1, -1}, bs;
-
-  PetscFunctionBegin;
-  if (!a->built && !a->staging) PetscCall(MatSetUp_SeqBinBCSR(A));
-  PetscCheck(PetscAbs(A->rmap->bs) == a->bs, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP, "Block size changed from %" PetscInt_FMT " to %" PetscInt_FMT " after preallocation", a->bs, A->rmap->bs);
-  bs = a->bs;
-  for (PetscInt i = 0; i < m; i++) {
-    const PetscInt br = im[i];
-    if (br < 0) continue;
-    PetscCheck(br < a->mbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Block row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", br, a->mbs);
-    for (PetscInt j = 0; j < n; j++) {
-      const PetscInt bc = in[j];
-      if (bc < 0) continue;
-      PetscCheck(bc < a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Block column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", bc, a->nbs);
-      if (a->sym && bc < br) continue; /* symmetric storage: the lower triangle is implied */
-      for (PetscInt ii = 0; ii < bs; ii++) {
-        for (PetscInt jj = 0; jj < bs; jj++) {
-          const PetscInt    prow = i * bs + ii, pcol = j * bs + jj;
-          const PetscScalar x    = v ? (a->roworiented ? v[prow * (n * bs) + pcol] : v[pcol * (m * bs) + prow]) : 0.0;
-          if (a->built) PetscCall(LayoutAdd(a, br, bc, ii * bs + jj, x, mode, br * bs + ii, bc * bs + jj, cache));
-          else PetscCall(StagingAdd(A, a, br, bc, ii * bs + jj, x, mode, br * bs + ii, bc * bs + jj));
-        }
-      }
-    }
-  }
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode MatGetValues_SeqBinBCSR(Mat A, PetscInt m, const PetscInt im[], PetscInt n, const PetscInt in[], PetscScalar v[])
-{
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-
-  PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatGetValues needs an assembled MATSEQBINBCSR matrix");
-  for (PetscInt i = 0; i < m; i++) {
-    const PetscInt r = im[i];
-    if (r < 0) continue;
-    PetscCheck(r < A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", r, A->rmap->n);
-    for (PetscInt j = 0; j < n; j++) {
-      const PetscInt c = in[j];
-      if (c < 0) continue;
-      PetscCheck(c < A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", c, A->cmap->n);
-      if (a->sym && c / a->bs < r / a->bs) { /* the transposed entry of the stored upper block */
-        const PetscInt s = MatSeqBinBCSRFindSlot(a, c / a->bs, r / a->bs);
-        v[i * n + j]     = s < 0 ? 0.0 : BinBCSRGetValue(a, BinBCSRValueIndex(s, (c % a->bs) * a->bs + r % a->bs, a->bw, a->bs2));
-        continue;
-      }
-      const PetscInt s = MatSeqBinBCSRFindSlot(a, r / a->bs, c / a->bs);
-      v[i * n + j]     = s < 0 ? 0.0 : BinBCSRGetValue(a, BinBCSRValueIndex(s, (r % a->bs) * a->bs + c % a->bs, a->bw, a->bs2));
-    }
-  }
-  PetscFunctionReturn(0);
-}
+#include "binbcsr_ops.h"
+#include "../common/binbcsr_type.h"
 
 static PetscErrorCode MatSetOption_SeqBinBCSR(Mat A, MatOption op, PetscBool flg)
 {
@@ -464,13 +101,6 @@ static PetscErrorCode MatBinBCSRSetPrecision_SeqBinBCSR(Mat A, MatBinBCSRPrecisi
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode MatBinBCSRGetPrecision_SeqBinBCSR(Mat A, MatBinBCSRPrecision *p)
-{
-  PetscFunctionBegin;
-  *p = ((Mat_SeqBinBCSR *)A->data)->precision;
-  PetscFunctionReturn(0);
-}
-
 static PetscErrorCode MatBinBCSRSetSymmetricStorage_SeqBinBCSR(Mat A, PetscBool flg)
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
@@ -488,98 +118,135 @@ static PetscErrorCode MatBinBCSRSetSymmetricStorage_SeqBinBCSR(Mat A, PetscBool 
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode MatBinBCSRGetSymmetricStorage_SeqBinBCSR(Mat A, PetscBool *flg)
+/* Settings that are a field of Mat_SeqBinBCSR and nothing more (the COO mirror, the streams, and the
+   getters of precision and storage): written and read as they are, by one pair of functions. */
+template <class T, T Mat_SeqBinBCSR::*field>
+static PetscErrorCode MatSeqBinBCSRSetField(Mat A, T v)
 {
   PetscFunctionBegin;
-  *flg = ((Mat_SeqBinBCSR *)A->data)->sym;
+  ((Mat_SeqBinBCSR *)A->data)->*field = v;
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode MatBinBCSRSetCOOMirror_SeqBinBCSR(Mat A, PetscBool flg)
+template <class T, T Mat_SeqBinBCSR::*field>
+static PetscErrorCode MatSeqBinBCSRGetField(Mat A, T *v)
 {
   PetscFunctionBegin;
-  ((Mat_SeqBinBCSR *)A->data)->coo_mirror = flg;
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode MatBinBCSRGetCOOMirror_SeqBinBCSR(Mat A, PetscBool *flg)
-{
-  PetscFunctionBegin;
-  *flg = ((Mat_SeqBinBCSR *)A->data)->coo_mirror;
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode MatBinBCSRSetStreams_SeqBinBCSR(Mat A, PetscInt streams)
-{
-  PetscFunctionBegin;
-  ((Mat_SeqBinBCSR *)A->data)->streams = streams;
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode MatBinBCSRGetStreams_SeqBinBCSR(Mat A, PetscInt *streams)
-{
-  PetscFunctionBegin;
-  *streams = ((Mat_SeqBinBCSR *)A->data)->streams;
+  *v = ((Mat_SeqBinBCSR *)A->data)->*field;
   PetscFunctionReturn(0);
 }
 
 static PetscErrorCode MatSetFromOptions_SeqBinBCSR(Mat A, PetscOptionItems *PetscOptionsObject)
 {
-  Mat_SeqBinBCSR     *a = (Mat_SeqBinBCSR *)A->data;
-  PetscInt            bw;
-  MatBinBCSRPrecision p  = a->precision;
-  PetscBool           set, sym;
-  PetscInt            streams = a->streams;
-
   PetscFunctionBegin;
-  PetscCall(MatBinBCSRGetBinWidth_SeqBinBCSR(A, &bw));
   PetscOptionsHeadBegin(PetscOptionsObject, "MATSEQBINBCSR options");
-  PetscCall(PetscOptionsInt("-mat_binbcsr_bin_width", "Rows (block rows) per bin", "MatBinBCSRSetBinWidth", bw, &bw, &set));
-  if (set) PetscCall(MatBinBCSRSetBinWidth_SeqBinBCSR(A, bw));
-  PetscCall(PetscOptionsEnum("-mat_binbcsr_precision", "Storage precision of the values", "MatBinBCSRSetPrecision", MatBinBCSRPrecisions, (PetscEnum)p, (PetscEnum *)&p, &set));
-  if (set) PetscCall(MatBinBCSRSetPrecision_SeqBinBCSR(A, p));
-  sym = a->sym;
-  PetscCall(PetscOptionsBool("-mat_binbcsr_symmetric_storage", "Store the upper triangle only (symmetric matrices; the lower triangle given is ignored)", "MatBinBCSRSetSymmetricStorage", sym, &sym, &set));
-  if (set) PetscCall(MatBinBCSRSetSymmetricStorage_SeqBinBCSR(A, sym));
-  PetscCall(PetscOptionsBool("-mat_binbcsr_coo_mirror", "COO entries of off-diagonal blocks also fill the transposed place (give one triangle of a symmetric matrix)", "MatBinBCSRSetCOOMirror", a->coo_mirror, &a->coo_mirror, nullptr));
-  PetscCall(PetscOptionsInt("-mat_binbcsr_streams", "Runs of bins the product sweeps side by side (1, 2, 4, 8)", "MatBinBCSRSetStreams", streams, &streams, &set));
-  if (set) PetscCall(MatBinBCSRSetStreams(A, streams));
+  PetscCall(MatBinBCSRReadOptions_Private(A, PetscOptionsObject));
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }
 
-/* Minimal MatGetInfo so that programs asking for it work before binbcsr_ops.cpp provides the full one
-   (MatSeqBinBCSRSetOps_Ops runs after this table is filled and may replace it). */
-static PetscErrorCode MatGetInfo_SeqBinBCSR_Basic(Mat A, MatInfoType flag, MatInfo *info)
-{
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+static PetscErrorCode MatDestroy_SeqBinBCSR(Mat);
 
-  PetscFunctionBegin;
-  (void)flag;
-  PetscCall(PetscMemzero(info, sizeof(*info)));
-  info->block_size   = (PetscLogDouble)a->bs;
-  info->nz_used      = a->built ? (PetscLogDouble)a->nz * a->bs2 : 0;
-  info->nz_allocated = a->built ? (PetscLogDouble)a->nslots * a->bs2 : 0;
-  info->nz_unneeded  = info->nz_allocated - info->nz_used;
-  info->assemblies   = (PetscLogDouble)A->num_ass;
-  info->memory       = 0;
-  PetscFunctionReturn(0);
+/* The ops table: every operation of the type, one named slot each (slots not named stay NULL, so
+   PETSc's generic code runs or MatXXX reports the operation as missing). Filled once, copied into
+   each new matrix by MatCreate_SeqBinBCSR. Named assignments rather than PETSc's positional
+   initialiser, so the table reads the same whatever slots a PETSc version adds or drops. */
+static const struct _MatOps &MatOps_SeqBinBCSR(void)
+{
+  static const struct _MatOps ops = [] {
+    struct _MatOps o = {};
+    BinBCSRSetCommonOps(o); /* common/: the same function for seq and mpi */
+    /* values in and out, assembly */
+    o.setvalues        = MatSetValues_SeqBinBCSR;
+    o.setvaluesblocked = MatSetValuesBlocked_SeqBinBCSR;
+    o.getvalues        = MatGetValues_SeqBinBCSR;
+    o.getrow           = MatGetRow_SeqBinBCSR;
+    o.restorerow       = MatRestoreRow_SeqBinBCSR;
+    o.getrowij         = MatGetRowIJ_SeqBinBCSR; /* binbcsr_rowij.cpp */
+    o.restorerowij     = MatRestoreRowIJ_SeqBinBCSR;
+    o.assemblyend      = MatAssemblyEnd_SeqBinBCSR;
+    o.setoption        = MatSetOption_SeqBinBCSR;
+    o.setup            = MatSetUp_SeqBinBCSR;
+    o.setfromoptions   = MatSetFromOptions_SeqBinBCSR;
+    o.zeroentries      = MatZeroEntries_SeqBinBCSR;
+    /* products and the diagonal */
+    o.mult                        = MatMult_SeqBinBCSR;
+    o.multadd                     = MatMultAdd_SeqBinBCSR;
+    o.multtranspose               = MatMultTranspose_SeqBinBCSR;
+    o.multtransposeadd            = MatMultTransposeAdd_SeqBinBCSR;
+    o.getdiagonal                 = MatGetDiagonal_SeqBinBCSR;
+    o.invertblockdiagonal         = MatInvertBlockDiagonal_SeqBinBCSR;
+    o.invertvariableblockdiagonal = MatInvertVariableBlockDiagonal_SeqBinBCSR;
+    o.sor                         = MatSOR_SeqBinBCSR;
+    o.multdiagonalblock           = MatMultDiagonalBlock_SeqBinBCSR;
+    /* value operations (binbcsr_ops.cpp) */
+    o.scale           = MatScale_SeqBinBCSR;
+    o.shift           = MatShift_SeqBinBCSR;
+    o.diagonalset     = MatDiagonalSet_SeqBinBCSR;
+    o.axpy            = MatAXPY_SeqBinBCSR;
+    o.zerorows        = MatZeroRows_SeqBinBCSR;
+    o.zerorowscolumns = MatZeroRowsColumns_SeqBinBCSR;
+    o.norm            = MatNorm_SeqBinBCSR;
+    o.getinfo         = MatGetInfo_SeqBinBCSR;
+    /* rows and columns (binbcsr_rowops.cpp) */
+    o.diagonalscale       = MatDiagonalScale_SeqBinBCSR;
+    o.getrowmaxabs        = MatGetRowMaxAbs_SeqBinBCSR;
+    o.getrowmax           = MatGetRowMax_SeqBinBCSR;
+    o.getrowmin           = MatGetRowMin_SeqBinBCSR;
+    o.getrowminabs        = MatGetRowMinAbs_SeqBinBCSR;
+    o.getcolumnreductions = MatGetColumnReductions_SeqBinBCSR;
+    o.missingdiagonal     = MatMissingDiagonal_SeqBinBCSR;
+    o.equal               = MatEqual_SeqBinBCSR;
+    /* new matrices, view, load */
+    o.transpose         = MatTranspose_SeqBinBCSR;
+    o.duplicate         = MatDuplicate_SeqBinBCSR;
+    o.copy              = MatCopy_SeqBinBCSR;
+    o.convertfrom       = MatConvertFrom_SeqBinBCSR;
+    o.destroy           = MatDestroy_SeqBinBCSR;
+    o.view              = MatView_SeqBinBCSR;
+    o.load              = MatLoad_SeqBinBCSR;
+    /* through the AIJ shadow (common/; MatCreateSubMatrix uses createsubmatrices on one rank) */
+    o.creatempimatconcatenateseqmat = MatCreateMPIMatConcatenateSeqMat_BinBCSR;
+    return o;
+  }();
+  return ops;
 }
 
-static const char *const composed_names[] = {"MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatBinBCSRSetCOOMirror_C", "MatBinBCSRGetCOOMirror_C", "MatBinBCSRSetStreams_C", "MatBinBCSRGetStreams_C", "MatSeqAIJSetPreallocation_C", "MatSeqBAIJSetPreallocation_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatConvert_seqbinbcsr_seqaij_C", "MatConvert_seqbinbcsr_seqbaij_C", "MatProductSetFromOptions_anytype_C", "MatAXPYGetPreallocation_C"};
+/* The composed functions, composed by MatCreate_SeqBinBCSR and cleared by MatDestroy_SeqBinBCSR. */
+static const BinBCSRComposed composed[] = {
+  BINBCSR_COMPOSED("MatBinBCSRSetBinWidth_C", MatBinBCSRSetBinWidth_SeqBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRGetBinWidth_C", MatBinBCSRGetBinWidth_SeqBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRSetPrecision_C", MatBinBCSRSetPrecision_SeqBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRGetPrecision_C", (&MatSeqBinBCSRGetField<MatBinBCSRPrecision, &Mat_SeqBinBCSR::precision>)),
+  BINBCSR_COMPOSED("MatBinBCSRSetSymmetricStorage_C", MatBinBCSRSetSymmetricStorage_SeqBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRGetSymmetricStorage_C", (&MatSeqBinBCSRGetField<PetscBool, &Mat_SeqBinBCSR::sym>)),
+  BINBCSR_COMPOSED("MatBinBCSRSetCOOMirror_C", (&MatSeqBinBCSRSetField<PetscBool, &Mat_SeqBinBCSR::coo_mirror>)),
+  BINBCSR_COMPOSED("MatBinBCSRGetCOOMirror_C", (&MatSeqBinBCSRGetField<PetscBool, &Mat_SeqBinBCSR::coo_mirror>)),
+  BINBCSR_COMPOSED("MatBinBCSRSetStreams_C", (&MatSeqBinBCSRSetField<PetscInt, &Mat_SeqBinBCSR::streams>)),
+  BINBCSR_COMPOSED("MatBinBCSRGetStreams_C", (&MatSeqBinBCSRGetField<PetscInt, &Mat_SeqBinBCSR::streams>)),
+  BINBCSR_COMPOSED("MatSeqAIJSetPreallocation_C", MatSeqAIJSetPreallocation_SeqBinBCSR),
+  BINBCSR_COMPOSED("MatSeqBAIJSetPreallocation_C", MatSeqBAIJSetPreallocation_SeqBinBCSR),
+  BINBCSR_COMPOSED("MatSetPreallocationCOO_C", MatSetPreallocationCOO_SeqBinBCSR),
+  BINBCSR_COMPOSED("MatSetValuesCOO_C", MatSetValuesCOO_SeqBinBCSR),
+  BINBCSR_COMPOSED("MatMultDotLocal_C", MatMultDotLocal_SeqBinBCSR),
+  BINBCSR_COMPOSED("MatConvert_seqbinbcsr_seqaij_C", MatConvert_SeqBinBCSR_SeqAIJ),
+  BINBCSR_COMPOSED("MatConvert_seqbinbcsr_seqbaij_C", MatConvert_SeqBinBCSR_SeqBAIJ),
+#if defined(PETSC_HAVE_HYPRE)
+  BINBCSR_COMPOSED("MatConvert_seqbinbcsr_hypre_C", MatConvert_BinBCSR_HYPRE),
+#endif
+  BINBCSR_COMPOSED("MatProductSetFromOptions_anytype_C", MatProductSetFromOptions_BinBCSR), /* products with other types */
+  BINBCSR_COMPOSED("MatAXPYGetPreallocation_C", MatAXPYGetPreallocation_BinBCSR),
+};
 
 static PetscErrorCode MatDestroy_SeqBinBCSR(Mat A)
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
 
   PetscFunctionBegin;
-  if (a) {
-    PetscCall(MatSeqBinBCSRFreeLayout(a));
-    delete a->staging;
-  }
+  if (a) PetscCall(MatSeqBinBCSRFreeStorage(a));
   PetscCall(PetscFree(A->data));
   PetscCall(PetscObjectChangeTypeName((PetscObject)A, nullptr));
-  for (const char *name : composed_names) PetscCall(PetscObjectComposeFunction((PetscObject)A, name, nullptr));
+  PetscCall(BinBCSRComposeList((PetscObject)A, composed, PETSC_TRUE));
   PetscFunctionReturn(0);
 }
 
@@ -600,54 +267,8 @@ PetscErrorCode MatCreate_SeqBinBCSR(Mat A)
   a->bs          = 1;
   a->bs2         = 1;
 
-  PetscCall(PetscMemzero(A->ops, sizeof(struct _MatOps)));
-  A->ops->setvalues           = MatSetValues_SeqBinBCSR;
-  A->ops->setvaluesblocked    = MatSetValuesBlocked_SeqBinBCSR;
-  A->ops->getvalues           = MatGetValues_SeqBinBCSR;
-  A->ops->getrow              = MatGetRow_SeqBinBCSR;
-  A->ops->restorerow          = MatRestoreRow_SeqBinBCSR;
-  A->ops->mult                = MatMult_SeqBinBCSR;
-  A->ops->multadd             = MatMultAdd_SeqBinBCSR;
-  A->ops->multtranspose       = MatMultTranspose_SeqBinBCSR;
-  A->ops->multtransposeadd    = MatMultTransposeAdd_SeqBinBCSR;
-  A->ops->getdiagonal         = MatGetDiagonal_SeqBinBCSR;
-  A->ops->invertblockdiagonal = MatInvertBlockDiagonal_SeqBinBCSR;
-  A->ops->invertvariableblockdiagonal = MatInvertVariableBlockDiagonal_SeqBinBCSR;
-  A->ops->sor                 = MatSOR_SeqBinBCSR;
-  A->ops->multdiagonalblock   = MatMultDiagonalBlock_SeqBinBCSR;
-  A->ops->assemblyend         = MatAssemblyEnd_SeqBinBCSR;
-  A->ops->setoption           = MatSetOption_SeqBinBCSR;
-  A->ops->setup               = MatSetUp_SeqBinBCSR;
-  A->ops->duplicate           = MatDuplicate_SeqBinBCSR;
-  A->ops->copy                = MatCopy_SeqBinBCSR;
-  A->ops->destroy             = MatDestroy_SeqBinBCSR;
-  A->ops->view                = MatView_SeqBinBCSR;
-  A->ops->convertfrom         = MatConvertFrom_SeqBinBCSR;
-  A->ops->setfromoptions      = MatSetFromOptions_SeqBinBCSR;
-  A->ops->getinfo             = MatGetInfo_SeqBinBCSR_Basic;
-  A->ops->creategraph         = MatCreateGraph_BinBCSR; /* PCGAMG, through the AIJ shadow */
-  A->ops->productsetfromoptions = MatProductSetFromOptions_BinBCSR;
-
+  PetscCall(PetscMemcpy(A->ops, &MatOps_SeqBinBCSR(), sizeof(struct _MatOps)));
   PetscCall(PetscObjectChangeTypeName((PetscObject)A, MATSEQBINBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRSetBinWidth_C", MatBinBCSRSetBinWidth_SeqBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRGetBinWidth_C", MatBinBCSRGetBinWidth_SeqBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRSetPrecision_C", MatBinBCSRSetPrecision_SeqBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRGetPrecision_C", MatBinBCSRGetPrecision_SeqBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRSetSymmetricStorage_C", MatBinBCSRSetSymmetricStorage_SeqBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRGetSymmetricStorage_C", MatBinBCSRGetSymmetricStorage_SeqBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRSetCOOMirror_C", MatBinBCSRSetCOOMirror_SeqBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRGetCOOMirror_C", MatBinBCSRGetCOOMirror_SeqBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRSetStreams_C", MatBinBCSRSetStreams_SeqBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatBinBCSRGetStreams_C", MatBinBCSRGetStreams_SeqBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatSeqAIJSetPreallocation_C", MatSeqAIJSetPreallocation_SeqBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatSeqBAIJSetPreallocation_C", MatSeqBAIJSetPreallocation_SeqBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatSetPreallocationCOO_C", MatSetPreallocationCOO_SeqBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatSetValuesCOO_C", MatSetValuesCOO_SeqBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatMultDotLocal_C", MatMultDotLocal_SeqBinBCSR));
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatConvert_seqbinbcsr_seqaij_C", MatConvert_SeqBinBCSR_SeqAIJ));
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatConvert_seqbinbcsr_seqbaij_C", MatConvert_SeqBinBCSR_SeqBAIJ));
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatProductSetFromOptions_anytype_C", MatProductSetFromOptions_BinBCSR)); /* products with other types */
-
-  PetscCall(MatSeqBinBCSRSetOps_Ops(A));
+  PetscCall(BinBCSRComposeList((PetscObject)A, composed, PETSC_FALSE));
   PetscFunctionReturn(0);
 }

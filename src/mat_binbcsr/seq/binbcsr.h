@@ -39,7 +39,7 @@
 
    (row 1's slot k=1 and row 3's slots k=1,2 are padding: zero values, repeated last column; the
    phantom lane of bin 2 has no column, its padding reads column 0). The padding overhead is
-   nslots / nz - 1 (here 12/8 - 1 = 50%; FEM matrices give a few %). tests/unit/mat_core/layout.cpp
+   nslots / nz - 1 (here 12/8 - 1 = 50%; FEM matrices give a few %). tests/unit/mat_binbcsr/mat_core/layout.cpp
    checks this example.
 */
 #ifndef BINBCSR_SEQ_H
@@ -124,10 +124,6 @@ typedef struct {
   MatScalar       *sor_idiag; /* [mbs * bs2] (D + sor_shift I)^-1 for MatSOR, valid for sor_state */
   PetscObjectState sor_state; /* state of the matrix when sor_idiag was computed (0: never) */
   PetscReal        sor_shift;
-
-  /* Viewers other than ASCII (binary, ...): binbcsr_ops.cpp may set this hook in
-     MatSeqBinBCSRSetOps_Ops; ops->view (binbcsr.cpp) handles ASCII and forwards the rest here. */
-  PetscErrorCode (*view_other)(Mat, PetscViewer);
 } Mat_SeqBinBCSR;
 
 /* Default bin width, measured on this project's AVX-512 machine (docs/mat_binbcsr.md): 8 block rows
@@ -184,11 +180,18 @@ PETSC_INTERN PetscErrorCode MatSeqBinBCSRStagingDropLower(Mat);
 /* ASCII MatView (info formats and the default entry listing). */
 PETSC_INTERN PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat, PetscViewer);
 
-/* Filled by the second part of the implementation (binbcsr_ops.cpp); called at the end of
-   MatCreate_SeqBinBCSR so both parts contribute to one ops table. */
-PETSC_INTERN PetscErrorCode MatSeqBinBCSRSetOps_Ops(Mat);
+/* Staging, preallocation, MatSetValues and assembly (binbcsr_assembly.cpp) */
+PETSC_INTERN PetscErrorCode MatSetUp_SeqBinBCSR(Mat);
+PETSC_INTERN PetscErrorCode MatSeqAIJSetPreallocation_SeqBinBCSR(Mat, PetscInt, const PetscInt[]);
+PETSC_INTERN PetscErrorCode MatSeqBAIJSetPreallocation_SeqBinBCSR(Mat, PetscInt, PetscInt, const PetscInt[]);
+PETSC_INTERN PetscErrorCode MatSetValues_SeqBinBCSR(Mat, PetscInt, const PetscInt[], PetscInt, const PetscInt[], const PetscScalar[], InsertMode);
+PETSC_INTERN PetscErrorCode MatSetValuesBlocked_SeqBinBCSR(Mat, PetscInt, const PetscInt[], PetscInt, const PetscInt[], const PetscScalar[], InsertMode);
+PETSC_INTERN PetscErrorCode MatGetValues_SeqBinBCSR(Mat, PetscInt, const PetscInt[], PetscInt, const PetscInt[], PetscScalar[]);
+PETSC_INTERN PetscErrorCode MatAssemblyEnd_SeqBinBCSR(Mat, MatAssemblyType);
+/* The layout, the staging and the COO map freed (MatDestroy) */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRFreeStorage(Mat_SeqBinBCSR *);
 
-/* Parts of binbcsr.cpp's ops table implemented in the other files of this folder. */
+/* Parts of the ops table (binbcsr.cpp) implemented in the other files of this folder. */
 PETSC_INTERN PetscErrorCode MatMult_SeqBinBCSR(Mat, Vec, Vec);
 PETSC_INTERN PetscErrorCode MatMultAdd_SeqBinBCSR(Mat, Vec, Vec, Vec);
 PETSC_INTERN PetscErrorCode MatMultTranspose_SeqBinBCSR(Mat, Vec, Vec);

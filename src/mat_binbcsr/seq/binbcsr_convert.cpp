@@ -1,5 +1,6 @@
 /* MATSEQBINBCSR rows, copies, conversions and ASCII views. */
 #include "binbcsr.h"
+#include "binbcsr_ops.h"
 #include "../binbcsr_kernels.h"
 #include <petscviewer.h>
 #include <algorithm>
@@ -432,19 +433,11 @@ PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
 
 PetscErrorCode MatView_SeqBinBCSR(Mat A, PetscViewer viewer)
 {
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-  PetscBool       isascii;
+  PetscBool isascii;
 
   PetscFunctionBegin;
   PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &isascii));
   if (isascii) PetscCall(MatView_SeqBinBCSR_ASCII(A, viewer));
-  else if (a->view_other) PetscCall(a->view_other(A, viewer));
-  else {
-    /* any other viewer: through an AIJ copy */
-    Mat B;
-    PetscCall(MatConvert(A, MATSEQAIJ, MAT_INITIAL_MATRIX, &B));
-    PetscCall(MatView(B, viewer));
-    PetscCall(MatDestroy(&B));
-  }
+  else PetscCall(MatView_SeqBinBCSR_Other(A, viewer)); /* binary natively, the rest through a seqaij copy */
   PetscFunctionReturn(0);
 }

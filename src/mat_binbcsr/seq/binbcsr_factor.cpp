@@ -14,7 +14,7 @@
    Cholesky, which seqsbaij factors in natural order only, get a shadow of the renumbered matrix and
    permuting solves. LU and Cholesky default to nested dissection, ILU and ICC to natural. */
 #include "binbcsr.h"
-#include "../binbcsr_factor_routing.h"
+#include "../common/binbcsr_factor_routing.h"
 #include <algorithm>
 #include <vector>
 

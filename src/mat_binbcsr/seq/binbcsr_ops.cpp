@@ -213,7 +213,7 @@ PetscBool MatSeqBinBCSRSameLayout(const Mat_SeqBinBCSR *y, const Mat_SeqBinBCSR 
   return std::equal(y->bin_start, y->bin_start + y->nbins + 1, x->bin_start) && std::equal(y->row_nz, y->row_nz + y->mbs, x->row_nz) && std::equal(y->col, y->col + y->nslots, x->col) ? PETSC_TRUE : PETSC_FALSE;
 }
 
-static PetscErrorCode MatZeroEntries_SeqBinBCSR(Mat A)
+PetscErrorCode MatZeroEntries_SeqBinBCSR(Mat A)
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
 
@@ -228,7 +228,7 @@ static PetscErrorCode MatZeroEntries_SeqBinBCSR(Mat A)
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode MatScale_SeqBinBCSR(Mat A, PetscScalar alpha)
+PetscErrorCode MatScale_SeqBinBCSR(Mat A, PetscScalar alpha)
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
 
@@ -246,7 +246,7 @@ static PetscErrorCode MatScale_SeqBinBCSR(Mat A, PetscScalar alpha)
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode MatShift_SeqBinBCSR(Mat A, PetscScalar alpha)
+PetscErrorCode MatShift_SeqBinBCSR(Mat A, PetscScalar alpha)
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
   const PetscInt  n = PetscMin(A->rmap->n, A->cmap->n);
@@ -264,7 +264,7 @@ static PetscErrorCode MatShift_SeqBinBCSR(Mat A, PetscScalar alpha)
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode MatDiagonalSet_SeqBinBCSR(Mat A, Vec D, InsertMode mode)
+PetscErrorCode MatDiagonalSet_SeqBinBCSR(Mat A, Vec D, InsertMode mode)
 {
   Mat_SeqBinBCSR    *a = (Mat_SeqBinBCSR *)A->data;
   const PetscScalar *d;
@@ -299,7 +299,7 @@ static PetscErrorCode MatDiagonalSet_SeqBinBCSR(Mat A, Vec D, InsertMode mode)
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode MatAXPY_SeqBinBCSR(Mat Y, PetscScalar alpha, Mat X, MatStructure str)
+PetscErrorCode MatAXPY_SeqBinBCSR(Mat Y, PetscScalar alpha, Mat X, MatStructure str)
 {
   Mat_SeqBinBCSR *y = (Mat_SeqBinBCSR *)Y->data;
   PetscBool       xbin, contains;
@@ -350,7 +350,7 @@ static PetscErrorCode MatAXPY_SeqBinBCSR(Mat Y, PetscScalar alpha, Mat X, MatStr
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode MatZeroRows_SeqBinBCSR(Mat A, PetscInt N, const PetscInt rows[], PetscScalar diag, Vec x, Vec b)
+PetscErrorCode MatZeroRows_SeqBinBCSR(Mat A, PetscInt N, const PetscInt rows[], PetscScalar diag, Vec x, Vec b)
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
   const int       bw = (int)a->bw, bs = (int)a->bs;
@@ -384,7 +384,7 @@ static PetscErrorCode MatZeroRows_SeqBinBCSR(Mat A, PetscInt N, const PetscInt r
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode MatZeroRowsColumns_SeqBinBCSR(Mat A, PetscInt N, const PetscInt rows[], PetscScalar diag, Vec x, Vec b)
+PetscErrorCode MatZeroRowsColumns_SeqBinBCSR(Mat A, PetscInt N, const PetscInt rows[], PetscScalar diag, Vec x, Vec b)
 {
   Mat_SeqBinBCSR    *a = (Mat_SeqBinBCSR *)A->data;
   const int          bw = (int)a->bw, bs = (int)a->bs;
@@ -463,7 +463,7 @@ static PetscErrorCode MaxColumnSum(Mat A, PetscReal *nrm)
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode MatNorm_SeqBinBCSR(Mat A, NormType type, PetscReal *nrm)
+PetscErrorCode MatNorm_SeqBinBCSR(Mat A, NormType type, PetscReal *nrm)
 {
   Mat_SeqBinBCSR *a  = (Mat_SeqBinBCSR *)A->data;
   const int       bw = (int)a->bw, bs = (int)a->bs, bs2 = (int)a->bs2;
@@ -513,7 +513,7 @@ static PetscErrorCode MatNorm_SeqBinBCSR(Mat A, NormType type, PetscReal *nrm)
 }
 
 /* As BAIJ: block_size is bs^2 (values per stored block); allocated counts padding slots. */
-static PetscErrorCode MatGetInfo_SeqBinBCSR(Mat A, MatInfoType flag, MatInfo *info)
+PetscErrorCode MatGetInfo_SeqBinBCSR(Mat A, MatInfoType flag, MatInfo *info)
 {
   Mat_SeqBinBCSR *a   = (Mat_SeqBinBCSR *)A->data;
   const double    bs2 = (double)PetscMax(a->bs2, 1);
@@ -531,53 +531,5 @@ static PetscErrorCode MatGetInfo_SeqBinBCSR(Mat A, MatInfoType flag, MatInfo *in
     info->nz_unneeded        = info->nz_allocated - info->nz_used;
     info->memory             = info->nz_allocated * value_bytes + (double)(a->nslots + a->nbins + 1 + 2 * a->mbs + (a->sym ? a->nz + a->mbs + 1 : 0)) * sizeof(PetscInt) + (a->coo_jmap ? (double)(a->nslots * bs2 + 1 + a->coo_n) * sizeof(PetscInt) : 0.0);
   }
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode MatSeqBinBCSRSetOps_Ops(Mat A)
-{
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-
-  PetscFunctionBegin;
-  A->ops->zeroentries       = MatZeroEntries_SeqBinBCSR;
-  A->ops->scale             = MatScale_SeqBinBCSR;
-  A->ops->shift             = MatShift_SeqBinBCSR;
-  A->ops->diagonalset       = MatDiagonalSet_SeqBinBCSR;
-  A->ops->axpy              = MatAXPY_SeqBinBCSR;
-  A->ops->zerorows          = MatZeroRows_SeqBinBCSR;
-  A->ops->zerorowscolumns   = MatZeroRowsColumns_SeqBinBCSR;
-  A->ops->norm              = MatNorm_SeqBinBCSR;
-  A->ops->getinfo           = MatGetInfo_SeqBinBCSR;
-  A->ops->transpose         = MatTranspose_SeqBinBCSR;
-  A->ops->diagonalscale     = MatDiagonalScale_SeqBinBCSR;
-  A->ops->getrowmaxabs      = MatGetRowMaxAbs_SeqBinBCSR;
-  A->ops->getrowmax         = MatGetRowMax_SeqBinBCSR;
-  A->ops->getrowmin         = MatGetRowMin_SeqBinBCSR;
-  A->ops->getrowminabs      = MatGetRowMinAbs_SeqBinBCSR;
-  A->ops->getcolumnreductions = MatGetColumnReductions_SeqBinBCSR;
-  A->ops->missingdiagonal   = MatMissingDiagonal_SeqBinBCSR;
-  A->ops->equal             = MatEqual_SeqBinBCSR;
-  A->ops->permute           = MatPermute_BinBCSR;
-  A->ops->issymmetric       = MatIsSymmetric_BinBCSR;
-  A->ops->findzerodiagonals = MatFindZeroDiagonals_BinBCSR;
-  A->ops->findnonzerorows   = MatFindNonzeroRows_BinBCSR;
-  A->ops->setrandom         = MatSetRandom_BinBCSR;
-  A->ops->realpart          = MatRealPart_BinBCSR;
-  A->ops->imaginarypart     = MatImaginaryPart_BinBCSR;
-  A->ops->load              = MatLoad_SeqBinBCSR;
-  /* submatrices through an AIJ shadow (binbcsr_submat.cpp); MatCreateSubMatrix uses createsubmatrices on one rank */
-  A->ops->increaseoverlap               = MatIncreaseOverlap_BinBCSR;
-  A->ops->createsubmatrices             = MatCreateSubMatrices_BinBCSR;
-  A->ops->fdcoloringcreate              = MatFDColoringCreate_BinBCSR;
-  A->ops->fdcoloringsetup               = MatFDColoringSetUp_BinBCSR;
-  A->ops->fdcoloringapply               = MatFDColoringApply_BinBCSR;
-  A->ops->creatempimatconcatenateseqmat = MatCreateMPIMatConcatenateSeqMat_BinBCSR;
-  A->ops->getrowij                      = MatGetRowIJ_SeqBinBCSR; /* binbcsr_rowij.cpp */
-  A->ops->restorerowij                  = MatRestoreRowIJ_SeqBinBCSR;
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatAXPYGetPreallocation_C", MatAXPYGetPreallocation_BinBCSR));
-#if defined(PETSC_HAVE_HYPRE)
-  PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatConvert_seqbinbcsr_hypre_C", MatConvert_BinBCSR_HYPRE));
-#endif
-  a->view_other             = MatView_SeqBinBCSR_Other;
   PetscFunctionReturn(0);
 }

@@ -1,9 +1,21 @@
-/* MATSEQBINBCSR: ops-table entries of binbcsr_ops.cpp implemented in the other files of its part
-   (binary I/O in binbcsr_io.cpp, transpose in binbcsr_transpose.cpp). */
+/* MATSEQBINBCSR: the value operations of binbcsr_ops.cpp and the entries of the ops table (binbcsr.cpp)
+   next to them: binary I/O (binbcsr_io.cpp), transpose (binbcsr_transpose.cpp), rows and columns
+   (binbcsr_rowops.cpp). */
 #ifndef BINBCSR_SEQ_OPS_H
 #define BINBCSR_SEQ_OPS_H
 
 #include "binbcsr.h"
+
+/* Value operations (binbcsr_ops.cpp) */
+PETSC_INTERN PetscErrorCode MatZeroEntries_SeqBinBCSR(Mat);
+PETSC_INTERN PetscErrorCode MatScale_SeqBinBCSR(Mat, PetscScalar);
+PETSC_INTERN PetscErrorCode MatShift_SeqBinBCSR(Mat, PetscScalar);
+PETSC_INTERN PetscErrorCode MatDiagonalSet_SeqBinBCSR(Mat, Vec, InsertMode);
+PETSC_INTERN PetscErrorCode MatAXPY_SeqBinBCSR(Mat, PetscScalar, Mat, MatStructure);
+PETSC_INTERN PetscErrorCode MatZeroRows_SeqBinBCSR(Mat, PetscInt, const PetscInt[], PetscScalar, Vec, Vec);
+PETSC_INTERN PetscErrorCode MatZeroRowsColumns_SeqBinBCSR(Mat, PetscInt, const PetscInt[], PetscScalar, Vec, Vec);
+PETSC_INTERN PetscErrorCode MatNorm_SeqBinBCSR(Mat, NormType, PetscReal *);
+PETSC_INTERN PetscErrorCode MatGetInfo_SeqBinBCSR(Mat, MatInfoType, MatInfo *);
 
 /* MatLoad from a PETSc binary file (the format seqaij and seqbaij write). */
 PETSC_INTERN PetscErrorCode MatLoad_SeqBinBCSR(Mat, PetscViewer);

@@ -2,7 +2,7 @@
 // the fused product is used, and single storage behaves as documented (converges on the rounded
 // operator; against the double-precision matrix the residual has a floor near float rounding).
 #include <catch2/catch.hpp>
-#include "mcg_test_problems.h"
+#include "mcg_test_problems.hpp"
 #include <cstdlib>
 #include <cstring>
 

@@ -1,7 +1,7 @@
 // KSPMCG is CG in exact arithmetic: its iterates, residual histories and iteration counts must match
 // KSPCG's (same PC, same norm type) to round-off on SPD systems.
 #include <catch2/catch.hpp>
-#include "mcg_test_problems.h"
+#include "mcg_test_problems.hpp"
 #include <cstdlib>
 
 using namespace mcg_test;

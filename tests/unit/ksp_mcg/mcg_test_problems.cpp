@@ -1,4 +1,4 @@
-#include "mcg_test_problems.h"
+#include "mcg_test_problems.hpp"
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>

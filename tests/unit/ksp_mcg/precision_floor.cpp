@@ -1,7 +1,7 @@
 // KSPMCG's precision floor: with single-precision operator storage it must not claim a tolerance below
 // what the rounded products can resolve (u ||A|| ||x||), and must report the residual honestly.
 #include <catch2/catch.hpp>
-#include "mcg_test_problems.h"
+#include "mcg_test_problems.hpp"
 #include <cstdio>
 #include <string>
 

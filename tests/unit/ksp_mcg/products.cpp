@@ -3,7 +3,7 @@
 // of N iterations makes exactly N products, as KSPCG does; on one process a solve to a tolerance skips
 // the product after the converged iteration too.
 #include <catch2/catch.hpp>
-#include "mcg_test_problems.h"
+#include "mcg_test_problems.hpp"
 
 using namespace mcg_test;
 

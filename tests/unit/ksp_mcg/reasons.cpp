@@ -1,7 +1,7 @@
 // KSPMCG reports a defined KSPConvergedReason for bad input: it never divides by zero, never loops
 // past max_it and never reports a non-converged solve as converged.
 #include <catch2/catch.hpp>
-#include "mcg_test_problems.h"
+#include "mcg_test_problems.hpp"
 
 using namespace mcg_test;
 

@@ -1,7 +1,7 @@
 // Counts global reductions: MPI_Allreduce is wrapped here through the MPI profiling interface, so
 // every call made by PETSc and by the plug-in during a solve passes through this counter.
 #include <catch2/catch.hpp>
-#include "mcg_test_problems.h"
+#include "mcg_test_problems.hpp"
 
 using namespace mcg_test;
 

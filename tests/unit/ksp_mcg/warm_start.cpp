@@ -3,7 +3,7 @@
 // from the same guess, and the A-norm of the error never grows with the iteration count nor exceeds
 // the guess's. (The cloth blows up with warm-started 30 iterations all the same: docs/cloth.md says why.)
 #include <catch2/catch.hpp>
-#include "mcg_test_problems.h"
+#include "mcg_test_problems.hpp"
 
 using namespace mcg_test;
 

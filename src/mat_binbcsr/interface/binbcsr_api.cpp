@@ -1,0 +1,440 @@
+/* The public functions of MATBINBCSR (include/petscbinbcsr.h) and the type's manual page. Each
+   dispatches to the composed implementation of the actual type (seq/ or mpi/) and does nothing on
+   other types, so user code can call them unconditionally. */
+#include "binbcsr_impl.h"
+#include <petsc/private/matimpl.h>
+
+/*MC
+   MATBINBCSR - "binbcsr": the BIN-CSR (block size 1) and BIN-BCSR (block size 3) sparse matrix, a
+   format whose products and updates read memory the way SIMD lanes and GPU warps want it. Picks
+   `MATSEQBINBCSR` on one process and `MATMPIBINBCSR` on several.
+
+   Options Database Keys:
++  -mat_type binbcsr                        - the type (the block size from `MatSetBlockSize()` or -mat_block_size)
+.  -mat_binbcsr_bin_width <bw>              - rows (block rows) per bin, see `MatBinBCSRSetBinWidth()`
+.  -mat_binbcsr_precision <double,single>   - value storage, see `MatBinBCSRSetPrecision()`
+.  -mat_binbcsr_symmetric_storage           - upper block triangle only, see `MatBinBCSRSetSymmetricStorage()`
+.  -mat_binbcsr_coo_mirror                  - COO entries fill their transposed place, see `MatBinBCSRSetCOOMirror()`
+.  -mat_binbcsr_streams <k>                 - runs of bins the product sweeps side by side, see `MatBinBCSRSetStreams()`
+-  -mat_mpibinbcsr_inner_type <type>        - type of the parts of `MATMPIBINBCSR` (default seqbinbcsr)
+
+   Level: beginner
+
+   Notes:
+   Rows (block rows of bs x bs blocks) are grouped into bins of bw consecutive rows; each row of a bin
+   is a lane. A bin is padded to its own longest row, and entry k of every lane lies side by side:
+   entry k of lane l of bin b is slot bin_start[b] + k bw + l, so one sweep over k feeds all lanes
+   from contiguous memory and no lane needs a reduction. Each slot has one block column; padding
+   slots hold zero values and a valid column (the lane's last real one), so the kernels have no
+   branches. The bs^2 values of the slots of one k are stored entry by entry: entry e of slot s is
+   val[(s - l) bs^2 + e bw + l], l = s mod bw.
+
+   The 5x5 matrix below with bw = 2 and scalar entries (bs = 1):
+.vb
+   [ a . b . . ]   bin 0: rows 0,1  longest row 2 -> 2 x 2 slots
+   [ . c . . . ]   bin 1: rows 2,3  longest row 3 -> 3 x 2 slots
+   [ d . e f . ]   bin 2: row 4 (+ a phantom lane) -> 1 x 2 slots
+   [ . . . h . ]
+   [ . . . . i ]        bin_start = [0, 4, 10, 12]
+
+   slot :  0  1  2  3 |  4  5  6  7  8  9 | 10 11
+   lane :  0  1  0  1 |  0  1  0  1  0  1 |  0  1
+   col  :  0  1  2  1 |  0  3  2  3  3  3 |  4  0
+   value:  a  c  b  0 |  d  h  e  0  f  0 |  i  0
+           k=0   k=1     k=0   k=1   k=2     k=0
+.ve
+   The padding overhead is slots / stored blocks - 1 (here 12/8 - 1 = 50%; FEM matrices give a few
+   percent). The layout is frozen at the first final assembly (or `MatSetPreallocationCOO()`, a
+   conversion or a load): a later new nonzero location is an error unless `MAT_NEW_NONZERO_LOCATIONS`
+   is false. `MATMPIBINBCSR` stores each process's rows as a diagonal and an off-diagonal part, both
+   `MATSEQBINBCSR`, and overlaps the ghost exchange of `MatMult()` with the diagonal-part product.
+   Operations the format does not do natively (submatrices, factorisations by external packages,
+   graphs for `PCGAMG`, finite-difference colouring) go through an AIJ copy kept in step with the
+   matrix. src/mat_binbcsr/seq/binbcsr.h defines the layout; docs/mat_binbcsr.md describes it.
+
+.seealso: `MatCreate()`, `MatSetType()`, `MatBinBCSRSetBinWidth()`, `MatBinBCSRSetPrecision()`,
+          `MatBinBCSRSetSymmetricStorage()`, `MatBinBCSRSetCOOMirror()`, `MatBinBCSRSetStreams()`,
+          `MatBinBCSRSetFromOptions()`, `MatMultDotLocal()`, `KSPMCG`, `MATBAIJ`, `MATSELL`
+M*/
+
+/*@
+   MatBinBCSRSetFromOptions - Applies the `-mat_binbcsr_*` options of the options database (under the
+   matrix's prefix) to a `MATBINBCSR` matrix whose type the program chose
+
+   Collective
+
+   Input Parameter:
+.  A - the matrix
+
+   Options Database Keys:
++  -mat_binbcsr_bin_width <bw>       - rows (block rows) per bin, see `MatBinBCSRSetBinWidth()`
+.  -mat_binbcsr_precision <double,single> - value storage, see `MatBinBCSRSetPrecision()`
+.  -mat_binbcsr_symmetric_storage    - upper triangle only, see `MatBinBCSRSetSymmetricStorage()`
+.  -mat_binbcsr_coo_mirror           - COO entries fill their transposed place, see `MatBinBCSRSetCOOMirror()`
+-  -mat_binbcsr_streams <k>          - runs of bins swept side by side, see `MatBinBCSRSetStreams()`
+
+   Level: beginner
+
+   Note:
+   `MatSetFromOptions()` reads the same options but also lets `-mat_type` replace the type the program
+   set with `MatSetType()`. A no-op on matrices of other types.
+
+.seealso: `MATBINBCSR`, `MatSetFromOptions()`
+@*/
+PetscErrorCode MatBinBCSRSetFromOptions(Mat A)
+{
+  PetscErrorCode (*is_binbcsr)(Mat, PetscInt) = nullptr;
+
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscCall(PetscObjectQueryFunction((PetscObject)A, "MatBinBCSRSetBinWidth_C", &is_binbcsr));
+  if (!is_binbcsr || !A->ops->setfromoptions) PetscFunctionReturn(0);
+  PetscObjectOptionsBegin((PetscObject)A);
+  PetscCall((*A->ops->setfromoptions)(A, PetscOptionsObject));
+  PetscOptionsEnd();
+  PetscFunctionReturn(0);
+}
+
+/*@
+   MatBinBCSRSetBinWidth - Sets the number of rows (block rows) per bin of a `MATBINBCSR` matrix
+
+   Logically Collective
+
+   Input Parameters:
++  A  - the matrix
+-  bw - rows (block rows) per bin, in [1, 1024]; on one process `PETSC_DEFAULT` restores the default
+
+   Options Database Key:
+.  -mat_binbcsr_bin_width <bw> - sets the bin width
+
+   Level: intermediate
+
+   Notes:
+   The default is 8 block rows for block size 3 and 16 rows for block size 1 (measured with
+   examples/binbcsr_tune, docs/mat_binbcsr.md). Set it before the layout is built: the first final
+   assembly, `MatSetPreallocationCOO()`, a conversion or a load. A no-op on matrices of other types.
+
+.seealso: `MATBINBCSR`, `MatBinBCSRGetBinWidth()`
+@*/
+PetscErrorCode MatBinBCSRSetBinWidth(Mat A, PetscInt bw)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidLogicalCollectiveInt(A, bw, 2);
+  PetscTryMethod(A, "MatBinBCSRSetBinWidth_C", (Mat, PetscInt), (A, bw));
+  PetscFunctionReturn(0);
+}
+
+/*@
+   MatBinBCSRGetBinWidth - Gets the number of rows (block rows) per bin of a `MATBINBCSR` matrix
+
+   Not Collective
+
+   Input Parameter:
+.  A - the matrix
+
+   Output Parameter:
+.  bw - the bin width the layout has or will have; 0 on matrices of other types
+
+   Level: intermediate
+
+.seealso: `MATBINBCSR`, `MatBinBCSRSetBinWidth()`
+@*/
+PetscErrorCode MatBinBCSRGetBinWidth(Mat A, PetscInt *bw)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidIntPointer(bw, 2);
+  *bw = 0;
+  PetscTryMethod(A, "MatBinBCSRGetBinWidth_C", (Mat, PetscInt *), (A, bw));
+  PetscFunctionReturn(0);
+}
+
+/*@
+   MatBinBCSRSetPrecision - Sets the storage precision of the values of a `MATBINBCSR` matrix
+
+   Logically Collective
+
+   Input Parameters:
++  A - the matrix
+-  p - `MAT_BINBCSR_PRECISION_DOUBLE` (default) or `MAT_BINBCSR_PRECISION_SINGLE`
+
+   Options Database Key:
+.  -mat_binbcsr_precision <double,single> - sets the precision
+
+   Level: intermediate
+
+   Notes:
+   Products always accumulate in double; single storage halves the bytes a product streams. The
+   precision may be changed at any time: the stored values are converted. A no-op on matrices of
+   other types.
+
+.seealso: `MATBINBCSR`, `MatBinBCSRGetPrecision()`, `MatBinBCSRPrecision`
+@*/
+PetscErrorCode MatBinBCSRSetPrecision(Mat A, MatBinBCSRPrecision p)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidLogicalCollectiveEnum(A, p, 2);
+  PetscTryMethod(A, "MatBinBCSRSetPrecision_C", (Mat, MatBinBCSRPrecision), (A, p));
+  PetscFunctionReturn(0);
+}
+
+/*@
+   MatBinBCSRGetPrecision - Gets the storage precision of the values of a `MATBINBCSR` matrix
+
+   Not Collective
+
+   Input Parameter:
+.  A - the matrix
+
+   Output Parameter:
+.  p - the precision; `MAT_BINBCSR_PRECISION_DOUBLE` on matrices of other types
+
+   Level: intermediate
+
+.seealso: `MATBINBCSR`, `MatBinBCSRSetPrecision()`
+@*/
+PetscErrorCode MatBinBCSRGetPrecision(Mat A, MatBinBCSRPrecision *p)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidPointer(p, 2);
+  *p = MAT_BINBCSR_PRECISION_DOUBLE;
+  PetscTryMethod(A, "MatBinBCSRGetPrecision_C", (Mat, MatBinBCSRPrecision *), (A, p));
+  PetscFunctionReturn(0);
+}
+
+/*@
+   MatBinBCSRSetSymmetricStorage - Stores only the blocks on and above the block diagonal of a
+   symmetric `MATBINBCSR` matrix
+
+   Logically Collective
+
+   Input Parameters:
++  A   - the matrix, square
+-  flg - `PETSC_TRUE` for symmetric storage
+
+   Options Database Key:
+.  -mat_binbcsr_symmetric_storage - sets symmetric storage
+
+   Level: intermediate
+
+   Notes:
+   About half the bytes of whole storage. Values given below the block diagonal (`MatSetValues()`,
+   COO) are ignored, as `MATSBAIJ` does with `MAT_IGNORE_LOWER_TRIANGULAR`; the matrix is marked
+   `MAT_SYMMETRIC` and `MAT_SYMMETRY_ETERNAL`. The product scatters the transposed blocks without
+   atomics, by an edge colouring of each bin. On several processes the diagonal part is stored this
+   way and the off-diagonal part stays whole. Set before the layout is built. A no-op on matrices of
+   other types.
+
+.seealso: `MATBINBCSR`, `MatBinBCSRGetSymmetricStorage()`, `MatBinBCSRSetCOOMirror()`
+@*/
+PetscErrorCode MatBinBCSRSetSymmetricStorage(Mat A, PetscBool flg)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidLogicalCollectiveBool(A, flg, 2);
+  PetscTryMethod(A, "MatBinBCSRSetSymmetricStorage_C", (Mat, PetscBool), (A, flg));
+  PetscFunctionReturn(0);
+}
+
+/*@
+   MatBinBCSRGetSymmetricStorage - Tells whether a `MATBINBCSR` matrix stores only its upper block triangle
+
+   Not Collective
+
+   Input Parameter:
+.  A - the matrix
+
+   Output Parameter:
+.  flg - `PETSC_TRUE` for symmetric storage; `PETSC_FALSE` on matrices of other types
+
+   Level: intermediate
+
+.seealso: `MATBINBCSR`, `MatBinBCSRSetSymmetricStorage()`
+@*/
+PetscErrorCode MatBinBCSRGetSymmetricStorage(Mat A, PetscBool *flg)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidBoolPointer(flg, 2);
+  *flg = PETSC_FALSE;
+  PetscTryMethod(A, "MatBinBCSRGetSymmetricStorage_C", (Mat, PetscBool *), (A, flg));
+  PetscFunctionReturn(0);
+}
+
+/*@
+   MatBinBCSRSetCOOMirror - Makes every COO entry of an off-diagonal block also add its value at the
+   transposed place, so that the caller lists one triangle of a symmetric matrix
+
+   Logically Collective
+
+   Input Parameters:
++  A   - the matrix, square
+-  flg - `PETSC_TRUE` to mirror
+
+   Options Database Key:
+.  -mat_binbcsr_coo_mirror - sets the mirror
+
+   Level: advanced
+
+   Notes:
+   Entry (r, c) of block (I, J), I != J, also lands at (c, r) of block (J, I); the diagonal blocks are
+   listed in full. Entries are summed as usual: a block listed in both triangles gets both its own and
+   its twin's values. Takes effect at the next `MatSetPreallocationCOO()`. A no-op on matrices of other
+   types.
+
+.seealso: `MATBINBCSR`, `MatBinBCSRGetCOOMirror()`, `MatSetPreallocationCOO()`, `MatSetValuesCOO()`
+@*/
+PetscErrorCode MatBinBCSRSetCOOMirror(Mat A, PetscBool flg)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidLogicalCollectiveBool(A, flg, 2);
+  PetscTryMethod(A, "MatBinBCSRSetCOOMirror_C", (Mat, PetscBool), (A, flg));
+  PetscFunctionReturn(0);
+}
+
+/*@
+   MatBinBCSRGetCOOMirror - Tells whether COO entries of a `MATBINBCSR` matrix are mirrored
+
+   Not Collective
+
+   Input Parameter:
+.  A - the matrix
+
+   Output Parameter:
+.  flg - `PETSC_TRUE` if mirrored; `PETSC_FALSE` on matrices of other types
+
+   Level: advanced
+
+.seealso: `MATBINBCSR`, `MatBinBCSRSetCOOMirror()`
+@*/
+PetscErrorCode MatBinBCSRGetCOOMirror(Mat A, PetscBool *flg)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidBoolPointer(flg, 2);
+  *flg = PETSC_FALSE;
+  PetscTryMethod(A, "MatBinBCSRGetCOOMirror_C", (Mat, PetscBool *), (A, flg));
+  PetscFunctionReturn(0);
+}
+
+/*@
+   MatBinBCSRSetStreams - Sets how many runs of consecutive bins the product y = A x sweeps side by side
+
+   Logically Collective
+
+   Input Parameters:
++  A       - the matrix
+-  streams - 1, 2, 4 or 8 (default 4)
+
+   Options Database Key:
+.  -mat_binbcsr_streams <k> - sets the number of runs
+
+   Level: advanced
+
+   Notes:
+   One core then streams the values from that many places at once, which the hardware prefetcher
+   serves faster than one stream (block size 1 or 3; bin width 4, 8, 16 or 32; whole or symmetric
+   storage). A traversal order only: the layout, the results and every other operation are the same
+   for any value, and it may change at any time. A no-op on matrices of other types.
+
+.seealso: `MATBINBCSR`, `MatBinBCSRGetStreams()`
+@*/
+PetscErrorCode MatBinBCSRSetStreams(Mat A, PetscInt streams)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidLogicalCollectiveInt(A, streams, 2);
+  PetscCheck(streams == 1 || streams == 2 || streams == 4 || streams == 8, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_OUTOFRANGE, "Streams %" PetscInt_FMT ": must be 1, 2, 4 or 8", streams);
+  PetscTryMethod(A, "MatBinBCSRSetStreams_C", (Mat, PetscInt), (A, streams));
+  PetscFunctionReturn(0);
+}
+
+/*@
+   MatBinBCSRGetStreams - Gets how many runs of bins the product of a `MATBINBCSR` matrix sweeps side by side
+
+   Not Collective
+
+   Input Parameter:
+.  A - the matrix
+
+   Output Parameter:
+.  streams - the number of runs; 1 on matrices of other types
+
+   Level: advanced
+
+.seealso: `MATBINBCSR`, `MatBinBCSRSetStreams()`
+@*/
+PetscErrorCode MatBinBCSRGetStreams(Mat A, PetscInt *streams)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidIntPointer(streams, 2);
+  *streams = 1;
+  PetscTryMethod(A, "MatBinBCSRGetStreams_C", (Mat, PetscInt *), (A, streams));
+  PetscFunctionReturn(0);
+}
+
+/*@
+   MatMultDotLocal - Computes y = A x and the local part of the dot product x^T y in one pass over A
+
+   Neighbor-wise Collective
+
+   Input Parameters:
++  A - the matrix
+-  x - the vector to multiply
+
+   Output Parameters:
++  y     - the product A x
+-  xdoty - this process's part of x^T y (its rows only, not reduced across processes)
+
+   Level: developer
+
+   Notes:
+   One pass when the matrix type provides it (the composed "MatMultDotLocal_C": `MATBINBCSR` does),
+   otherwise `MatMult()` and a local dot. The caller reduces the dot across processes, typically
+   together with other dots: `KSPMCG` does so once per iteration.
+
+.seealso: `MATBINBCSR`, `KSPMCG`, `MatMult()`
+@*/
+PetscErrorCode MatMultDotLocal(Mat A, Vec x, Vec y, PetscScalar *xdoty)
+{
+  PetscErrorCode (*fused)(Mat, Vec, Vec, PetscScalar *) = nullptr;
+
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidHeaderSpecific(x, VEC_CLASSID, 2);
+  PetscValidHeaderSpecific(y, VEC_CLASSID, 3);
+  PetscValidScalarPointer(xdoty, 4);
+  PetscCall(PetscObjectQueryFunction((PetscObject)A, "MatMultDotLocal_C", &fused));
+  if (fused) {
+    PetscCall(fused(A, x, y, xdoty));
+  } else {
+    const PetscScalar *xa, *ya;
+    PetscInt           n;
+    PetscScalar        sum = 0;
+    PetscCall(MatMult(A, x, y));
+    PetscCall(VecGetLocalSize(x, &n));
+    PetscCall(VecGetArrayRead(x, &xa));
+    PetscCall(VecGetArrayRead(y, &ya));
+    for (PetscInt i = 0; i < n; i++) sum += xa[i] * ya[i];
+    PetscCall(VecRestoreArrayRead(x, &xa));
+    PetscCall(VecRestoreArrayRead(y, &ya));
+    PetscCall(PetscLogFlops(2.0 * n));
+    *xdoty = sum;
+  }
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatBinBCSRCheckVecLocalSize(Vec v, PetscInt n, const char *what)
+{
+  PetscInt nv;
+
+  PetscFunctionBegin;
+  PetscCall(VecGetLocalSize(v, &nv));
+  PetscCheck(nv == n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "%s has %" PetscInt_FMT " local entries, the matrix needs %" PetscInt_FMT, what, nv, n);
+  PetscFunctionReturn(0);
+}

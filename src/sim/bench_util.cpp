@@ -1,0 +1,59 @@
+#include "sim/bench_util.h"
+
+#include <petscbinbcsr.h>
+
+PetscErrorCode ReplaceWithBinBCSRSymmetric(Mat *A)
+{
+  Mat       S;
+  PetscInt  bs, rlo, rhi, m, n;
+  PetscBool sym;
+
+  PetscFunctionBegin;
+  PetscCall(MatGetLocalSize(*A, &m, &n));
+  PetscCall(MatGetBlockSize(*A, &bs));
+  PetscCall(MatCreate(PetscObjectComm((PetscObject)*A), &S));
+  PetscCall(MatSetSizes(S, m, n, PETSC_DETERMINE, PETSC_DETERMINE));
+  PetscCall(MatSetBlockSize(S, bs));
+  PetscCall(MatSetType(S, MATBINBCSR));
+  PetscCall(MatBinBCSRSetSymmetricStorage(S, PETSC_TRUE));
+  PetscCall(MatSetUp(S));
+  PetscCall(MatGetOwnershipRange(*A, &rlo, &rhi));
+  for (PetscInt r = rlo; r < rhi; r++) {
+    PetscInt           nz;
+    const PetscInt    *cols;
+    const PetscScalar *vals;
+    PetscCall(MatGetRow(*A, r, &nz, &cols, &vals));
+    PetscCall(MatSetValues(S, 1, &r, nz, cols, vals, INSERT_VALUES));
+    PetscCall(MatRestoreRow(*A, r, &nz, &cols, &vals));
+  }
+  PetscCall(MatAssemblyBegin(S, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(S, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatBinBCSRGetSymmetricStorage(S, &sym));
+  PetscCheck(sym, PetscObjectComm((PetscObject)S), PETSC_ERR_SUP, "symmetric storage not available");
+  PetscCall(MatDestroy(A));
+  *A = S;
+  PetscFunctionReturn(0);
+}
+
+std::vector<std::string> SplitList(const std::string &s)
+{
+  std::vector<std::string> out;
+  size_t                   start = 0;
+  while (start <= s.size()) {
+    size_t end = s.find(',', start);
+    if (end == std::string::npos) end = s.size();
+    if (end > start) out.push_back(s.substr(start, end - start));
+    start = end + 1;
+  }
+  return out;
+}
+
+std::string LastErrorText()
+{
+  const char *text     = nullptr;
+  char       *specific = nullptr;
+  PetscErrorMessage(PETSC_ERR_SUP, &text, &specific);
+  std::string s = specific ? specific : (text ? text : "error");
+  while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
+  return s;
+}

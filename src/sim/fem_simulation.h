@@ -1,0 +1,65 @@
+// The FEM time stepper on top of BlockSystem: what examples/fem runs and what the tests drive, so
+// both use one loop. Physics (element loop, pattern) comes from src/physics; this file adds the
+// PETSc solve, the MPI split and the timings.
+//
+// Parallel layout: every rank holds the whole mesh and state; the nodes are renumbered so that rank
+// p owns a contiguous range (METIS partition with RCM inside each part; RCM alone on one rank); each
+// rank assembles the elements inside its range and a balancing share of those cut by the partition
+// (physics::assign_elements_to_parts); the right-hand side is summed with
+// MPI_Reduce_scatter and dv gathered back with MPI_Allgatherv.
+#pragma once
+#include "sim/sim_system.h"
+#include "physics/corotational_assembly.hpp"
+#include "physics/fem_model.hpp"
+
+#include <array>
+#include <string>
+#include <vector>
+
+struct FemScene {
+  physics::TetMesh      mesh;    // order 1 or 2, in the input numbering
+  physics::FemSettings  settings;
+  std::vector<char>     fixed;   // per node of mesh (input numbering); empty = none
+  std::array<double, 3> gravity{0, 0, -9.81};
+  double                dt = 0.01;
+  double                rayleigh_alpha = 0, rayleigh_beta = 0;
+  bool                  is_static = false; // Newton steps on K(x) dx = f(x) + f_ext instead of time steps
+  bool                  merge_blocks = true;
+  bool                  rigid_body_modes = true; // the rest shape's rigid body modes as the matrix's near null space (PCGAMG)
+  bool                  reorder = true;
+  int                   bin_order_window = 256; // with reorder: sort rows by length in windows of this many nodes (physics/row_order.hpp); 0 = off
+};
+
+struct FemStepInfo {
+  SolveStats stats;
+  bool       finite = true; // dv had no NaN/Inf (else the state was left unchanged)
+  double     element_ms = 0, setvalues_ms = 0, comm_ms = 0, solve_ms = 0, total_ms = 0;
+};
+
+struct FemSimulation {
+  MPI_Comm              comm = MPI_COMM_NULL;
+  int                   rank = 0, size = 1;
+  physics::FemModel     model;       // renumbered mesh
+  std::vector<char>     fixed;       // renumbered
+  std::vector<int>      new_of_old;  // input node -> simulation node
+  std::vector<int>      part_offsets;
+  int                   own_begin = 0, own_end = 0;
+  std::vector<int>      elements;    // elements this rank assembles
+  physics::BlockPattern pattern;
+  physics::StepCoefficients coefficients;
+  BlockSystem           sys;
+  std::vector<double>   x, v;        // all nodes, simulation numbering, 3 per node
+  std::vector<double>   f_gravity;
+  double                dt = 0, rhs_gravity_scale = 0;
+  bool                  is_static = false;
+  bool                  cpu_timer = false; // FemStepInfo times in process CPU time instead of wall time
+  // work arrays
+  std::vector<double>   values, rhs_full, rhs_local, dv_local, dv_full;
+  std::vector<int>      counts, displs;
+};
+
+// Builds the model and the linear system; x = rest positions, v = 0. Errors in the scene (mesh,
+// material) come back as PETSC_ERR_USER_INPUT with the reason.
+PetscErrorCode FemSimulationCreate(MPI_Comm comm, const FemScene &scene, FemSimulation *sim);
+PetscErrorCode FemSimulationStep(FemSimulation *sim, FemStepInfo *info);
+PetscErrorCode FemSimulationDestroy(FemSimulation *sim);

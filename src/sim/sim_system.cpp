@@ -1,0 +1,382 @@
+#include "sim/sim_system.h"
+
+#include <petscbinbcsr.h>
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+
+namespace {
+
+// PETSc without CUDA/HIP/Kokkos reports a GPU type as merely "unknown"; say why instead.
+PetscErrorCode CheckMatTypeAvailable(MPI_Comm comm)
+{
+  char      type[256] = "";
+  PetscBool set       = PETSC_FALSE;
+
+  PetscFunctionBegin;
+  PetscCall(PetscOptionsGetString(nullptr, nullptr, "-mat_type", type, sizeof type, &set));
+  if (!set) PetscFunctionReturn(0);
+  const std::string t = type;
+  const bool cuda = t.find("cusparse") != std::string::npos || t.find("cuda") != std::string::npos;
+  const bool hip  = t.find("hipsparse") != std::string::npos || t.find("hip") == 0;
+  const bool kokkos = t.find("kokkos") != std::string::npos;
+#if !defined(PETSC_HAVE_CUDA)
+  PetscCheck(!cuda, comm, PETSC_ERR_SUP,
+             "-mat_type %s needs a PETSc configured with CUDA, and this PETSc has no CUDA support; "
+             "use -mat_type aij, baij, sell or binbcsr",
+             type);
+#endif
+#if !defined(PETSC_HAVE_HIP)
+  PetscCheck(!hip, comm, PETSC_ERR_SUP,
+             "-mat_type %s needs a PETSc configured with HIP, and this PETSc has no HIP support; "
+             "use -mat_type aij, baij, sell or binbcsr",
+             type);
+#endif
+#if !defined(PETSC_HAVE_KOKKOS_KERNELS)
+  PetscCheck(!kokkos, comm, PETSC_ERR_SUP,
+             "-mat_type %s needs a PETSc configured with Kokkos, and this PETSc has none; "
+             "use -mat_type aij, baij, sell or binbcsr",
+             type);
+#endif
+  (void)cuda; (void)hip; (void)kokkos;
+  PetscFunctionReturn(0);
+}
+
+// Exact per-row lengths of the block pattern (all ranks' contributions), computed through an aij
+// matrix of the block graph (native COO, handles off-rank entries), then handed to the preallocation
+// routines of every family (each is a no-op for the other families).
+// Also returns the number of distinct blocks over all ranks (nnz / 9). A may be null (count only).
+PetscErrorCode PreallocateFromBlockPattern(MPI_Comm comm, PetscInt n_local, PetscInt n_global,
+                                           const std::vector<PetscInt> &rows, const std::vector<PetscInt> &cols, Mat A,
+                                           PetscInt *n_blocks)
+{
+  Mat      graph;
+  PetscInt bstart, bend;
+
+  PetscFunctionBegin;
+  PetscCall(MatCreate(comm, &graph));
+  PetscCall(MatSetSizes(graph, n_local, n_local, n_global, n_global));
+  PetscCall(MatSetType(graph, MATAIJ));
+  {
+    std::vector<PetscInt> ci(rows), cj(cols);
+    PetscCall(MatSetPreallocationCOO(graph, (PetscCount)ci.size(), ci.data(), cj.data()));
+  }
+  std::vector<PetscScalar> ones(rows.size(), 1.0);
+  PetscCall(MatSetValuesCOO(graph, ones.data(), INSERT_VALUES));
+  PetscCall(MatGetOwnershipRange(graph, &bstart, &bend));
+  {
+    MatInfo info;
+    PetscCall(MatGetInfo(graph, MAT_GLOBAL_SUM, &info));
+    *n_blocks = (PetscInt)info.nz_used;
+  }
+  if (!A) {
+    PetscCall(MatDestroy(&graph));
+    PetscFunctionReturn(0);
+  }
+  // sbaij stores the upper triangle only: it gets its own (upper) counts.
+  std::vector<PetscInt> d_blocks(n_local), o_blocks(n_local), du_blocks(n_local), ou_blocks(n_local);
+  std::vector<PetscInt> d_rows(3 * n_local), o_rows(3 * n_local);
+  PetscInt d_max = 0, o_max = 0;
+  for (PetscInt i = bstart; i < bend; ++i) {
+    PetscInt        ncols;
+    const PetscInt *c;
+    PetscInt        d = 0, o = 0, du = 0, ou = 0;
+    PetscCall(MatGetRow(graph, i, &ncols, &c, nullptr));
+    for (PetscInt k = 0; k < ncols; ++k) {
+      const bool local = c[k] >= bstart && c[k] < bend;
+      local ? ++d : ++o;
+      if (c[k] >= i) local ? ++du : ++ou;
+    }
+    PetscCall(MatRestoreRow(graph, i, &ncols, &c, nullptr));
+    d_blocks[i - bstart]  = d;
+    o_blocks[i - bstart]  = o;
+    du_blocks[i - bstart] = du;
+    ou_blocks[i - bstart] = ou;
+    for (int r = 0; r < 3; ++r) {
+      d_rows[3 * (i - bstart) + r] = 3 * d;
+      o_rows[3 * (i - bstart) + r] = 3 * o;
+    }
+    d_max = std::max(d_max, 3 * d);
+    o_max = std::max(o_max, 3 * o);
+  }
+  PetscCall(MatDestroy(&graph));
+  PetscCall(MatXAIJSetPreallocation(A, 3, d_blocks.data(), o_blocks.data(), du_blocks.data(), ou_blocks.data()));
+  {
+    // The drivers hand over both triangles of their symmetric systems; sbaij keeps the upper one.
+    PetscBool is_sbaij;
+    PetscCall(PetscObjectTypeCompareAny((PetscObject)A, &is_sbaij, MATSEQSBAIJ, MATMPISBAIJ, ""));
+    if (is_sbaij) PetscCall(MatSetOption(A, MAT_IGNORE_LOWER_TRIANGULAR, PETSC_TRUE));
+  }
+  PetscCall(MatSeqSELLSetPreallocation(A, d_max, d_rows.data()));
+  PetscCall(MatMPISELLSetPreallocation(A, d_max, d_rows.data(), o_max, o_rows.data()));
+  PetscCall(MatSetUp(A));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatStoredTriangle(Mat A, PetscBool *upper_only, PetscBool *offrank_full, PetscBool *mirrored)
+{
+  PetscBool is_sbaij, sym = PETSC_FALSE, mirror = PETSC_FALSE;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)A, &is_sbaij, MATSEQSBAIJ, MATMPISBAIJ, MATSBAIJ, ""));
+  PetscCall(MatBinBCSRGetSymmetricStorage(A, &sym)); // PETSC_FALSE for other types
+  PetscCall(MatBinBCSRGetCOOMirror(A, &mirror));     // PETSC_FALSE for other types
+  *upper_only   = (is_sbaij || sym) ? PETSC_TRUE : PETSC_FALSE;
+  *offrank_full = (!is_sbaij && sym) ? PETSC_TRUE : PETSC_FALSE;
+  *mirrored     = mirror;
+  PetscFunctionReturn(0);
+}
+
+} // namespace
+
+PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, PetscBool *offrank_full, PetscInt *bin_width,
+                                         PetscBool *lower_mirrored)
+{
+  Mat       probe;
+  PetscBool mirrored;
+
+  PetscFunctionBegin;
+  PetscCall(CheckMatTypeAvailable(comm));
+  // A one-block-row-per-rank matrix of the type the options select, thrown away after the question.
+  PetscCall(MatCreate(comm, &probe));
+  PetscCall(MatSetSizes(probe, 3, 3, PETSC_DETERMINE, PETSC_DETERMINE));
+  PetscCall(MatSetBlockSize(probe, 3));
+  PetscCall(MatSetType(probe, MATAIJ));
+  PetscCall(MatSetFromOptions(probe));
+  PetscCall(MatStoredTriangle(probe, upper_only, offrank_full, &mirrored));
+  if (lower_mirrored) *lower_mirrored = mirrored;
+  if (bin_width) PetscCall(MatBinBCSRGetBinWidth(probe, bin_width)); // 0 for other types
+  PetscCall(MatDestroy(&probe));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, PetscInt n_block_rows_local,
+                                 const std::vector<PetscInt> &coo_block_row,
+                                 const std::vector<PetscInt> &coo_block_col, BlockSystem *sys)
+{
+  PetscFunctionBegin;
+  PetscCheck(sys, comm, PETSC_ERR_ARG_NULL, "BlockSystem pointer is null");
+  PetscCheck(n_block_rows_global > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "need at least one block row, got %" PetscInt_FMT,
+             n_block_rows_global);
+  PetscCheck(coo_block_row.size() == coo_block_col.size(), PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+             "COO block lists differ in length: %zu rows, %zu columns", coo_block_row.size(), coo_block_col.size());
+  PetscCheck(coo_block_row.size() * 9 < (size_t)PETSC_MAX_INT, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+             "%zu COO blocks expand to more scalar entries than 32-bit PetscInt can index", coo_block_row.size());
+  for (size_t k = 0; k < coo_block_row.size(); ++k) {
+    PetscCheck(coo_block_row[k] >= 0 && coo_block_row[k] < n_block_rows_global && coo_block_col[k] >= 0 &&
+                 coo_block_col[k] < n_block_rows_global,
+               PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+               "COO block %zu is (%" PetscInt_FMT ", %" PetscInt_FMT "), outside [0, %" PetscInt_FMT ")", k,
+               coo_block_row[k], coo_block_col[k], n_block_rows_global);
+  }
+  PetscCall(CheckMatTypeAvailable(comm));
+
+  *sys                     = BlockSystem{};
+  sys->n_block_rows_global = n_block_rows_global;
+  sys->coo_block_row       = coo_block_row;
+  sys->coo_block_col       = coo_block_col;
+  sys->n_coo_blocks        = (PetscInt)coo_block_row.size();
+
+  PetscInt n_local = n_block_rows_local;
+  PetscCall(PetscSplitOwnership(comm, &n_local, &n_block_rows_global));
+  sys->n_block_rows_local = n_local;
+
+  PetscCall(MatCreate(comm, &sys->A));
+  PetscCall(MatSetSizes(sys->A, 3 * n_local, 3 * n_local, 3 * n_block_rows_global, 3 * n_block_rows_global));
+  PetscCall(MatSetBlockSize(sys->A, 3));
+  PetscCall(MatSetType(sys->A, MATAIJ));
+  PetscCall(MatSetFromOptions(sys->A));
+  {
+    PetscBool offrank_full, mirrored;
+    PetscCall(MatStoredTriangle(sys->A, &sys->upper_only, &offrank_full, &mirrored));
+    if (mirrored) sys->upper_only = PETSC_TRUE; // the caller lists the upper triangle, the Mat mirrors it
+    for (size_t k = 0; mirrored && k < coo_block_row.size(); ++k)
+      PetscCheck(coo_block_row[k] <= coo_block_col[k], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
+                 "COO block %zu is (%" PetscInt_FMT ", %" PetscInt_FMT "), below the diagonal, but -mat_binbcsr_coo_mirror "
+                 "fills the lower triangle from the upper one: list the upper triangle only (see BlockSystemStoredTriangle)",
+                 k, coo_block_row[k], coo_block_col[k]);
+  }
+
+  // The block graph for the structural count (and the row lengths): an upper-triangle list stands
+  // for its mirror image too, so nnz counts the whole symmetric matrix whatever the caller listed.
+  std::vector<PetscInt> graph_row(coo_block_row), graph_col(coo_block_col);
+  if (sys->upper_only)
+    for (size_t k = 0; k < coo_block_row.size(); ++k)
+      if (coo_block_row[k] < coo_block_col[k]) {
+        graph_row.push_back(coo_block_col[k]);
+        graph_col.push_back(coo_block_row[k]);
+      }
+  {
+    PetscErrorCode (*f)(Mat, PetscCount, const PetscInt[], const PetscInt[]) = nullptr;
+    PetscCall(PetscObjectQueryFunction((PetscObject)sys->A, "MatSetPreallocationCOO_C", &f));
+    sys->native_coo = f ? PETSC_TRUE : PETSC_FALSE;
+  }
+  if (sys->native_coo) {
+    // 9 scalar entries per block, row-major, so block values need no reordering.
+    const size_t nb = coo_block_row.size();
+    std::vector<PetscInt> ci(9 * nb), cj(9 * nb);
+    for (size_t k = 0; k < nb; ++k)
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) {
+          ci[9 * k + 3 * r + c] = 3 * coo_block_row[k] + r;
+          cj[9 * k + 3 * r + c] = 3 * coo_block_col[k] + c;
+        }
+    PetscCall(MatSetPreallocationCOO(sys->A, (PetscCount)ci.size(), ci.data(), cj.data()));
+    PetscCall(PreallocateFromBlockPattern(comm, n_local, n_block_rows_global, graph_row, graph_col, nullptr, &sys->n_blocks));
+  } else {
+    // PETSc 3.18's generic COO preallocation cannot preallocate sell; preallocate every other type
+    // from the exact row lengths instead.
+    PetscCall(PreallocateFromBlockPattern(comm, n_local, n_block_rows_global, graph_row, graph_col, sys->A, &sys->n_blocks));
+    PetscCall(MatSetOption(sys->A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+  }
+  PetscCall(MatSetOption(sys->A, MAT_SYMMETRIC, PETSC_TRUE));
+  PetscCall(MatGetOwnershipRange(sys->A, &sys->row_begin, &sys->row_end));
+
+  PetscCall(MatCreateVecs(sys->A, &sys->x, &sys->b));
+  PetscCall(KSPCreate(comm, &sys->ksp));
+  PetscCall(KSPSetOperators(sys->ksp, sys->A, sys->A));
+  PetscCall(KSPSetType(sys->ksp, KSPCG));
+  {
+    PC pc;
+    PetscCall(KSPGetPC(sys->ksp, &pc));
+    PetscCall(PCSetType(pc, PCJACOBI)); // what the seed uses; works for every Mat type
+  }
+  PetscCall(KSPSetFromOptions(sys->ksp));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode BlockSystemSetRigidBodyModes(BlockSystem *sys, const PetscScalar *coords_local)
+{
+  Vec          coords;
+  MatNullSpace modes;
+  PetscScalar *c;
+
+  PetscFunctionBegin;
+  PetscCall(MatCreateVecs(sys->A, &coords, nullptr));
+  PetscCall(VecSetBlockSize(coords, 3));
+  PetscCall(VecGetArrayWrite(coords, &c));
+  for (PetscInt i = 0; i < sys->row_end - sys->row_begin; i++) c[i] = coords_local[i];
+  PetscCall(VecRestoreArrayWrite(coords, &c));
+  PetscCall(MatNullSpaceCreateRigidBody(coords, &modes));
+  PetscCall(MatSetNearNullSpace(sys->A, modes));
+  PetscCall(MatNullSpaceDestroy(&modes));
+  PetscCall(VecDestroy(&coords));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode BlockSystemSetValues(BlockSystem *sys, const PetscScalar *block_values)
+{
+  PetscFunctionBegin;
+  PetscCheck(sys && sys->A, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "BlockSystem not created");
+  sys->last_values = block_values;
+  if (sys->native_coo) {
+    PetscCall(MatSetValuesCOO(sys->A, block_values, INSERT_VALUES));
+  } else {
+    PetscCall(MatZeroEntries(sys->A));
+    for (PetscInt k = 0; k < sys->n_coo_blocks; ++k) {
+      const PetscInt r = sys->coo_block_row[k], c = sys->coo_block_col[k];
+      PetscCall(MatSetValuesBlocked(sys->A, 1, &r, 1, &c, block_values + 9 * k, ADD_VALUES));
+    }
+    PetscCall(MatAssemblyBegin(sys->A, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(sys->A, MAT_FINAL_ASSEMBLY));
+  }
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode BlockSystemSolve(BlockSystem *sys, const PetscScalar *rhs_local, PetscScalar *sol_local,
+                                SolveStats *stats)
+{
+  PetscScalar *a;
+  PetscBool    nonzero_guess;
+  const size_t n = (size_t)(sys->row_end - sys->row_begin);
+
+  PetscFunctionBegin;
+  PetscCall(VecGetArrayWrite(sys->b, &a));
+  std::memcpy(a, rhs_local, n * sizeof(PetscScalar));
+  PetscCall(VecRestoreArrayWrite(sys->b, &a));
+  PetscCall(KSPGetInitialGuessNonzero(sys->ksp, &nonzero_guess));
+  if (nonzero_guess) {
+    PetscCall(VecGetArrayWrite(sys->x, &a));
+    std::memcpy(a, sol_local, n * sizeof(PetscScalar));
+    PetscCall(VecRestoreArrayWrite(sys->x, &a));
+  }
+  const double t0 = MPI_Wtime();
+  PetscCall(KSPSolve(sys->ksp, sys->b, sys->x));
+  const double t1 = MPI_Wtime();
+  const PetscScalar *xa;
+  PetscCall(VecGetArrayRead(sys->x, &xa));
+  std::memcpy(sol_local, xa, n * sizeof(PetscScalar));
+  PetscCall(VecRestoreArrayRead(sys->x, &xa));
+  if (stats) {
+    PetscCall(KSPGetIterationNumber(sys->ksp, &stats->iterations));
+    PetscCall(KSPGetResidualNorm(sys->ksp, &stats->residual_norm));
+    PetscCall(KSPGetConvergedReason(sys->ksp, &stats->reason));
+    stats->ms = 1e3 * (t1 - t0);
+  }
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode BlockSystemDumpMatrix(BlockSystem *sys, const char *path)
+{
+  MPI_Comm    comm;
+  PetscViewer viewer;
+  Mat         aij;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectGetComm((PetscObject)sys->A, &comm));
+  PetscCheck(sys->last_values, comm, PETSC_ERR_ARG_WRONGSTATE, "BlockSystemDumpMatrix: no values set yet");
+  // Rebuilt as aij from the same COO list, so the dump works for every type (binbcsr has no MatView
+  // to binary of its own) and loads anywhere.
+  PetscCall(MatCreate(comm, &aij));
+  PetscCall(MatSetSizes(aij, sys->row_end - sys->row_begin, sys->row_end - sys->row_begin, 3 * sys->n_block_rows_global,
+                        3 * sys->n_block_rows_global));
+  PetscCall(MatSetBlockSize(aij, 3));
+  PetscCall(MatSetType(aij, MATAIJ));
+  {
+    // A matrix that ignores the lower triangle is dumped from the upper blocks and their mirror
+    // images (lower blocks the caller still listed, e.g. across ranks, are left out: the mirror
+    // of their upper twin replaces them).
+    std::vector<PetscInt>    ci, cj;
+    std::vector<PetscScalar> v;
+    for (size_t k = 0; k < sys->coo_block_row.size(); ++k) {
+      const PetscInt br = sys->coo_block_row[k], bc = sys->coo_block_col[k];
+      if (sys->upper_only && br > bc) continue;
+      for (int mirror = 0; mirror < ((sys->upper_only && br < bc) ? 2 : 1); ++mirror)
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) {
+            ci.push_back(3 * (mirror ? bc : br) + r);
+            cj.push_back(3 * (mirror ? br : bc) + c);
+            v.push_back(sys->last_values[9 * k + (mirror ? 3 * c + r : 3 * r + c)]);
+          }
+    }
+    PetscCall(MatSetPreallocationCOO(aij, (PetscCount)ci.size(), ci.data(), cj.data()));
+    PetscCall(MatSetValuesCOO(aij, v.data(), INSERT_VALUES));
+  }
+  PetscCall(PetscViewerBinaryOpen(comm, path, FILE_MODE_WRITE, &viewer));
+  PetscCall(MatView(aij, viewer));
+  PetscCall(PetscViewerDestroy(&viewer));
+  PetscCall(MatDestroy(&aij));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode BlockSystemGetInfo(BlockSystem *sys, PetscInt *nnz, const char **mat_type, const char **ksp_type)
+{
+  PetscFunctionBegin;
+  if (nnz) *nnz = 9 * sys->n_blocks;
+  if (mat_type) PetscCall(MatGetType(sys->A, (MatType *)mat_type));
+  if (ksp_type) PetscCall(KSPGetType(sys->ksp, (KSPType *)ksp_type));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode BlockSystemDestroy(BlockSystem *sys)
+{
+  PetscFunctionBegin;
+  if (!sys) PetscFunctionReturn(0);
+  PetscCall(KSPDestroy(&sys->ksp));
+  PetscCall(VecDestroy(&sys->x));
+  PetscCall(VecDestroy(&sys->b));
+  PetscCall(MatDestroy(&sys->A));
+  *sys = BlockSystem{};
+  PetscFunctionReturn(0);
+}
