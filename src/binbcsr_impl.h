@@ -9,6 +9,7 @@
 
 #include <petscbinbcsr.h>
 #include <petsc/private/petscimpl.h>
+#include "petsc_compat.h"
 
 PETSC_EXTERN PetscErrorCode MatCreate_SeqBinBCSR(Mat);
 PETSC_EXTERN PetscErrorCode MatCreate_MPIBinBCSR(Mat);
@@ -39,7 +40,7 @@ PETSC_INTERN PetscErrorCode MatFDColoringCreate_BinBCSR(Mat, ISColoring, MatFDCo
 PETSC_INTERN PetscErrorCode MatFDColoringSetUp_BinBCSR(Mat, ISColoring, MatFDColoring);
 PETSC_INTERN PetscErrorCode MatFDColoringApply_BinBCSR(Mat, MatFDColoring, Vec, void *);
 /* PCGAMG's needs through that shadow (MatCreateGraph, matrix products with binbcsr operands): common/binbcsr_shadow_ops.cpp */
-PETSC_INTERN PetscErrorCode MatCreateGraph_BinBCSR(Mat, PetscBool, PetscBool, PetscReal, Mat *);
+PETSC_INTERN PetscErrorCode MatCreateGraph_BinBCSR(Mat, PetscBool, PetscBool, PetscReal BINBCSR_CREATEGRAPH_TYPES, Mat *);
 PETSC_INTERN PetscErrorCode MatProductSetFromOptions_BinBCSR(Mat); /* also composed as MatProductSetFromOptions_anytype_C */
 /* MUMPS / SuperLU_DIST LU and Cholesky for seq and mpi binbcsr through that shadow: common/binbcsr_factor_external.cpp */
 PETSC_INTERN PetscErrorCode MatBinBCSRRegisterExternalFactors(void);

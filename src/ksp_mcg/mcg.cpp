@@ -128,7 +128,7 @@ static PetscErrorCode KSPConvergedReasonView_MCGFloor(KSP ksp, void *)
   if (!ismcg) PetscFunctionReturn(0);
   mcg = (KSP_MCG *)ksp->data;
   if (!mcg->floor_hit || ksp->reason != KSP_DIVERGED_BREAKDOWN) PetscFunctionReturn(0);
-  PetscCall(PetscOptionsGetViewer(PetscObjectComm((PetscObject)ksp), ((PetscObject)ksp)->options, ((PetscObject)ksp)->prefix, "-ksp_converged_reason", &viewer, &format, &flg));
+  PetscCall(PetscOptionsCreateViewer(PetscObjectComm((PetscObject)ksp), ((PetscObject)ksp)->options, ((PetscObject)ksp)->prefix, "-ksp_converged_reason", &viewer, &format, &flg));
   if (!flg) PetscFunctionReturn(0);
   PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &iascii));
   if (iascii) {

@@ -388,7 +388,7 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
     PetscCall(VecCopy(B, R));
   }
   /* the PC may have failed in KSPSetUp on some ranks only: make every rank see it in the dots */
-  if (ksp->reason == KSP_DIVERGED_PC_FAILED) PetscCall(VecSetInf(R));
+  if (ksp->reason == KSP_DIVERGED_PC_FAILED) PetscCall(BinBCSRVecSetInf(R));
   PetscCall(MCGPrecondition(ksp, R, U, dots));
   dots[MCG_DOT_XX] = 0; /* the x0 term of the drift estimate is left out: x1 stands for it */
   PetscCall(MCGMatMultDot(ksp, Amat, U, W, &dots[MCG_DOT_UW]));

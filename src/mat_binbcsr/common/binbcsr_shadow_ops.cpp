@@ -152,12 +152,12 @@ PetscErrorCode MatProductSetFromOptions_BinBCSR(Mat C)
 }
 
 /* ops->creategraph: the shadow's graph (GAMG's aggregation). */
-PetscErrorCode MatCreateGraph_BinBCSR(Mat A, PetscBool sym, PetscBool scale, PetscReal filter, Mat *graph)
+PetscErrorCode MatCreateGraph_BinBCSR(Mat A, PetscBool sym, PetscBool scale, PetscReal filter BINBCSR_CREATEGRAPH_ARGS, Mat *graph)
 {
   Mat S;
 
   PetscFunctionBegin;
   PetscCall(MatBinBCSRGetAIJShadow_Private(A, &S));
-  PetscCall(MatCreateGraph(S, sym, scale, filter, graph));
+  PetscCall(MatCreateGraph(S, sym, scale, filter BINBCSR_CREATEGRAPH_PASS, graph));
   PetscFunctionReturn(0);
 }

@@ -9,6 +9,7 @@
 
 #include <petsc/private/matimpl.h> // nonzerostate
 #include <petscksp.h>
+#include "petsc_compat.h" // MatCreateGraph's arguments
 
 using namespace pctest;
 
@@ -187,8 +188,8 @@ TEST_CASE("MatCreateGraph of binbcsr is aij's; a binbcsr matrix with row and col
   const FemProblem fem(4, 3, 3, true);
   Mat              A, R, GA, GR;
   PCHK(matrix_pair(fem, 3, storages[1], &A, &R)); // symmetric storage: the graph still sees the whole matrix
-  PCHK(MatCreateGraph(A, PETSC_TRUE, PETSC_TRUE, 0.01, &GA));
-  PCHK(MatCreateGraph(R, PETSC_TRUE, PETSC_TRUE, 0.01, &GR));
+  PCHK(MatCreateGraph(A, PETSC_TRUE, PETSC_TRUE, 0.01 BINBCSR_CREATEGRAPH_NO_INDEX, &GA));
+  PCHK(MatCreateGraph(R, PETSC_TRUE, PETSC_TRUE, 0.01 BINBCSR_CREATEGRAPH_NO_INDEX, &GR));
   CHECK(mat_rel_diff(GA, GR) < 1e-14);
   PetscInt m, n;
   PCHK(MatGetSize(GA, &m, &n));

@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# bench/readme_table.sh OUT_DIR RUN_NAME: the README's results table, as markdown, from one
+# scripts/bench run's spmv.csv and steps.csv, headed by the machine it ran on (CPU model, cores,
+# STREAM triad bandwidth measured by the same run) and the PETSc, date and commit. Writes
+# OUT_DIR/readme_table.md.
+set -euo pipefail
+out=$1
+run=$2
+spmv=$out/spmv.csv
+steps=$out/steps.csv
+[ -s "$spmv" ] || { echo "readme_table: no $spmv" >&2; exit 1; }
+
+cpu=$(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -1)
+triad=$(awk -F, 'NR > 1 && $NF == "ok" && $22 > best { best = $22 } END { if (best) printf "%.1f", best }' "$spmv")
+petsc=$(pkg-config --modversion PETSc 2>/dev/null || echo "?")
+commit=$(git rev-parse --short HEAD 2>/dev/null || echo "?")
+
+{
+  echo "Machine: ${cpu:-unknown CPU}, $(nproc) cores, STREAM triad ${triad:-?} GB/s on one core (measured by the same run);"
+  echo "PETSc $petsc; $(date -u +%Y-%m-%d), commit $commit; \`$run\`."
+  echo
+  echo "| matrix | rows | SpMV GFlop/s: aij | baij | binbcsr | binbcsr single | binbcsr x aij | binbcsr % of triad | ms per step: aij + cg | binbcsr + mcg | step speedup |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|"
+  # one row per matrix of the SpMV run (driver dumps as scene.bin); the scene's 1-rank step times beside it
+  awk -F, -v steps="$steps" '
+    BEGIN {
+      while ((getline line < steps) > 0) {
+        split(line, f, ",")
+        if (f[3] == "1") { aij[f[1] ".bin"] = f[4]; bin[f[1] ".bin"] = f[5]; sp[f[1] ".bin"] = f[6] }
+      }
+    }
+    NR > 1 && $NF == "ok" {
+      m = $1
+      if (!(m in rows)) { order[++n] = m; rows[m] = $3 }
+      g[m, $2] = $13
+      if ($2 == "binbcsr") { xa[m] = $18; pct[m] = $15 }
+    }
+    function v(x) { return x == "" ? "-" : x }
+    function num(x) { return x == "" ? "-" : sprintf("%.2f", x) }
+    END {
+      for (i = 1; i <= n; i++) {
+        m = order[i]; name = m; sub(/\.bin$/, "", name)
+        printf "| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n", name, rows[m],
+          num(g[m, "aij"]), num(g[m, "baij"]), num(g[m, "binbcsr"]), num(g[m, "binbcsr_single"]),
+          v(xa[m]), (pct[m] == "" ? "-" : sprintf("%.0f", pct[m])), v(aij[m]), v(bin[m]), v(sp[m])
+      }
+    }' "$spmv"
+  echo
+  echo "SpMV: one rank, minimum over the rounds, GFlop/s = 2 nnz / time; % of triad from the bytes the"
+  echo "format stores (padding included) plus x and y. Steps: one rank, the scene's options file, 30 CG"
+  echo "iterations per step (the bridge: IC(0)-CG to its tolerance), aij + cg against binbcsr + mcg."
+} >"$out/readme_table.md"
+echo "  wrote $out/readme_table.md"
