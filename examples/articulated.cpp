@@ -39,8 +39,8 @@ static PetscErrorCode BuildScene(MPI_Comm comm, std::string &name, physics::Arti
       PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-chain_angle", &o.angle, nullptr));
       PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-chain_mass_first", &o.mass_first, nullptr));
       PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-chain_mass_last", &o.mass_last, nullptr));
-      PetscCheck(o.mass_first > 0 && o.mass_last > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "link masses must be positive, got %g and %g",
-                 (double)o.mass_first, (double)o.mass_last);
+      PetscCheck(o.mass_first > 0 && o.mass_last > 0, comm, PETSC_ERR_ARG_OUTOFRANGE,
+                 "link masses must be positive, got %g and %g", (double)o.mass_first, (double)o.mass_last);
       scene = physics::make_chain(o);
     } else if (name == "bridge") {
       physics::BridgeOptions o;
@@ -52,7 +52,7 @@ static PetscErrorCode BuildScene(MPI_Comm comm, std::string &name, physics::Arti
       o.chains = (int)chains, o.links = (int)links, o.tie_every = (int)tie;
       scene = physics::make_bridge(o);
     } else if (name == "loop") {
-      scene = physics::make_four_bar();
+      scene          = physics::make_four_bar();
       PetscReal spin = 2.0;
       PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-loop_crank_speed", &spin, nullptr));
       scene.bodies[0].angular_velocity = Eigen::Vector3d(0, 0, spin);
@@ -70,7 +70,7 @@ static PetscErrorCode BuildScene(MPI_Comm comm, std::string &name, physics::Arti
 // Bodies as boxes (8 corners, one hexahedron each) or as points (-vtk_points, for huge scenes).
 static bool WriteFrame(const std::string &path, const physics::ArticulatedScene &scene, bool as_points)
 {
-  physics::VtkScene vtk;
+  physics::VtkScene      vtk;
   physics::VtkPointField speed{"speed", 1, {}};
   if (as_points) {
     vtk.cell_type = physics::VtkCellType::Vertex, vtk.nodes_per_cell = 1;
@@ -81,11 +81,14 @@ static bool WriteFrame(const std::string &path, const physics::ArticulatedScene 
     }
   } else {
     vtk.cell_type = physics::VtkCellType::Hexahedron, vtk.nodes_per_cell = 8;
-    const int corner[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}};
+    const int corner[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
+                              {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
     for (size_t i = 0; i < scene.bodies.size(); ++i) {
       const physics::RigidBody &b = scene.bodies[i];
       for (int c = 0; c < 8; ++c) {
-        const Eigen::Vector3d local(corner[c][0] * scene.body_sizes[i].x() / 2, corner[c][1] * scene.body_sizes[i].y() / 2, corner[c][2] * scene.body_sizes[i].z() / 2);
+        const Eigen::Vector3d local(corner[c][0] * scene.body_sizes[i].x() / 2,
+                                    corner[c][1] * scene.body_sizes[i].y() / 2,
+                                    corner[c][2] * scene.body_sizes[i].z() / 2);
         const Eigen::Vector3d p = b.position + b.orientation * local;
         for (int k = 0; k < 3; ++k) vtk.points.push_back(p[k]);
         vtk.connectivity.push_back((int)(8 * i + c));
@@ -100,7 +103,8 @@ static bool WriteFrame(const std::string &path, const physics::ArticulatedScene 
 // With the work split over ranks (physics::ArticulatedWorkSplit) each rank's bodies outside its active set
 // are stale: gather the state of every body from the rank that counts it (a sum in which the others add
 // zeros), for output and the final summary.
-static PetscErrorCode SyncScene(MPI_Comm comm, const physics::ArticulatedWorkSplit &split, physics::ArticulatedScene &scene)
+static PetscErrorCode SyncScene(MPI_Comm comm, const physics::ArticulatedWorkSplit &split,
+                                physics::ArticulatedScene &scene)
 {
   PetscFunctionBegin;
   if (split.body_counted.empty()) PetscFunctionReturn(0);
@@ -110,21 +114,24 @@ static PetscErrorCode SyncScene(MPI_Comm comm, const physics::ArticulatedWorkSpl
     if (!split.body_counted[i]) continue;
     const physics::RigidBody &b = scene.bodies[i];
     double                   *v = &state[nv * i];
-    for (int k = 0; k < 3; ++k) v[k] = b.position[k], v[7 + k] = b.velocity[k], v[10 + k] = b.angular_velocity[k];
+    for (int k = 0; k < 3; ++k)
+      v[k] = b.position[k], v[7 + k] = b.velocity[k], v[10 + k] = b.angular_velocity[k];
     for (int k = 0; k < 4; ++k) v[3 + k] = b.orientation.coeffs()[k];
   }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, state.data(), (int)state.size(), MPI_DOUBLE, MPI_SUM, comm));
   for (size_t i = 0; i < scene.bodies.size(); ++i) {
     physics::RigidBody &b = scene.bodies[i];
     const double       *v = &state[nv * i];
-    for (int k = 0; k < 3; ++k) b.position[k] = v[k], b.velocity[k] = v[7 + k], b.angular_velocity[k] = v[10 + k];
+    for (int k = 0; k < 3; ++k)
+      b.position[k] = v[k], b.velocity[k] = v[7 + k], b.angular_velocity[k] = v[10 + k];
     for (int k = 0; k < 4; ++k) b.orientation.coeffs()[k] = v[3 + k];
   }
   PetscFunctionReturn(0);
 }
 
 // Total energy and whether every body this rank moves is finite, over all ranks.
-static PetscErrorCode SceneState(MPI_Comm comm, const physics::ArticulatedWorkSplit &split, const physics::ArticulatedScene &scene, double *energy, bool *finite)
+static PetscErrorCode SceneState(MPI_Comm comm, const physics::ArticulatedWorkSplit &split,
+                                 const physics::ArticulatedScene &scene, double *energy, bool *finite)
 {
   PetscFunctionBegin;
   double e = 0, bad = 0;
@@ -132,7 +139,8 @@ static PetscErrorCode SceneState(MPI_Comm comm, const physics::ArticulatedWorkSp
     const physics::RigidBody &b = scene.bodies[i];
     if (!split.body_active.empty() && !split.body_active[i]) continue;
     bad += !(b.position.allFinite() && b.velocity.allFinite() && b.angular_velocity.allFinite());
-    if (split.body_counted.empty() || split.body_counted[i]) e += physics::mechanical_energy(b, scene.gravity);
+    if (split.body_counted.empty() || split.body_counted[i])
+      e += physics::mechanical_energy(b, scene.gravity);
   }
   if (!split.body_counted.empty()) {
     double v[2] = {e, bad};
@@ -159,7 +167,7 @@ int main(int argc, char **argv)
   physics::ArticulatedParams params;
   DriverOutput               out;
   PetscInt                   max_corr = params.max_corrections, max_halvings = params.max_halvings;
-  PetscBool                  vel_stab = PETSC_TRUE, refresh = PETSC_TRUE, warm = PETSC_FALSE, vtk_points = PETSC_FALSE;
+  PetscBool vel_stab = PETSC_TRUE, refresh = PETSC_TRUE, warm = PETSC_FALSE, vtk_points = PETSC_FALSE;
   PetscCall(DriverOutputFromOptions(comm, &out));
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-dt", &params.dt, nullptr));
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-joint_tol", &params.joint_tol, nullptr));
@@ -176,16 +184,19 @@ int main(int argc, char **argv)
   params.velocity_stabilisation = vel_stab;
   PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-vtk_points", &vtk_points, nullptr));
   const std::string bad = physics::validate_params(params);
-  PetscCheck(bad.empty(), comm, PETSC_ERR_ARG_OUTOFRANGE, "%s (-dt %g, -joint_tol %g, -max_corrections %d)", bad.c_str(), (double)params.dt,
-             (double)params.joint_tol, params.max_corrections);
-  PetscCheck(!scene.joints.empty(), comm, PETSC_ERR_ARG_WRONG, "scene %s has no joints: nothing to solve", scene_name.c_str());
+  PetscCheck(bad.empty(), comm, PETSC_ERR_ARG_OUTOFRANGE, "%s (-dt %g, -joint_tol %g, -max_corrections %d)",
+             bad.c_str(), (double)params.dt, (double)params.joint_tol, params.max_corrections);
+  PetscCheck(!scene.joints.empty(), comm, PETSC_ERR_ARG_WRONG, "scene %s has no joints: nothing to solve",
+             scene_name.c_str());
 
   physics::ArticulatedSolver solver = physics::make_articulated_solver(scene, params);
   const size_t               loops  = physics::loop_closing_joints(scene).size();
   ReplicatedSolver           rs;
-  PetscCall(ReplicatedSolverCreate(comm, solver.pattern.n_joints, solver.pattern.block_row, solver.pattern.block_col, &rs));
+  PetscCall(ReplicatedSolverCreate(comm, solver.pattern.n_joints, solver.pattern.block_row,
+                                   solver.pattern.block_col, &rs));
   const physics::BlockLinearSolver linear = ReplicatedSolverAdapter(&rs);
-  if (params.warm_start) PetscCall(KSPSetInitialGuessNonzero(rs.sys.ksp, PETSC_TRUE)); // the physics supplies the guesses
+  if (params.warm_start)
+    PetscCall(KSPSetInitialGuessNonzero(rs.sys.ksp, PETSC_TRUE)); // the physics supplies the guesses
   if (size > 1) { // each rank moves the bodies of its own joints only; the error maxima are all-reduced
     std::vector<int> joint_rank(scene.joints.size());
     for (int p = 0; p < size; ++p)
@@ -193,17 +204,24 @@ int main(int argc, char **argv)
     solver.split                    = physics::split_articulated_work(scene, joint_rank, rank);
     solver.split.max_over_processes = [&rs](double local) {
       double global = local;
-      if (MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_MAX, rs.comm) != MPI_SUCCESS && !rs.error) rs.error = PETSC_ERR_MPI;
+      if (MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_MAX, rs.comm) != MPI_SUCCESS && !rs.error)
+        rs.error = PETSC_ERR_MPI;
       return global;
     };
   }
   PetscInt    nnz;
   const char *mat_type, *ksp_type;
   PetscCall(BlockSystemGetInfo(&rs.sys, &nnz, &mat_type, &ksp_type));
-  PetscCall(PetscPrintf(comm, "articulated: scene %s, %zu bodies, %zu joints (%zu rows), %zu loops, %" PetscInt_FMT " nonzeros, mat %s, ksp %s, %d ranks\n",
-                        scene_name.c_str(), scene.bodies.size(), scene.joints.size(), 3 * scene.joints.size(), loops, nnz, mat_type, ksp_type, size));
+  PetscCall(PetscPrintf(comm,
+                        "articulated: scene %s, %zu bodies, %zu joints (%zu rows), %zu loops, %" PetscInt_FMT
+                        " nonzeros, mat %s, ksp %s, %d ranks\n",
+                        scene_name.c_str(), scene.bodies.size(), scene.joints.size(), 3 * scene.joints.size(),
+                        loops, nnz, mat_type, ksp_type, size));
 
-  auto write_frame = [&](PetscInt n) { return DriverWriteFrame(comm, &out, n, n * params.dt, [&](const std::string &path) { return WriteFrame(path, scene, vtk_points); }); };
+  auto write_frame = [&](PetscInt n) {
+    return DriverWriteFrame(comm, &out, n, n * params.dt,
+                            [&](const std::string &path) { return WriteFrame(path, scene, vtk_points); });
+  };
   PetscCall(write_frame(0));
 
   double e0;
@@ -219,8 +237,8 @@ int main(int argc, char **argv)
       m += b.mass;
       ke0 += physics::mechanical_energy(b, Eigen::Vector3d::Zero());
       const double r = 0.5 * scene.body_sizes[i].norm();
-      lo = lo.cwiseMin(b.position - Eigen::Vector3d::Constant(r));
-      hi = hi.cwiseMax(b.position + Eigen::Vector3d::Constant(r));
+      lo             = lo.cwiseMin(b.position - Eigen::Vector3d::Constant(r));
+      hi             = hi.cwiseMax(b.position + Eigen::Vector3d::Constant(r));
     }
     HealthBounds hb;
     hb.energy_scale  = m * scene.gravity.norm() * (hi - lo).norm() + ke0;
@@ -228,13 +246,14 @@ int main(int argc, char **argv)
     PetscCall(RunGuardFromOptions(comm, hb, &guard));
     RunGuardStart(&guard, e0, NAN);
   }
-  double       e_max = e0, worst_error = 0, worst_velocity = 0, step_ms_total = 0;
-  long long    done = 0, corrections = 0, halvings = 0, max_corrections_seen = 0, unconverged = 0, stalled = 0, singular_steps = 0, nan_steps = 0;
+  double    e_max = e0, worst_error = 0, worst_velocity = 0, step_ms_total = 0;
+  long long done = 0, corrections = 0, halvings = 0, max_corrections_seen = 0, unconverged = 0, stalled = 0,
+            singular_steps = 0, nan_steps = 0;
   for (PetscInt n = 1; n <= out.steps; ++n) {
     const long long its0 = rs.iterations, solves0 = rs.solves, diverged0 = rs.diverged_solves;
     const double    solve0 = rs.solve_ms, t0 = WallTime();
-    const physics::ArticulatedStepReport r = physics::articulated_step(scene, solver, params, linear);
-    const double step_ms = 1e3 * (WallTime() - t0);
+    const physics::ArticulatedStepReport r       = physics::articulated_step(scene, solver, params, linear);
+    const double                         step_ms = 1e3 * (WallTime() - t0);
     PetscCall(rs.error);
     ++done;
     step_ms_total += step_ms;
@@ -250,18 +269,23 @@ int main(int argc, char **argv)
     singular_steps += r.singular_detected;
     worst_error    = std::max(worst_error, r.joint_error);
     worst_velocity = std::max(worst_velocity, r.velocity_error);
-    e_max = std::max(e_max, energy);
+    e_max          = std::max(e_max, energy);
     if (n % out.progress_every == 0 || n == out.steps)
-      PetscCall(PetscPrintf(comm, "step %" PetscInt_FMT " t=%.4f corrections=%d solves=%lld cg_its=%lld joint_err=%.3e vel_err=%.3e energy=%.6e ms=%.2f solve_ms=%.2f%s%s\n",
-                            n, n * params.dt, r.corrections, rs.solves - solves0, rs.iterations - its0, r.joint_error, r.velocity_error, energy, step_ms,
-                            rs.solve_ms - solve0, r.converged ? "" : " UNCONVERGED", r.singular_detected ? " SINGULAR->regularised" : ""));
+      PetscCall(PetscPrintf(
+        comm,
+        "step %" PetscInt_FMT
+        " t=%.4f corrections=%d solves=%lld cg_its=%lld joint_err=%.3e vel_err=%.3e energy=%.6e ms=%.2f solve_ms=%.2f%s%s\n",
+        n, n * params.dt, r.corrections, rs.solves - solves0, rs.iterations - its0, r.joint_error,
+        r.velocity_error, energy, step_ms, rs.solve_ms - solve0, r.converged ? "" : " UNCONVERGED",
+        r.singular_detected ? " SINGULAR->regularised" : ""));
     if (n == 1 && out.dump) PetscCall(BlockSystemDumpMatrix(&rs.sys, out.dump_path));
     if (out.vtk && n % out.vtk_every == 0) PetscCall(SyncScene(comm, solver.split, scene));
     PetscCall(write_frame(n));
     StepHealth health;
     // A breakdown that switched the step to the regularised matrix is the physics' own recovery; any
     // other failed solve leaves the impulses it produced (or zeros) in the step.
-    if (rs.diverged_solves - diverged0 > (r.singular_detected ? 1 : 0)) health.solver_reason = rs.worst_reason;
+    if (rs.diverged_solves - diverged0 > (r.singular_detected ? 1 : 0))
+      health.solver_reason = rs.worst_reason;
     health.energy = energy;
     health.finite = finite && std::isfinite(energy);
     bool stop;

@@ -32,8 +32,7 @@
 #include <string>
 #include <vector>
 
-namespace
-{
+namespace {
 /* Process CPU time: on a machine shared with other jobs it leaves out the time we are descheduled
    (memory contention still counts). -timer wall switches to MPI_Wtime. */
 PetscBool use_wall = PETSC_FALSE;
@@ -48,7 +47,7 @@ double    Now()
 struct Variant {
   std::string name;
   Mat         A       = nullptr;
-  PetscInt    streams = 0; /* MatBinBCSRSetStreams before each batch; 0: aij/baij */
+  PetscInt    streams = 0;    /* MatBinBCSRSetStreams before each batch; 0: aij/baij */
   bool        owner   = true; /* destroys A (binbcsr matrices are shared by their stream counts) */
   double      best    = 1e300;
 };
@@ -92,8 +91,13 @@ PetscErrorCode TimeCOO(const StencilGrid &g, PetscInt repeats)
       PetscCall(MatSetValuesCOO(M[t], v.data(), INSERT_VALUES));
       best[t] = PetscMin(best[t], Now() - t0);
     }
-  PetscCall(PetscPrintf(PETSC_COMM_SELF, "COO refill (MatSetValuesCOO INSERT, %zu entries from %" PetscInt_FMT " hexahedra), minimum over %" PetscInt_FMT " calls\n", ci.size(), (g.nx - 1) * (g.ny - 1) * (g.nz - 1), repeats));
-  for (int t = 0; t < 3; t++) PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-16s %10.4f ms %8.2f x aij\n", names[t], 1e3 * best[t], best[0] / best[t]));
+  PetscCall(PetscPrintf(PETSC_COMM_SELF,
+                        "COO refill (MatSetValuesCOO INSERT, %zu entries from %" PetscInt_FMT
+                        " hexahedra), minimum over %" PetscInt_FMT " calls\n",
+                        ci.size(), (g.nx - 1) * (g.ny - 1) * (g.nz - 1), repeats));
+  for (int t = 0; t < 3; t++)
+    PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-16s %10.4f ms %8.2f x aij\n", names[t], 1e3 * best[t],
+                          best[0] / best[t]));
   for (int t = 0; t < 3; t++) PetscCall(MatDestroy(&M[t]));
   PetscFunctionReturn(0);
 }
@@ -149,7 +153,10 @@ int main(int argc, char **argv)
       PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-sweep_verbose", &s.verbose, nullptr));
       PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-stencil_sizes", sizes, &nsizes, &flg));
       if (!flg) nsizes = 2;
-      PetscCall(PetscPrintf(PETSC_COMM_SELF, "binbcsr_tune -sweep: ms per MatMult, minimum of %" PetscInt_FMT " rounds of %" PetscInt_FMT " (%s time); best/tuned as bin width/streams\n", s.repeats, s.batch, use_wall ? "wall" : "process CPU"));
+      PetscCall(PetscPrintf(PETSC_COMM_SELF,
+                            "binbcsr_tune -sweep: ms per MatMult, minimum of %" PetscInt_FMT
+                            " rounds of %" PetscInt_FMT " (%s time); best/tuned as bin width/streams\n",
+                            s.repeats, s.batch, use_wall ? "wall" : "process CPU"));
       for (PetscInt i = 0; i < nsizes; i++) {
         if (sizes[i] <= 0) continue;
         StencilGrid g;
@@ -168,7 +175,8 @@ int main(int argc, char **argv)
         PetscCall(MatSetBlockSize(aij, bs));
         PetscCall(MatLoad(aij, v));
         PetscCall(PetscViewerDestroy(&v));
-        PetscCall(TuneSweep(f.substr(f.find_last_of('/') == std::string::npos ? 0 : f.find_last_of('/') + 1), aij, s));
+        PetscCall(TuneSweep(f.substr(f.find_last_of('/') == std::string::npos ? 0 : f.find_last_of('/') + 1),
+                            aij, s));
         PetscCall(MatDestroy(&aij));
       }
       PetscCall(PetscFinalize());
@@ -183,10 +191,13 @@ int main(int argc, char **argv)
   for (PetscInt w = 0; w < nw; w++)
     for (int p = 0; p < 2; p++) {
       Mat A;
-      PetscCall(MakeBinBCSR(aij, bs, widths[w], 0, p ? MAT_BINBCSR_PRECISION_SINGLE : MAT_BINBCSR_PRECISION_DOUBLE, PETSC_FALSE, PETSC_FALSE, &A));
+      PetscCall(MakeBinBCSR(aij, bs, widths[w], 0,
+                            p ? MAT_BINBCSR_PRECISION_SINGLE : MAT_BINBCSR_PRECISION_DOUBLE, PETSC_FALSE,
+                            PETSC_FALSE, &A));
       for (PetscInt k = 0; k < ns; k++) {
         Variant v;
-        v.name    = std::string(p ? "single" : "double") + " bw " + std::to_string(widths[w]) + (ns > 1 ? " K " + std::to_string(streams[k]) : "");
+        v.name = std::string(p ? "single" : "double") + " bw " + std::to_string(widths[w]) +
+                 (ns > 1 ? " K " + std::to_string(streams[k]) : "");
         v.A       = A;
         v.streams = streams[k];
         v.owner   = k == 0;
@@ -203,9 +214,14 @@ int main(int argc, char **argv)
       for (PetscInt b = 0; b < batch; b++) PetscCall(MatMult(v.A, x, y));
       v.best = PetscMin(v.best, (Now() - t0) / batch);
     }
-  PetscCall(PetscPrintf(PETSC_COMM_SELF, "stencil %" PetscInt_FMT "^3, bs %" PetscInt_FMT ", %" PetscInt_FMT " rounds of %" PetscInt_FMT " MatMults, minimum per MatMult (%s time)\n", grid.nx, bs, repeats, batch, use_wall ? "wall" : "process CPU"));
+  PetscCall(PetscPrintf(PETSC_COMM_SELF,
+                        "stencil %" PetscInt_FMT "^3, bs %" PetscInt_FMT ", %" PetscInt_FMT
+                        " rounds of %" PetscInt_FMT " MatMults, minimum per MatMult (%s time)\n",
+                        grid.nx, bs, repeats, batch, use_wall ? "wall" : "process CPU"));
   PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-20s %10s %8s %8s\n", "variant", "ms", "x baij", "x aij"));
-  for (Variant &v : vars) PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-20s %10.4f %8.2f %8.2f\n", v.name.c_str(), 1e3 * v.best, vars[1].best / v.best, vars[0].best / v.best));
+  for (Variant &v : vars)
+    PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-20s %10.4f %8.2f %8.2f\n", v.name.c_str(), 1e3 * v.best,
+                          vars[1].best / v.best, vars[0].best / v.best));
   for (Variant &v : vars)
     if (v.owner) PetscCall(MatDestroy(&v.A));
   if (coo) PetscCall(TimeCOO(grid, repeats));

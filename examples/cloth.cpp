@@ -53,7 +53,7 @@ int main(int argc, char **argv)
   PetscCallMPI(MPI_Comm_size(comm, &size));
 
   physics::ClothOptions opt;
-  PetscInt              n = opt.n;
+  PetscInt              n         = opt.n;
   bool                  cpu_timer = false;
   PetscBool             hanging = PETSC_FALSE, sphere = PETSC_FALSE, exact = PETSC_FALSE, set;
   char                  pins[32] = "corners";
@@ -73,11 +73,13 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-sphere", &sphere, nullptr));
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-sphere_radius", &radius, nullptr));
   PetscCall(PetscOptionsGetRealArray(nullptr, nullptr, "-sphere_centre", centre, &ncentre, &set));
-  PetscCheck(!set || ncentre == 3, comm, PETSC_ERR_ARG_SIZ, "-sphere_centre needs 3 numbers, got %" PetscInt_FMT, ncentre);
+  PetscCheck(!set || ncentre == 3, comm, PETSC_ERR_ARG_SIZ,
+             "-sphere_centre needs 3 numbers, got %" PetscInt_FMT, ncentre);
   PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-cloth_exact_jacobian", &exact, nullptr));
   {
     PetscInt sweeps = params.strain_limit.max_sweeps;
-    PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-cloth_strain_limit", &params.strain_limit.max_strain, nullptr));
+    PetscCall(
+      PetscOptionsGetReal(nullptr, nullptr, "-cloth_strain_limit", &params.strain_limit.max_strain, nullptr));
     PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-cloth_strain_limit_sweeps", &sweeps, nullptr));
     params.strain_limit.max_sweeps = (int)sweeps;
   }
@@ -98,8 +100,11 @@ int main(int argc, char **argv)
   else if (!std::strcmp(pins, "none")) opt.pins = physics::ClothPins::None;
   else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "unknown -cloth_pins %s (corners, four, top, none)", pins);
   const std::string bad = physics::validate_params(params);
-  PetscCheck(bad.empty(), comm, PETSC_ERR_ARG_OUTOFRANGE, "%s (-dt %g, -cloth_strain_limit %g, -cloth_strain_limit_sweeps %d)", bad.c_str(), (double)params.dt, (double)params.strain_limit.max_strain, params.strain_limit.max_sweeps);
-  PetscCheck(!sphere || radius > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-sphere_radius must be positive, got %g", (double)radius);
+  PetscCheck(bad.empty(), comm, PETSC_ERR_ARG_OUTOFRANGE,
+             "%s (-dt %g, -cloth_strain_limit %g, -cloth_strain_limit_sweeps %d)", bad.c_str(),
+             (double)params.dt, (double)params.strain_limit.max_strain, params.strain_limit.max_sweeps);
+  PetscCheck(!sphere || radius > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-sphere_radius must be positive, got %g",
+             (double)radius);
 
   physics::Cloth cloth;
   try {
@@ -107,9 +112,9 @@ int main(int argc, char **argv)
   } catch (const std::invalid_argument &e) {
     SETERRQ(comm, PETSC_ERR_ARG_OUTOFRANGE, "cloth: %s", e.what());
   }
-  cloth.sphere.enabled = sphere;
-  cloth.sphere.radius  = radius;
-  cloth.sphere.centre  = Eigen::Vector3d(centre[0], centre[1], centre[2]);
+  cloth.sphere.enabled      = sphere;
+  cloth.sphere.radius       = radius;
+  cloth.sphere.centre       = Eigen::Vector3d(centre[0], centre[1], centre[2]);
   const std::string problem = physics::validate_cloth(cloth);
   PetscCheck(problem.empty(), comm, PETSC_ERR_ARG_WRONG, "cloth: %s", problem.c_str());
 
@@ -124,19 +129,27 @@ int main(int argc, char **argv)
   {
     std::vector<char> own(cloth.particle_count());
     for (int p = 0; p < cloth.particle_count(); ++p) own[p] = ReplicatedSolverOwnsRow(&rs, p);
-    sys = physics::make_cloth_system(cloth, own, [&](int row, int col) { return ReplicatedSolverStoresBlock(&rs, row, col); });
+    sys = physics::make_cloth_system(
+      cloth, own, [&](int row, int col) { return ReplicatedSolverStoresBlock(&rs, row, col); });
   }
   PetscCall(ReplicatedSolverSetLocalPattern(&rs, sys.block_row, sys.block_col));
   const physics::BlockLinearSolver linear = ReplicatedSolverAdapter(&rs);
-  PetscInt    nnz;
-  const char *mat_type, *ksp_type;
+  PetscInt                         nnz;
+  const char                      *mat_type, *ksp_type;
   PetscCall(BlockSystemGetInfo(&rs.sys, &nnz, &mat_type, &ksp_type));
-  PetscCall(PetscPrintf(comm, "cloth: %d x %d particles (%d unknowns), %zu springs, %" PetscInt_FMT " nonzeros, mat %s, ksp %s, %d ranks\n", cloth.n, cloth.n,
-                        3 * cloth.particle_count(), cloth.springs.size(), nnz, mat_type, ksp_type, size));
-  PetscCall(PetscSynchronizedPrintf(comm, "  rank %d assembles %zu springs, %zu blocks\n", rank, sys.springs.size(), sys.block_row.size()));
+  PetscCall(PetscPrintf(comm,
+                        "cloth: %d x %d particles (%d unknowns), %zu springs, %" PetscInt_FMT
+                        " nonzeros, mat %s, ksp %s, %d ranks\n",
+                        cloth.n, cloth.n, 3 * cloth.particle_count(), cloth.springs.size(), nnz, mat_type,
+                        ksp_type, size));
+  PetscCall(PetscSynchronizedPrintf(comm, "  rank %d assembles %zu springs, %zu blocks\n", rank,
+                                    sys.springs.size(), sys.block_row.size()));
   PetscCall(PetscSynchronizedFlush(comm, PETSC_STDOUT));
 
-  auto write_frame = [&](PetscInt step) { return DriverWriteFrame(comm, &out, step, step * params.dt, [&](const std::string &path) { return WriteFrame(path, cloth); }); };
+  auto write_frame = [&](PetscInt step) {
+    return DriverWriteFrame(comm, &out, step, step * params.dt,
+                            [&](const std::string &path) { return WriteFrame(path, cloth); });
+  };
   PetscCall(write_frame(0));
 
   const double e0 = physics::cloth_energy(cloth);
@@ -147,7 +160,8 @@ int main(int argc, char **argv)
     // draped for 20 steps), so the bound is 4 x the scale; a spring at twice its rest length is no
     // cloth any more.
     double m = 0, ke0 = 0;
-    for (int p = 0; p < cloth.particle_count(); ++p) m += cloth.mass[p], ke0 += 0.5 * cloth.mass[p] * cloth.velocity[p].squaredNorm();
+    for (int p = 0; p < cloth.particle_count(); ++p)
+      m += cloth.mass[p], ke0 += 0.5 * cloth.mass[p] * cloth.velocity[p].squaredNorm();
     HealthBounds hb;
     hb.energy_scale  = m * cloth.gravity.norm() * opt.size + ke0;
     hb.energy_growth = 4.0;
@@ -155,19 +169,20 @@ int main(int argc, char **argv)
     PetscCall(RunGuardFromOptions(comm, hb, &guard));
     RunGuardStart(&guard, e0, NAN);
   }
-  const auto   now = cpu_timer ? ProcessCpuTime : WallTime;
-  double       step_ms_total = 0, max_stretch = 0;
-  long long    nan_steps = 0, unconverged = 0, contacts = 0, done = 0;
+  const auto now           = cpu_timer ? ProcessCpuTime : WallTime;
+  double     step_ms_total = 0, max_stretch = 0;
+  long long  nan_steps = 0, unconverged = 0, contacts = 0, done = 0;
   for (PetscInt step = 1; step <= out.steps; ++step) {
-    const long long its0 = rs.iterations;
-    const double    solve0 = rs.solve_ms, t0 = now();
-    const physics::ClothStepReport r = physics::cloth_step(cloth, sys, params, linear);
-    const double step_ms = 1e3 * (now() - t0);
+    const long long                its0   = rs.iterations;
+    const double                   solve0 = rs.solve_ms, t0 = now();
+    const physics::ClothStepReport r       = physics::cloth_step(cloth, sys, params, linear);
+    const double                   step_ms = 1e3 * (now() - t0);
     PetscCall(rs.error);
     ++done;
     step_ms_total += step_ms;
     bool finite = true;
-    for (int p = 0; p < cloth.particle_count(); ++p) finite &= cloth.position[p].allFinite() && cloth.velocity[p].allFinite();
+    for (int p = 0; p < cloth.particle_count(); ++p)
+      finite &= cloth.position[p].allFinite() && cloth.velocity[p].allFinite();
     nan_steps += !finite;
     unconverged += !r.converged;
     contacts += r.contacts;
@@ -175,9 +190,12 @@ int main(int argc, char **argv)
     if (step % out.progress_every == 0 || step == out.steps) {
       double stretch = r.max_stretch;
       PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &stretch, 1, MPI_DOUBLE, MPI_MAX, comm));
-      PetscCall(PetscPrintf(comm, "step %" PetscInt_FMT " t=%.4f cg_its=%lld stretch=%.5f contacts=%d energy=%.6e ms=%.2f solve_ms=%.2f%s\n", step, step * params.dt,
-                            rs.iterations - its0, stretch, r.contacts, physics::cloth_energy(cloth), step_ms, rs.solve_ms - solve0,
-                            r.converged ? "" : " UNCONVERGED"));
+      PetscCall(PetscPrintf(
+        comm,
+        "step %" PetscInt_FMT
+        " t=%.4f cg_its=%lld stretch=%.5f contacts=%d energy=%.6e ms=%.2f solve_ms=%.2f%s\n",
+        step, step * params.dt, rs.iterations - its0, stretch, r.contacts, physics::cloth_energy(cloth),
+        step_ms, rs.solve_ms - solve0, r.converged ? "" : " UNCONVERGED"));
     }
     if (step == 1 && out.dump) PetscCall(BlockSystemDumpMatrix(&rs.sys, out.dump_path));
     PetscCall(write_frame(step));
@@ -194,7 +212,8 @@ int main(int argc, char **argv)
 
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &max_stretch, 1, MPI_DOUBLE, MPI_MAX, comm));
   double ke = 0;
-  for (int p = 0; p < cloth.particle_count(); ++p) ke += 0.5 * cloth.mass[p] * cloth.velocity[p].squaredNorm();
+  for (int p = 0; p < cloth.particle_count(); ++p)
+    ke += 0.5 * cloth.mass[p] * cloth.velocity[p].squaredNorm();
   SummaryLine s;
   s.add("program", std::string("cloth"));
   s.add("ranks", (long long)size);

@@ -42,37 +42,37 @@ static const char help[] = "Corotational FEM (P1/P2 tetrahedra), implicit Euler,
 namespace {
 
 struct Options {
-  char        mesh[PETSC_MAX_PATH_LEN] = "";
-  PetscReal   mesh_size                = 0; // for .geo files
-  PetscReal   box[6]                   = {1, 0.1, 0.1, 20, 2, 2};
-  PetscBool   box_set                  = PETSC_FALSE;
-  PetscInt    order                    = 1;
-  PetscBool   corotational             = PETSC_TRUE;
-  PetscBool   lumped                   = PETSC_FALSE;
-  PetscReal   young = 1e6, poisson = 0.3, density = 1000;
-  PetscReal   dt = 0.01;
-  PetscInt    steps = 10;
-  PetscReal   gravity[3] = {0, 0, -9.81};
-  PetscReal   rayleigh[2] = {0, 0};
-  char        fix[256]    = "";
-  PetscReal   fix_box[6]  = {0};
-  PetscBool   fix_box_set = PETSC_FALSE;
-  char        vtk[PETSC_MAX_PATH_LEN] = "";
-  PetscInt    vtk_every = 1;
-  char        dump[PETSC_MAX_PATH_LEN] = "";
-  PetscBool   merge   = PETSC_TRUE;
-  PetscBool   rigid_body_modes = PETSC_TRUE;
-  PetscBool   reorder = PETSC_TRUE;
-  PetscInt    bin_order_window = FemScene().bin_order_window;
-  PetscBool   quiet   = PETSC_FALSE;
-  PetscInt    element_bench = 0;
-  PetscBool   cpu_timer = PETSC_FALSE;
-  PetscBool   scalar_elements = PETSC_FALSE;
-  PetscBool   is_static = PETSC_FALSE;
-  PetscReal   v0[3] = {0, 0, 0};
-  PetscReal   spin[3] = {0, 0, 0};
-  PetscReal   stretch = 1;
-  PetscReal   perturb[4] = {-1, 0, 0, 0}; // node, dx, dy, dz (rest numbering)
+  char      mesh[PETSC_MAX_PATH_LEN] = "";
+  PetscReal mesh_size                = 0; // for .geo files
+  PetscReal box[6]                   = {1, 0.1, 0.1, 20, 2, 2};
+  PetscBool box_set                  = PETSC_FALSE;
+  PetscInt  order                    = 1;
+  PetscBool corotational             = PETSC_TRUE;
+  PetscBool lumped                   = PETSC_FALSE;
+  PetscReal young = 1e6, poisson = 0.3, density = 1000;
+  PetscReal dt                       = 0.01;
+  PetscInt  steps                    = 10;
+  PetscReal gravity[3]               = {0, 0, -9.81};
+  PetscReal rayleigh[2]              = {0, 0};
+  char      fix[256]                 = "";
+  PetscReal fix_box[6]               = {0};
+  PetscBool fix_box_set              = PETSC_FALSE;
+  char      vtk[PETSC_MAX_PATH_LEN]  = "";
+  PetscInt  vtk_every                = 1;
+  char      dump[PETSC_MAX_PATH_LEN] = "";
+  PetscBool merge                    = PETSC_TRUE;
+  PetscBool rigid_body_modes         = PETSC_TRUE;
+  PetscBool reorder                  = PETSC_TRUE;
+  PetscInt  bin_order_window         = FemScene().bin_order_window;
+  PetscBool quiet                    = PETSC_FALSE;
+  PetscInt  element_bench            = 0;
+  PetscBool cpu_timer                = PETSC_FALSE;
+  PetscBool scalar_elements          = PETSC_FALSE;
+  PetscBool is_static                = PETSC_FALSE;
+  PetscReal v0[3]                    = {0, 0, 0};
+  PetscReal spin[3]                  = {0, 0, 0};
+  PetscReal stretch                  = 1;
+  PetscReal perturb[4]               = {-1, 0, 0, 0}; // node, dx, dy, dz (rest numbering)
 };
 
 PetscErrorCode GetOptions(Options &o)
@@ -81,77 +81,104 @@ PetscErrorCode GetOptions(Options &o)
   PetscBool set;
   PetscFunctionBegin;
   PetscOptionsBegin(PETSC_COMM_WORLD, nullptr, "FEM driver options", "fem");
-  PetscCall(PetscOptionsString("-mesh", "gmsh mesh (.msh 2.2/4.1 ASCII) or geometry (.geo, meshed by gmsh)", "", o.mesh, o.mesh,
-                               sizeof o.mesh, nullptr));
-  PetscCall(PetscOptionsReal("-mesh_size", "gmsh characteristic length for .geo input", "", o.mesh_size, &o.mesh_size, nullptr));
+  PetscCall(PetscOptionsString("-mesh", "gmsh mesh (.msh 2.2/4.1 ASCII) or geometry (.geo, meshed by gmsh)",
+                               "", o.mesh, o.mesh, sizeof o.mesh, nullptr));
+  PetscCall(PetscOptionsReal("-mesh_size", "gmsh characteristic length for .geo input", "", o.mesh_size,
+                             &o.mesh_size, nullptr));
   n = 6;
-  PetscCall(PetscOptionsRealArray("-mesh_box", "lx,ly,lz,nx,ny,nz: box of 6 tets per cell", "", o.box, &n, &o.box_set));
-  PetscCheck(!o.box_set || n == 6, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "-mesh_box needs lx,ly,lz,nx,ny,nz");
-  PetscCall(PetscOptionsInt("-fem_order", "1 (4-node) or 2 (10-node) tetrahedra", "", o.order, &o.order, nullptr));
-  PetscCheck(o.order == 1 || o.order == 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-fem_order must be 1 or 2");
-  PetscCall(PetscOptionsBool("-fem_corotational", "corotational (1) or plain linear (0) elasticity", "", o.corotational,
-                             &o.corotational, nullptr));
-  PetscCall(PetscOptionsBool("-fem_mass_lumped", "P2: HRZ-lumped instead of consistent mass", "", o.lumped, &o.lumped, nullptr));
+  PetscCall(PetscOptionsRealArray("-mesh_box", "lx,ly,lz,nx,ny,nz: box of 6 tets per cell", "", o.box, &n,
+                                  &o.box_set));
+  PetscCheck(!o.box_set || n == 6, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG,
+             "-mesh_box needs lx,ly,lz,nx,ny,nz");
+  PetscCall(
+    PetscOptionsInt("-fem_order", "1 (4-node) or 2 (10-node) tetrahedra", "", o.order, &o.order, nullptr));
+  PetscCheck(o.order == 1 || o.order == 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+             "-fem_order must be 1 or 2");
+  PetscCall(PetscOptionsBool("-fem_corotational", "corotational (1) or plain linear (0) elasticity", "",
+                             o.corotational, &o.corotational, nullptr));
+  PetscCall(PetscOptionsBool("-fem_mass_lumped", "P2: HRZ-lumped instead of consistent mass", "", o.lumped,
+                             &o.lumped, nullptr));
   PetscCall(PetscOptionsReal("-young", "Young's modulus (Pa)", "", o.young, &o.young, nullptr));
   PetscCall(PetscOptionsReal("-poisson", "Poisson's ratio", "", o.poisson, &o.poisson, nullptr));
   PetscCall(PetscOptionsReal("-density", "density (kg/m^3)", "", o.density, &o.density, nullptr));
   PetscCall(PetscOptionsReal("-dt", "time step (s)", "", o.dt, &o.dt, nullptr));
-  PetscCall(PetscOptionsInt("-steps", "time steps (Newton iterations with -static)", "", o.steps, &o.steps, nullptr));
+  PetscCall(
+    PetscOptionsInt("-steps", "time steps (Newton iterations with -static)", "", o.steps, &o.steps, nullptr));
   n = 3;
   PetscCall(PetscOptionsRealArray("-gravity", "gx,gy,gz", "", o.gravity, &n, &set));
   PetscCheck(!set || n == 3, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "-gravity needs gx,gy,gz");
   n = 2;
-  PetscCall(PetscOptionsRealArray("-rayleigh", "alpha,beta: damping D = alpha M + beta K", "", o.rayleigh, &n, &set));
+  PetscCall(
+    PetscOptionsRealArray("-rayleigh", "alpha,beta: damping D = alpha M + beta K", "", o.rayleigh, &n, &set));
   PetscCheck(!set || n == 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "-rayleigh needs alpha,beta");
-  PetscCall(PetscOptionsString("-fix", "none | xmin|xmax|ymin|ymax|zmin|zmax[:fraction of the extent, default 0.01]", "", o.fix,
-                               o.fix, sizeof o.fix, nullptr));
+  PetscCall(PetscOptionsString("-fix",
+                               "none | xmin|xmax|ymin|ymax|zmin|zmax[:fraction of the extent, default 0.01]",
+                               "", o.fix, o.fix, sizeof o.fix, nullptr));
   n = 6;
-  PetscCall(PetscOptionsRealArray("-fix_box", "x0,y0,z0,x1,y1,z1: fix the nodes in this box", "", o.fix_box, &n, &o.fix_box_set));
-  PetscCheck(!o.fix_box_set || n == 6, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "-fix_box needs x0,y0,z0,x1,y1,z1");
-  PetscCall(PetscOptionsString("-vtk", "write PREFIX_NNNN.vtu frames and PREFIX.pvd", "", o.vtk, o.vtk, sizeof o.vtk, nullptr));
-  PetscCall(PetscOptionsInt("-vtk_every", "write a frame every k steps", "", o.vtk_every, &o.vtk_every, nullptr));
-  PetscCall(PetscOptionsString("-dump_matrix", "write the first step's matrix (PETSc binary)", "", o.dump, o.dump, sizeof o.dump,
-                               nullptr));
-  PetscCall(PetscOptionsBool("-fem_merge_blocks", "sum element blocks into unique COO blocks here (1) or let the Mat do it (0)",
+  PetscCall(PetscOptionsRealArray("-fix_box", "x0,y0,z0,x1,y1,z1: fix the nodes in this box", "", o.fix_box,
+                                  &n, &o.fix_box_set));
+  PetscCheck(!o.fix_box_set || n == 6, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG,
+             "-fix_box needs x0,y0,z0,x1,y1,z1");
+  PetscCall(PetscOptionsString("-vtk", "write PREFIX_NNNN.vtu frames and PREFIX.pvd", "", o.vtk, o.vtk,
+                               sizeof o.vtk, nullptr));
+  PetscCall(
+    PetscOptionsInt("-vtk_every", "write a frame every k steps", "", o.vtk_every, &o.vtk_every, nullptr));
+  PetscCall(PetscOptionsString("-dump_matrix", "write the first step's matrix (PETSc binary)", "", o.dump,
+                               o.dump, sizeof o.dump, nullptr));
+  PetscCall(PetscOptionsBool("-fem_merge_blocks",
+                             "sum element blocks into unique COO blocks here (1) or let the Mat do it (0)",
                              "", o.merge, &o.merge, nullptr));
-  PetscCall(PetscOptionsBool("-fem_rigid_body_modes", "give the matrix the rest shape's rigid body modes as near null space (PCGAMG's coarse space; 0: GAMG's default, translations only)",
-                             "", o.rigid_body_modes, &o.rigid_body_modes, nullptr));
-  PetscCall(PetscOptionsBool("-fem_reorder", "METIS partition / RCM renumbering of the nodes", "", o.reorder, &o.reorder, nullptr));
-  PetscCall(PetscOptionsInt("-fem_bin_order_window", "with -fem_reorder: sort nodes by row length in windows of N (0 = off)", "", o.bin_order_window, &o.bin_order_window, nullptr));
-  PetscCall(PetscOptionsInt("-fem_element_bench", "after the steps, time the element loop N more times (CPU time)", "",
+  PetscCall(PetscOptionsBool(
+    "-fem_rigid_body_modes",
+    "give the matrix the rest shape's rigid body modes as near null space (PCGAMG's coarse space; 0: GAMG's default, translations only)",
+    "", o.rigid_body_modes, &o.rigid_body_modes, nullptr));
+  PetscCall(PetscOptionsBool("-fem_reorder", "METIS partition / RCM renumbering of the nodes", "", o.reorder,
+                             &o.reorder, nullptr));
+  PetscCall(PetscOptionsInt("-fem_bin_order_window",
+                            "with -fem_reorder: sort nodes by row length in windows of N (0 = off)", "",
+                            o.bin_order_window, &o.bin_order_window, nullptr));
+  PetscCall(PetscOptionsInt("-fem_element_bench",
+                            "after the steps, time the element loop N more times (CPU time)", "",
                             o.element_bench, &o.element_bench, nullptr));
   {
     const char *timers[] = {"wall", "cpu"};
     PetscInt    t        = o.cpu_timer ? 1 : 0;
-    PetscCall(PetscOptionsEList("-fem_timer", "per-step timings in wall time or process CPU time (a shared machine)", "", timers, 2,
-                                timers[t], &t, nullptr));
+    PetscCall(PetscOptionsEList("-fem_timer",
+                                "per-step timings in wall time or process CPU time (a shared machine)", "",
+                                timers, 2, timers[t], &t, nullptr));
     o.cpu_timer = t == 1 ? PETSC_TRUE : PETSC_FALSE;
   }
   {
     const char *kernels[] = {"batched", "scalar"};
     PetscInt    k         = o.scalar_elements ? 1 : 0;
-    PetscCall(PetscOptionsEList("-fem_element_kernel", "element loop: batched over SIMD lanes, or the scalar reference", "",
-                                kernels, 2, kernels[k], &k, nullptr));
+    PetscCall(PetscOptionsEList("-fem_element_kernel",
+                                "element loop: batched over SIMD lanes, or the scalar reference", "", kernels,
+                                2, kernels[k], &k, nullptr));
     o.scalar_elements = k == 1 ? PETSC_TRUE : PETSC_FALSE;
   }
   PetscCall(PetscOptionsBool("-fem_quiet", "no progress line per step", "", o.quiet, &o.quiet, nullptr));
-  PetscCall(PetscOptionsBool("-static", "solve K(x) dx = f(x) + f_ext by Newton steps instead of time steps", "", o.is_static,
-                             &o.is_static, nullptr));
+  PetscCall(PetscOptionsBool("-static", "solve K(x) dx = f(x) + f_ext by Newton steps instead of time steps",
+                             "", o.is_static, &o.is_static, nullptr));
   n = 3;
   PetscCall(PetscOptionsRealArray("-initial_velocity", "vx,vy,vz", "", o.v0, &n, nullptr));
   n = 3;
-  PetscCall(PetscOptionsRealArray("-initial_spin", "wx,wy,wz: rigid angular velocity about the centroid", "", o.spin, &n, nullptr));
-  PetscCall(PetscOptionsReal("-initial_stretch", "scale initial positions about the centroid", "", o.stretch, &o.stretch, nullptr));
+  PetscCall(PetscOptionsRealArray("-initial_spin", "wx,wy,wz: rigid angular velocity about the centroid", "",
+                                  o.spin, &n, nullptr));
+  PetscCall(PetscOptionsReal("-initial_stretch", "scale initial positions about the centroid", "", o.stretch,
+                             &o.stretch, nullptr));
   n = 4;
-  PetscCall(PetscOptionsRealArray("-initial_perturb", "node,dx,dy,dz: move one node (e.g. to invert an element)", "", o.perturb,
+  PetscCall(PetscOptionsRealArray("-initial_perturb",
+                                  "node,dx,dy,dz: move one node (e.g. to invert an element)", "", o.perturb,
                                   &n, nullptr));
   PetscOptionsEnd();
-  PetscCheck(o.dt > 0 && std::isfinite(o.dt), PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-dt must be positive");
+  PetscCheck(o.dt > 0 && std::isfinite(o.dt), PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+             "-dt must be positive");
   for (int d = 0; d < 3; ++d)
-    PetscCheck(std::isfinite(o.gravity[d]) && std::isfinite(o.v0[d]) && std::isfinite(o.spin[d]), PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+    PetscCheck(std::isfinite(o.gravity[d]) && std::isfinite(o.v0[d]) && std::isfinite(o.spin[d]),
+               PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
                "-gravity, -initial_velocity and -initial_spin must be finite");
-  PetscCheck(std::isfinite(o.rayleigh[0]) && std::isfinite(o.rayleigh[1]) && std::isfinite(o.stretch), PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
-             "-rayleigh and -initial_stretch must be finite");
+  PetscCheck(std::isfinite(o.rayleigh[0]) && std::isfinite(o.rayleigh[1]) && std::isfinite(o.stretch),
+             PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-rayleigh and -initial_stretch must be finite");
   PetscCheck(o.steps >= 0, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-steps must be >= 0");
   PetscCheck(o.vtk_every >= 1, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-vtk_every must be >= 1");
   PetscFunctionReturn(0);
@@ -186,12 +213,13 @@ PetscErrorCode MeshGeo(MPI_Comm comm, const std::string geo, double size, std::s
   base              = base.substr(0, base.find_last_of('.'));
   char sz[64];
   std::snprintf(sz, sizeof sz, "%.17g", size);
-  const std::string options = "-3 -format msh41 -v 1 -nt 1 " + (size > 0 ? "-clmax " + std::string(sz) + " " : std::string());
+  const std::string options =
+    "-3 -format msh41 -v 1 -nt 1 " + (size > 0 ? "-clmax " + std::string(sz) + " " : std::string());
   // The cache entry is named by what decides the mesh: the .geo file's contents and the meshing options
   // (the base name alone would hand an edited file, or another folder's file of that name, a stale mesh).
   // A .geo that includes other files (Merge, Include) is keyed on its own text only.
-  int         failed = 0;
-  char        key[17] = "";
+  int  failed  = 0;
+  char key[17] = "";
   if (!rank) {
     std::ifstream in(geo, std::ios::binary);
     std::string   text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -204,10 +232,11 @@ PetscErrorCode MeshGeo(MPI_Comm comm, const std::string geo, double size, std::s
     mkdir(dir.c_str(), 0755);
     const std::string tmp = *msh + ".tmp." + std::to_string(getpid()) + ".msh";
     std::string       cmd = "gmsh " + options + "'" + geo + "' -o '" + tmp + "' > /dev/null 2>&1";
-    failed = std::system(cmd.c_str()) != 0 || std::rename(tmp.c_str(), msh->c_str()) != 0;
+    failed                = std::system(cmd.c_str()) != 0 || std::rename(tmp.c_str(), msh->c_str()) != 0;
   }
   PetscCallMPI(MPI_Bcast(&failed, 1, MPI_INT, 0, comm));
-  PetscCheck(!failed, comm, PETSC_ERR_LIB, "gmsh could not mesh %s (is gmsh installed? scripts/setup installs it)", geo.c_str());
+  PetscCheck(!failed, comm, PETSC_ERR_LIB,
+             "gmsh could not mesh %s (is gmsh installed? scripts/setup installs it)", geo.c_str());
   PetscFunctionReturn(0);
 }
 
@@ -218,22 +247,26 @@ std::vector<char> SelectFixed(const physics::TetMesh &mesh, const Options &o)
   const auto        bb  = physics::bounding_box(mesh);
   std::string       fix = o.fix;
   if (!fix.empty() && fix != "none") {
-    double      fraction = 0.01;
-    const auto  colon    = fix.find(':');
+    double     fraction = 0.01;
+    const auto colon    = fix.find(':');
     if (colon != std::string::npos) {
       fraction = std::atof(fix.c_str() + colon + 1);
       fix      = fix.substr(0, colon);
     }
     if (fix.size() != 4 || fix[0] < 'x' || fix[0] > 'z' || (fix.substr(1) != "min" && fix.substr(1) != "max"))
-      throw std::invalid_argument("-fix " + std::string(o.fix) + ": expected none, xmin, xmax, ymin, ymax, zmin or zmax[:fraction]");
+      throw std::invalid_argument("-fix " + std::string(o.fix) +
+                                  ": expected none, xmin, xmax, ymin, ymax, zmin or zmax[:fraction]");
     const int    axis   = fix[0] - 'x';
     const bool   is_min = fix.substr(1) == "min";
     const double extent = bb[3 + axis] - bb[axis];
     const double tol    = std::max(fraction, 1e-9) * extent;
-    for (int i : physics::nodes_beyond_plane(mesh, axis, is_min ? bb[axis] : bb[3 + axis], is_min ? -1 : 1, tol)) fixed[i] = 1;
+    for (int i :
+         physics::nodes_beyond_plane(mesh, axis, is_min ? bb[axis] : bb[3 + axis], is_min ? -1 : 1, tol))
+      fixed[i] = 1;
   }
   if (o.fix_box_set)
-    for (int i : physics::nodes_in_box(mesh, {o.fix_box[0], o.fix_box[1], o.fix_box[2]}, {o.fix_box[3], o.fix_box[4], o.fix_box[5]}))
+    for (int i : physics::nodes_in_box(mesh, {o.fix_box[0], o.fix_box[1], o.fix_box[2]},
+                                       {o.fix_box[3], o.fix_box[4], o.fix_box[5]}))
       fixed[i] = 1;
   return fixed;
 }
@@ -256,7 +289,10 @@ int TipNode(const physics::TetMesh &mesh, const std::vector<char> &fixed)
     if (nf)
       for (int d = 0; d < 3; ++d) dist += std::pow(mesh.nodes[3 * i + d] - c[d] / nf, 2);
     else dist = mesh.nodes[3 * i];
-    if (dist > bd + 1e-12) { bd = dist; best = i; }
+    if (dist > bd + 1e-12) {
+      bd   = dist;
+      best = i;
+    }
   }
   return best;
 }
@@ -280,15 +316,17 @@ int main(int argc, char **argv)
   std::string mesh_name;
   {
     std::string msh = o.mesh;
-    if (msh.size() > 4 && msh.substr(msh.size() - 4) == ".geo") PetscCall(MeshGeo(comm, msh, o.mesh_size, &msh));
+    if (msh.size() > 4 && msh.substr(msh.size() - 4) == ".geo")
+      PetscCall(MeshGeo(comm, msh, o.mesh_size, &msh));
     std::string error;
     try {
       if (!msh.empty()) {
         scene.mesh = physics::read_msh_file(msh);
         mesh_name  = o.mesh;
       } else {
-        scene.mesh = physics::make_box_mesh(o.box[0], o.box[1], o.box[2], (int)o.box[3], (int)o.box[4], (int)o.box[5]);
-        mesh_name  = "box";
+        scene.mesh =
+          physics::make_box_mesh(o.box[0], o.box[1], o.box[2], (int)o.box[3], (int)o.box[4], (int)o.box[5]);
+        mesh_name = "box";
       }
       if (o.order == 2) scene.mesh = physics::promote_to_quadratic(scene.mesh);
       scene.fixed = SelectFixed(scene.mesh, o);
@@ -311,13 +349,13 @@ int main(int argc, char **argv)
     scene.reorder               = o.reorder;
     scene.bin_order_window      = (int)o.bin_order_window;
   }
-  const int tip_input = TipNode(scene.mesh, scene.fixed);
+  const int     tip_input = TipNode(scene.mesh, scene.fixed);
   FemSimulation sim;
   PetscCall(FemSimulationCreate(comm, scene, &sim));
-  sim.cpu_timer = o.cpu_timer;
+  sim.cpu_timer      = o.cpu_timer;
   sim.element_kernel = o.scalar_elements ? physics::ElementKernel::Scalar : physics::ElementKernel::Batched;
-  const physics::FemModel &model = sim.model;
-  const int n_nodes = model.node_count(), npe = model.npe, tip = sim.new_of_old[tip_input];
+  const physics::FemModel   &model   = sim.model;
+  const int                  n_nodes = model.node_count(), npe = model.npe, tip = sim.new_of_old[tip_input];
   const std::vector<double> &X = model.mesh.nodes;
   std::vector<double>       &x = sim.x, &v = sim.v;
 
@@ -336,7 +374,8 @@ int main(int argc, char **argv)
     }
     if (o.perturb[0] >= 0) {
       // The node is named in the numbering of the input (promoted) mesh.
-      PetscCheck((PetscInt)o.perturb[0] < n_nodes, comm, PETSC_ERR_ARG_OUTOFRANGE, "-initial_perturb: node out of range");
+      PetscCheck((PetscInt)o.perturb[0] < n_nodes, comm, PETSC_ERR_ARG_OUTOFRANGE,
+                 "-initial_perturb: node out of range");
       const int node = sim.new_of_old[(int)o.perturb[0]];
       for (int d = 0; d < 3; ++d) x[3 * node + d] += o.perturb[1 + d];
     }
@@ -348,8 +387,8 @@ int main(int argc, char **argv)
       r = std::min(r, physics::element_signed_volume(model.mesh, x.data(), e) / model.volume[e]);
     return r;
   };
-  auto inverted_fraction = [&] { return FemInvertedFraction(sim); };
-  auto total_energy      = [&] { return FemTotalEnergy(sim); };
+  auto     inverted_fraction = [&] { return FemInvertedFraction(sim); };
+  auto     total_energy      = [&] { return FemTotalEnergy(sim); };
   RunGuard guard;
   PetscCall(RunGuardFromOptions(comm, FemHealthBounds(sim), &guard));
   RunGuardStart(&guard, total_energy(), inverted_fraction());
@@ -357,19 +396,21 @@ int main(int argc, char **argv)
   const char *mat_type, *ksp_type;
   PetscCall(BlockSystemGetInfo(&sim.sys, &nnz, &mat_type, &ksp_type));
   const long long n_fixed = std::count(sim.fixed.begin(), sim.fixed.end(), 1);
-  PetscCall(PetscPrintf(comm,
-                        "fem: mesh %s order %d elements %d nodes %d dofs %d fixed nodes %lld nnz %" PetscInt_FMT
-                        " ranks %d mat %s ksp %s corotational %d mass %s\n",
-                        mesh_name.c_str(), (int)o.order, model.element_count(), n_nodes, 3 * n_nodes, n_fixed, nnz, size,
-                        mat_type, ksp_type, (int)o.corotational, o.order == 1 ? "lumped" : (o.lumped ? "hrz" : "consistent")));
-  PetscCall(PetscPrintf(comm, "fem: initial min volume ratio %g (negative: inverted elements)\n", min_volume_ratio()));
+  PetscCall(PetscPrintf(
+    comm,
+    "fem: mesh %s order %d elements %d nodes %d dofs %d fixed nodes %lld nnz %" PetscInt_FMT
+    " ranks %d mat %s ksp %s corotational %d mass %s\n",
+    mesh_name.c_str(), (int)o.order, model.element_count(), n_nodes, 3 * n_nodes, n_fixed, nnz, size,
+    mat_type, ksp_type, (int)o.corotational, o.order == 1 ? "lumped" : (o.lumped ? "hrz" : "consistent")));
+  PetscCall(PetscPrintf(comm, "fem: initial min volume ratio %g (negative: inverted elements)\n",
+                        min_volume_ratio()));
 
   std::vector<std::pair<std::string, double>> frames;
-  auto write_frame = [&](int step) {
+  auto                                        write_frame = [&](int step) {
     if (rank || !o.vtk[0]) return;
     physics::VtkScene vs;
-    vs.points         = x;
-    vs.cell_type      = npe == 4 ? physics::VtkCellType::Tetra : physics::VtkCellType::QuadraticTetra;
+    vs.points = x;
+    vs.cell_type = npe == 4 ? physics::VtkCellType::Tetra : physics::VtkCellType::QuadraticTetra;
     vs.nodes_per_cell = npe;
     vs.connectivity   = model.mesh.elements;
     std::vector<double> u(x.size());
@@ -390,12 +431,13 @@ int main(int argc, char **argv)
     if (!parent.empty()) std::filesystem::create_directories(parent, ec);
   }
   write_frame(0);
-  PetscCheck(rank || !o.vtk[0] || !frames.empty(), PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "-vtk %s: cannot write %s_0000.vtu", o.vtk, o.vtk);
+  PetscCheck(rank || !o.vtk[0] || !frames.empty(), PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN,
+             "-vtk %s: cannot write %s_0000.vtu", o.vtk, o.vtk);
 
   // ---- time loop ----------------------------------------------------------------------------
   double             t_element = 0, t_setvalues = 0, t_solve = 0, t_comm = 0, t_total = 0;
-  long long          its_total  = 0, svd_rotations = 0;
-  int                steps_done = 0;
+  long long          its_total = 0, svd_rotations = 0;
+  int                steps_done  = 0;
   KSPConvergedReason last_reason = KSP_CONVERGED_ITERATING;
   for (int step = 1; step <= o.steps; ++step) {
     FemStepInfo info;
@@ -411,9 +453,10 @@ int main(int argc, char **argv)
     last_reason = info.stats.reason;
     steps_done  = step;
     if (!o.quiet)
-      PetscCall(PetscPrintf(comm, "step %d its %" PetscInt_FMT " res %.3e reason %s assembly_ms %.2f solve_ms %.2f\n", step,
-                            info.stats.iterations, (double)info.stats.residual_norm, KSPConvergedReasons[info.stats.reason],
-                            info.element_ms + info.setvalues_ms, info.solve_ms));
+      PetscCall(PetscPrintf(
+        comm, "step %d its %" PetscInt_FMT " res %.3e reason %s assembly_ms %.2f solve_ms %.2f\n", step,
+        info.stats.iterations, (double)info.stats.residual_norm, KSPConvergedReasons[info.stats.reason],
+        info.element_ms + info.setvalues_ms, info.solve_ms));
     StepHealth health;
     health.solver_reason     = info.stats.reason;
     health.energy            = total_energy();
@@ -426,15 +469,15 @@ int main(int argc, char **argv)
   }
   if (o.element_bench > 0) {
     // CPU time of this process (less sensitive to other jobs than wall time); min and median.
-    auto cpu_ms = [] { return 1e3 * ProcessCpuTime(); };
+    auto                cpu_ms = [] { return 1e3 * ProcessCpuTime(); };
     std::vector<double> reset_ms, loop_ms;
     for (PetscInt r = 0; r < o.element_bench; ++r) {
       const double c0 = cpu_ms();
       physics::reset_block_values(sim.pattern, sim.values);
       std::fill(sim.rhs_full.begin(), sim.rhs_full.end(), 0.0);
       const double c1 = cpu_ms();
-      physics::assemble_elements(model, sim.elements, x.data(), v.data(), sim.coefficients, &sim.pattern, sim.values.data(),
-                                 sim.rhs_full.data(), nullptr, sim.element_kernel);
+      physics::assemble_elements(model, sim.elements, x.data(), v.data(), sim.coefficients, &sim.pattern,
+                                 sim.values.data(), sim.rhs_full.data(), nullptr, sim.element_kernel);
       const double c2 = cpu_ms();
       reset_ms.push_back(c1 - c0);
       loop_ms.push_back(c2 - c1);
@@ -449,28 +492,35 @@ int main(int argc, char **argv)
     std::sort(reset_ms.begin(), reset_ms.end());
     std::sort(loop_ms.begin(), loop_ms.end());
     std::sort(refill_ms.begin(), refill_ms.end());
-    PetscCall(PetscSynchronizedPrintf(comm, "element_bench rank %d elements %zu coo_blocks %zu reset_ms min %.3f median %.3f loop_ms min %.3f median %.3f ns_per_element %.1f setvalues_ms min %.3f median %.3f\n",
-                                      rank, sim.elements.size(), sim.pattern.rows.size(), reset_ms.front(), reset_ms[reset_ms.size() / 2], loop_ms.front(),
-                                      loop_ms[loop_ms.size() / 2], 1e6 * loop_ms.front() / std::max<size_t>(sim.elements.size(), 1),
-                                      refill_ms.front(), refill_ms[refill_ms.size() / 2]));
+    PetscCall(PetscSynchronizedPrintf(
+      comm,
+      "element_bench rank %d elements %zu coo_blocks %zu reset_ms min %.3f median %.3f loop_ms min %.3f median %.3f ns_per_element %.1f setvalues_ms min %.3f median %.3f\n",
+      rank, sim.elements.size(), sim.pattern.rows.size(), reset_ms.front(), reset_ms[reset_ms.size() / 2],
+      loop_ms.front(), loop_ms[loop_ms.size() / 2],
+      1e6 * loop_ms.front() / std::max<size_t>(sim.elements.size(), 1), refill_ms.front(),
+      refill_ms[refill_ms.size() / 2]));
     PetscCall(PetscSynchronizedFlush(comm, PETSC_STDOUT));
   }
-  t_element *= 1e-3; t_comm *= 1e-3; t_setvalues *= 1e-3; t_solve *= 1e-3; t_total *= 1e-3;
+  t_element *= 1e-3;
+  t_comm *= 1e-3;
+  t_setvalues *= 1e-3;
+  t_solve *= 1e-3;
+  t_total *= 1e-3;
 
   // ---- summary ------------------------------------------------------------------------------
-  const physics::FemEnergy E = physics::fem_energy(model, x.data(), v.data());
-  const auto               P = physics::linear_momentum(model, v.data());
-  double cen[3] = {0, 0, 0}, mass_sum = 0;
-  const double min_vol_ratio = min_volume_ratio();
+  const physics::FemEnergy E      = physics::fem_energy(model, x.data(), v.data());
+  const auto               P      = physics::linear_momentum(model, v.data());
+  double                   cen[3] = {0, 0, 0}, mass_sum = 0;
+  const double             min_vol_ratio = min_volume_ratio();
   {
-    const auto                w = physics::gravity_forces(model, {1, 1, 1}); // row sums of M (may be < 0 for P2 corners)
+    const auto w = physics::gravity_forces(model, {1, 1, 1}); // row sums of M (may be < 0 for P2 corners)
     for (int i = 0; i < n_nodes; ++i) {
       for (int d = 0; d < 3; ++d) cen[d] += w[3 * i] * (x[3 * i + d] - X[3 * i + d]);
       mass_sum += w[3 * i];
     }
   }
-  const int    steps_div = std::max(steps_done, 1);
-  SummaryLine  s;
+  const int   steps_div = std::max(steps_done, 1);
+  SummaryLine s;
   s.add("program", std::string("fem"));
   s.add("mat_type", std::string(mat_type));
   s.add("ksp_type", std::string(ksp_type));

@@ -18,8 +18,7 @@
 #include <limits>
 #include <vector>
 
-namespace
-{
+namespace {
 
 struct Flavour {
   const char         *label;
@@ -47,7 +46,8 @@ int main(int argc, char **argv)
   StencilGrid grid;
   PetscInt    repeats = 10;
 
-  PetscCall(PetscInitialize(&argc, &argv, nullptr, "Times MATSEQBINBCSR's value operations against seqaij and seqbaij.\n"));
+  PetscCall(PetscInitialize(&argc, &argv, nullptr,
+                            "Times MATSEQBINBCSR's value operations against seqaij and seqbaij.\n"));
   PetscCall(PetscBinBCSRRegisterAll());
   grid.nx = grid.ny = grid.nz = 24;
   PetscCall(StencilGridFromOptions(nullptr, &grid));
@@ -61,8 +61,13 @@ int main(int argc, char **argv)
     {"binbcsr-sym", MATSEQBINBCSR, MAT_BINBCSR_PRECISION_DOUBLE, true},
     {"binbcsr-sym-single", MATSEQBINBCSR, MAT_BINBCSR_PRECISION_SINGLE, true},
   };
-  const char *ops[] = {"axpy_same", "scale", "shift", "norm_frobenius", "norm_1", "zero_rows_columns", "diag_scale", "row_max_abs", "col_norms_2", "vpb_inverse", "nonzero_rows"};
-  PetscCall(PetscPrintf(PETSC_COMM_SELF, "27-point 3x3-block stencil, %" PetscInt_FMT "^3 nodes, %" PetscInt_FMT " rows; minimum of %" PetscInt_FMT " runs, ms\n", grid.nx, 3 * grid.nodes(), repeats));
+  const char *ops[] = {"axpy_same",         "scale",      "shift",       "norm_frobenius", "norm_1",
+                       "zero_rows_columns", "diag_scale", "row_max_abs", "col_norms_2",    "vpb_inverse",
+                       "nonzero_rows"};
+  PetscCall(PetscPrintf(PETSC_COMM_SELF,
+                        "27-point 3x3-block stencil, %" PetscInt_FMT "^3 nodes, %" PetscInt_FMT
+                        " rows; minimum of %" PetscInt_FMT " runs, ms\n",
+                        grid.nx, 3 * grid.nodes(), repeats));
   PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-16s", "type"));
   for (const char *op : ops) PetscCall(PetscPrintf(PETSC_COMM_SELF, " %18s", op));
   PetscCall(PetscPrintf(PETSC_COMM_SELF, "\n"));
@@ -86,17 +91,23 @@ int main(int argc, char **argv)
     for (PetscInt node = 0; node < grid.nx * grid.ny; node++)
       for (PetscInt c = 0; c < 3; c++) rows.push_back(3 * node + c);
 
-    PetscCall(Time(repeats, [&] { return MatAXPY(A, 1e-3, X, SAME_NONZERO_PATTERN); }, &t));
+    PetscCall(Time(
+      repeats, [&] { return MatAXPY(A, 1e-3, X, SAME_NONZERO_PATTERN); }, &t));
     ms.push_back(t);
-    PetscCall(Time(repeats, [&] { return MatScale(A, 1.0001); }, &t));
+    PetscCall(Time(
+      repeats, [&] { return MatScale(A, 1.0001); }, &t));
     ms.push_back(t);
-    PetscCall(Time(repeats, [&] { return MatShift(A, 1e-3); }, &t));
+    PetscCall(Time(
+      repeats, [&] { return MatShift(A, 1e-3); }, &t));
     ms.push_back(t);
-    PetscCall(Time(repeats, [&] { return MatNorm(A, NORM_FROBENIUS, &nrm); }, &t));
+    PetscCall(Time(
+      repeats, [&] { return MatNorm(A, NORM_FROBENIUS, &nrm); }, &t));
     ms.push_back(t);
-    PetscCall(Time(repeats, [&] { return MatNorm(A, NORM_1, &nrm); }, &t));
+    PetscCall(Time(
+      repeats, [&] { return MatNorm(A, NORM_1, &nrm); }, &t));
     ms.push_back(t);
-    PetscCall(Time(repeats, [&] { return MatZeroRowsColumns(A, (PetscInt)rows.size(), rows.data(), 1.0, x, b); }, &t));
+    PetscCall(Time(
+      repeats, [&] { return MatZeroRowsColumns(A, (PetscInt)rows.size(), rows.data(), 1.0, x, b); }, &t));
     ms.push_back(t);
 
     {
@@ -106,11 +117,14 @@ int main(int argc, char **argv)
       PetscCall(VecDuplicate(x, &d));
       PetscCall(VecDuplicate(x, &rmax));
       PetscCall(VecSet(d, 1.0001));
-      PetscCall(Time(repeats, [&] { return MatDiagonalScale(A, d, d); }, &t));
+      PetscCall(Time(
+        repeats, [&] { return MatDiagonalScale(A, d, d); }, &t));
       ms.push_back(t);
-      PetscCall(Time(repeats, [&] { return MatGetRowMaxAbs(A, rmax, at.data()); }, &t));
+      PetscCall(Time(
+        repeats, [&] { return MatGetRowMaxAbs(A, rmax, at.data()); }, &t));
       ms.push_back(t);
-      PetscCall(Time(repeats, [&] { return MatGetColumnNorms(A, NORM_2, norms.data()); }, &t));
+      PetscCall(Time(
+        repeats, [&] { return MatGetColumnNorms(A, NORM_2, norms.data()); }, &t));
       ms.push_back(t);
       PetscCall(VecDestroy(&d));
       PetscCall(VecDestroy(&rmax));
@@ -122,12 +136,19 @@ int main(int argc, char **argv)
       IS                       kept;
       t = -1; /* not provided by the type */
       PetscCall(MatHasOperation(A, MATOP_INVERT_VBLOCK_DIAGONAL, &has));
-      if (has) PetscCall(Time(repeats, [&] { return MatInvertVariableBlockDiagonal(A, (PetscInt)sizes.size(), sizes.data(), inv.data()); }, &t));
+      if (has)
+        PetscCall(Time(
+          repeats,
+          [&] { return MatInvertVariableBlockDiagonal(A, (PetscInt)sizes.size(), sizes.data(), inv.data()); },
+          &t));
       ms.push_back(t);
-      PetscCall(Time(repeats, [&] {
-        PetscCall(MatFindNonzeroRows(A, &kept));
-        return ISDestroy(&kept);
-      }, &t));
+      PetscCall(Time(
+        repeats,
+        [&] {
+          PetscCall(MatFindNonzeroRows(A, &kept));
+          return ISDestroy(&kept);
+        },
+        &t));
       ms.push_back(t);
     }
 

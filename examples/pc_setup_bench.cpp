@@ -29,13 +29,16 @@ std::vector<std::pair<std::string, std::string>> pc_options(const std::string &p
   if (pc == "gasm") return {{"-pc_type", "gasm"}, {"-sub_pc_type", "icc"}};
   // the copy's own solver is left out (Jacobi): what is timed is getting the copy
   if (pc == "redundant") return {{"-pc_type", "redundant"}, {"-redundant_pc_type", "jacobi"}};
-  if (pc == "fieldsplit") return {{"-pc_type", "fieldsplit"}, {"-pc_fieldsplit_block_size", "3"}, {"-fieldsplit_pc_type", "jacobi"}};
+  if (pc == "fieldsplit")
+    return {
+      {"-pc_type", "fieldsplit"}, {"-pc_fieldsplit_block_size", "3"}, {"-fieldsplit_pc_type", "jacobi"}};
   if (pc == "mumps") return {{"-pc_type", "cholesky"}, {"-pc_factor_mat_solver_type", "mumps"}};
   if (pc == "hypre") return {{"-pc_type", "hypre"}};
   return {{"-pc_type", pc}};
 }
 
-PetscErrorCode time_setups(Mat A, const std::string &pc, PetscInt refills, double *first_ms, double *refill_ms)
+PetscErrorCode time_setups(Mat A, const std::string &pc, PetscInt refills, double *first_ms,
+                           double *refill_ms)
 {
   KSP ksp;
   PC  p;
@@ -53,7 +56,7 @@ PetscErrorCode time_setups(Mat A, const std::string &pc, PetscInt refills, doubl
   PetscCallMPI(MPI_Barrier(PetscObjectComm((PetscObject)A)));
   *first_ms = 1e3 * (MPI_Wtime() - t0);
   for (auto &[k, v] : opts) PetscCall(PetscOptionsClearValue(nullptr, k.c_str()));
-  t0        = MPI_Wtime();
+  t0 = MPI_Wtime();
   for (PetscInt r = 0; r < refills; ++r) {
     PetscCall(MatScale(A, r % 2 ? 1.0 / 1.01 : 1.01)); // new values, same pattern
     PetscCall(PCSetUp(p));
@@ -82,8 +85,12 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-pcs", pcs, sizeof pcs, nullptr));
   PetscMPIInt size;
   PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
-  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "27-point block stencil %" PetscInt_FMT "^3 nodes (%" PetscInt_FMT " rows), %d ranks; min over %" PetscInt_FMT " repeats\n", grid.nx, 3 * grid.nodes(), size, repeats));
-  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "%-12s %-10s %14s %20s\n", "pc", "format", "first (ms)", "after refill (ms)"));
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD,
+                        "27-point block stencil %" PetscInt_FMT "^3 nodes (%" PetscInt_FMT
+                        " rows), %d ranks; min over %" PetscInt_FMT " repeats\n",
+                        grid.nx, 3 * grid.nodes(), size, repeats));
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "%-12s %-10s %14s %20s\n", "pc", "format", "first (ms)",
+                        "after refill (ms)"));
   for (const std::string &pc : SplitList(pcs)) {
     for (const std::string &fmt : SplitList(formats)) {
       Mat    A;
@@ -96,7 +103,8 @@ int main(int argc, char **argv)
         refill = std::min(refill, g);
       }
       PetscCall(MatDestroy(&A));
-      PetscCall(PetscPrintf(PETSC_COMM_WORLD, "%-12s %-10s %14.2f %20.2f\n", pc.c_str(), fmt.c_str(), first, refill));
+      PetscCall(
+        PetscPrintf(PETSC_COMM_WORLD, "%-12s %-10s %14.2f %20.2f\n", pc.c_str(), fmt.c_str(), first, refill));
     }
   }
   PetscCall(PetscFinalize());

@@ -97,7 +97,8 @@ PetscErrorCode time_mult(Mat A, PetscInt repeats, PetscReal min_batch_ms, double
 
 // Largest number of ghost block columns over the ranks: block columns outside the rank's range that
 // its rows touch.
-PetscErrorCode max_ghosts(const StencilGrid &grid, const Ordering &ord, PetscInt rstart, PetscInt rend, PetscInt *ghosts)
+PetscErrorCode max_ghosts(const StencilGrid &grid, const Ordering &ord, PetscInt rstart, PetscInt rend,
+                          PetscInt *ghosts)
 {
   PetscFunctionBeginUser;
   std::vector<int> old_of_new(ord.new_of_old.size());
@@ -127,7 +128,9 @@ int main(int argc, char **argv)
   char        formats[256] = "binbcsr,baij,aij";
   PetscMPIInt size;
 
-  PetscCall(PetscInitialize(&argc, &argv, nullptr, "reorder_bench: MatMult time under natural, shuffled, RCM and nested-dissection numberings"));
+  PetscCall(PetscInitialize(
+    &argc, &argv, nullptr,
+    "reorder_bench: MatMult time under natural, shuffled, RCM and nested-dissection numberings"));
   PetscCall(PetscBinBCSRRegisterAll());
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-n", &n, nullptr));
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-repeats", &repeats, nullptr));
@@ -139,12 +142,13 @@ int main(int argc, char **argv)
   grid.nx = grid.ny = grid.nz = n;
   // the stencil couples the nodes of each hexahedral cell: build that mesh's graph
   std::vector<int> hexes;
-  auto             id = [&](PetscInt i, PetscInt j, PetscInt k) { return static_cast<int>(i + n * (j + n * k)); };
+  auto id = [&](PetscInt i, PetscInt j, PetscInt k) { return static_cast<int>(i + n * (j + n * k)); };
   for (PetscInt k = 0; k + 1 < n; ++k)
     for (PetscInt j = 0; j + 1 < n; ++j)
       for (PetscInt i = 0; i + 1 < n; ++i)
         for (int c = 0; c < 8; ++c) hexes.push_back(id(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1)));
-  const physics::AdjacencyGraph graph = physics::graph_from_elements(static_cast<int>(grid.nodes()), 8, hexes);
+  const physics::AdjacencyGraph graph =
+    physics::graph_from_elements(static_cast<int>(grid.nodes()), 8, hexes);
 
   std::vector<Ordering> orders;
   Ordering              natural{"natural", std::vector<int>(grid.nodes()), {}, 0};
@@ -157,19 +161,24 @@ int main(int argc, char **argv)
   physics::Renumbering sh;
   sh.new_of_old = shuffled.new_of_old;
   sh.old_of_new.resize(sh.new_of_old.size());
-  for (std::size_t v = 0; v < sh.new_of_old.size(); ++v) sh.old_of_new[sh.new_of_old[v]] = static_cast<int>(v);
+  for (std::size_t v = 0; v < sh.new_of_old.size(); ++v)
+    sh.old_of_new[sh.new_of_old[v]] = static_cast<int>(v);
   const physics::AdjacencyGraph shuffled_graph = physics::renumber_graph(graph, sh);
   auto compose = [&](const physics::Renumbering &r, const char *name, std::vector<int> offsets) {
     Ordering o{name, std::vector<int>(grid.nodes()), offsets, 0};
-    for (std::size_t v = 0; v < o.new_of_old.size(); ++v) o.new_of_old[v] = r.new_of_old[shuffled.new_of_old[v]];
+    for (std::size_t v = 0; v < o.new_of_old.size(); ++v)
+      o.new_of_old[v] = r.new_of_old[shuffled.new_of_old[v]];
     return o;
   };
   double t0 = MPI_Wtime();
-  orders.push_back(compose(physics::reorder_for_locality(shuffled_graph, physics::LocalOrder::ReverseCuthillMcKee), "shuffled+RCM", {}));
+  orders.push_back(
+    compose(physics::reorder_for_locality(shuffled_graph, physics::LocalOrder::ReverseCuthillMcKee),
+            "shuffled+RCM", {}));
   const double t_rcm = MPI_Wtime() - t0;
   t0                 = MPI_Wtime();
-  orders.push_back(compose(physics::reorder_for_locality(shuffled_graph, physics::LocalOrder::NestedDissection), "shuffled+ND", {}));
-  const double t_nd = MPI_Wtime() - t0;
+  orders.push_back(compose(
+    physics::reorder_for_locality(shuffled_graph, physics::LocalOrder::NestedDissection), "shuffled+ND", {}));
+  const double t_nd   = MPI_Wtime() - t0;
   double       t_part = 0;
   if (size > 1) {
     physics::PartitionOptions opt;
@@ -187,10 +196,17 @@ int main(int argc, char **argv)
     o.bandwidth = physics::graph_bandwidth(physics::renumber_graph(graph, r));
   }
 
-  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "reorder_bench: 27-point 3x3-block stencil, %" PetscInt_FMT "^3 nodes (%" PetscInt_FMT " rows), %d rank(s)\n", n, 3 * grid.nodes(), size));
-  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "reordering cost: RCM %.3f s, nested dissection %.3f s%s", t_rcm, t_nd, size > 1 ? "" : "\n"));
-  if (size > 1) PetscCall(PetscPrintf(PETSC_COMM_WORLD, ", METIS %d-way partition + RCM %.3f s\n", size, t_part));
-  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "MatMult ms: min over %" PetscInt_FMT " rounds of the slowest rank's batch average\n", repeats));
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD,
+                        "reorder_bench: 27-point 3x3-block stencil, %" PetscInt_FMT "^3 nodes (%" PetscInt_FMT
+                        " rows), %d rank(s)\n",
+                        n, 3 * grid.nodes(), size));
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "reordering cost: RCM %.3f s, nested dissection %.3f s%s", t_rcm,
+                        t_nd, size > 1 ? "" : "\n"));
+  if (size > 1)
+    PetscCall(PetscPrintf(PETSC_COMM_WORLD, ", METIS %d-way partition + RCM %.3f s\n", size, t_part));
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD,
+                        "MatMult ms: min over %" PetscInt_FMT " rounds of the slowest rank's batch average\n",
+                        repeats));
   PetscCall(PetscPrintf(PETSC_COMM_WORLD, "%-20s %10s %10s", "numbering", "bandwidth", "ghosts"));
   std::vector<std::string> fmts;
   {
@@ -201,7 +217,7 @@ int main(int argc, char **argv)
   for (const auto &f : fmts) PetscCall(PetscPrintf(PETSC_COMM_WORLD, " %12s", f.c_str()));
   PetscCall(PetscPrintf(PETSC_COMM_WORLD, "\n"));
   for (const auto &o : orders) {
-    PetscInt ghosts = 0;
+    PetscInt            ghosts = 0;
     std::vector<double> ms;
     for (const auto &f : fmts) {
       Mat    A;
@@ -216,7 +232,8 @@ int main(int argc, char **argv)
       ms.push_back(best);
       PetscCall(MatDestroy(&A));
     }
-    PetscCall(PetscPrintf(PETSC_COMM_WORLD, "%-20s %10d %10" PetscInt_FMT, o.name.c_str(), o.bandwidth, ghosts));
+    PetscCall(
+      PetscPrintf(PETSC_COMM_WORLD, "%-20s %10d %10" PetscInt_FMT, o.name.c_str(), o.bandwidth, ghosts));
     for (double t : ms) PetscCall(PetscPrintf(PETSC_COMM_WORLD, " %12.3f", t));
     PetscCall(PetscPrintf(PETSC_COMM_WORLD, "\n"));
   }

@@ -54,11 +54,11 @@ struct Solver {
 struct Run {
   Solver              solver;
   Format              format;
-  Mat                 A = nullptr;
+  Mat                 A   = nullptr;
   KSP                 ksp = nullptr;
   std::string         note; // why the format or solver is not available
-  PetscInt            its = 0;
-  KSPConvergedReason  reason = KSP_CONVERGED_ITERATING;
+  PetscInt            its      = 0;
+  KSPConvergedReason  reason   = KSP_CONVERGED_ITERATING;
   double              true_rel = -1;
   std::vector<double> per_it;     // wall seconds per iteration, one per timed round
   std::vector<double> per_it_cpu; // process CPU seconds per iteration, one per timed round
@@ -73,7 +73,8 @@ PetscErrorCode BuildMatrix(MPI_Comm comm, const StencilGrid &grid, const Format 
     MatBinBCSRPrecision p;
     PetscCall(MatBinBCSRSetPrecision(*A, MAT_BINBCSR_PRECISION_SINGLE));
     PetscCall(MatBinBCSRGetPrecision(*A, &p));
-    PetscCheck(p == MAT_BINBCSR_PRECISION_SINGLE, comm, PETSC_ERR_SUP, "single storage not available for %s", f.type.c_str());
+    PetscCheck(p == MAT_BINBCSR_PRECISION_SINGLE, comm, PETSC_ERR_SUP, "single storage not available for %s",
+               f.type.c_str());
   }
   PetscFunctionReturn(0);
 }
@@ -146,9 +147,11 @@ PetscErrorCode HistoryMonitor(KSP ksp, PetscInt, PetscReal rnorm, void *ctx)
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode WriteHistory(MPI_Comm comm, const StencilGrid &grid, Mat Aref, Vec b, PetscInt its, const char *path)
+PetscErrorCode WriteHistory(MPI_Comm comm, const StencilGrid &grid, Mat Aref, Vec b, PetscInt its,
+                            const char *path)
 {
-  const Format                     formats[] = {{"aij", MATAIJ, false}, {"binbcsr", MATBINBCSR, false}, {"binbcsr_single", MATBINBCSR, true}};
+  const Format formats[] = {
+    {"aij", MATAIJ, false}, {"binbcsr", MATBINBCSR, false}, {"binbcsr_single", MATBINBCSR, true}};
   std::vector<std::string>         labels;
   std::vector<std::vector<double>> rec, tru;
   FILE                            *fp;
@@ -158,29 +161,31 @@ PetscErrorCode WriteHistory(MPI_Comm comm, const StencilGrid &grid, Mat Aref, Ve
     Mat                 A = nullptr;
     std::string         note;
     std::vector<double> r, t;
-    PetscCall(Try([&]() -> PetscErrorCode {
-      KSP        ksp;
-      Vec        x, work;
-      HistoryCtx ctx;
-      PetscFunctionBegin;
-      PetscCall(BuildMatrix(comm, grid, f, &A));
-      PetscCall(MakeKSP(comm, A, Solver{"mcg", KSPMCG}, 1e-30, its, &ksp));
-      PetscCall(KSPMCGSetFixedIterations(ksp, its));
-      PetscCall(VecDuplicate(b, &x));
-      PetscCall(VecDuplicate(b, &work));
-      PetscCall(VecNorm(b, NORM_2, &ctx.bnorm));
-      ctx.Aref = Aref;
-      ctx.b = b;
-      ctx.work = work;
-      ctx.recursive = &r;
-      ctx.truth = &t;
-      PetscCall(KSPMonitorSet(ksp, HistoryMonitor, &ctx, nullptr));
-      PetscCall(KSPSolve(ksp, b, x));
-      PetscCall(KSPDestroy(&ksp));
-      PetscCall(VecDestroy(&x));
-      PetscCall(VecDestroy(&work));
-      PetscFunctionReturn(0);
-    }, &note));
+    PetscCall(Try(
+      [&]() -> PetscErrorCode {
+        KSP        ksp;
+        Vec        x, work;
+        HistoryCtx ctx;
+        PetscFunctionBegin;
+        PetscCall(BuildMatrix(comm, grid, f, &A));
+        PetscCall(MakeKSP(comm, A, Solver{"mcg", KSPMCG}, 1e-30, its, &ksp));
+        PetscCall(KSPMCGSetFixedIterations(ksp, its));
+        PetscCall(VecDuplicate(b, &x));
+        PetscCall(VecDuplicate(b, &work));
+        PetscCall(VecNorm(b, NORM_2, &ctx.bnorm));
+        ctx.Aref      = Aref;
+        ctx.b         = b;
+        ctx.work      = work;
+        ctx.recursive = &r;
+        ctx.truth     = &t;
+        PetscCall(KSPMonitorSet(ksp, HistoryMonitor, &ctx, nullptr));
+        PetscCall(KSPSolve(ksp, b, x));
+        PetscCall(KSPDestroy(&ksp));
+        PetscCall(VecDestroy(&x));
+        PetscCall(VecDestroy(&work));
+        PetscFunctionReturn(0);
+      },
+      &note));
     PetscCall(MatDestroy(&A));
     if (!note.empty()) {
       PetscCall(PetscPrintf(comm, "history: %s skipped (%s)\n", f.label.c_str(), note.c_str()));
@@ -192,7 +197,8 @@ PetscErrorCode WriteHistory(MPI_Comm comm, const StencilGrid &grid, Mat Aref, Ve
   }
   PetscCall(PetscFOpen(comm, path, "w", &fp));
   PetscCall(PetscFPrintf(comm, fp, "iteration"));
-  for (const std::string &l : labels) PetscCall(PetscFPrintf(comm, fp, ",%s_recursive,%s_true", l.c_str(), l.c_str()));
+  for (const std::string &l : labels)
+    PetscCall(PetscFPrintf(comm, fp, ",%s_recursive,%s_true", l.c_str(), l.c_str()));
   PetscCall(PetscFPrintf(comm, fp, "\n"));
   for (PetscInt k = 0; k <= its; k++) {
     PetscCall(PetscFPrintf(comm, fp, "%" PetscInt_FMT, k));
@@ -205,7 +211,10 @@ PetscErrorCode WriteHistory(MPI_Comm comm, const StencilGrid &grid, Mat Aref, Ve
   PetscCall(PetscFClose(comm, fp));
   for (size_t f = 0; f < labels.size(); f++) {
     const double floor = tru[f].empty() ? 0 : *std::min_element(tru[f].begin(), tru[f].end());
-    PetscCall(PetscPrintf(comm, "history %-15s: %zu iterations, lowest true residual (vs double matrix) %.2e, last recursive %.2e\n", labels[f].c_str(), tru[f].size() - 1, floor, rec[f].empty() ? 0.0 : rec[f].back()));
+    PetscCall(PetscPrintf(
+      comm,
+      "history %-15s: %zu iterations, lowest true residual (vs double matrix) %.2e, last recursive %.2e\n",
+      labels[f].c_str(), tru[f].size() - 1, floor, rec[f].empty() ? 0.0 : rec[f].back()));
   }
   PetscCall(PetscPrintf(comm, "history written to %s\n", path));
   PetscFunctionReturn(0);
@@ -219,7 +228,7 @@ int main(int argc, char **argv)
   StencilGrid grid;
   char        solvers_opt[256] = "cg,cg_sr,pipecg,mcg", formats_opt[256] = "aij,baij,binbcsr,binbcsr_single";
   char        csv[PETSC_MAX_PATH_LEN] = "", history_csv[PETSC_MAX_PATH_LEN] = "";
-  PetscReal   rtol = 1e-6;
+  PetscReal   rtol    = 1e-6;
   PetscInt    repeats = 3, history_its = 200, timed_its = 50;
   PetscMPIInt size;
   Mat         Aref;
@@ -228,13 +237,14 @@ int main(int argc, char **argv)
   PetscFunctionBeginUser;
   PetscCall(PetscInitialize(&argc, &argv, nullptr, "solve_bench: Krylov solvers x matrix formats\n"));
   PetscCall(PetscBinBCSRRegisterAll());
-  comm   = PETSC_COMM_WORLD;
+  comm    = PETSC_COMM_WORLD;
   grid.nx = grid.ny = grid.nz = 32;
   PetscCall(StencilGridFromOptions(nullptr, &grid));
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-solvers", solvers_opt, sizeof(solvers_opt), nullptr));
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-formats", formats_opt, sizeof(formats_opt), nullptr));
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-csv", csv, sizeof(csv), nullptr));
-  PetscCall(PetscOptionsGetString(nullptr, nullptr, "-history_csv", history_csv, sizeof(history_csv), nullptr));
+  PetscCall(
+    PetscOptionsGetString(nullptr, nullptr, "-history_csv", history_csv, sizeof(history_csv), nullptr));
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-rtol", &rtol, nullptr));
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-repeats", &repeats, nullptr));
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-timed_its", &timed_its, nullptr));
@@ -264,19 +274,26 @@ int main(int argc, char **argv)
   {
     PetscInt lo, hi;
     PetscCall(VecGetOwnershipRange(xstar, &lo, &hi));
-    for (PetscInt i = lo; i < hi; i++) PetscCall(VecSetValue(xstar, i, 1.0 + 0.5 * std::sin(0.001 * i), INSERT_VALUES));
+    for (PetscInt i = lo; i < hi; i++)
+      PetscCall(VecSetValue(xstar, i, 1.0 + 0.5 * std::sin(0.001 * i), INSERT_VALUES));
     PetscCall(VecAssemblyBegin(xstar));
     PetscCall(VecAssemblyEnd(xstar));
     PetscCall(MatMult(Aref, xstar, b));
   }
   PetscInt rows;
   PetscCall(MatGetSize(Aref, &rows, nullptr));
-  PetscCall(PetscPrintf(comm, "solve_bench: %" PetscInt_FMT "x%" PetscInt_FMT "x%" PetscInt_FMT " nodes, %" PetscInt_FMT " rows, shift %g, %d rank(s), jacobi, rtol %g (unpreconditioned norm), %" PetscInt_FMT " timed rounds of %" PetscInt_FMT " iterations\n", grid.nx, grid.ny, grid.nz, rows, (double)grid.shift, size, (double)rtol, repeats, timed_its));
+  PetscCall(
+    PetscPrintf(comm,
+                "solve_bench: %" PetscInt_FMT "x%" PetscInt_FMT "x%" PetscInt_FMT " nodes, %" PetscInt_FMT
+                " rows, shift %g, %d rank(s), jacobi, rtol %g (unpreconditioned norm), %" PetscInt_FMT
+                " timed rounds of %" PetscInt_FMT " iterations\n",
+                grid.nx, grid.ny, grid.nz, rows, (double)grid.shift, size, (double)rtol, repeats, timed_its));
 
   // matrices (one per format, shared by the solvers) and the untimed first solve of each pair
   std::vector<Mat>         mats(formats.size(), nullptr);
   std::vector<std::string> mat_notes(formats.size());
-  for (size_t f = 0; f < formats.size(); f++) PetscCall(Try([&]() { return BuildMatrix(comm, grid, formats[f], &mats[f]); }, &mat_notes[f]));
+  for (size_t f = 0; f < formats.size(); f++)
+    PetscCall(Try([&]() { return BuildMatrix(comm, grid, formats[f], &mats[f]); }, &mat_notes[f]));
   std::vector<Run> runs;
   for (const Solver &s : solvers)
     for (size_t f = 0; f < formats.size(); f++) {
@@ -288,18 +305,20 @@ int main(int argc, char **argv)
       if (r.note.empty()) {
         Vec x;
         PetscCall(VecDuplicate(b, &x));
-        PetscCall(Try([&]() -> PetscErrorCode {
-          PetscFunctionBegin;
-          PetscCall(MakeKSP(comm, r.A, s, rtol, 10000, &r.ksp));
-          PetscCall(KSPSolve(r.ksp, b, x));
-          PetscCall(KSPGetIterationNumber(r.ksp, &r.its));
-          PetscCall(KSPGetConvergedReason(r.ksp, &r.reason));
-          PetscCall(TrueRelResidual(Aref, b, x, work, &r.true_rel));
-          /* timed solves: exactly timed_its iterations */
-          PetscCall(KSPSetConvergenceTest(r.ksp, KSPConvergedSkip, nullptr, nullptr));
-          PetscCall(KSPSetTolerances(r.ksp, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT, timed_its));
-          PetscFunctionReturn(0);
-        }, &r.note));
+        PetscCall(Try(
+          [&]() -> PetscErrorCode {
+            PetscFunctionBegin;
+            PetscCall(MakeKSP(comm, r.A, s, rtol, 10000, &r.ksp));
+            PetscCall(KSPSolve(r.ksp, b, x));
+            PetscCall(KSPGetIterationNumber(r.ksp, &r.its));
+            PetscCall(KSPGetConvergedReason(r.ksp, &r.reason));
+            PetscCall(TrueRelResidual(Aref, b, x, work, &r.true_rel));
+            /* timed solves: exactly timed_its iterations */
+            PetscCall(KSPSetConvergenceTest(r.ksp, KSPConvergedSkip, nullptr, nullptr));
+            PetscCall(KSPSetTolerances(r.ksp, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT, timed_its));
+            PetscFunctionReturn(0);
+          },
+          &r.note));
         PetscCall(VecDestroy(&x));
         if (!r.note.empty()) PetscCall(KSPDestroy(&r.ksp));
       }
@@ -331,16 +350,26 @@ int main(int argc, char **argv)
     if (r.solver.label == "cg" && r.format.label == "aij" && r.ksp) cg_aij = &r;
   }
   const Run *base = cg_baij ? cg_baij : cg_aij;
-  PetscCall(PetscPrintf(comm, "\n%-8s %-15s %5s %-16s %11s %11s %11s %11s %9s %11s\n", "solver", "format", "its", "reason", "cpu ms/it", "cpu med", "wall ms/it", "wall med", "speedup", "true_resid"));
+  PetscCall(PetscPrintf(comm, "\n%-8s %-15s %5s %-16s %11s %11s %11s %11s %9s %11s\n", "solver", "format",
+                        "its", "reason", "cpu ms/it", "cpu med", "wall ms/it", "wall med", "speedup",
+                        "true_resid"));
   for (const Run &r : runs) {
     if (!r.ksp) {
-      PetscCall(PetscPrintf(comm, "%-8s %-15s   n/a  (%s)\n", r.solver.label.c_str(), r.format.label.c_str(), r.note.c_str()));
+      PetscCall(PetscPrintf(comm, "%-8s %-15s   n/a  (%s)\n", r.solver.label.c_str(), r.format.label.c_str(),
+                            r.note.c_str()));
       continue;
     }
     const double speedup = base ? Min(base->per_it_cpu) / Min(r.per_it_cpu) : 0;
-    PetscCall(PetscPrintf(comm, "%-8s %-15s %5" PetscInt_FMT " %-16s %11.3f %11.3f %11.3f %11.3f %8.2fx %11.2e\n", r.solver.label.c_str(), r.format.label.c_str(), r.its, KSPConvergedReasons[r.reason], 1e3 * Min(r.per_it_cpu), 1e3 * Median(r.per_it_cpu), 1e3 * Min(r.per_it), 1e3 * Median(r.per_it), speedup, r.true_rel));
+    PetscCall(PetscPrintf(comm,
+                          "%-8s %-15s %5" PetscInt_FMT " %-16s %11.3f %11.3f %11.3f %11.3f %8.2fx %11.2e\n",
+                          r.solver.label.c_str(), r.format.label.c_str(), r.its,
+                          KSPConvergedReasons[r.reason], 1e3 * Min(r.per_it_cpu), 1e3 * Median(r.per_it_cpu),
+                          1e3 * Min(r.per_it), 1e3 * Median(r.per_it), speedup, r.true_rel));
   }
-  if (base) PetscCall(PetscPrintf(comm, "speedup: CPU time per iteration of cg+%s divided by the row's (min over rounds)\n", base->format.label.c_str()));
+  if (base)
+    PetscCall(PetscPrintf(comm,
+                          "speedup: CPU time per iteration of cg+%s divided by the row's (min over rounds)\n",
+                          base->format.label.c_str()));
 
   // targets (one rank): mcg+binbcsr double >= 1.15x, single >= 1.8x cg+baij per iteration; iterations within 2 of cg
   SummaryLine summary;
@@ -348,13 +377,26 @@ int main(int argc, char **argv)
   summary.add("rows", (long long)rows);
   for (const Run &r : runs) {
     if (!r.ksp || r.solver.label != "mcg" || r.format.type != MATBINBCSR || !cg_baij) continue;
-    const double target = r.format.single ? 1.8 : 1.15, speedup = Min(cg_baij->per_it_cpu) / Min(r.per_it_cpu);
-    const double wall_speedup = Min(cg_baij->per_it) / Min(r.per_it), wall_median_speedup = Median(cg_baij->per_it) / Median(r.per_it);
-    const Run   *cg_same = nullptr;
+    const double target              = r.format.single ? 1.8 : 1.15,
+                 speedup             = Min(cg_baij->per_it_cpu) / Min(r.per_it_cpu);
+    const double wall_speedup        = Min(cg_baij->per_it) / Min(r.per_it),
+                 wall_median_speedup = Median(cg_baij->per_it) / Median(r.per_it);
+    const Run *cg_same               = nullptr;
     for (const Run &c : runs)
-      if (c.ksp && c.solver.label == "cg" && c.format.label == (r.format.single ? "baij" : r.format.label)) cg_same = &c;
-    PetscCall(PetscPrintf(comm, "target: mcg+%s per iteration vs cg+baij: %.2fx CPU (target >= %.2fx) %s [wall: %.2fx min, %.2fx median]", r.format.label.c_str(), speedup, target, speedup >= target ? "MET" : "NOT MET", wall_speedup, wall_median_speedup));
-    if (cg_same) PetscCall(PetscPrintf(comm, "; iterations %" PetscInt_FMT " vs cg+%s %" PetscInt_FMT "%s", r.its, cg_same->format.label.c_str(), cg_same->its, r.format.single ? "" : (std::abs(r.its - cg_same->its) <= 2 ? " (within 2: MET)" : " (within 2: NOT MET)")));
+      if (c.ksp && c.solver.label == "cg" && c.format.label == (r.format.single ? "baij" : r.format.label))
+        cg_same = &c;
+    PetscCall(PetscPrintf(
+      comm,
+      "target: mcg+%s per iteration vs cg+baij: %.2fx CPU (target >= %.2fx) %s [wall: %.2fx min, %.2fx median]",
+      r.format.label.c_str(), speedup, target, speedup >= target ? "MET" : "NOT MET", wall_speedup,
+      wall_median_speedup));
+    if (cg_same)
+      PetscCall(
+        PetscPrintf(comm, "; iterations %" PetscInt_FMT " vs cg+%s %" PetscInt_FMT "%s", r.its,
+                    cg_same->format.label.c_str(), cg_same->its,
+                    r.format.single
+                      ? ""
+                      : (std::abs(r.its - cg_same->its) <= 2 ? " (within 2: MET)" : " (within 2: NOT MET)")));
     PetscCall(PetscPrintf(comm, "\n"));
     summary.add(std::string("speedup_mcg_") + r.format.label, speedup);
   }
@@ -363,10 +405,18 @@ int main(int argc, char **argv)
   if (csv[0]) {
     FILE *fp;
     PetscCall(PetscFOpen(comm, csv, "w", &fp));
-    PetscCall(PetscFPrintf(comm, fp, "solver,format,rows,ranks,its,reason,cpu_sec_per_it_min,cpu_sec_per_it_median,wall_sec_per_it_min,wall_sec_per_it_median,true_rel_residual,note\n"));
+    PetscCall(PetscFPrintf(
+      comm, fp,
+      "solver,format,rows,ranks,its,reason,cpu_sec_per_it_min,cpu_sec_per_it_median,wall_sec_per_it_min,wall_sec_per_it_median,true_rel_residual,note\n"));
     for (const Run &r : runs) {
-      if (!r.ksp) PetscCall(PetscFPrintf(comm, fp, "%s,%s,%" PetscInt_FMT ",%d,,,,,,,,\"%s\"\n", r.solver.label.c_str(), r.format.label.c_str(), rows, size, r.note.c_str()));
-      else PetscCall(PetscFPrintf(comm, fp, "%s,%s,%" PetscInt_FMT ",%d,%" PetscInt_FMT ",%s,%.6e,%.6e,%.6e,%.6e,%.6e,\n", r.solver.label.c_str(), r.format.label.c_str(), rows, size, r.its, KSPConvergedReasons[r.reason], Min(r.per_it_cpu), Median(r.per_it_cpu), Min(r.per_it), Median(r.per_it), r.true_rel));
+      if (!r.ksp)
+        PetscCall(PetscFPrintf(comm, fp, "%s,%s,%" PetscInt_FMT ",%d,,,,,,,,\"%s\"\n", r.solver.label.c_str(),
+                               r.format.label.c_str(), rows, size, r.note.c_str()));
+      else
+        PetscCall(PetscFPrintf(
+          comm, fp, "%s,%s,%" PetscInt_FMT ",%d,%" PetscInt_FMT ",%s,%.6e,%.6e,%.6e,%.6e,%.6e,\n",
+          r.solver.label.c_str(), r.format.label.c_str(), rows, size, r.its, KSPConvergedReasons[r.reason],
+          Min(r.per_it_cpu), Median(r.per_it_cpu), Min(r.per_it), Median(r.per_it), r.true_rel));
     }
     PetscCall(PetscFClose(comm, fp));
     PetscCall(PetscPrintf(comm, "table written to %s\n", csv));

@@ -107,9 +107,9 @@ PetscErrorCode MeasureStats(Mat aij, MatrixStats *st)
   PetscCall(MatGetSize(aij, &st->rows, nullptr));
   PetscCall(MatGetBlockSize(aij, &st->bs));
   PetscCall(MatGetOwnershipRange(aij, &rstart, &rend));
-  const PetscInt bs = st->bs;
-  PetscInt       maxr = 0, minr = PETSC_MAX_INT, slice_max = 0;
-  double         nnz = 0, sell = 0, blocks = 0, upper = 0;
+  const PetscInt        bs   = st->bs;
+  PetscInt              maxr = 0, minr = PETSC_MAX_INT, slice_max = 0;
+  double                nnz = 0, sell = 0, blocks = 0, upper = 0;
   std::vector<PetscInt> bcols;
   st->block_row_len.clear();
   for (PetscInt r = rstart; r < rend; ++r) {
@@ -155,7 +155,7 @@ PetscErrorCode MeasureStats(Mat aij, MatrixStats *st)
 double BinnedBlocks(const MatrixStats &st, PetscInt bin_width, MPI_Comm comm, double *bins)
 {
   double         slots = 0, nb = 0;
-  const PetscInt n     = (PetscInt)st.block_row_len.size();
+  const PetscInt n = (PetscInt)st.block_row_len.size();
   for (PetscInt start = 0; start < n; start += bin_width) {
     const PetscInt end     = std::min(n, start + bin_width);
     PetscInt       longest = 0;
@@ -172,7 +172,7 @@ double BinnedBlocks(const MatrixStats &st, PetscInt bin_width, MPI_Comm comm, do
 double ModelBytes(const Candidate &c, const MatrixStats &st, MPI_Comm comm, double *padding)
 {
   const double bs = (double)st.bs, nbrows = (double)st.rows / bs, vec = 16.0 * st.rows;
-  *padding        = -1;
+  *padding = -1;
   if (c.spec.type == "aij") return st.nnz * 12 + 4 * (st.rows + 1) + vec;
   if (c.spec.type == "baij") return st.blocks * (8 * bs * bs + 4) + 4 * (nbrows + 1) + vec;
   if (c.spec.type == "sbaij") return st.upper_blocks * (8 * bs * bs + 4) + 4 * (nbrows + 1) + vec;
@@ -180,7 +180,8 @@ double ModelBytes(const Candidate &c, const MatrixStats &st, MPI_Comm comm, doub
   if (c.spec.type == "binbcsr" && c.spec.sym) {
     MatInfo info;
     if (MatGetInfo(c.A, MAT_GLOBAL_SUM, &info)) return 0;
-    const double slots = info.nz_allocated / (bs * bs), bins = std::ceil(nbrows / std::max<PetscInt>(1, c.bin_width));
+    const double slots = info.nz_allocated / (bs * bs),
+                 bins  = std::ceil(nbrows / std::max<PetscInt>(1, c.bin_width));
     *padding           = 100.0 * (slots - st.upper_blocks) / st.upper_blocks;
     return slots * ((c.spec.single ? 4 : 8) * bs * bs + 4) + 4 * (bins + 1) + vec + 8.0 * st.rows;
   }
@@ -293,7 +294,7 @@ PetscErrorCode BenchMatrix(MPI_Comm comm, const MatrixSource &src, const Setting
   PetscCall(MatCreateVecs(reference, &x, &y_ref));
   PetscCall(VecDuplicate(y_ref, &y));
   {
-    PetscInt lo, hi;
+    PetscInt     lo, hi;
     PetscScalar *xa;
     PetscCall(VecGetOwnershipRange(x, &lo, &hi));
     PetscCall(VecGetArray(x, &xa));
@@ -313,7 +314,8 @@ PetscErrorCode BenchMatrix(MPI_Comm comm, const MatrixSource &src, const Setting
       std::string ignored;
       info.nz_allocated = info.nz_used = 0;
       PetscCall(Try([&] { return MatGetInfo(c.A, MAT_GLOBAL_SUM, &info); }, &ignored));
-      if (ignored.empty() && info.nz_allocated > 0 && info.nz_used > 0) c.padding_info = 100.0 * (info.nz_allocated - info.nz_used) / info.nz_used;
+      if (ignored.empty() && info.nz_allocated > 0 && info.nz_used > 0)
+        c.padding_info = 100.0 * (info.nz_allocated - info.nz_used) / info.nz_used;
     }
     if (set.stats_only) continue;
     PetscCall(Try(
@@ -360,43 +362,79 @@ PetscErrorCode BenchMatrix(MPI_Comm comm, const MatrixSource &src, const Setting
   // Report.
   PetscMPIInt size;
   PetscCallMPI(MPI_Comm_size(comm, &size));
-  PetscCall(PetscPrintf(comm, "\n== %s: %" PetscInt_FMT " rows, nnz %.0f, bs %" PetscInt_FMT ", row length max %" PetscInt_FMT " min %" PetscInt_FMT " avg %.1f, %d rank(s)\n", src.name.c_str(), st.rows, st.nnz, st.bs, st.max_row, st.min_row, st.avg_row, size));
+  PetscCall(PetscPrintf(comm,
+                        "\n== %s: %" PetscInt_FMT " rows, nnz %.0f, bs %" PetscInt_FMT
+                        ", row length max %" PetscInt_FMT " min %" PetscInt_FMT " avg %.1f, %d rank(s)\n",
+                        src.name.c_str(), st.rows, st.nnz, st.bs, st.max_row, st.min_row, st.avg_row, size));
   {
-    double aij_bytes = 12.0 * st.nnz;
-    const double llc = (double)LastLevelCacheBytes();
-    if (llc > 0 && aij_bytes < 2 * llc) PetscCall(PetscPrintf(comm, "   (aij values+indices %.0f MB vs %.0f MB last-level cache: partly cache-resident, %%read and %%triad may exceed 100)\n", aij_bytes * 1e-6, llc * 1e-6));
+    double       aij_bytes = 12.0 * st.nnz;
+    const double llc       = (double)LastLevelCacheBytes();
+    if (llc > 0 && aij_bytes < 2 * llc)
+      PetscCall(PetscPrintf(
+        comm,
+        "   (aij values+indices %.0f MB vs %.0f MB last-level cache: partly cache-resident, %%read and %%triad may exceed 100)\n",
+        aij_bytes * 1e-6, llc * 1e-6));
   }
-  const double triad_GBs = (set.triad && !triad_seconds.empty()) ? set.triad->bytes / Min(triad_seconds) * 1e-9 : 0;
-  if (triad_GBs > 0) PetscCall(PetscPrintf(comm, "   STREAM triad in the same rounds: %.2f GB/s (best of %d)\n", triad_GBs, (int)triad_seconds.size()));
+  const double triad_GBs =
+    (set.triad && !triad_seconds.empty()) ? set.triad->bytes / Min(triad_seconds) * 1e-9 : 0;
+  if (triad_GBs > 0)
+    PetscCall(PetscPrintf(comm, "   STREAM triad in the same rounds: %.2f GB/s (best of %d)\n", triad_GBs,
+                          (int)triad_seconds.size()));
   const double read_GBs = set.read ? set.read->patterns[ReadArrayBest(set.read)].best_GBs : 0;
-  if (read_GBs > 0) PetscCall(PetscPrintf(comm, "   read bandwidth (best pattern, %s, so far): %.2f GB/s\n", set.read->patterns[ReadArrayBest(set.read)].name.c_str(), read_GBs));
+  if (read_GBs > 0)
+    PetscCall(PetscPrintf(comm, "   read bandwidth (best pattern, %s, so far): %.2f GB/s\n",
+                          set.read->patterns[ReadArrayBest(set.read)].name.c_str(), read_GBs));
   double t_aij = 0, t_baij = 0, b_baij = 0;
   for (const Candidate &c : cands) {
     if (c.spec.label == "aij" && !c.per_mult.empty()) t_aij = Min(c.per_mult);
     if (c.spec.label == "baij" && !c.per_mult.empty()) t_baij = Min(c.per_mult);
     if (c.spec.label == "baij" && c.A) b_baij = c.bytes;
   }
-  PetscCall(PetscPrintf(comm, "%-15s %-11s %9s %9s %8s %8s %7s %7s %9s %7s %7s %7s %7s %9s\n", "format", "type", "ms(min)", "ms(med)", "GFlop/s", "GB/s", "%read", "%triad", "MB", "/baijB", "x aij", "x baij", "pad%", "rel.err"));
+  PetscCall(PetscPrintf(comm, "%-15s %-11s %9s %9s %8s %8s %7s %7s %9s %7s %7s %7s %7s %9s\n", "format",
+                        "type", "ms(min)", "ms(med)", "GFlop/s", "GB/s", "%read", "%triad", "MB", "/baijB",
+                        "x aij", "x baij", "pad%", "rel.err"));
   for (const Candidate &c : cands) {
     if (!c.A || !c.note.empty()) {
-      PetscCall(PetscPrintf(comm, "%-15s skipped: %s\n", c.spec.label.c_str(), c.note.empty() ? "not created" : c.note.c_str()));
-      if (set.csv) PetscCall(PetscFPrintf(comm, set.csv, "%s,%s,%" PetscInt_FMT ",%.0f,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%.2f,%d,,,,,,,,,,,,,%.3f,,%.3f,skipped\n", src.name.c_str(), c.spec.label.c_str(), st.rows, st.nnz, st.bs, st.max_row, st.min_row, st.avg_row, size, triad_GBs, read_GBs));
+      PetscCall(PetscPrintf(comm, "%-15s skipped: %s\n", c.spec.label.c_str(),
+                            c.note.empty() ? "not created" : c.note.c_str()));
+      if (set.csv)
+        PetscCall(PetscFPrintf(comm, set.csv,
+                               "%s,%s,%" PetscInt_FMT ",%.0f,%" PetscInt_FMT ",%" PetscInt_FMT
+                               ",%" PetscInt_FMT ",%.2f,%d,,,,,,,,,,,,,%.3f,,%.3f,skipped\n",
+                               src.name.c_str(), c.spec.label.c_str(), st.rows, st.nnz, st.bs, st.max_row,
+                               st.min_row, st.avg_row, size, triad_GBs, read_GBs));
       continue;
     }
     const double tmin = Min(c.per_mult), tmed = Median(c.per_mult);
-    const double gflops = tmin > 0 ? 2.0 * st.nnz / tmin * 1e-9 : 0, gbs = tmin > 0 ? c.bytes / tmin * 1e-9 : 0;
-    const double frac = triad_GBs > 0 ? 100.0 * gbs / triad_GBs : 0, rfrac = read_GBs > 0 ? 100.0 * gbs / read_GBs : 0;
-    char         pad[32] = "-", xa[16] = "-", xb[16] = "-", rb[16] = "-";
+    const double gflops = tmin > 0 ? 2.0 * st.nnz / tmin * 1e-9 : 0,
+                 gbs    = tmin > 0 ? c.bytes / tmin * 1e-9 : 0;
+    const double frac   = triad_GBs > 0 ? 100.0 * gbs / triad_GBs : 0,
+                 rfrac  = read_GBs > 0 ? 100.0 * gbs / read_GBs : 0;
+    char pad[32] = "-", xa[16] = "-", xb[16] = "-", rb[16] = "-";
     if (c.padding >= 0) std::snprintf(pad, sizeof pad, "%.1f", c.padding);
     if (t_aij > 0 && tmin > 0) std::snprintf(xa, sizeof xa, "%.2f", t_aij / tmin);
     if (t_baij > 0 && tmin > 0) std::snprintf(xb, sizeof xb, "%.2f", t_baij / tmin);
     if (b_baij > 0) std::snprintf(rb, sizeof rb, "%.2f", c.bytes / b_baij);
-    PetscCall(PetscPrintf(comm, "%-15s %-11s %9.4f %9.4f %8.2f %8.2f %7.1f %7.1f %9.1f %7s %7s %7s %7s %9.1e\n", c.spec.label.c_str(), c.actual_type.c_str(), tmin * 1e3, tmed * 1e3, gflops, gbs, rfrac, frac, c.bytes * 1e-6, rb, xa, xb, pad, c.rel_err));
+    PetscCall(PetscPrintf(comm,
+                          "%-15s %-11s %9.4f %9.4f %8.2f %8.2f %7.1f %7.1f %9.1f %7s %7s %7s %7s %9.1e\n",
+                          c.spec.label.c_str(), c.actual_type.c_str(), tmin * 1e3, tmed * 1e3, gflops, gbs,
+                          rfrac, frac, c.bytes * 1e-6, rb, xa, xb, pad, c.rel_err));
     if (set.csv)
-      PetscCall(PetscFPrintf(comm, set.csv, "%s,%s,%" PetscInt_FMT ",%.0f,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%.2f,%d,%s,%.6f,%.6f,%.4f,%.4f,%.2f,%.0f,%s,%s,%s,%s,%.3e,%.3f,%.2f,%.3f,ok\n", src.name.c_str(), c.spec.label.c_str(), st.rows, st.nnz, st.bs, st.max_row, st.min_row, st.avg_row, size, c.actual_type.c_str(), tmin * 1e3, tmed * 1e3, gflops, gbs, frac, c.bytes, rb, xa, xb, c.padding >= 0 ? pad : "", c.rel_err, triad_GBs, rfrac, read_GBs));
-    if (c.spec.label == "binbcsr") PetscCall(PetscPrintf(comm, "  (binbcsr bin width %" PetscInt_FMT " block rows; -mat_binbcsr_bin_width changes it)\n", c.bin_width));
+      PetscCall(PetscFPrintf(comm, set.csv,
+                             "%s,%s,%" PetscInt_FMT ",%.0f,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT
+                             ",%.2f,%d,%s,%.6f,%.6f,%.4f,%.4f,%.2f,%.0f,%s,%s,%s,%s,%.3e,%.3f,%.2f,%.3f,ok\n",
+                             src.name.c_str(), c.spec.label.c_str(), st.rows, st.nnz, st.bs, st.max_row,
+                             st.min_row, st.avg_row, size, c.actual_type.c_str(), tmin * 1e3, tmed * 1e3,
+                             gflops, gbs, frac, c.bytes, rb, xa, xb, c.padding >= 0 ? pad : "", c.rel_err,
+                             triad_GBs, rfrac, read_GBs));
+    if (c.spec.label == "binbcsr")
+      PetscCall(PetscPrintf(
+        comm, "  (binbcsr bin width %" PetscInt_FMT " block rows; -mat_binbcsr_bin_width changes it)\n",
+        c.bin_width));
     if (c.padding >= 0 && c.padding_info >= 0 && std::fabs(c.padding - c.padding_info) > 0.5)
-      PetscCall(PetscPrintf(comm, "  note: %s reports %.1f%% padding through MatGetInfo (model above: %.1f%%)\n", c.spec.label.c_str(), c.padding_info, c.padding));
+      PetscCall(PetscPrintf(comm,
+                            "  note: %s reports %.1f%% padding through MatGetInfo (model above: %.1f%%)\n",
+                            c.spec.label.c_str(), c.padding_info, c.padding));
   }
 
   for (Candidate &c : cands) PetscCall(MatDestroy(&c.A));
@@ -421,11 +459,12 @@ int main(int argc, char **argv)
   PetscCall(PetscBinBCSRRegisterAll());
   MPI_Comm comm = PETSC_COMM_WORLD;
 
-  Settings set;
-  char     buf[PETSC_MAX_PATH_LEN] = "";
+  Settings  set;
+  char      buf[PETSC_MAX_PATH_LEN] = "";
   PetscBool flg;
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-formats", buf, sizeof buf, &flg));
-  const std::string formats = flg ? buf : "aij,baij,sbaij,sell,binbcsr,binbcsr_single,binbcsr_sym,binbcsr_sym_single";
+  const std::string formats =
+    flg ? buf : "aij,baij,sbaij,sell,binbcsr,binbcsr_single,binbcsr_sym,binbcsr_sym_single";
   for (const std::string &f : SplitList(formats)) {
     FormatSpec spec;
     spec.label = f;
@@ -435,7 +474,12 @@ int main(int argc, char **argv)
       spec.single = f != "binbcsr_sym";
       spec.sym    = f != "binbcsr_single";
     }
-    PetscCheck(spec.type == "aij" || spec.type == "baij" || spec.type == "sbaij" || spec.type == "sell" || spec.type == "binbcsr", comm, PETSC_ERR_ARG_WRONG, "Unknown format %s: use aij, baij, sbaij, sell, binbcsr, binbcsr_single, binbcsr_sym, binbcsr_sym_single", f.c_str());
+    PetscCheck(
+      spec.type == "aij" || spec.type == "baij" || spec.type == "sbaij" || spec.type == "sell" ||
+        spec.type == "binbcsr",
+      comm, PETSC_ERR_ARG_WRONG,
+      "Unknown format %s: use aij, baij, sbaij, sell, binbcsr, binbcsr_single, binbcsr_sym, binbcsr_sym_single",
+      f.c_str());
     set.formats.push_back(spec);
   }
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-repeats", &set.repeats, nullptr));
@@ -444,7 +488,8 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-bs", &set.file_bs, nullptr));
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-timer", buf, sizeof buf, &flg));
   if (flg) {
-    PetscCheck(!std::strcmp(buf, "wall") || !std::strcmp(buf, "cpu"), comm, PETSC_ERR_ARG_WRONG, "-timer wall|cpu, not %s", buf);
+    PetscCheck(!std::strcmp(buf, "wall") || !std::strcmp(buf, "cpu"), comm, PETSC_ERR_ARG_WRONG,
+               "-timer wall|cpu, not %s", buf);
     set.cpu_clock = (PetscBool)!std::strcmp(buf, "cpu");
   }
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-save_dir", buf, sizeof buf, &flg));
@@ -464,7 +509,7 @@ int main(int argc, char **argv)
     if (sizes[i] <= 0) continue;
     MatrixSource s;
     s.grid.nx = s.grid.ny = s.grid.nz = sizes[i];
-    s.name = "stencil" + std::to_string(sizes[i]);
+    s.name                            = "stencil" + std::to_string(sizes[i]);
     sources.push_back(s);
   }
   for (const std::string &p : files) {
@@ -478,7 +523,9 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-csv", buf, sizeof buf, &flg));
   if (flg) {
     PetscCall(PetscFOpen(comm, buf, "w", &set.csv));
-    PetscCall(PetscFPrintf(comm, set.csv, "matrix,format,rows,nnz,bs,max_row,min_row,avg_row,ranks,type,ms_min,ms_median,gflops,gbs,pct_triad,bytes,bytes_vs_baij,speedup_vs_aij,speedup_vs_baij,padding_pct,rel_err,triad_gbs,pct_read,read_gbs,status\n"));
+    PetscCall(PetscFPrintf(
+      comm, set.csv,
+      "matrix,format,rows,nnz,bs,max_row,min_row,avg_row,ranks,type,ms_min,ms_median,gflops,gbs,pct_triad,bytes,bytes_vs_baij,speedup_vs_aij,speedup_vs_baij,padding_pct,rel_err,triad_gbs,pct_read,read_gbs,status\n"));
   }
 
   StreamResult stream;
@@ -488,18 +535,33 @@ int main(int argc, char **argv)
     PetscCall(MeasureStreamTriadFromOptions(comm, &stream));
     PetscCall(TriadArraysCreate(comm, stream.elements_per_rank, &triad));
     triad.cpu_clock = set.cpu_clock;
-    set.triad = &triad;
+    set.triad       = &triad;
     PetscCall(ReadArrayCreate(comm, 0, &read));
     read.cpu_clock = set.cpu_clock;
     PetscCall(ReadArrayMeasureAll(comm, &read, 5));
     set.read = &read;
-    PetscCall(PetscPrintf(comm, "Read bandwidth of one %.0f MB array per rank (%d rank(s), best of 5 passes each, GB/s):", 8e-6 * (double)read.n, stream.ranks));
-    for (const ReadPattern &rp : read.patterns) PetscCall(PetscPrintf(comm, "  %s %.2f", rp.name.c_str(), rp.best_GBs));
-    PetscCall(PetscPrintf(comm, "\n  %%read: a format's bytes-model GB/s against the best of these (also passes beside the products); %%triad: against STREAM triad\n"));
-    if (LastLevelCacheBytes() > 0) PetscCall(PetscPrintf(comm, "Last-level cache %.1f MiB (/sys/devices/system/cpu/cpu0/cache)\n", (double)LastLevelCacheBytes() / (1 << 20)));
-    PetscCall(PetscPrintf(comm, "STREAM triad: %.2f GB/s best, %.2f GB/s median (%d rank(s), %.0f MB per array in all, %" PetscInt_FMT " repeats)\n", stream.best_GBs, stream.median_GBs, stream.ranks, 8e-6 * (double)stream.elements_per_rank * stream.ranks, stream.repeats));
+    PetscCall(PetscPrintf(
+      comm, "Read bandwidth of one %.0f MB array per rank (%d rank(s), best of 5 passes each, GB/s):",
+      8e-6 * (double)read.n, stream.ranks));
+    for (const ReadPattern &rp : read.patterns)
+      PetscCall(PetscPrintf(comm, "  %s %.2f", rp.name.c_str(), rp.best_GBs));
+    PetscCall(PetscPrintf(
+      comm,
+      "\n  %%read: a format's bytes-model GB/s against the best of these (also passes beside the products); %%triad: against STREAM triad\n"));
+    if (LastLevelCacheBytes() > 0)
+      PetscCall(PetscPrintf(comm, "Last-level cache %.1f MiB (/sys/devices/system/cpu/cpu0/cache)\n",
+                            (double)LastLevelCacheBytes() / (1 << 20)));
+    PetscCall(PetscPrintf(
+      comm,
+      "STREAM triad: %.2f GB/s best, %.2f GB/s median (%d rank(s), %.0f MB per array in all, %" PetscInt_FMT
+      " repeats)\n",
+      stream.best_GBs, stream.median_GBs, stream.ranks,
+      8e-6 * (double)stream.elements_per_rank * stream.ranks, stream.repeats));
   }
-  PetscCall(PetscPrintf(comm, "Bytes model: stored matrix arrays (padding included) + x + y, each once; GFlop/s = 2 nnz / t; ms per MatMult (%s)\n", set.cpu_clock ? "process CPU time: -timer cpu" : "wall clock"));
+  PetscCall(PetscPrintf(
+    comm,
+    "Bytes model: stored matrix arrays (padding included) + x + y, each once; GFlop/s = 2 nnz / t; ms per MatMult (%s)\n",
+    set.cpu_clock ? "process CPU time: -timer cpu" : "wall clock"));
   for (const MatrixSource &s : sources) PetscCall(BenchMatrix(comm, s, set));
   if (set.csv) PetscCall(PetscFClose(comm, set.csv));
   if (set.triad) PetscCall(TriadArraysDestroy(set.triad));

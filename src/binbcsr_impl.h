@@ -26,11 +26,15 @@ PETSC_INTERN PetscErrorCode MatBinBCSRCreateLike_Private(Mat src, MatType type, 
 
 /* Submatrices (PCASM, PCGASM, PCREDUNDANT, PCFIELDSPLIT) of seq and mpi binbcsr through an AIJ shadow: common/binbcsr_submat.cpp */
 PETSC_INTERN PetscErrorCode MatIncreaseOverlap_BinBCSR(Mat, PetscInt, IS[], PetscInt);
-PETSC_INTERN PetscErrorCode MatCreateSubMatrices_BinBCSR(Mat, PetscInt, const IS[], const IS[], MatReuse, Mat *[]);
-PETSC_INTERN PetscErrorCode MatCreateSubMatricesMPI_BinBCSR(Mat, PetscInt, const IS[], const IS[], MatReuse, Mat *[]);
+PETSC_INTERN PetscErrorCode MatCreateSubMatrices_BinBCSR(Mat, PetscInt, const IS[], const IS[], MatReuse,
+                                                         Mat *[]);
+PETSC_INTERN PetscErrorCode MatCreateSubMatricesMPI_BinBCSR(Mat, PetscInt, const IS[], const IS[], MatReuse,
+                                                            Mat *[]);
 PETSC_INTERN PetscErrorCode MatCreateSubMatrix_BinBCSR(Mat, IS, IS, MatReuse, Mat *);
-PETSC_INTERN PetscErrorCode MatCreateMPIMatConcatenateSeqMat_BinBCSR(MPI_Comm, Mat, PetscInt, MatReuse, Mat *);
-PETSC_INTERN PetscErrorCode MatConvert_BinBCSR_HYPRE(Mat, MatType, MatReuse, Mat *); /* composed as MatConvert_<type>_hypre_C */
+PETSC_INTERN PetscErrorCode MatCreateMPIMatConcatenateSeqMat_BinBCSR(MPI_Comm, Mat, PetscInt, MatReuse,
+                                                                     Mat *);
+PETSC_INTERN PetscErrorCode MatConvert_BinBCSR_HYPRE(Mat, MatType, MatReuse,
+                                                     Mat *); /* composed as MatConvert_<type>_hypre_C */
 /* The seqaij/mpiaij copy of a binbcsr matrix, composed on it, refreshed when the matrix changed (collective) */
 PETSC_INTERN PetscErrorCode MatBinBCSRGetAIJShadow_Private(Mat, Mat *);
 /* and back: the shadow's values written into the matrix (both then in step) */
@@ -40,21 +44,27 @@ PETSC_INTERN PetscErrorCode MatFDColoringCreate_BinBCSR(Mat, ISColoring, MatFDCo
 PETSC_INTERN PetscErrorCode MatFDColoringSetUp_BinBCSR(Mat, ISColoring, MatFDColoring);
 PETSC_INTERN PetscErrorCode MatFDColoringApply_BinBCSR(Mat, MatFDColoring, Vec, void *);
 /* PCGAMG's needs through that shadow (MatCreateGraph, matrix products with binbcsr operands): common/binbcsr_shadow_ops.cpp */
-PETSC_INTERN PetscErrorCode MatCreateGraph_BinBCSR(Mat, PetscBool, PetscBool, PetscReal BINBCSR_CREATEGRAPH_TYPES, Mat *);
-PETSC_INTERN PetscErrorCode MatProductSetFromOptions_BinBCSR(Mat); /* also composed as MatProductSetFromOptions_anytype_C */
+PETSC_INTERN PetscErrorCode MatCreateGraph_BinBCSR(Mat, PetscBool, PetscBool,
+                                                   PetscReal BINBCSR_CREATEGRAPH_TYPES, Mat *);
+PETSC_INTERN PetscErrorCode
+  MatProductSetFromOptions_BinBCSR(Mat); /* also composed as MatProductSetFromOptions_anytype_C */
 /* MUMPS / SuperLU_DIST LU and Cholesky for seq and mpi binbcsr through that shadow: common/binbcsr_factor_external.cpp */
 PETSC_INTERN PetscErrorCode MatBinBCSRRegisterExternalFactors(void);
 
 /* MATSEQBINBCSR parts of MATMPIBINBCSR: after MatSetPreallocationCOO, compose the part's COO map with
    from[] (part entry -> source index); the two-source refill then reads source p < n from v and
    p >= n from recv[p - n]. A plain MatSetValuesCOO on the part keeps its own map. */
-PETSC_INTERN PetscErrorCode MatSeqBinBCSRComposeCOO(Mat, const PetscCount from[], PetscCount n, PetscCount nsrc); /* from[] < n: the caller's values, else received */
-PETSC_INTERN PetscErrorCode MatSetValuesCOOTwoSources_SeqBinBCSR(Mat, const PetscScalar v[], PetscCount n, const PetscScalar recv[], InsertMode);
+PETSC_INTERN PetscErrorCode
+                            MatSeqBinBCSRComposeCOO(Mat, const PetscCount from[], PetscCount n,
+                                                    PetscCount nsrc); /* from[] < n: the caller's values, else received */
+PETSC_INTERN PetscErrorCode MatSetValuesCOOTwoSources_SeqBinBCSR(Mat, const PetscScalar v[], PetscCount n,
+                                                                 const PetscScalar recv[], InsertMode);
 
 /* An empty, set-up matrix of A's binbcsr type and configuration (bin width, precision, storage, MPI inner
    type) with the given local sizes and block sizes; and the MatAXPY_Basic hook built on it, composed as
    "MatAXPYGetPreallocation_C" (common/binbcsr_permute.cpp) */
-PETSC_INTERN PetscErrorCode MatBinBCSRCreateEmptyLike_Private(Mat A, PetscInt m, PetscInt n, PetscInt rbs, PetscInt cbs, Mat *C);
+PETSC_INTERN PetscErrorCode MatBinBCSRCreateEmptyLike_Private(Mat A, PetscInt m, PetscInt n, PetscInt rbs,
+                                                              PetscInt cbs, Mat *C);
 PETSC_INTERN PetscErrorCode MatAXPYGetPreallocation_BinBCSR(Mat Y, Mat X, Mat *B);
 /* MatPermute of seq and mpi binbcsr: a new matrix of the same type and configuration (common/binbcsr_permute.cpp) */
 PETSC_INTERN PetscErrorCode MatPermute_BinBCSR(Mat, IS, IS, Mat *);
@@ -75,14 +85,16 @@ PETSC_INTERN PetscErrorCode MatBinBCSRReadOptions_Private(Mat, PetscOptionItems 
 PETSC_INTERN PetscErrorCode MatBinBCSRCheckVecLocalSize(Vec v, PetscInt n, const char *what);
 
 /* Registered once by PetscBinBCSRRegisterAll(). */
-PETSC_EXTERN PetscLogEvent MAT_BinBCSR_BuildLayout; /* first final assembly: staging -> bins */
+PETSC_EXTERN PetscLogEvent MAT_BinBCSR_BuildLayout;  /* first final assembly: staging -> bins */
 PETSC_EXTERN PetscLogEvent MAT_BinBCSR_SetValuesCOO; /* slot refill by gather */
 PETSC_EXTERN PetscLogEvent MAT_BinBCSR_Tune;         /* the layout tuner (timing a sample's products) */
 PETSC_EXTERN PetscLogEvent MAT_BinBCSR_MultDot;      /* y = A x fused with x.y */
 PETSC_EXTERN PetscLogEvent KSP_MCG_FusedUpdate;      /* x, r, z (Jacobi), p, s updates + local dots */
 PETSC_EXTERN PetscLogEvent KSP_MCG_Reduction;        /* the one global reduction per iteration */
-PETSC_EXTERN PetscLogEvent MAT_BinBCSR_DeviceMult;   /* MatMult of a device matrix on host vectors (copies in and out) */
-PETSC_EXTERN PetscLogEvent MAT_BinBCSR_DeviceUpload; /* values to the device: whole array, or COO values + gather */
-PETSC_EXTERN PetscLogEvent KSP_MCG_DeviceSolve;      /* a KSPMCG solve run on the device */
+PETSC_EXTERN PetscLogEvent
+  MAT_BinBCSR_DeviceMult; /* MatMult of a device matrix on host vectors (copies in and out) */
+PETSC_EXTERN PetscLogEvent
+  MAT_BinBCSR_DeviceUpload; /* values to the device: whole array, or COO values + gather */
+PETSC_EXTERN PetscLogEvent KSP_MCG_DeviceSolve; /* a KSPMCG solve run on the device */
 
 #endif

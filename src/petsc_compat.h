@@ -13,9 +13,9 @@
    by (num_idx, index[]). BINBCSR_CREATEGRAPH_ARGS declares the parameters after `filter`,
    BINBCSR_CREATEGRAPH_PASS hands them on, BINBCSR_CREATEGRAPH_NO_INDEX passes none. */
 #if PETSC_VERSION_GE(3, 21, 0)
-  #define BINBCSR_CREATEGRAPH_ARGS , PetscInt num_idx, PetscInt index[]
-  #define BINBCSR_CREATEGRAPH_PASS , num_idx, index
-  #define BINBCSR_CREATEGRAPH_TYPES , PetscInt, PetscInt[]
+  #define BINBCSR_CREATEGRAPH_ARGS     , PetscInt num_idx, PetscInt index[]
+  #define BINBCSR_CREATEGRAPH_PASS     , num_idx, index
+  #define BINBCSR_CREATEGRAPH_TYPES    , PetscInt, PetscInt[]
   #define BINBCSR_CREATEGRAPH_NO_INDEX , 0, nullptr
 #else
   #define BINBCSR_CREATEGRAPH_ARGS

@@ -10,9 +10,11 @@ PetscLogEvent MAT_BinBCSR_DeviceMult   = 0;
 PetscLogEvent MAT_BinBCSR_DeviceUpload = 0;
 PetscLogEvent KSP_MCG_DeviceSolve      = 0;
 
-const char *const MatBinBCSRPrecisions[] = {"double", "single", "MatBinBCSRPrecision", "MAT_BINBCSR_PRECISION_", nullptr};
-const char *const MatBinBCSRDevices[]    = {"none", "reference", "cuda", "MatBinBCSRDevice", "MAT_BINBCSR_DEVICE_", nullptr};
-const char *const MatBinBCSRTunes[]      = {"off", "auto", "MatBinBCSRTune", "MAT_BINBCSR_TUNE_", nullptr};
+const char *const MatBinBCSRPrecisions[] = {"double", "single", "MatBinBCSRPrecision",
+                                            "MAT_BINBCSR_PRECISION_", nullptr};
+const char *const MatBinBCSRDevices[]    = {
+     "none", "reference", "cuda", "MatBinBCSRDevice", "MAT_BINBCSR_DEVICE_", nullptr};
+const char *const MatBinBCSRTunes[] = {"off", "auto", "MatBinBCSRTune", "MAT_BINBCSR_TUNE_", nullptr};
 
 static PetscBool registered = PETSC_FALSE;
 
@@ -62,7 +64,8 @@ PetscErrorCode PetscBinBCSRRegisterAll(void)
   PetscCall(MatRegister(MATMPIBINBCSR, MatCreate_MPIBinBCSR));
   PetscCall(MatRegisterRootName(MATBINBCSR, MATSEQBINBCSR, MATMPIBINBCSR));
   PetscCall(KSPRegister(KSPMCG, KSPCreate_MCG));
-  for (MatFactorType ft : {MAT_FACTOR_ICC, MAT_FACTOR_CHOLESKY, MAT_FACTOR_ILU, MAT_FACTOR_LU}) PetscCall(MatSolverTypeRegister(MATSOLVERPETSC, MATSEQBINBCSR, ft, MatGetFactor_SeqBinBCSR_Petsc));
+  for (MatFactorType ft : {MAT_FACTOR_ICC, MAT_FACTOR_CHOLESKY, MAT_FACTOR_ILU, MAT_FACTOR_LU})
+    PetscCall(MatSolverTypeRegister(MATSOLVERPETSC, MATSEQBINBCSR, ft, MatGetFactor_SeqBinBCSR_Petsc));
   PetscCall(MatBinBCSRRegisterExternalFactors());
   PetscCall(PetscLogEventRegister("BinBCSRBuildLay", MAT_CLASSID, &MAT_BinBCSR_BuildLayout));
   PetscCall(PetscLogEventRegister("BinBCSRSetCOO", MAT_CLASSID, &MAT_BinBCSR_SetValuesCOO));

@@ -15,8 +15,7 @@
 #include <string>
 #include <vector>
 
-namespace gpu_bench
-{
+namespace gpu_bench {
 
 // A square matrix of bs x bs blocks in block CSR (row-major blocks), host side.
 struct BlockMatrix {
@@ -24,8 +23,8 @@ struct BlockMatrix {
   int                 bs = 3, mbs = 0;
   std::vector<int>    ptr, col;
   std::vector<double> val;
-  long   nblocks() const { return (long)col.size(); }
-  int    n() const { return mbs * bs; }
+  long                nblocks() const { return (long)col.size(); }
+  int                 n() const { return mbs * bs; }
 };
 
 uint64_t mix(uint64_t h)
@@ -51,12 +50,13 @@ BlockMatrix stencil_matrix(int n)
   for (int z = 0; z < n; z++)
     for (int y = 0; y < n; y++)
       for (int x = 0; x < n; x++) {
-        const long i = ((long)z * n + y) * n + x;
+        const long i        = ((long)z * n + y) * n + x;
         long       diag_pos = -1;
         for (int dz = -1; dz <= 1; dz++)
           for (int dy = -1; dy <= 1; dy++)
             for (int dx = -1; dx <= 1; dx++) {
-              if (z + dz < 0 || z + dz >= n || y + dy < 0 || y + dy >= n || x + dx < 0 || x + dx >= n) continue;
+              if (z + dz < 0 || z + dz >= n || y + dy < 0 || y + dy >= n || x + dx < 0 || x + dx >= n)
+                continue;
               const long j = ((long)(z + dz) * n + y + dy) * n + x + dx;
               A.col.push_back((int)j);
               const size_t at = A.val.size();
@@ -65,9 +65,10 @@ BlockMatrix stencil_matrix(int n)
                 diag_pos = (long)at;
                 continue;
               }
-              const uint64_t key = (uint64_t)std::min(i, j) * 0x9E3779B97F4A7C15ULL + (uint64_t)std::max(i, j);
-              const double   u   = unit_random(key * 7 + 1);
-              double         s[6];
+              const uint64_t key =
+                (uint64_t)std::min(i, j) * 0x9E3779B97F4A7C15ULL + (uint64_t)std::max(i, j);
+              const double u = unit_random(key * 7 + 1);
+              double       s[6];
               for (int k = 0; k < 6; k++) s[k] = unit_random(key * 7 + 2 + k);
               const double S[9] = {s[0], s[1], s[2], s[1], s[3], s[4], s[2], s[4], s[5]};
               for (int e = 0; e < 9; e++) A.val[at + e] = (e % 4 == 0 ? -(1.0 + 0.5 * u) : 0.0) - 0.2 * S[e];
@@ -87,7 +88,10 @@ BlockMatrix stencil_matrix(int n)
   return A;
 }
 
-uint32_t big_endian32(const unsigned char *p) { return (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3]; }
+uint32_t big_endian32(const unsigned char *p)
+{
+  return (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3];
+}
 
 // A PETSc binary matrix (big-endian: class id 1211216, M, N, nz, row lengths, columns, values), grouped
 // into bs x bs blocks (entries the blocks hold but the file does not are zeros).
@@ -109,7 +113,8 @@ BlockMatrix read_petsc_binary(const std::string &path, int bs)
   const uint32_t id = big_endian32(&bytes[0]);
   const long     M = big_endian32(&bytes[4]), N = big_endian32(&bytes[8]), nz = big_endian32(&bytes[12]);
   if (id != 1211216 || M != N || M % bs || M <= 0 || nz < 0) {
-    std::fprintf(stderr, "%s: not a square PETSc binary matrix with block size %d (class id %u, %ld x %ld)\n", path.c_str(), bs, id, M, N);
+    std::fprintf(stderr, "%s: not a square PETSc binary matrix with block size %d (class id %u, %ld x %ld)\n",
+                 path.c_str(), bs, id, M, N);
     std::exit(2);
   }
   need(16 + 4 * (size_t)M + 12 * (size_t)nz);
@@ -129,7 +134,8 @@ BlockMatrix read_petsc_binary(const std::string &path, int bs)
   for (int br = 0; br < A.mbs; br++) {
     std::vector<int> bcols;
     for (long r = (long)br * bs; r < (long)(br + 1) * bs; r++)
-      for (long p = rowptr[r]; p < rowptr[r + 1]; p++) bcols.push_back((int)(big_endian32(cols + 4 * p) / bs));
+      for (long p = rowptr[r]; p < rowptr[r + 1]; p++)
+        bcols.push_back((int)(big_endian32(cols + 4 * p) / bs));
     std::sort(bcols.begin(), bcols.end());
     bcols.erase(std::unique(bcols.begin(), bcols.end()), bcols.end());
     const size_t first = A.col.size();
@@ -179,15 +185,15 @@ ScalarCSR scalar_csr(const BlockMatrix &A)
 }
 
 // The bins of a block CSR pattern (bs 1 for BIN-CSR), values in the tile layout, in V.
-template <typename V>
-struct Bins {
-  int               bs, bw, mbs;
-  std::vector<int>  start, col;
-  std::vector<V>    val;
-  long              nslots() const { return (long)col.size(); }
+template <typename V> struct Bins {
+  int              bs, bw, mbs;
+  std::vector<int> start, col;
+  std::vector<V>   val;
+  long             nslots() const { return (long)col.size(); }
 };
 template <typename V>
-Bins<V> make_bins(const std::vector<int> &ptr, const std::vector<int> &col, const std::vector<double> &val, int bs, int mbs, int bw)
+Bins<V> make_bins(const std::vector<int> &ptr, const std::vector<int> &col, const std::vector<double> &val,
+                  int bs, int mbs, int bw)
 {
   Bins<V> B;
   B.bs  = bs;
@@ -201,7 +207,8 @@ Bins<V> make_bins(const std::vector<int> &ptr, const std::vector<int> &col, cons
   for (int r = 0; r < mbs; r++)
     for (int k = 0; k < ptr[r + 1] - ptr[r]; k++) {
       const long s = binbcsr::row_slot<int>(B.start.data(), bw, r, k);
-      for (int e = 0; e < bs * bs; e++) B.val[binbcsr::value_index(s, e, bw, bs * bs)] = (V)val[(size_t)(ptr[r] + k) * bs * bs + e];
+      for (int e = 0; e < bs * bs; e++)
+        B.val[binbcsr::value_index(s, e, bw, bs * bs)] = (V)val[(size_t)(ptr[r] + k) * bs * bs + e];
     }
   return B;
 }

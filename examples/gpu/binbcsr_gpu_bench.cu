@@ -28,8 +28,7 @@
 #include <string>
 #include <vector>
 
-namespace
-{
+namespace {
 using namespace gpu_bench;
 
 void fail(const char *what, const char *file, int line)
@@ -37,18 +36,18 @@ void fail(const char *what, const char *file, int line)
   std::fprintf(stderr, "%s:%d: %s\n", file, line, what);
   std::exit(2);
 }
-#define CK(call) \
-  do { \
-    cudaError_t e_ = (call); \
+#define CK(call)                                                             \
+  do {                                                                       \
+    cudaError_t e_ = (call);                                                 \
     if (e_ != cudaSuccess) fail(cudaGetErrorString(e_), __FILE__, __LINE__); \
   } while (0)
-#define CKS(call) \
-  do { \
-    cusparseStatus_t e_ = (call); \
+#define CKS(call)                                                                            \
+  do {                                                                                       \
+    cusparseStatus_t e_ = (call);                                                            \
     if (e_ != CUSPARSE_STATUS_SUCCESS) fail(cusparseGetErrorString(e_), __FILE__, __LINE__); \
   } while (0)
-#define CKB(call) \
-  do { \
+#define CKB(call)                                                         \
+  do {                                                                    \
     if ((call) != CUBLAS_STATUS_SUCCESS) fail(#call, __FILE__, __LINE__); \
   } while (0)
 #define CKL() CK(cudaGetLastError())
@@ -56,16 +55,14 @@ void fail(const char *what, const char *file, int line)
 int  failures   = 0;
 bool check_only = false; /* -check_only: every kernel once and checked, nothing timed (sanitizers) */
 
-template <typename T>
-T *to_device(const std::vector<T> &h)
+template <typename T> T *to_device(const std::vector<T> &h)
 {
   T *d = nullptr;
   CK(cudaMalloc(&d, std::max<size_t>(h.size(), 1) * sizeof(T)));
   if (!h.empty()) CK(cudaMemcpy(d, h.data(), h.size() * sizeof(T), cudaMemcpyHostToDevice));
   return d;
 }
-template <typename T>
-std::vector<T> to_host(const T *d, size_t n)
+template <typename T> std::vector<T> to_host(const T *d, size_t n)
 {
   std::vector<T> h(n);
   CK(cudaMemcpy(h.data(), d, n * sizeof(T), cudaMemcpyDeviceToHost));
@@ -73,8 +70,7 @@ std::vector<T> to_host(const T *d, size_t n)
 }
 
 // Seconds per call of f: the median over 7 batches of events around `per_batch` calls, after a warm-up.
-template <class F>
-double time_per_call(F &&f, int per_batch)
+template <class F> double time_per_call(F &&f, int per_batch)
 {
   if (check_only) return NAN;
   cudaEvent_t a, b;
@@ -99,16 +95,17 @@ double time_per_call(F &&f, int per_batch)
 }
 
 // Calls per batch so that a batch takes about 20 ms (one timed call first).
-template <class F>
-int batch_size(F &&f)
+template <class F> int batch_size(F &&f)
 {
   const double one = time_per_call(f, 1);
   return (int)std::min(2000.0, std::max(5.0, 0.02 / std::max(one, 1e-7)));
 }
 
-__global__ void triad(long n, const double *__restrict__ a, const double *__restrict__ b, double *__restrict__ c)
+__global__ void triad(long n, const double *__restrict__ a, const double *__restrict__ b,
+                      double *__restrict__ c)
 {
-  for (long i = blockIdx.x * (long)blockDim.x + threadIdx.x; i < n; i += (long)gridDim.x * blockDim.x) c[i] = a[i] + 1.5 * b[i];
+  for (long i = blockIdx.x * (long)blockDim.x + threadIdx.x; i < n; i += (long)gridDim.x * blockDim.x)
+    c[i] = a[i] + 1.5 * b[i];
 }
 
 // STREAM triad over 3 arrays of 2^26 doubles (1.6 GB, far beyond L2): bytes read + written per second.
@@ -130,7 +127,8 @@ double triad_bandwidth()
 }
 
 // Host reference y = A x in double, and per row the scale sum_j |a_ij x_j| the errors are measured against.
-void host_product(const ScalarCSR &S, const std::vector<double> &x, std::vector<double> &y, std::vector<double> &scale)
+void host_product(const ScalarCSR &S, const std::vector<double> &x, std::vector<double> &y,
+                  std::vector<double> &scale)
 {
   const size_t n = S.ptr.size() - 1;
   y.assign(n, 0.0);
@@ -163,18 +161,23 @@ double product_error(const T *dy, const std::vector<double> &ref, const std::vec
 void print_rows(const std::vector<Row> &rows, double bw_triad)
 {
   const double csr = rows[0].seconds;
-  std::printf("%-26s %9s %9s %8s %7s %7s %9s %9s %s\n", "format", "us", "GFlop/s", "GB/s", "%triad", "x csr", "error", "bound", "check");
+  std::printf("%-26s %9s %9s %8s %7s %7s %9s %9s %s\n", "format", "us", "GFlop/s", "GB/s", "%triad", "x csr",
+              "error", "bound", "check");
   for (const Row &r : rows) {
     const bool ok = r.error <= r.bound;
     failures += !ok;
-    std::printf("%-26s %9.2f %9.1f %8.1f %7.1f %7.2f %9.1e %9.1e %s\n", r.format.c_str(), r.seconds * 1e6, r.flops / r.seconds * 1e-9, r.bytes / r.seconds * 1e-9, 100.0 * r.bytes / r.seconds / bw_triad, csr / r.seconds, r.error, r.bound, ok ? "ok" : "FAIL");
+    std::printf("%-26s %9.2f %9.1f %8.1f %7.1f %7.2f %9.1e %9.1e %s\n", r.format.c_str(), r.seconds * 1e6,
+                r.flops / r.seconds * 1e-9, r.bytes / r.seconds * 1e-9,
+                100.0 * r.bytes / r.seconds / bw_triad, csr / r.seconds, r.error, r.bound,
+                ok ? "ok" : "FAIL");
   }
 }
 
 // One product row of the table: y poisoned with NaN (an entry the product does not write fails the
 // check), one checked run, then the timing.
 template <typename T, class F>
-Row measure_product(const char *name, F &&run, T *dy, long n, double bytes, double flops, const std::vector<double> &ref, const std::vector<double> &scale, double bound)
+Row measure_product(const char *name, F &&run, T *dy, long n, double bytes, double flops,
+                    const std::vector<double> &ref, const std::vector<double> &scale, double bound)
 {
   CK(cudaMemset(dy, 0xFF, n * sizeof(T)));
   run();
@@ -186,7 +189,9 @@ Row measure_product(const char *name, F &&run, T *dy, long n, double bytes, doub
 
 // cuSPARSE SpMV through the generic API, in T (x, y and values all T).
 template <typename T>
-Row cusparse_row(cusparseHandle_t h, cusparseSpMatDescr_t mat, const char *name, double matrix_bytes, double flops, long n, const std::vector<double> &x, const std::vector<double> &ref, const std::vector<double> &scale, double bound, cusparseSpMVAlg_t alg)
+Row cusparse_row(cusparseHandle_t h, cusparseSpMatDescr_t mat, const char *name, double matrix_bytes,
+                 double flops, long n, const std::vector<double> &x, const std::vector<double> &ref,
+                 const std::vector<double> &scale, double bound, cusparseSpMVAlg_t alg)
 {
   const cudaDataType dt = sizeof(T) == 8 ? CUDA_R_64F : CUDA_R_32F;
   std::vector<T>     xt(x.begin(), x.end());
@@ -198,10 +203,13 @@ Row cusparse_row(cusparseHandle_t h, cusparseSpMatDescr_t mat, const char *name,
   const T one = 1, zero = 0;
   size_t  buf_size = 0;
   void   *buf      = nullptr;
-  CKS(cusparseSpMV_bufferSize(h, CUSPARSE_OPERATION_NON_TRANSPOSE, &one, mat, vx, &zero, vy, dt, alg, &buf_size));
+  CKS(cusparseSpMV_bufferSize(h, CUSPARSE_OPERATION_NON_TRANSPOSE, &one, mat, vx, &zero, vy, dt, alg,
+                              &buf_size));
   CK(cudaMalloc(&buf, std::max<size_t>(buf_size, 8)));
-  auto run = [&] { CKS(cusparseSpMV(h, CUSPARSE_OPERATION_NON_TRANSPOSE, &one, mat, vx, &zero, vy, dt, alg, buf)); };
-  Row  r   = measure_product(name, run, dy, n, matrix_bytes + 2.0 * n * sizeof(T), flops, ref, scale, bound);
+  auto run = [&] {
+    CKS(cusparseSpMV(h, CUSPARSE_OPERATION_NON_TRANSPOSE, &one, mat, vx, &zero, vy, dt, alg, buf));
+  };
+  Row r = measure_product(name, run, dy, n, matrix_bytes + 2.0 * n * sizeof(T), flops, ref, scale, bound);
   CKS(cusparseDestroyDnVec(vx));
   CKS(cusparseDestroyDnVec(vy));
   CK(cudaFree(buf));
@@ -212,18 +220,22 @@ Row cusparse_row(cusparseHandle_t h, cusparseSpMatDescr_t mat, const char *name,
 
 // Our product: bins in V, x and y in double.
 template <int BS, typename V>
-Row bin_row(const Bins<V> &B, bool per_row, const char *name, double flops, const std::vector<double> &x, const std::vector<double> &ref, const std::vector<double> &scale, double bound)
+Row bin_row(const Bins<V> &B, bool per_row, const char *name, double flops, const std::vector<double> &x,
+            const std::vector<double> &ref, const std::vector<double> &scale, double bound)
 {
   const long n  = (long)B.mbs * BS;
   V         *dv = to_device(B.val);
   int       *dc = to_device(B.col), *ds = to_device(B.start);
   double    *dx = to_device(x), *dy;
   CK(cudaMalloc(&dy, n * 8));
-  const int bt = binbcsr::cuda::block_threads, lanes_blocks = (B.mbs + bt - 1) / bt, rows_blocks = (int)((binbcsr::cuda::rows_threads(B.mbs, B.bw, BS) + bt - 1) / bt);
+  const int bt = binbcsr::cuda::block_threads, lanes_blocks = (B.mbs + bt - 1) / bt,
+            rows_blocks  = (int)((binbcsr::cuda::rows_threads(B.mbs, B.bw, BS) + bt - 1) / bt);
   const int split_blocks = (int)((binbcsr::cuda::split_threads(B.mbs, BS) + bt - 1) / bt);
-  auto      run = [&] {
-    if (per_row && B.bw == 8) binbcsr::cuda::bin_mult_split8<BS, V><<<split_blocks, bt>>>(dv, dc, ds, B.mbs, dx, dy);
-    else if (per_row) binbcsr::cuda::bin_mult_rows<BS, V><<<rows_blocks, bt>>>(dv, dc, ds, B.mbs, B.bw, dx, dy);
+  auto      run          = [&] {
+    if (per_row && B.bw == 8)
+      binbcsr::cuda::bin_mult_split8<BS, V><<<split_blocks, bt>>>(dv, dc, ds, B.mbs, dx, dy);
+    else if (per_row)
+      binbcsr::cuda::bin_mult_rows<BS, V><<<rows_blocks, bt>>>(dv, dc, ds, B.mbs, B.bw, dx, dy);
     else binbcsr::cuda::bin_mult<BS, V><<<lanes_blocks, bt>>>(dv, dc, ds, B.mbs, B.bw, dx, dy);
   };
   const double bytes = (double)B.val.size() * sizeof(V) + 4.0 * (B.col.size() + B.start.size()) + 16.0 * n;
@@ -252,17 +264,21 @@ void spmv_table(const BlockMatrix &A, const ScalarCSR &S, cusparseHandle_t h, do
 
   std::vector<Row> rows;
   // cuSPARSE CSR
-  int   *dptr = to_device(S.ptr), *dcol = to_device(S.col);
-  double *dval = to_device(S.val);
-  std::vector<float> sval32(S.val.begin(), S.val.end());
-  float *dval32 = to_device(sval32);
+  int                 *dptr = to_device(S.ptr), *dcol = to_device(S.col);
+  double              *dval = to_device(S.val);
+  std::vector<float>   sval32(S.val.begin(), S.val.end());
+  float               *dval32 = to_device(sval32);
   cusparseSpMatDescr_t m;
-  const double csr_bytes64 = 12.0 * nnz + 4.0 * (n + 1), csr_bytes32 = 8.0 * nnz + 4.0 * (n + 1);
-  CKS(cusparseCreateCsr(&m, n, n, nnz, dptr, dcol, dval, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO, CUDA_R_64F));
-  rows.push_back(cusparse_row<double>(h, m, "cusparse csr double", csr_bytes64, flops, n, x, ref, scale, b64, CUSPARSE_SPMV_CSR_ALG1));
+  const double         csr_bytes64 = 12.0 * nnz + 4.0 * (n + 1), csr_bytes32 = 8.0 * nnz + 4.0 * (n + 1);
+  CKS(cusparseCreateCsr(&m, n, n, nnz, dptr, dcol, dval, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_32I,
+                        CUSPARSE_INDEX_BASE_ZERO, CUDA_R_64F));
+  rows.push_back(cusparse_row<double>(h, m, "cusparse csr double", csr_bytes64, flops, n, x, ref, scale, b64,
+                                      CUSPARSE_SPMV_CSR_ALG1));
   CKS(cusparseDestroySpMat(m));
-  CKS(cusparseCreateCsr(&m, n, n, nnz, dptr, dcol, dval32, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO, CUDA_R_32F));
-  rows.push_back(cusparse_row<float>(h, m, "cusparse csr single", csr_bytes32, flops, n, x, ref, scale, b32, CUSPARSE_SPMV_CSR_ALG1));
+  CKS(cusparseCreateCsr(&m, n, n, nnz, dptr, dcol, dval32, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_32I,
+                        CUSPARSE_INDEX_BASE_ZERO, CUDA_R_32F));
+  rows.push_back(cusparse_row<float>(h, m, "cusparse csr single", csr_bytes32, flops, n, x, ref, scale, b32,
+                                     CUSPARSE_SPMV_CSR_ALG1));
   CKS(cusparseDestroySpMat(m));
   CK(cudaFree(dval));
   CK(cudaFree(dval32));
@@ -270,16 +286,21 @@ void spmv_table(const BlockMatrix &A, const ScalarCSR &S, cusparseHandle_t h, do
   CK(cudaFree(dcol));
   // cuSPARSE BSR (block rows as A, row-major blocks)
   if (A.bs > 1) {
-    int   *bptr = to_device(A.ptr), *bcol = to_device(A.col);
-    double *bval = to_device(A.val);
+    int               *bptr = to_device(A.ptr), *bcol = to_device(A.col);
+    double            *bval = to_device(A.val);
     std::vector<float> bv32(A.val.begin(), A.val.end());
-    float *bval32 = to_device(bv32);
-    const double bsr_bytes64 = 8.0 * A.val.size() + 4.0 * (A.col.size() + A.ptr.size()), bsr_bytes32 = 4.0 * A.val.size() + 4.0 * (A.col.size() + A.ptr.size());
-    CKS(cusparseCreateBsr(&m, A.mbs, A.mbs, A.nblocks(), A.bs, A.bs, bptr, bcol, bval, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO, CUDA_R_64F, CUSPARSE_ORDER_ROW));
-    rows.push_back(cusparse_row<double>(h, m, "cusparse bsr double", bsr_bytes64, flops, n, x, ref, scale, b64, CUSPARSE_SPMV_BSR_ALG1));
+    float             *bval32      = to_device(bv32);
+    const double       bsr_bytes64 = 8.0 * A.val.size() + 4.0 * (A.col.size() + A.ptr.size()),
+                 bsr_bytes32       = 4.0 * A.val.size() + 4.0 * (A.col.size() + A.ptr.size());
+    CKS(cusparseCreateBsr(&m, A.mbs, A.mbs, A.nblocks(), A.bs, A.bs, bptr, bcol, bval, CUSPARSE_INDEX_32I,
+                          CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO, CUDA_R_64F, CUSPARSE_ORDER_ROW));
+    rows.push_back(cusparse_row<double>(h, m, "cusparse bsr double", bsr_bytes64, flops, n, x, ref, scale,
+                                        b64, CUSPARSE_SPMV_BSR_ALG1));
     CKS(cusparseDestroySpMat(m));
-    CKS(cusparseCreateBsr(&m, A.mbs, A.mbs, A.nblocks(), A.bs, A.bs, bptr, bcol, bval32, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO, CUDA_R_32F, CUSPARSE_ORDER_ROW));
-    rows.push_back(cusparse_row<float>(h, m, "cusparse bsr single", bsr_bytes32, flops, n, x, ref, scale, b32, CUSPARSE_SPMV_BSR_ALG1));
+    CKS(cusparseCreateBsr(&m, A.mbs, A.mbs, A.nblocks(), A.bs, A.bs, bptr, bcol, bval32, CUSPARSE_INDEX_32I,
+                          CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO, CUDA_R_32F, CUSPARSE_ORDER_ROW));
+    rows.push_back(cusparse_row<float>(h, m, "cusparse bsr single", bsr_bytes32, flops, n, x, ref, scale, b32,
+                                       CUSPARSE_SPMV_BSR_ALG1));
     CKS(cusparseDestroySpMat(m));
     CK(cudaFree(bptr));
     CK(cudaFree(bcol));
@@ -288,12 +309,13 @@ void spmv_table(const BlockMatrix &A, const ScalarCSR &S, cusparseHandle_t h, do
   }
   // cuSPARSE sliced ELL, slice 32 (padding column -1): the nearest cuSPARSE format to BIN-CSR
   {
-    const int          slice = 32, nslices = (int)((n + slice - 1) / slice);
+    const int           slice = 32, nslices = (int)((n + slice - 1) / slice);
     std::vector<int>    off(nslices + 1, 0), scol;
     std::vector<double> sval;
     for (int sl = 0; sl < nslices; sl++) {
       int len = 0;
-      for (long r = (long)sl * slice; r < std::min(n, (long)(sl + 1) * slice); r++) len = std::max(len, S.ptr[r + 1] - S.ptr[r]);
+      for (long r = (long)sl * slice; r < std::min(n, (long)(sl + 1) * slice); r++)
+        len = std::max(len, S.ptr[r + 1] - S.ptr[r]);
       off[sl + 1] = off[sl] + len * slice;
     }
     scol.assign(off[nslices], -1);
@@ -305,15 +327,22 @@ void spmv_table(const BlockMatrix &A, const ScalarCSR &S, cusparseHandle_t h, do
         sval[at]      = S.val[S.ptr[r] + k];
       }
     std::vector<float> sv32(sval.begin(), sval.end());
-    int   *doff = to_device(off), *dsc = to_device(scol);
-    double *dsv = to_device(sval);
-    float *dsv32 = to_device(sv32);
-    const double sell_bytes64 = 12.0 * scol.size() + 4.0 * off.size(), sell_bytes32 = 8.0 * scol.size() + 4.0 * off.size();
-    CKS(cusparseCreateSlicedEll(&m, n, n, nnz, (int64_t)scol.size(), slice, doff, dsc, dsv, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO, CUDA_R_64F));
-    rows.push_back(cusparse_row<double>(h, m, "cusparse sell32 double", sell_bytes64, flops, n, x, ref, scale, b64, CUSPARSE_SPMV_SELL_ALG1));
+    int               *doff = to_device(off), *dsc = to_device(scol);
+    double            *dsv          = to_device(sval);
+    float             *dsv32        = to_device(sv32);
+    const double       sell_bytes64 = 12.0 * scol.size() + 4.0 * off.size(),
+                 sell_bytes32       = 8.0 * scol.size() + 4.0 * off.size();
+    CKS(cusparseCreateSlicedEll(&m, n, n, nnz, (int64_t)scol.size(), slice, doff, dsc, dsv,
+                                CUSPARSE_INDEX_32I, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO,
+                                CUDA_R_64F));
+    rows.push_back(cusparse_row<double>(h, m, "cusparse sell32 double", sell_bytes64, flops, n, x, ref, scale,
+                                        b64, CUSPARSE_SPMV_SELL_ALG1));
     CKS(cusparseDestroySpMat(m));
-    CKS(cusparseCreateSlicedEll(&m, n, n, nnz, (int64_t)scol.size(), slice, doff, dsc, dsv32, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO, CUDA_R_32F));
-    rows.push_back(cusparse_row<float>(h, m, "cusparse sell32 single", sell_bytes32, flops, n, x, ref, scale, b32, CUSPARSE_SPMV_SELL_ALG1));
+    CKS(cusparseCreateSlicedEll(&m, n, n, nnz, (int64_t)scol.size(), slice, doff, dsc, dsv32,
+                                CUSPARSE_INDEX_32I, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO,
+                                CUDA_R_32F));
+    rows.push_back(cusparse_row<float>(h, m, "cusparse sell32 single", sell_bytes32, flops, n, x, ref, scale,
+                                       b32, CUSPARSE_SPMV_SELL_ALG1));
     CKS(cusparseDestroySpMat(m));
     CK(cudaFree(doff));
     CK(cudaFree(dsc));
@@ -331,25 +360,33 @@ void spmv_table(const BlockMatrix &A, const ScalarCSR &S, cusparseHandle_t h, do
   }
   if (A.bs == 3)
     for (int bw : {32, 16, 8}) {
-      const auto   B    = make_bins<double>(A.ptr, A.col, A.val, 3, A.mbs, bw);
-      const auto   F    = make_bins<float>(A.ptr, A.col, A.val, 3, A.mbs, bw);
-      const std::string tail = bw == 8 ? ", split 4)" : ")", d = "bin-bcsr double (bw " + std::to_string(bw) + tail, s = "bin-bcsr single (bw " + std::to_string(bw) + tail;
+      const auto        B    = make_bins<double>(A.ptr, A.col, A.val, 3, A.mbs, bw);
+      const auto        F    = make_bins<float>(A.ptr, A.col, A.val, 3, A.mbs, bw);
+      const std::string tail = bw == 8 ? ", split 4)" : ")",
+                        d    = "bin-bcsr double (bw " + std::to_string(bw) + tail,
+                        s    = "bin-bcsr single (bw " + std::to_string(bw) + tail;
       if (bw == 32) pad_bcsr32 = 100.0 * ((double)B.nslots() / A.nblocks() - 1.0);
       rows.push_back(bin_row<3, double>(B, true, d.c_str(), flops, x, ref, scale, b64));
       rows.push_back(bin_row<3, float>(F, true, s.c_str(), flops, x, ref, scale, bstore32));
       if (bw == 32) { /* one thread per lane for all 3 point rows: a third of the threads */
-        rows.push_back(bin_row<3, double>(B, false, "bin-bcsr double, lane/thread", flops, x, ref, scale, b64));
-        rows.push_back(bin_row<3, float>(F, false, "bin-bcsr single, lane/thread", flops, x, ref, scale, bstore32));
+        rows.push_back(
+          bin_row<3, double>(B, false, "bin-bcsr double, lane/thread", flops, x, ref, scale, b64));
+        rows.push_back(
+          bin_row<3, float>(F, false, "bin-bcsr single, lane/thread", flops, x, ref, scale, bstore32));
       }
     }
-  std::printf("\n== %s: %ld rows, %ld nonzeros (%ld blocks of %dx%d), block row length %d..%d (avg %.1f), padding bin-csr %.1f%%, bin-bcsr (bw 32) %.1f%%\n", A.name.c_str(), n, nnz, A.nblocks(), A.bs, A.bs, minrow, maxrow, (double)A.nblocks() / A.mbs, pad_csr, pad_bcsr32);
+  std::printf(
+    "\n== %s: %ld rows, %ld nonzeros (%ld blocks of %dx%d), block row length %d..%d (avg %.1f), padding bin-csr %.1f%%, bin-bcsr (bw 32) %.1f%%\n",
+    A.name.c_str(), n, nnz, A.nblocks(), A.bs, A.bs, minrow, maxrow, (double)A.nblocks() / A.mbs, pad_csr,
+    pad_bcsr32);
   print_rows(rows, bw_triad);
 }
 
 // ---------------------------------------------------------------------------------------------------
 // CG, Jacobi-preconditioned, from x = 0, a fixed number of iterations.
 
-__global__ void pointwise_mult(int n, const double *__restrict__ a, const double *__restrict__ b, double *__restrict__ c)
+__global__ void pointwise_mult(int n, const double *__restrict__ a, const double *__restrict__ b,
+                               double *__restrict__ c)
 {
   for (int i = blockIdx.x * blockDim.x + threadIdx.x; i < n; i += gridDim.x * blockDim.x) c[i] = a[i] * b[i];
 }
@@ -363,15 +400,16 @@ struct CGResult {
 // the BIN-BCSR kernel with bins != nullptr), cuBLAS dots that return to the host, axpys, a Jacobi
 // kernel: 8 launches and 2 host synchronisations per iteration.
 template <typename V>
-CGResult stock_cg(cusparseHandle_t sh, cublasHandle_t bh, const ScalarCSR &S, const Bins<V> *bins, const std::vector<double> &dinv_h, const std::vector<double> &b_h, int its)
+CGResult stock_cg(cusparseHandle_t sh, cublasHandle_t bh, const ScalarCSR &S, const Bins<V> *bins,
+                  const std::vector<double> &dinv_h, const std::vector<double> &b_h, int its)
 {
-  const int n = (int)dinv_h.size();
+  const int n    = (int)dinv_h.size();
   double   *dinv = to_device(dinv_h), *b = to_device(b_h), *x, *r, *z, *p, *q;
   for (double **v : {&x, &r, &z, &p, &q}) CK(cudaMalloc(v, n * 8));
-  int    *dptr = nullptr, *dcol = nullptr, *bc = nullptr, *bst = nullptr;
-  double *dval = nullptr;
-  V      *bv   = nullptr;
-  cusparseSpMatDescr_t m  = nullptr;
+  int                 *dptr = nullptr, *dcol = nullptr, *bc = nullptr, *bst = nullptr;
+  double              *dval = nullptr;
+  V                   *bv   = nullptr;
+  cusparseSpMatDescr_t m    = nullptr;
   cusparseDnVecDescr_t vp = nullptr, vq = nullptr;
   void                *buf = nullptr;
   const double         one = 1.0, zero = 0.0;
@@ -379,21 +417,28 @@ CGResult stock_cg(cusparseHandle_t sh, cublasHandle_t bh, const ScalarCSR &S, co
     dptr = to_device(S.ptr);
     dcol = to_device(S.col);
     dval = to_device(S.val);
-    CKS(cusparseCreateCsr(&m, n, n, (int64_t)S.col.size(), dptr, dcol, dval, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO, CUDA_R_64F));
+    CKS(cusparseCreateCsr(&m, n, n, (int64_t)S.col.size(), dptr, dcol, dval, CUSPARSE_INDEX_32I,
+                          CUSPARSE_INDEX_32I, CUSPARSE_INDEX_BASE_ZERO, CUDA_R_64F));
     CKS(cusparseCreateDnVec(&vp, n, p, CUDA_R_64F));
     CKS(cusparseCreateDnVec(&vq, n, q, CUDA_R_64F));
     size_t sz = 0;
-    CKS(cusparseSpMV_bufferSize(sh, CUSPARSE_OPERATION_NON_TRANSPOSE, &one, m, vp, &zero, vq, CUDA_R_64F, CUSPARSE_SPMV_CSR_ALG1, &sz));
+    CKS(cusparseSpMV_bufferSize(sh, CUSPARSE_OPERATION_NON_TRANSPOSE, &one, m, vp, &zero, vq, CUDA_R_64F,
+                                CUSPARSE_SPMV_CSR_ALG1, &sz));
     CK(cudaMalloc(&buf, std::max<size_t>(sz, 8)));
   } else {
     bv  = to_device(bins->val);
     bc  = to_device(bins->col);
     bst = to_device(bins->start);
   }
-  const int vb = std::min((n + 255) / 256, 132 * 8);
+  const int vb   = std::min((n + 255) / 256, 132 * 8);
   auto      spmv = [&] {
-    if (!bins) CKS(cusparseSpMV(sh, CUSPARSE_OPERATION_NON_TRANSPOSE, &one, m, vp, &zero, vq, CUDA_R_64F, CUSPARSE_SPMV_CSR_ALG1, buf));
-    else binbcsr::cuda::bin_mult_rows<3, V><<<(int)((binbcsr::cuda::rows_threads(bins->mbs, bins->bw, 3) + 255) / 256), 256>>>(bv, bc, bst, bins->mbs, bins->bw, p, q);
+    if (!bins)
+      CKS(cusparseSpMV(sh, CUSPARSE_OPERATION_NON_TRANSPOSE, &one, m, vp, &zero, vq, CUDA_R_64F,
+                            CUSPARSE_SPMV_CSR_ALG1, buf));
+    else
+      binbcsr::cuda::bin_mult_rows<3, V>
+        <<<(int)((binbcsr::cuda::rows_threads(bins->mbs, bins->bw, 3) + 255) / 256), 256>>>(
+          bv, bc, bst, bins->mbs, bins->bw, p, q);
   };
   CGResult res;
   auto     solve = [&](bool record) {
@@ -407,7 +452,8 @@ CGResult stock_cg(cusparseHandle_t sh, cublasHandle_t bh, const ScalarCSR &S, co
     for (int it = 0; it < its; it++) {
       spmv();
       CKB(cublasDdot(bh, n, p, 1, q, 1, &pq));
-      const double a = pq > 0.0 ? rz / pq : 0.0, ma = -a; /* the merged CG's guards: p = 0 once converged exactly */
+      const double a  = pq > 0.0 ? rz / pq : 0.0,
+                   ma = -a; /* the merged CG's guards: p = 0 once converged exactly */
       CKB(cublasDaxpy(bh, n, &a, p, 1, x, 1));
       CKB(cublasDaxpy(bh, n, &ma, q, 1, r, 1));
       pointwise_mult<<<vb, 256>>>(n, dinv, r, z);
@@ -428,22 +474,28 @@ CGResult stock_cg(cusparseHandle_t sh, cublasHandle_t bh, const ScalarCSR &S, co
     CKS(cusparseDestroyDnVec(vp));
     CKS(cusparseDestroyDnVec(vq));
   }
-  for (void *v : {(void *)dinv, (void *)b, (void *)x, (void *)r, (void *)z, (void *)p, (void *)q, (void *)dptr, (void *)dcol, (void *)dval, (void *)bv, (void *)bc, (void *)bst, buf}) CK(cudaFree(v));
+  for (void *v : {(void *)dinv, (void *)b, (void *)x, (void *)r, (void *)z, (void *)p, (void *)q,
+                  (void *)dptr, (void *)dcol, (void *)dval, (void *)bv, (void *)bc, (void *)bst, buf})
+    CK(cudaFree(v));
   return res;
 }
 
 // The merged CG with BIN-BCSR: 3 launches per iteration, no host synchronisation until the end; with
 // graph, the whole fixed-iteration solve is captured once and replayed as one launch.
 template <typename V>
-CGResult merged_cg(const Bins<V> &B, const std::vector<double> &dinv_h, const std::vector<double> &b_h, int its, bool graph)
+CGResult merged_cg(const Bins<V> &B, const std::vector<double> &dinv_h, const std::vector<double> &b_h,
+                   int its, bool graph)
 {
-  namespace bc = binbcsr::cuda;
-  const int n = (int)dinv_h.size();
+  namespace bc   = binbcsr::cuda;
+  const int n    = (int)dinv_h.size();
   double   *dinv = to_device(dinv_h), *b = to_device(b_h), *x, *r, *z, *p, *q, *partials, *hist;
   for (double **v : {&x, &r, &z, &p, &q}) CK(cudaMalloc(v, n * 8));
-  V  *dv = to_device(B.val);
-  int *dc = to_device(B.col), *ds = to_device(B.start);
-  const int sb = (int)(((B.bw == 8 ? bc::split_threads(B.mbs, 3) : bc::rows_threads(B.mbs, B.bw, 3)) + bc::block_threads - 1) / bc::block_threads), vb = std::min((n + bc::block_threads - 1) / bc::block_threads, 132 * 8);
+  V        *dv = to_device(B.val);
+  int      *dc = to_device(B.col), *ds = to_device(B.start);
+  const int sb = (int)(((B.bw == 8 ? bc::split_threads(B.mbs, 3) : bc::rows_threads(B.mbs, B.bw, 3)) +
+                        bc::block_threads - 1) /
+                       bc::block_threads),
+            vb = std::min((n + bc::block_threads - 1) / bc::block_threads, 132 * 8);
   CK(cudaMalloc(&partials, std::max(sb, vb) * 8));
   CK(cudaMalloc(&hist, (its + 1) * 8));
   bc::MCGScalars *s;
@@ -455,9 +507,14 @@ CGResult merged_cg(const Bins<V> &B, const std::vector<double> &dinv_h, const st
     bc::mcg_start<<<vb, bc::block_threads, 0, st>>>(n, dinv, b, x, r, z, p, partials, s, hist);
     for (int it = 0; it < its; it++) {
       const int cur = it % 2;
-      if (B.bw == 8) bc::bin_mult_dot_split8<3, V><<<sb, bc::block_threads, 0, st>>>(dv, dc, ds, B.mbs, p, q, partials, &s->ticket, &s->pq);
-      else bc::bin_mult_dot<3, V><<<sb, bc::block_threads, 0, st>>>(dv, dc, ds, B.mbs, B.bw, p, q, partials, &s->ticket, &s->pq);
-      bc::mcg_update<<<vb, bc::block_threads, 0, st>>>(n, cur, dinv, p, q, x, r, z, partials, s, hist + it + 1);
+      if (B.bw == 8)
+        bc::bin_mult_dot_split8<3, V>
+          <<<sb, bc::block_threads, 0, st>>>(dv, dc, ds, B.mbs, p, q, partials, &s->ticket, &s->pq);
+      else
+        bc::bin_mult_dot<3, V>
+          <<<sb, bc::block_threads, 0, st>>>(dv, dc, ds, B.mbs, B.bw, p, q, partials, &s->ticket, &s->pq);
+      bc::mcg_update<<<vb, bc::block_threads, 0, st>>>(n, cur, dinv, p, q, x, r, z, partials, s,
+                                                       hist + it + 1);
       bc::mcg_direction<<<vb, bc::block_threads, 0, st>>>(n, cur, z, p, s);
     }
   };
@@ -484,7 +541,9 @@ CGResult merged_cg(const Bins<V> &B, const std::vector<double> &dinv_h, const st
   res.seconds_per_it = time_per_call(solve, 3) / its;
   if (exec) CK(cudaGraphExecDestroy(exec));
   CK(cudaStreamDestroy(st));
-  for (void *v : {(void *)dinv, (void *)b, (void *)x, (void *)r, (void *)z, (void *)p, (void *)q, (void *)partials, (void *)hist, (void *)s, (void *)dv, (void *)dc, (void *)ds}) CK(cudaFree(v));
+  for (void *v : {(void *)dinv, (void *)b, (void *)x, (void *)r, (void *)z, (void *)p, (void *)q,
+                  (void *)partials, (void *)hist, (void *)s, (void *)dv, (void *)dc, (void *)ds})
+    CK(cudaFree(v));
   return res;
 }
 
@@ -493,7 +552,8 @@ double history_difference(const std::vector<double> &a, const std::vector<double
 {
   double d = 0.0;
   for (size_t i = 0; i < std::min({a.size(), b.size(), upto + 1}); i++) {
-    const double e = std::fabs(std::sqrt(std::fabs(a[i])) - std::sqrt(std::fabs(b[i]))) / std::sqrt(std::fabs(b[i]));
+    const double e =
+      std::fabs(std::sqrt(std::fabs(a[i])) - std::sqrt(std::fabs(b[i]))) / std::sqrt(std::fabs(b[i]));
     if (!(e <= d)) d = std::isnan(e) ? INFINITY : e;
   }
   return d;
@@ -506,21 +566,23 @@ void cg_table(const BlockMatrix &A, const ScalarCSR &S, cusparseHandle_t sh, cub
   for (int br = 0; br < A.mbs; br++)
     for (int p = A.ptr[br]; p < A.ptr[br + 1]; p++)
       if (A.col[p] == br)
-        for (int i = 0; i < A.bs; i++) dinv[br * A.bs + i] = 1.0 / A.val[(size_t)p * A.bs * A.bs + i * A.bs + i];
+        for (int i = 0; i < A.bs; i++)
+          dinv[br * A.bs + i] = 1.0 / A.val[(size_t)p * A.bs * A.bs + i * A.bs + i];
   for (int i = 0; i < n; i++) b[i] = unit_random(0x5EEDULL + i);
-  const auto     B32 = make_bins<double>(A.ptr, A.col, A.val, 3, A.mbs, 32);
-  const auto     F32 = make_bins<float>(A.ptr, A.col, A.val, 3, A.mbs, 32);
-  const auto     B8  = make_bins<double>(A.ptr, A.col, A.val, 3, A.mbs, 8);
-  const auto     F8  = make_bins<float>(A.ptr, A.col, A.val, 3, A.mbs, 8);
-  const CGResult stock = stock_cg<double>(sh, bh, S, nullptr, dinv, b, its);
-  const CGResult stock_bins = stock_cg<double>(sh, bh, S, &B32, dinv, b, its);
-  const CGResult mcg = merged_cg<double>(B32, dinv, b, its, false);
-  const CGResult mcg_graph = merged_cg<double>(B32, dinv, b, its, true);
-  const CGResult mcg_single = merged_cg<float>(F32, dinv, b, its, true);
-  const CGResult mcg8 = merged_cg<double>(B8, dinv, b, its, true);
+  const auto     B32         = make_bins<double>(A.ptr, A.col, A.val, 3, A.mbs, 32);
+  const auto     F32         = make_bins<float>(A.ptr, A.col, A.val, 3, A.mbs, 32);
+  const auto     B8          = make_bins<double>(A.ptr, A.col, A.val, 3, A.mbs, 8);
+  const auto     F8          = make_bins<float>(A.ptr, A.col, A.val, 3, A.mbs, 8);
+  const CGResult stock       = stock_cg<double>(sh, bh, S, nullptr, dinv, b, its);
+  const CGResult stock_bins  = stock_cg<double>(sh, bh, S, &B32, dinv, b, its);
+  const CGResult mcg         = merged_cg<double>(B32, dinv, b, its, false);
+  const CGResult mcg_graph   = merged_cg<double>(B32, dinv, b, its, true);
+  const CGResult mcg_single  = merged_cg<float>(F32, dinv, b, its, true);
+  const CGResult mcg8        = merged_cg<double>(B8, dinv, b, its, true);
   const CGResult mcg8_single = merged_cg<float>(F8, dinv, b, its, true);
 
-  const size_t   upto = 30; /* residual histories of different summation orders drift apart slowly; compare the simulation's 30 */
+  const size_t upto =
+    30; /* residual histories of different summation orders drift apart slowly; compare the simulation's 30 */
   struct Line {
     const char     *name;
     const CGResult *r;
@@ -532,13 +594,16 @@ void cg_table(const BlockMatrix &A, const ScalarCSR &S, cusparseHandle_t sh, cub
                {"merged cg, single, graph", &mcg_single, 1e-3},
                {"merged cg, bw 8 split, graph", &mcg8, 1e-8},
                {"merged cg, bw 8 split, single", &mcg8_single, 1e-3}};
-  std::printf("\n-- CG (Jacobi, from zero, %d iterations) on %s: sqrt(r.z) %.3e -> %.3e\n", its, A.name.c_str(), std::sqrt(stock.rz.front()), std::sqrt(std::fabs(stock.rz.back())));
-  std::printf("%-30s %12s %10s %22s %s\n", "solver", "us/iteration", "speed-up", "history diff (30 its)", "check");
+  std::printf("\n-- CG (Jacobi, from zero, %d iterations) on %s: sqrt(r.z) %.3e -> %.3e\n", its,
+              A.name.c_str(), std::sqrt(stock.rz.front()), std::sqrt(std::fabs(stock.rz.back())));
+  std::printf("%-30s %12s %10s %22s %s\n", "solver", "us/iteration", "speed-up", "history diff (30 its)",
+              "check");
   for (const Line &l : lines) {
     const double d  = history_difference(l.r->rz, stock.rz, upto);
     const bool   ok = l.r == &stock || d <= l.bound;
     failures += !ok;
-    std::printf("%-30s %12.2f %10.2f %22.1e %s\n", l.name, l.r->seconds_per_it * 1e6, stock.seconds_per_it / l.r->seconds_per_it, d, ok ? "ok" : "FAIL");
+    std::printf("%-30s %12.2f %10.2f %22.1e %s\n", l.name, l.r->seconds_per_it * 1e6,
+                stock.seconds_per_it / l.r->seconds_per_it, d, ok ? "ok" : "FAIL");
   }
 }
 
@@ -551,7 +616,7 @@ int main(int argc, char **argv)
   int                      bs = 3, its = 1000;
   bool                     cg = true, triad_run = true;
   for (int i = 1; i < argc; i++) {
-    const std::string a = argv[i];
+    const std::string a    = argv[i];
     auto              next = [&]() -> std::string {
       if (i + 1 >= argc) {
         std::fprintf(stderr, "%s needs a value\n", a.c_str());
@@ -570,10 +635,14 @@ int main(int argc, char **argv)
     else if (a == "-bs") bs = std::atoi(next().c_str());
     else if (a == "-cg_its") its = std::atoi(next().c_str());
     else if (a == "-no_cg") cg = false;
-    else if (a == "-no_triad") triad_run = false; /* e.g. under compute-sanitizer, where 1.5 GB of triad takes minutes */
+    else if (a == "-no_triad")
+      triad_run = false; /* e.g. under compute-sanitizer, where 1.5 GB of triad takes minutes */
     else if (a == "-check_only") check_only = true, triad_run = false;
     else {
-      std::fprintf(stderr, "unknown option %s\nusage: %s [-stencil 16,32] [-f A.bin]... [-bs 3] [-cg_its 1000] [-no_cg] [-no_triad] [-check_only]\n", a.c_str(), argv[0]);
+      std::fprintf(
+        stderr,
+        "unknown option %s\nusage: %s [-stencil 16,32] [-f A.bin]... [-bs 3] [-cg_its 1000] [-no_cg] [-no_triad] [-check_only]\n",
+        a.c_str(), argv[0]);
       return 2;
     }
   }
@@ -581,8 +650,10 @@ int main(int argc, char **argv)
   cudaDeviceProp prop;
   CK(cudaGetDeviceProperties(&prop, 0));
   const double bw_triad = triad_run ? triad_bandwidth() : NAN;
-  std::printf("device: %s, %d SMs, L2 %.0f MB; STREAM triad %.0f GB/s (3 x 512 MB arrays)\n", prop.name, prop.multiProcessorCount, prop.l2CacheSize / 1e6, bw_triad * 1e-9);
-  std::printf("bytes model: values + column indices + row/bin offsets + x read once + y written once; GFlop/s = 2 nnz / t\n");
+  std::printf("device: %s, %d SMs, L2 %.0f MB; STREAM triad %.0f GB/s (3 x 512 MB arrays)\n", prop.name,
+              prop.multiProcessorCount, prop.l2CacheSize / 1e6, bw_triad * 1e-9);
+  std::printf(
+    "bytes model: values + column indices + row/bin offsets + x read once + y written once; GFlop/s = 2 nnz / t\n");
   cusparseHandle_t sh;
   cublasHandle_t   bh;
   CKS(cusparseCreate(&sh));

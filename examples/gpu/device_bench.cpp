@@ -12,11 +12,12 @@
 
 using namespace binbcsr::device;
 
-namespace
+namespace {
+double now()
 {
-double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
-template <class F>
-double median_time(Executor &E, F &&f, double batch_s)
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+template <class F> double median_time(Executor &E, F &&f, double batch_s)
 {
   std::vector<double> t;
   for (int b = 0; b < 5; b++) {
@@ -50,54 +51,70 @@ void bench(Executor &E, const gpu_bench::BlockMatrix &A, double batch_s)
   X->upload(x.data());
   for (int sym = 0; sym < 2; sym++)
     for (int single = 0; single < 2; single++) {
-      const HostBins B     = bins_from_bcsr(A.bs, A.mbs, A.ptr.data(), A.col.data(), A.val.data(), 8, sym);
-      auto           M     = E.matrix(B.layout(), single ? Precision::single_values : Precision::double_values);
+      const HostBins B = bins_from_bcsr(A.bs, A.mbs, A.ptr.data(), A.col.data(), A.val.data(), 8, sym);
+      auto           M = E.matrix(B.layout(), single ? Precision::single_values : Precision::double_values);
       M->set_values(B.val.data());
-      const double   bytes = (double)B.val.size() * (single ? 4 : 8) + B.col.size() * 4.0 + 16.0 * n;
-      const double   t     = median_time(E, [&] { M->mult(*X, *Y); }, batch_s);
+      const double bytes = (double)B.val.size() * (single ? 4 : 8) + B.col.size() * 4.0 + 16.0 * n;
+      const double t     = median_time(
+            E, [&] { M->mult(*X, *Y); }, batch_s);
       std::vector<double> y(n);
       Y->download(y.data());
       double err = 0, sc = 0;
-      for (long i = 0; i < n; i++) err = std::max(err, std::fabs(y[i] - ref[i])), sc = std::max(sc, std::fabs(ref[i]));
+      for (long i = 0; i < n; i++)
+        err = std::max(err, std::fabs(y[i] - ref[i])), sc = std::max(sc, std::fabs(ref[i]));
       char name[64];
-      std::snprintf(name, sizeof name, "mult %s %s", sym ? "symmetric" : "whole", single ? "single" : "double");
+      std::snprintf(name, sizeof name, "mult %s %s", sym ? "symmetric" : "whole",
+                    single ? "single" : "double");
       std::printf("  %-26s %10.1f %10.0f %.1e\n", name, t * 1e6, bytes / t * 1e-9, err / sc);
       if (!sym && !single) {
-        const double td = median_time(E, [&] { M->mult_dot(*X, *Y); }, batch_s);
+        const double td = median_time(
+          E, [&] { M->mult_dot(*X, *Y); }, batch_s);
         std::printf("  %-26s %10.1f %10.0f\n", "mult_dot whole double", td * 1e6, bytes / td * 1e-9);
         /* refill: one COO entry per stored scalar, in block CSR order (an assembly's element order
            would add duplicates; the gather reads each once) */
-        std::vector<int> ci, cj;
+        std::vector<int>    ci, cj;
         std::vector<double> cv;
         for (int r = 0; r < A.mbs; r++)
           for (int p = A.ptr[r]; p < A.ptr[r + 1]; p++)
-            for (int e = 0; e < A.bs * A.bs; e++) ci.push_back(r * A.bs + e / A.bs), cj.push_back(A.col[p] * A.bs + e % A.bs), cv.push_back(A.val[(size_t)p * A.bs * A.bs + e]);
+            for (int e = 0; e < A.bs * A.bs; e++)
+              ci.push_back(r * A.bs + e / A.bs), cj.push_back(A.col[p] * A.bs + e % A.bs),
+                cv.push_back(A.val[(size_t)p * A.bs * A.bs + e]);
         const HostGather G = gather_from_coo(B, (long)cv.size(), ci.data(), cj.data());
         M->set_gather_map(G.map());
-        const double tr = median_time(E, [&] { M->refill(cv.data()); }, batch_s);
-        std::printf("  %-26s %10.1f %10.0f (COO upload included)\n", "refill from COO", tr * 1e6, (cv.size() * 16.0 + G.perm.size() * 4.0 + G.jmap.size() * 4.0 + B.val.size() * 8.0) / tr * 1e-9);
+        const double tr = median_time(
+          E, [&] { M->refill(cv.data()); }, batch_s);
+        std::printf("  %-26s %10.1f %10.0f (COO upload included)\n", "refill from COO", tr * 1e6,
+                    (cv.size() * 16.0 + G.perm.size() * 4.0 + G.jmap.size() * 4.0 + B.val.size() * 8.0) / tr *
+                      1e-9);
         /* the merged CG, Jacobi */
         std::vector<double> dinv(n, 1.0);
         for (int r = 0; r < A.mbs; r++)
           for (int p = A.ptr[r]; p < A.ptr[r + 1]; p++)
             if (A.col[p] == r)
-              for (int i = 0; i < A.bs; i++) dinv[(size_t)r * A.bs + i] = 1.0 / A.val[(size_t)p * A.bs * A.bs + i * A.bs + i];
+              for (int i = 0; i < A.bs; i++)
+                dinv[(size_t)r * A.bs + i] = 1.0 / A.val[(size_t)p * A.bs * A.bs + i * A.bs + i];
         auto D = E.vector(n), Bv = E.vector(n), Xs = E.vector(n);
         D->upload(dinv.data());
         Bv->upload(ref.data());
         SolveSettings fixed;
         fixed.fixed_its = 30;
         SolveResult  last;
-        const double tf = median_time(E, [&] { last = M->solve(*D, *Bv, *Xs, fixed); }, batch_s);
-        std::printf("  %-26s %10.1f %10s %d its, %d host copies, %.2f us/iteration\n", "CG 30 fixed iterations", tf * 1e6, "", last.its, last.host_syncs, tf * 1e6 / 30);
+        const double tf = median_time(
+          E, [&] { last = M->solve(*D, *Bv, *Xs, fixed); }, batch_s);
+        std::printf("  %-26s %10.1f %10s %d its, %d host copies, %.2f us/iteration\n",
+                    "CG 30 fixed iterations", tf * 1e6, "", last.its, last.host_syncs, tf * 1e6 / 30);
         SolveSettings tol;
-        tol.rtol = 1e-6;
-        const double tt = median_time(E, [&] { last = M->solve(*D, *Bv, *Xs, tol); }, batch_s);
+        tol.rtol        = 1e-6;
+        const double tt = median_time(
+          E, [&] { last = M->solve(*D, *Bv, *Xs, tol); }, batch_s);
         std::vector<double> xs(n);
         Xs->download(xs.data());
         double xerr = 0;
         for (long i = 0; i < n; i++) xerr = std::max(xerr, std::fabs(xs[i] - x[i]));
-        std::printf("  %-26s %10.1f %10s %d its, reason %d, %d host copies, %.2f us/iteration, max |x - x*| %.1e\n", "CG to rtol 1e-6", tt * 1e6, "", last.its, last.reason, last.host_syncs, tt * 1e6 / std::max(1, last.its), xerr);
+        std::printf(
+          "  %-26s %10.1f %10s %d its, reason %d, %d host copies, %.2f us/iteration, max |x - x*| %.1e\n",
+          "CG to rtol 1e-6", tt * 1e6, "", last.its, last.reason, last.host_syncs,
+          tt * 1e6 / std::max(1, last.its), xerr);
       }
     }
 }
@@ -122,7 +139,9 @@ int main(int argc, char **argv)
     } else if (i + 1 < argc && a == "-f") files.push_back(argv[++i]);
     else if (i + 1 < argc && a == "-batch_ms") batch_s = std::atof(argv[++i]) * 1e-3;
     else {
-      std::fprintf(stderr, "usage: %s [-executor cuda|reference] [-stencil 16,32] [-f A.bin]... [-batch_ms 20]\n", argv[0]);
+      std::fprintf(stderr,
+                   "usage: %s [-executor cuda|reference] [-stencil 16,32] [-f A.bin]... [-batch_ms 20]\n",
+                   argv[0]);
       return 2;
     }
   }

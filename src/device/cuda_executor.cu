@@ -16,28 +16,25 @@
 #include <stdexcept>
 #include <tuple>
 
-namespace binbcsr
-{
-namespace device
-{
-namespace
-{
+namespace binbcsr {
+namespace device {
+namespace {
 
 constexpr int T = binbcsr::cuda::block_threads; /* 256 */
 
 void ck(cudaError_t e, const char *what)
 {
-  if (e != cudaSuccess) throw std::runtime_error(std::string("cuda executor: ") + what + ": " + cudaGetErrorString(e));
+  if (e != cudaSuccess)
+    throw std::runtime_error(std::string("cuda executor: ") + what + ": " + cudaGetErrorString(e));
 }
 #define CK(x) ck((x), #x)
 
-template <typename X>
-struct DevBuf {
-  X   *p = nullptr;
-  long n = 0;
+template <typename X> struct DevBuf {
+  X   *p   = nullptr;
+  long n   = 0;
   DevBuf() = default;
   explicit DevBuf(long n_) { resize(n_); }
-  DevBuf(const DevBuf &) = delete;
+  DevBuf(const DevBuf &)            = delete;
   DevBuf &operator=(const DevBuf &) = delete;
   ~DevBuf() { cudaFree(p); }
   void resize(long n_)
@@ -52,13 +49,12 @@ struct DevBuf {
   void get(X *h, long cnt) const { CK(cudaMemcpy(h, p, sizeof(X) * cnt, cudaMemcpyDeviceToHost)); }
 };
 
-class CudaVector : public Vector
-{
+class CudaVector : public Vector {
 public:
   explicit CudaVector(long n) : d(n) { CK(cudaMemset(d.p, 0, sizeof(double) * n)); }
-  long         size() const override { return d.n; }
-  void         upload(const double *h) override { d.put(h, d.n); }
-  void         download(double *h) const override { d.get(h, d.n); }
+  long           size() const override { return d.n; }
+  void           upload(const double *h) override { d.put(h, d.n); }
+  void           download(double *h) const override { d.get(h, d.n); }
   DevBuf<double> d;
 };
 const double *dp(const Vector &x) { return static_cast<const CudaVector &>(x).d.p; }
@@ -69,16 +65,20 @@ long blocks(long threads) { return (threads + T - 1) / T; }
 /* ---- kernels ---------------------------------------------------------------------------------- */
 
 template <typename V, bool ADD>
-__global__ void __launch_bounds__(T) k_refill(V *val, const int *bin_start, int nbins, int bw, int bs2, const int *jmap, const int *perm, const double *coo, long ncoo)
+__global__ void __launch_bounds__(T) k_refill(V *val, const int *bin_start, int nbins, int bw, int bs2,
+                                              const int *jmap, const int *perm, const double *coo, long ncoo)
 {
   const long t = (long)blockIdx.x * blockDim.x + threadIdx.x;
-  if (t < (long)nbins * bw) lane_refill<V, ADD>(val, bin_start, (int)(t / bw), (int)(t % bw), bw, bs2, jmap, perm, coo, ncoo);
+  if (t < (long)nbins * bw)
+    lane_refill<V, ADD>(val, bin_start, (int)(t / bw), (int)(t % bw), bw, bs2, jmap, perm, coo, ncoo);
 }
 
 /* Whole storage, y = A x and the block partials of x.y (partials may be null): bw 8 by the split8
    mapping (a warp per bin and point row), other widths one thread per point row of a lane. */
 template <int BS, typename V, bool SPLIT>
-__device__ __forceinline__ void whole_body(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start, int mbs, int bw, const double *__restrict__ x, double *__restrict__ y, double *partials)
+__device__ __forceinline__ void
+whole_body(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start, int mbs,
+           int bw, const double *__restrict__ x, double *__restrict__ y, double *partials)
 {
   double d = 0.0;
   if (SPLIT) {
@@ -93,7 +93,7 @@ __device__ __forceinline__ void whole_body(const V *__restrict__ val, const int 
     const int  b = (int)(t / (BS * bw)), i = (int)(t / bw % BS), lane = (int)(t % bw), r = b * bw + lane;
     if (r < mbs) {
       const int    s0 = bin_start[b], len = (bin_start[b + 1] - s0) / bw;
-      const double s  = lane_row_mult<BS, V, int>(val + (long)s0 * BS * BS, col + s0, len, bw, BS, lane, i, x);
+      const double s = lane_row_mult<BS, V, int>(val + (long)s0 * BS * BS, col + s0, len, bw, BS, lane, i, x);
       y[(long)r * BS + i] = s;
       d                   = s * x[(long)r * BS + i];
     }
@@ -104,7 +104,9 @@ __device__ __forceinline__ void whole_body(const V *__restrict__ val, const int 
   }
 }
 template <int BS, typename V, bool SPLIT>
-__global__ void __launch_bounds__(T) k_whole(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start, int mbs, int bw, const double *__restrict__ x, double *__restrict__ y, double *partials)
+__global__ void __launch_bounds__(T)
+  k_whole(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start, int mbs,
+          int bw, const double *__restrict__ x, double *__restrict__ y, double *partials)
 {
   whole_body<BS, V, SPLIT>(val, col, bin_start, mbs, bw, x, y, partials);
 }
@@ -113,12 +115,15 @@ __global__ void __launch_bounds__(T) k_whole(const V *__restrict__ val, const in
    y_c += block^T x_r (into rows of other bins too) and the lane's own row are atomic adds into a
    zeroed y. */
 template <int BS, typename V>
-__global__ void __launch_bounds__(T) k_sym(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start, int nbins, int mbs, int bw, const double *__restrict__ x, double *y)
+__global__ void __launch_bounds__(T)
+  k_sym(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start, int nbins,
+        int mbs, int bw, const double *__restrict__ x, double *y)
 {
   const int b = (int)(((long)blockIdx.x * blockDim.x + threadIdx.x) / 32), lane = threadIdx.x % 32;
   if (b >= nbins || lane >= bw) return;
-  const int  r = b * bw + lane, own = r < mbs ? r : mbs - 1, s0 = bin_start[b], len = (bin_start[b + 1] - s0) / bw;
-  double     acc[BS], xr[BS];
+  const int r = b * bw + lane, own = r < mbs ? r : mbs - 1, s0 = bin_start[b],
+            len = (bin_start[b + 1] - s0) / bw;
+  double acc[BS], xr[BS];
   for (int i = 0; i < BS; i++) {
     acc[i] = 0.0;
     xr[i]  = r < mbs ? x[(long)r * BS + i] : 0.0;
@@ -142,7 +147,8 @@ __global__ void __launch_bounds__(T) k_sym(const V *__restrict__ val, const int 
 __global__ void __launch_bounds__(T) k_dot(long n, const double *x, const double *y, double *partials)
 {
   double d = 0.0;
-  for (long i = (long)blockIdx.x * blockDim.x + threadIdx.x; i < n; i += (long)gridDim.x * blockDim.x) d += x[i] * y[i];
+  for (long i = (long)blockIdx.x * blockDim.x + threadIdx.x; i < n; i += (long)gridDim.x * blockDim.x)
+    d += x[i] * y[i];
   const double s = binbcsr::cuda::block_sum(d);
   if (threadIdx.x == 0) partials[blockIdx.x] = s;
 }
@@ -158,10 +164,14 @@ __device__ void sum_partials(const double *partials, int nparts, int stride, int
     __syncthreads();
   }
 }
-__global__ void __launch_bounds__(T) k_finish_dot(const double *partials, int nparts, double *out) { sum_partials(partials, nparts, 1, 1, out); }
+__global__ void __launch_bounds__(T) k_finish_dot(const double *partials, int nparts, double *out)
+{
+  sum_partials(partials, nparts, 1, 1, out);
+}
 
 /* r = b - r (after r = A x), or r = b and x = 0; p = s = 0. */
-__global__ void __launch_bounds__(T) k_residual(long n, int zero, const double *b, double *x, double *r, double *p, double *s)
+__global__ void __launch_bounds__(T)
+  k_residual(long n, int zero, const double *b, double *x, double *r, double *p, double *s)
 {
   for (long i = (long)blockIdx.x * blockDim.x + threadIdx.x; i < n; i += (long)gridDim.x * blockDim.x) {
     if (zero) {
@@ -186,21 +196,26 @@ __device__ void store_block_sums(double ru, double rr, double uu, double xx, dou
 
 /* u = M^-1 r and the partials of r.u, r.r, u.u (x.x: 0). */
 template <bool J>
-__global__ void __launch_bounds__(T) k_precondition(long n, const double *r, const double *dinv, double *u, double *partials)
+__global__ void __launch_bounds__(T)
+  k_precondition(long n, const double *r, const double *dinv, double *u, double *partials)
 {
   double ru = 0, rr = 0, uu = 0;
-  for (long i = (long)blockIdx.x * blockDim.x + threadIdx.x; i < n; i += (long)gridDim.x * blockDim.x) mcg_precondition_index<J, double>(i, r, dinv, u, ru, rr, uu);
+  for (long i = (long)blockIdx.x * blockDim.x + threadIdx.x; i < n; i += (long)gridDim.x * blockDim.x)
+    mcg_precondition_index<J, double>(i, r, dinv, u, ru, rr, uu);
   store_block_sums(ru, rr, uu, 0.0, partials);
 }
 
 /* The iteration's vector pass (mcg_update_index), partials of r.u, r.r, u.u, x.x (stride 4). */
 template <bool J>
-__global__ void __launch_bounds__(T) k_update(long n, const MCGState *st, double *u, const double *w, double *p, double *s, double *x, double *r, const double *dinv, double *partials)
+__global__ void __launch_bounds__(T)
+  k_update(long n, const MCGState *st, double *u, const double *w, double *p, double *s, double *x, double *r,
+           const double *dinv, double *partials)
 {
   if (st->done || st->want_verify) return;
   const double alpha = st->alpha, beta = st->beta;
   double       ru = 0, rr = 0, uu = 0, xx = 0;
-  for (long i = (long)blockIdx.x * blockDim.x + threadIdx.x; i < n; i += (long)gridDim.x * blockDim.x) mcg_update_index<J, double>(i, alpha, beta, u, w, p, s, x, r, dinv, ru, rr, uu, xx);
+  for (long i = (long)blockIdx.x * blockDim.x + threadIdx.x; i < n; i += (long)gridDim.x * blockDim.x)
+    mcg_update_index<J, double>(i, alpha, beta, u, w, p, s, x, r, dinv, ru, rr, uu, xx);
   store_block_sums(ru, rr, uu, xx, partials);
 }
 
@@ -222,7 +237,8 @@ __device__ void gather_dots(const double *vp, int nvp, const double *pp, int npp
 }
 /* kind 0: the start (mcg_start_step, and mcg_start_test when test); 1: an iteration (mcg_step);
    2: the true-residual check (mcg_verify_step); 3: the restart's u.w (mcg_restart_step). */
-__global__ void __launch_bounds__(T) k_finish(int kind, int test, const double *vp, int nvp, const double *pp, int npp, MCGState *st, double *dots, double *hist)
+__global__ void __launch_bounds__(T) k_finish(int kind, int test, const double *vp, int nvp, const double *pp,
+                                              int npp, MCGState *st, double *dots, double *hist)
 {
   if (kind == 1 && (st->done || st->want_verify)) return;
   if (kind == 3) {
@@ -244,7 +260,10 @@ __global__ void __launch_bounds__(T) k_finish(int kind, int test, const double *
 
 /* The product of a CG pass: w = A u with partials of u.w, skipped (u.w = 0) after the last iteration. */
 template <int BS, typename V, bool SPLIT>
-__global__ void __launch_bounds__(T) k_cg_product(const MCGState *st, const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start, int mbs, int bw, const double *__restrict__ u, double *__restrict__ w, double *partials)
+__global__ void __launch_bounds__(T)
+  k_cg_product(const MCGState *st, const V *__restrict__ val, const int *__restrict__ col,
+               const int *__restrict__ bin_start, int mbs, int bw, const double *__restrict__ u,
+               double *__restrict__ w, double *partials)
 {
   if (st->done || st->want_verify) return;
   if (st->its + 1 >= st->max_its) {
@@ -256,14 +275,13 @@ __global__ void __launch_bounds__(T) k_cg_product(const MCGState *st, const V *_
 
 /* ---- matrix ----------------------------------------------------------------------------------- */
 
-template <typename V>
-class CudaMatrix : public Matrix
-{
+template <typename V> class CudaMatrix : public Matrix {
 public:
   CudaMatrix(const Layout &L, Precision p) : prec(p)
   {
     if (L.bs != 1 && L.bs != 3) throw std::invalid_argument("cuda executor: block sizes 1 and 3 only");
-    if (L.bw < 1 || L.bw > 32 || L.mbs < 1) throw std::invalid_argument("cuda executor: needs 1 <= bw <= 32 and mbs >= 1");
+    if (L.bw < 1 || L.bw > 32 || L.mbs < 1)
+      throw std::invalid_argument("cuda executor: needs 1 <= bw <= 32 and mbs >= 1");
     lay = L;
     h_bin_start.assign(L.bin_start, L.bin_start + L.nbins() + 1);
     d_bin_start.resize(h_bin_start.size());
@@ -322,8 +340,12 @@ public:
   void refill_device(const double *coo, bool add)
   {
     const long th = (long)lay.nbins() * lay.bw;
-    if (add) k_refill<V, true><<<blocks(th), T, 0, stream>>>(d_val.p, d_bin_start.p, lay.nbins(), lay.bw, lay.bs * lay.bs, d_jmap.p, d_perm.p, coo, ncoo);
-    else k_refill<V, false><<<blocks(th), T, 0, stream>>>(d_val.p, d_bin_start.p, lay.nbins(), lay.bw, lay.bs * lay.bs, d_jmap.p, d_perm.p, coo, ncoo);
+    if (add)
+      k_refill<V, true><<<blocks(th), T, 0, stream>>>(d_val.p, d_bin_start.p, lay.nbins(), lay.bw,
+                                                      lay.bs * lay.bs, d_jmap.p, d_perm.p, coo, ncoo);
+    else
+      k_refill<V, false><<<blocks(th), T, 0, stream>>>(d_val.p, d_bin_start.p, lay.nbins(), lay.bw,
+                                                       lay.bs * lay.bs, d_jmap.p, d_perm.p, coo, ncoo);
     CK(cudaGetLastError());
   }
   long prod_blocks() const
@@ -338,15 +360,25 @@ public:
     double *pp = dot ? d_pp.p : nullptr;
     if (lay.symmetric) {
       CK(cudaMemsetAsync(y, 0, sizeof(double) * lay.n(), stream));
-      if (lay.bs == 3) k_sym<3, V><<<prod_blocks(), T, 0, stream>>>(d_val.p, d_col.p, d_bin_start.p, lay.nbins(), lay.mbs, lay.bw, x, y);
-      else k_sym<1, V><<<prod_blocks(), T, 0, stream>>>(d_val.p, d_col.p, d_bin_start.p, lay.nbins(), lay.mbs, lay.bw, x, y);
+      if (lay.bs == 3)
+        k_sym<3, V><<<prod_blocks(), T, 0, stream>>>(d_val.p, d_col.p, d_bin_start.p, lay.nbins(), lay.mbs,
+                                                     lay.bw, x, y);
+      else
+        k_sym<1, V><<<prod_blocks(), T, 0, stream>>>(d_val.p, d_col.p, d_bin_start.p, lay.nbins(), lay.mbs,
+                                                     lay.bw, x, y);
       if (dot) k_dot<<<vec_blocks(), T, 0, stream>>>(lay.n(), x, y, pp);
     } else {
       const long nb = prod_blocks();
-      if (lay.bs == 3 && lay.bw == 8) k_whole<3, V, true><<<nb, T, 0, stream>>>(d_val.p, d_col.p, d_bin_start.p, lay.mbs, 8, x, y, pp);
-      else if (lay.bs == 3) k_whole<3, V, false><<<nb, T, 0, stream>>>(d_val.p, d_col.p, d_bin_start.p, lay.mbs, lay.bw, x, y, pp);
-      else if (lay.bw == 8) k_whole<1, V, true><<<nb, T, 0, stream>>>(d_val.p, d_col.p, d_bin_start.p, lay.mbs, 8, x, y, pp);
-      else k_whole<1, V, false><<<nb, T, 0, stream>>>(d_val.p, d_col.p, d_bin_start.p, lay.mbs, lay.bw, x, y, pp);
+      if (lay.bs == 3 && lay.bw == 8)
+        k_whole<3, V, true><<<nb, T, 0, stream>>>(d_val.p, d_col.p, d_bin_start.p, lay.mbs, 8, x, y, pp);
+      else if (lay.bs == 3)
+        k_whole<3, V, false>
+          <<<nb, T, 0, stream>>>(d_val.p, d_col.p, d_bin_start.p, lay.mbs, lay.bw, x, y, pp);
+      else if (lay.bw == 8)
+        k_whole<1, V, true><<<nb, T, 0, stream>>>(d_val.p, d_col.p, d_bin_start.p, lay.mbs, 8, x, y, pp);
+      else
+        k_whole<1, V, false>
+          <<<nb, T, 0, stream>>>(d_val.p, d_col.p, d_bin_start.p, lay.mbs, lay.bw, x, y, pp);
     }
     CK(cudaGetLastError());
   }
@@ -375,30 +407,37 @@ public:
       return;
     }
     const long nb = prod_blocks();
-    if (lay.bs == 3 && lay.bw == 8) k_cg_product<3, V, true><<<nb, T, 0, stream>>>(st, d_val.p, d_col.p, d_bin_start.p, lay.mbs, 8, u, w, d_pp.p);
-    else if (lay.bs == 3) k_cg_product<3, V, false><<<nb, T, 0, stream>>>(st, d_val.p, d_col.p, d_bin_start.p, lay.mbs, lay.bw, u, w, d_pp.p);
-    else if (lay.bw == 8) k_cg_product<1, V, true><<<nb, T, 0, stream>>>(st, d_val.p, d_col.p, d_bin_start.p, lay.mbs, 8, u, w, d_pp.p);
-    else k_cg_product<1, V, false><<<nb, T, 0, stream>>>(st, d_val.p, d_col.p, d_bin_start.p, lay.mbs, lay.bw, u, w, d_pp.p);
+    if (lay.bs == 3 && lay.bw == 8)
+      k_cg_product<3, V, true>
+        <<<nb, T, 0, stream>>>(st, d_val.p, d_col.p, d_bin_start.p, lay.mbs, 8, u, w, d_pp.p);
+    else if (lay.bs == 3)
+      k_cg_product<3, V, false>
+        <<<nb, T, 0, stream>>>(st, d_val.p, d_col.p, d_bin_start.p, lay.mbs, lay.bw, u, w, d_pp.p);
+    else if (lay.bw == 8)
+      k_cg_product<1, V, true>
+        <<<nb, T, 0, stream>>>(st, d_val.p, d_col.p, d_bin_start.p, lay.mbs, 8, u, w, d_pp.p);
+    else
+      k_cg_product<1, V, false>
+        <<<nb, T, 0, stream>>>(st, d_val.p, d_col.p, d_bin_start.p, lay.mbs, lay.bw, u, w, d_pp.p);
     CK(cudaGetLastError());
   }
   SolveResult solve(const Vector &dinv, const Vector &b, Vector &x, const SolveSettings &st) override;
 
-  Layout          lay;
-  Precision       prec;
+  Layout           lay;
+  Precision        prec;
   std::vector<int> h_bin_start;
-  DevBuf<int>     d_bin_start, d_col, d_jmap, d_perm;
-  DevBuf<V>       d_val;
-  DevBuf<double>  d_coo, d_pp;
-  long            ncoo = 0;
-  cudaStream_t    stream{};
+  DevBuf<int>      d_bin_start, d_col, d_jmap, d_perm;
+  DevBuf<V>        d_val;
+  DevBuf<double>   d_coo, d_pp;
+  long             ncoo = 0;
+  cudaStream_t     stream{};
   /* the CG's workspace, kept between solves so that captured graphs stay valid */
   DevBuf<double>   r, u, w, p, s, vp, hist, dots;
   DevBuf<MCGState> state;
   std::map<std::tuple<int, const double *, const double *, double *, bool>, cudaGraphExec_t> graphs;
 };
 
-template <typename V>
-struct CudaOps {
+template <typename V> struct CudaOps {
   CudaMatrix<V> &A;
   const double  *dinv, *b;
   double        *x;
@@ -421,15 +460,21 @@ struct CudaOps {
     residual(guess_zero);
     precondition();
     A.launch_mult(A.u.p, A.w.p, true);
-    k_finish<<<1, T, 0, A.stream>>>(0, test_on_device, A.vp.p, nvb, A.d_pp.p, A.dot_parts(), A.state.p, A.dots.p, A.hist.p);
+    k_finish<<<1, T, 0, A.stream>>>(0, test_on_device, A.vp.p, nvb, A.d_pp.p, A.dot_parts(), A.state.p,
+                                    A.dots.p, A.hist.p);
     CK(cudaGetLastError());
   }
   void launch_iteration()
   {
-    if (jacobi) k_update<true><<<nvb, T, 0, A.stream>>>(n, A.state.p, A.u.p, A.w.p, A.p.p, A.s.p, x, A.r.p, dinv, A.vp.p);
-    else k_update<false><<<nvb, T, 0, A.stream>>>(n, A.state.p, A.u.p, A.w.p, A.p.p, A.s.p, x, A.r.p, dinv, A.vp.p);
+    if (jacobi)
+      k_update<true>
+        <<<nvb, T, 0, A.stream>>>(n, A.state.p, A.u.p, A.w.p, A.p.p, A.s.p, x, A.r.p, dinv, A.vp.p);
+    else
+      k_update<false>
+        <<<nvb, T, 0, A.stream>>>(n, A.state.p, A.u.p, A.w.p, A.p.p, A.s.p, x, A.r.p, dinv, A.vp.p);
     A.launch_cg_product(A.state.p, A.u.p, A.w.p);
-    k_finish<<<1, T, 0, A.stream>>>(1, 0, A.vp.p, nvb, A.d_pp.p, A.dot_parts(), A.state.p, A.dots.p, A.hist.p);
+    k_finish<<<1, T, 0, A.stream>>>(1, 0, A.vp.p, nvb, A.d_pp.p, A.dot_parts(), A.state.p, A.dots.p,
+                                    A.hist.p);
   }
   void iterations(int k)
   {
@@ -468,7 +513,10 @@ struct CudaOps {
     CK(cudaMemcpyAsync(&o, A.state.p, sizeof(MCGState), cudaMemcpyDeviceToHost, A.stream));
     CK(cudaStreamSynchronize(A.stream));
   }
-  void put_state(const MCGState &o) { CK(cudaMemcpyAsync(A.state.p, &o, sizeof(MCGState), cudaMemcpyHostToDevice, A.stream)); }
+  void put_state(const MCGState &o)
+  {
+    CK(cudaMemcpyAsync(A.state.p, &o, sizeof(MCGState), cudaMemcpyHostToDevice, A.stream));
+  }
   void history(double *h, int count)
   {
     CK(cudaMemcpyAsync(h, A.hist.p, sizeof(double) * count, cudaMemcpyDeviceToHost, A.stream));
@@ -490,14 +538,13 @@ SolveResult CudaMatrix<V>::solve(const Vector &dinv, const Vector &b, Vector &x,
     drop_graphs();
     hist.resize(its);
   }
-  CudaOps<V> ops{*this, dp(dinv), dp(b), dp(x), st.jacobi, n, vec_blocks()};
+  CudaOps<V>  ops{*this, dp(dinv), dp(b), dp(x), st.jacobi, n, vec_blocks()};
   SolveResult res = run_mcg(ops, st);
   CK(cudaStreamSynchronize(stream));
   return res;
 }
 
-class CudaExecutor : public Executor
-{
+class CudaExecutor : public Executor {
 public:
   const char             *name() const override { return "cuda"; }
   std::unique_ptr<Vector> vector(long n) override { return std::make_unique<CudaVector>(n); }

@@ -11,21 +11,21 @@
 #include "ksp_mcg/mcg_kernels.h"
 #include <math.h>
 
-namespace binbcsr
-{
-namespace device
-{
+namespace binbcsr {
+namespace device {
 
 /* Refill of lane `lane` of bin b (the seed's Listing 2.9, one thread per lane): every stored value of
    the lane's len slot groups is the sum of its COO entries (padding: none, so zero). The lanes of a
    bin write neighbouring addresses (coalesced), no value is written twice, so no atomics. */
 template <typename V, bool ADD>
-BINBCSR_HD void lane_refill(V *val, const int *bin_start, int b, int lane, int bw, int bs2, const int *jmap, const int *perm, const double *coo, long ncoo)
+BINBCSR_HD void lane_refill(V *val, const int *bin_start, int b, int lane, int bw, int bs2, const int *jmap,
+                            const int *perm, const double *coo, long ncoo)
 {
   const int s0 = bin_start[b], len = (bin_start[b + 1] - s0) / bw;
   for (int k = 0; k < len; k++)
     for (int e = 0; e < bs2; e++) {
-      const long   v = ((long)s0 + (long)k * bw) * bs2 + (long)e * bw + lane; /* value_index of slot s0 + k bw + lane */
+      const long v =
+        ((long)s0 + (long)k * bw) * bs2 + (long)e * bw + lane; /* value_index of slot s0 + k bw + lane */
       const double s = coo_gather<int>(coo, ncoo, nullptr, jmap, perm, v);
       val[v]         = (V)(ADD ? (double)val[v] + s : s);
     }
@@ -41,7 +41,8 @@ struct MCGState {
   int    norm, max_its, fixed, verify; /* norm: device::Norm as int */
   double atol, ttol, divergence, roundoff, stagnation;
   /* iteration */
-  int    its, nhist, reason, fresh, done, want_verify, floor_hit, true_checks, restarts; /* nhist: norms in the history */
+  int its, nhist, reason, fresh, done, want_verify, floor_hit, true_checks,
+    restarts; /* nhist: norms in the history */
   double gamma, gamma_old, delta, pAp, alpha, beta, rnorm;
   double rr;                                 /* r.r of the last reduction (breakdown test) */
   double anorm, xnorm, sum_x, sum_r, floor_; /* rounding drift and precision floor estimates */
@@ -59,10 +60,14 @@ BINBCSR_HD bool   mcg_finite(double a) { return a - a == 0.0; } /* false for NaN
 BINBCSR_HD double mcg_norm(const MCGState &s, const double *dots)
 {
   switch (s.norm) {
-  case 0: return sqrt(mcg_abs(dots[MCG_DOT_UU]));
-  case 1: return sqrt(mcg_abs(dots[MCG_DOT_RR]));
-  case 2: return sqrt(mcg_abs(dots[MCG_DOT_RU]));
-  default: return 0.0;
+  case 0:
+    return sqrt(mcg_abs(dots[MCG_DOT_UU]));
+  case 1:
+    return sqrt(mcg_abs(dots[MCG_DOT_RR]));
+  case 2:
+    return sqrt(mcg_abs(dots[MCG_DOT_RU]));
+  default:
+    return 0.0;
   }
 }
 

@@ -2,10 +2,8 @@
    compiled into the library (CMake: nvcc found and the CUDA language enabled). */
 #include "reference.h"
 
-namespace binbcsr
-{
-namespace device
-{
+namespace binbcsr {
+namespace device {
 
 bool cuda_built()
 {
@@ -25,7 +23,8 @@ std::unique_ptr<Executor> make_executor(const std::string &name, std::string *wh
 #if defined(BINBCSR_DEVICE_HAVE_CUDA)
     return make_cuda_executor(why);
 #else
-    *why = "the cuda executor is not built into this library (the PETSc plug-in links the reference executor only; scripts/gpu_check builds the cuda one, docs/gpu.md)";
+    *why =
+      "the cuda executor is not built into this library (the PETSc plug-in links the reference executor only; scripts/gpu_check builds the cuda one, docs/gpu.md)";
     return nullptr;
 #endif
   }

@@ -4,10 +4,8 @@
 #include <algorithm>
 #include <stdexcept>
 
-namespace binbcsr
-{
-namespace device
-{
+namespace binbcsr {
+namespace device {
 
 Layout HostBins::layout() const
 {
@@ -28,8 +26,7 @@ long HostBins::slot(int r, int c) const
   return it != rs.end() && it->first == c ? it->second : -1;
 }
 
-namespace
-{
+namespace {
 /* Symmetric storage: slot k of lane l of each bin chosen greedily so that no two lanes scatter to one
    column in one slot group (the diagonal block and padding do not scatter). */
 void colour_bins(HostBins &B, const int *ptr, const int *cols)
@@ -38,8 +35,8 @@ void colour_bins(HostBins &B, const int *ptr, const int *cols)
   B.bin_start.assign(nbins + 1, 0);
   B.col.clear();
   for (int b = 0; b < nbins; b++) {
-    std::vector<std::vector<int>> lane_col(B.bw);    /* lane_col[l][k]: column at slot k, -1 free */
-    std::vector<std::vector<int>> scatter;           /* scatter[k]: columns scattered to at slot k */
+    std::vector<std::vector<int>> lane_col(B.bw); /* lane_col[l][k]: column at slot k, -1 free */
+    std::vector<std::vector<int>> scatter;        /* scatter[k]: columns scattered to at slot k */
     for (int l = 0; l < B.bw; l++) {
       const int r = b * B.bw + l;
       if (r >= B.mbs) break;
@@ -65,9 +62,9 @@ void colour_bins(HostBins &B, const int *ptr, const int *cols)
     for (int l = 0; l < B.bw; l++) {
       const int r = b * B.bw + l, own = r < B.mbs ? r : B.mbs - 1;
       for (size_t k = 0; k < len; k++) {
-        const int c  = k < lane_col[l].size() ? lane_col[l][k] : -1;
-        const int s  = s0 + (int)k * B.bw + l;
-        B.col[s]     = c >= 0 ? c : own;
+        const int c = k < lane_col[l].size() ? lane_col[l][k] : -1;
+        const int s = s0 + (int)k * B.bw + l;
+        B.col[s]    = c >= 0 ? c : own;
         if (c >= 0) B.row_slots[r].push_back({c, s});
       }
     }
@@ -77,9 +74,11 @@ void colour_bins(HostBins &B, const int *ptr, const int *cols)
 }
 } // namespace
 
-HostBins bins_from_bcsr(int bs, int mbs, const int *ptr, const int *cols, const double *vals, int bw, bool symmetric)
+HostBins bins_from_bcsr(int bs, int mbs, const int *ptr, const int *cols, const double *vals, int bw,
+                        bool symmetric)
 {
-  if (bs < 1 || bs > 8 || bw < 1 || bw > 32 || mbs < 1) throw std::invalid_argument("bins_from_bcsr: needs 1 <= bs <= 8, 1 <= bw <= 32, mbs >= 1");
+  if (bs < 1 || bs > 8 || bw < 1 || bw > 32 || mbs < 1)
+    throw std::invalid_argument("bins_from_bcsr: needs 1 <= bs <= 8, 1 <= bw <= 32, mbs >= 1");
   HostBins B;
   B.bs        = bs;
   B.bw        = bw;
@@ -93,7 +92,9 @@ HostBins bins_from_bcsr(int bs, int mbs, const int *ptr, const int *cols, const 
     B.col.resize(nslots);
     binbcsr::bin_columns<int>(ptr, cols, mbs, bw, B.bin_start.data(), B.col.data(), nullptr);
     for (int r = 0; r < mbs; r++)
-      for (int k = 0; k < ptr[r + 1] - ptr[r]; k++) B.row_slots[r].push_back({cols[ptr[r] + k], (int)binbcsr::row_slot<int>(B.bin_start.data(), bw, r, k)});
+      for (int k = 0; k < ptr[r + 1] - ptr[r]; k++)
+        B.row_slots[r].push_back(
+          {cols[ptr[r] + k], (int)binbcsr::row_slot<int>(B.bin_start.data(), bw, r, k)});
   }
   const int bs2 = bs * bs;
   B.val.assign(B.col.size() * bs2, 0.0);

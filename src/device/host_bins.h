@@ -8,10 +8,8 @@
 
 #include "device.h"
 
-namespace binbcsr
-{
-namespace device
-{
+namespace binbcsr {
+namespace device {
 
 struct HostBins {
   int                 bs = 3, bw = 8, mbs = 0;
@@ -20,13 +18,15 @@ struct HostBins {
   std::vector<double> val; /* the bins' value array, padding zero */
   Layout              layout() const;
   /* slot of block (r, c), -1 when not stored */
-  long                slot(int r, int c) const;
-  std::vector<std::vector<std::pair<int, int>>> row_slots; /* per block row: (column, slot), ascending column */
+  long slot(int r, int c) const;
+  std::vector<std::vector<std::pair<int, int>>>
+    row_slots; /* per block row: (column, slot), ascending column */
 };
 
 /* ptr[mbs + 1], cols (sorted, unique per row), vals (bs x bs row-major blocks, nullptr: zeros). With
    symmetric, blocks below the diagonal are dropped (the matrix must be symmetric for the products to be A's). */
-HostBins bins_from_bcsr(int bs, int mbs, const int *ptr, const int *cols, const double *vals, int bw, bool symmetric);
+HostBins bins_from_bcsr(int bs, int mbs, const int *ptr, const int *cols, const double *vals, int bw,
+                        bool symmetric);
 
 struct HostGather {
   long             ncoo = 0;

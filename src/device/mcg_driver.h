@@ -19,10 +19,8 @@
 #include "device.h"
 #include "device_bodies.h"
 
-namespace binbcsr
-{
-namespace device
-{
+namespace binbcsr {
+namespace device {
 
 inline MCGState mcg_initial_state(const SolveSettings &st)
 {
@@ -39,8 +37,7 @@ inline MCGState mcg_initial_state(const SolveSettings &st)
   return s;
 }
 
-template <class Ops>
-SolveResult run_mcg(Ops &ops, const SolveSettings &st)
+template <class Ops> SolveResult run_mcg(Ops &ops, const SolveSettings &st)
 {
   SolveResult res;
   MCGState    s = mcg_initial_state(st);

@@ -7,17 +7,13 @@
 #include <cstring>
 #include <stdexcept>
 
-namespace binbcsr
-{
-namespace device
-{
-namespace
-{
+namespace binbcsr {
+namespace device {
+namespace {
 
-class RefVector : public Vector
-{
+class RefVector : public Vector {
 public:
-  explicit RefVector(long n) : v(n, 0.0) { }
+  explicit RefVector(long n) : v(n, 0.0) {}
   long size() const override { return (long)v.size(); }
   void upload(const double *h) override { std::memcpy(v.data(), h, v.size() * sizeof(double)); }
   void download(double *h) const override { std::memcpy(h, v.data(), v.size() * sizeof(double)); }
@@ -26,8 +22,7 @@ public:
 const double *data(const Vector &x) { return static_cast<const RefVector &>(x).v.data(); }
 double       *data(Vector &x) { return static_cast<RefVector &>(x).v.data(); }
 
-template <int BS, typename V>
-void whole_mult(const Layout &L, const V *val, const double *x, double *y)
+template <int BS, typename V> void whole_mult(const Layout &L, const V *val, const double *x, double *y)
 {
   const int bs = BS ? BS : L.bs, bs2 = bs * bs;
   for (int b = 0; b < L.nbins(); b++) {
@@ -42,19 +37,18 @@ void whole_mult(const Layout &L, const V *val, const double *x, double *y)
   }
 }
 
-template <int BS, typename V>
-void sym_mult(const Layout &L, const V *val, const double *x, double *y)
+template <int BS, typename V> void sym_mult(const Layout &L, const V *val, const double *x, double *y)
 {
   const int bs = BS ? BS : L.bs, bs2 = bs * bs;
   std::memset(y, 0, sizeof(double) * L.n());
   for (int b = 0; b < L.nbins(); b++) {
     const int s0 = L.bin_start[b], len = (L.bin_start[b + 1] - s0) / L.bw;
     for (int lane = 0; lane < L.bw; lane++) {
-      const long r = (long)b * L.bw + lane;
-      const bool real = r < L.mbs;
+      const long r                = (long)b * L.bw + lane;
+      const bool real             = r < L.mbs;
       double     acc[BS ? BS : 8] = {0}, xr[BS ? BS : 8] = {0};
       for (int i = 0; i < bs && real; i++) xr[i] = x[r * bs + i];
-      const int  own  = real ? (int)r : L.mbs - 1;
+      const int own = real ? (int)r : L.mbs - 1;
       /* The device layout carries no diagonal-slot map: the diagonal block is the lane's first slot of
          column own (padding follows the real slots and also names own). A row without a diagonal
          block then multiplies one padding slot by x_own (zero unless x_own is not finite): the device
@@ -62,19 +56,19 @@ void sym_mult(const Layout &L, const V *val, const double *x, double *y)
       int kd = -1;
       for (int k = 0; k < len && kd < 0; k++)
         if (L.col[s0 + (long)k * L.bw + lane] == own) kd = k;
-      sym_lane_mult<BS, V, int>(val + (long)s0 * bs2, L.col + s0, len, L.bw, bs, lane, own, kd, x, xr, y, acc);
+      sym_lane_mult<BS, V, int>(val + (long)s0 * bs2, L.col + s0, len, L.bw, bs, lane, own, kd, x, xr, y,
+                                acc);
       for (int i = 0; i < bs && real; i++) y[r * bs + i] += acc[i];
     }
   }
 }
 
-template <typename V>
-class RefMatrix : public Matrix
-{
+template <typename V> class RefMatrix : public Matrix {
 public:
   RefMatrix(const Layout &L, Precision p) : prec(p)
   {
-    if (L.bs < 1 || L.bs > 8 || L.bw < 1 || L.mbs < 1) throw std::invalid_argument("device: layout needs 1 <= bs <= 8, bw >= 1, mbs >= 1");
+    if (L.bs < 1 || L.bs > 8 || L.bw < 1 || L.mbs < 1)
+      throw std::invalid_argument("device: layout needs 1 <= bs <= 8, bw >= 1, mbs >= 1");
     bin_start.assign(L.bin_start, L.bin_start + L.nbins() + 1);
     col.assign(L.col, L.col + L.nslots());
     lay           = L;
@@ -104,8 +98,12 @@ public:
     coo_buf.assign(coo, coo + ncoo); /* the upload a device executor makes */
     for (int b = 0; b < lay.nbins(); b++)
       for (int lane = 0; lane < lay.bw; lane++) {
-        if (add) lane_refill<V, true>(val.data(), bin_start.data(), b, lane, lay.bw, lay.bs * lay.bs, jmap.data(), perm.data(), coo_buf.data(), ncoo);
-        else lane_refill<V, false>(val.data(), bin_start.data(), b, lane, lay.bw, lay.bs * lay.bs, jmap.data(), perm.data(), coo_buf.data(), ncoo);
+        if (add)
+          lane_refill<V, true>(val.data(), bin_start.data(), b, lane, lay.bw, lay.bs * lay.bs, jmap.data(),
+                               perm.data(), coo_buf.data(), ncoo);
+        else
+          lane_refill<V, false>(val.data(), bin_start.data(), b, lane, lay.bw, lay.bs * lay.bs, jmap.data(),
+                                perm.data(), coo_buf.data(), ncoo);
       }
   }
   void mult_raw(const double *x, double *y) const
@@ -120,12 +118,12 @@ public:
       else whole_mult<0, V>(lay, val.data(), x, y);
     }
   }
-  void mult(const Vector &x, Vector &y) override { mult_raw(data(x), data(y)); }
+  void   mult(const Vector &x, Vector &y) override { mult_raw(data(x), data(y)); }
   double mult_dot(const Vector &x, Vector &y) override
   {
     mult_raw(data(x), data(y));
     const double *xa = data(x), *ya = data(y);
-    double        d  = 0.0;
+    double        d = 0.0;
     for (long i = 0; i < lay.n(); i++) d += xa[i] * ya[i];
     return d;
   }
@@ -142,8 +140,7 @@ private:
 
 /* The merged CG on the host arrays, in the passes the cuda executor launches (each reduction a
    sequential sum here). */
-template <typename V>
-struct RefOps {
+template <typename V> struct RefOps {
   const RefMatrix<V> &A;
   const double       *dinv, *b;
   double             *x;
@@ -151,7 +148,11 @@ struct RefOps {
   long                n;
   std::vector<double> r, u, w, p, s, hist;
   MCGState            st;
-  RefOps(const RefMatrix<V> &A_, const double *dinv_, const double *b_, double *x_, bool jac, int max_its) : A(A_), dinv(dinv_), b(b_), x(x_), jacobi(jac), n(A_.layout().n()), r(n), u(n), w(n), p(n, 0.0), s(n, 0.0), hist((size_t)max_its + 1) { }
+  RefOps(const RefMatrix<V> &A_, const double *dinv_, const double *b_, double *x_, bool jac, int max_its)
+      : A(A_), dinv(dinv_), b(b_), x(x_), jacobi(jac), n(A_.layout().n()), r(n), u(n), w(n), p(n, 0.0),
+        s(n, 0.0), hist((size_t)max_its + 1)
+  {
+  }
 
   void precondition(double *dots)
   {
@@ -195,8 +196,12 @@ struct RefOps {
     for (int t = 0; t < k && !st.done && !st.want_verify; t++) {
       double ru = 0, rr = 0, uu = 0, xx = 0, dots[MCG_NDOTS];
       for (long i = 0; i < n; i++) {
-        if (jacobi) mcg_update_index<true, double>(i, st.alpha, st.beta, u.data(), w.data(), p.data(), s.data(), x, r.data(), dinv, ru, rr, uu, xx);
-        else mcg_update_index<false, double>(i, st.alpha, st.beta, u.data(), w.data(), p.data(), s.data(), x, r.data(), nullptr, ru, rr, uu, xx);
+        if (jacobi)
+          mcg_update_index<true, double>(i, st.alpha, st.beta, u.data(), w.data(), p.data(), s.data(), x,
+                                         r.data(), dinv, ru, rr, uu, xx);
+        else
+          mcg_update_index<false, double>(i, st.alpha, st.beta, u.data(), w.data(), p.data(), s.data(), x,
+                                          r.data(), nullptr, ru, rr, uu, xx);
       }
       dots[MCG_DOT_RU] = ru;
       dots[MCG_DOT_RR] = rr;
@@ -228,8 +233,7 @@ SolveResult RefMatrix<V>::solve(const Vector &dinv, const Vector &b, Vector &x, 
   return run_mcg(ops, st);
 }
 
-class RefExecutor : public Executor
-{
+class RefExecutor : public Executor {
 public:
   const char             *name() const override { return "reference"; }
   std::unique_ptr<Vector> vector(long n) override { return std::make_unique<RefVector>(n); }
@@ -238,7 +242,7 @@ public:
     if (p == Precision::single_values) return std::make_unique<RefMatrix<float>>(L, p);
     return std::make_unique<RefMatrix<double>>(L, p);
   }
-  void synchronize() override { }
+  void synchronize() override {}
 };
 
 } // namespace

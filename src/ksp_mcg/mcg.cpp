@@ -44,36 +44,82 @@ static PetscErrorCode KSPView_MCG(KSP ksp, PetscViewer viewer)
   PetscFunctionBegin;
   PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &iascii));
   if (!iascii) PetscFunctionReturn(0);
-  PetscCall(PetscViewerASCIIPrintf(viewer, "  merged CG (Chronopoulos-Gear): one global reduction per iteration\n"));
-  if (mcg->fixed_its > 0) PetscCall(PetscViewerASCIIPrintf(viewer, "  fixed iterations: %" PetscInt_FMT " per solve, no convergence test (tolerances ignored)\n", mcg->fixed_its));
-  else PetscCall(PetscViewerASCIIPrintf(viewer, "  fixed iterations: off (tolerances decide); true-residual check before claiming convergence: %s\n", mcg->verify ? "on" : "off"));
+  PetscCall(
+    PetscViewerASCIIPrintf(viewer, "  merged CG (Chronopoulos-Gear): one global reduction per iteration\n"));
+  if (mcg->fixed_its > 0)
+    PetscCall(PetscViewerASCIIPrintf(
+      viewer, "  fixed iterations: %" PetscInt_FMT " per solve, no convergence test (tolerances ignored)\n",
+      mcg->fixed_its));
+  else
+    PetscCall(PetscViewerASCIIPrintf(
+      viewer,
+      "  fixed iterations: off (tolerances decide); true-residual check before claiming convergence: %s\n",
+      mcg->verify ? "on" : "off"));
   if (ksp->setupstage == KSP_SETUP_NEW && !mcg->dinv && !mcg->why_generic[0]) {
-    PetscCall(PetscViewerASCIIPrintf(viewer, "  fused preconditioner (jacobi/pbjacobi/none in the vector pass): %s; decided at the first solve\n", mcg->allow_fused ? "allowed" : "off"));
+    PetscCall(PetscViewerASCIIPrintf(
+      viewer,
+      "  fused preconditioner (jacobi/pbjacobi/none in the vector pass): %s; decided at the first solve\n",
+      mcg->allow_fused ? "allowed" : "off"));
   } else {
     switch (mcg->how) {
     case MCG_PC_JACOBI:
-      PetscCall(PetscViewerASCIIPrintf(viewer, "  fast path: on, Jacobi fused into the vector pass (own D^-1 from MatGetDiagonal%s)\n", mcg->dinv_zeros ? ", zero diagonal entries replaced as PCJACOBI does" : ""));
+      PetscCall(PetscViewerASCIIPrintf(
+        viewer, "  fast path: on, Jacobi fused into the vector pass (own D^-1 from MatGetDiagonal%s)\n",
+        mcg->dinv_zeros ? ", zero diagonal entries replaced as PCJACOBI does" : ""));
       break;
     case MCG_PC_PBJACOBI:
-      PetscCall(PetscViewerASCIIPrintf(viewer, "  fast path: on, point-block Jacobi fused into the vector pass (own 3x3 block inverses from MatInvertBlockDiagonal)\n"));
+      PetscCall(PetscViewerASCIIPrintf(
+        viewer,
+        "  fast path: on, point-block Jacobi fused into the vector pass (own 3x3 block inverses from MatInvertBlockDiagonal)\n"));
       break;
     case MCG_PC_NONE:
-      PetscCall(PetscViewerASCIIPrintf(viewer, "  fast path: on, no preconditioner, one fused vector pass\n"));
+      PetscCall(
+        PetscViewerASCIIPrintf(viewer, "  fast path: on, no preconditioner, one fused vector pass\n"));
       break;
     default:
-      PetscCall(PetscViewerASCIIPrintf(viewer, "  fast path: off (%s): PCApply between two fused vector passes\n", mcg->why_generic));
+      PetscCall(PetscViewerASCIIPrintf(
+        viewer, "  fast path: off (%s): PCApply between two fused vector passes\n", mcg->why_generic));
     }
-    PetscCall(PetscViewerASCIIPrintf(viewer, "  matrix product fused with u.Au: %s\n", mcg->mat_fused ? "yes (matrix type provides MatMultDotLocal)" : "no (MatMult, then a local dot)"));
+    PetscCall(PetscViewerASCIIPrintf(viewer, "  matrix product fused with u.Au: %s\n",
+                                     mcg->mat_fused ? "yes (matrix type provides MatMultDotLocal)"
+                                                    : "no (MatMult, then a local dot)"));
   }
   if (mcg->fixed_its <= 0) {
-    if (mcg->floor_set == 0) PetscCall(PetscViewerASCIIPrintf(viewer, "  precision floor: off (-ksp_mcg_precision_floor 0)\n"));
-    else if (mcg->floor_set > 0 || mcg->roundoff > 0) PetscCall(PetscViewerASCIIPrintf(viewer, "  precision floor: operator products rounded at u = %g (%s); no tolerance is claimed below u ||A|| ||x||, the solve stops there with DIVERGED_BREAKDOWN\n", (double)(mcg->floor_set > 0 ? mcg->floor_set : mcg->roundoff), mcg->floor_set > 0 ? "-ksp_mcg_precision_floor" : "values stored in single precision"));
-    else if (ksp->setupstage == KSP_SETUP_NEW) PetscCall(PetscViewerASCIIPrintf(viewer, "  precision floor: decided from the matrix at the first solve (single-precision storage: u = %g)\n", MCG_SINGLE_ROUNDOFF));
-    else PetscCall(PetscViewerASCIIPrintf(viewer, "  precision floor: none (operator products in double precision)\n"));
+    if (mcg->floor_set == 0)
+      PetscCall(PetscViewerASCIIPrintf(viewer, "  precision floor: off (-ksp_mcg_precision_floor 0)\n"));
+    else if (mcg->floor_set > 0 || mcg->roundoff > 0)
+      PetscCall(PetscViewerASCIIPrintf(
+        viewer,
+        "  precision floor: operator products rounded at u = %g (%s); no tolerance is claimed below u ||A|| ||x||, the solve stops there with DIVERGED_BREAKDOWN\n",
+        (double)(mcg->floor_set > 0 ? mcg->floor_set : mcg->roundoff),
+        mcg->floor_set > 0 ? "-ksp_mcg_precision_floor" : "values stored in single precision"));
+    else if (ksp->setupstage == KSP_SETUP_NEW)
+      PetscCall(PetscViewerASCIIPrintf(
+        viewer,
+        "  precision floor: decided from the matrix at the first solve (single-precision storage: u = %g)\n",
+        MCG_SINGLE_ROUNDOFF));
+    else
+      PetscCall(
+        PetscViewerASCIIPrintf(viewer, "  precision floor: none (operator products in double precision)\n"));
   }
-  if (mcg->floor > 0) PetscCall(PetscViewerASCIIPrintf(viewer, "  last solve: precision floor u ||A|| ||x|| = %g (||A|| >= %g, ||x|| = %g)%s\n", (double)mcg->floor, (double)mcg->floor_anorm, (double)mcg->floor_xnorm, mcg->floor_hit && ksp->reason == KSP_DIVERGED_BREAKDOWN ? ": REACHED before the tolerance, stopped there (DIVERGED_BREAKDOWN; the residual against the assembled values is about the floor)" : mcg->floor_hit ? ": reached" : ", not reached"));
-  if (mcg->drift > 0) PetscCall(PetscViewerASCIIPrintf(viewer, "  last solve: estimated rounding drift of the recursive residual %g (claims %g times above it are not re-checked)\n", (double)mcg->drift, MCG_DRIFT_MARGIN));
-  if (mcg->true_checks) PetscCall(PetscViewerASCIIPrintf(viewer, "  last solve: %" PetscInt_FMT " true-residual checks, %" PetscInt_FMT " restarts, true residual norm %g\n", mcg->true_checks, mcg->restarts, (double)mcg->true_rnorm));
+  if (mcg->floor > 0)
+    PetscCall(PetscViewerASCIIPrintf(
+      viewer, "  last solve: precision floor u ||A|| ||x|| = %g (||A|| >= %g, ||x|| = %g)%s\n",
+      (double)mcg->floor, (double)mcg->floor_anorm, (double)mcg->floor_xnorm,
+      mcg->floor_hit && ksp->reason == KSP_DIVERGED_BREAKDOWN
+        ? ": REACHED before the tolerance, stopped there (DIVERGED_BREAKDOWN; the residual against the assembled values is about the floor)"
+      : mcg->floor_hit ? ": reached"
+                       : ", not reached"));
+  if (mcg->drift > 0)
+    PetscCall(PetscViewerASCIIPrintf(
+      viewer,
+      "  last solve: estimated rounding drift of the recursive residual %g (claims %g times above it are not re-checked)\n",
+      (double)mcg->drift, MCG_DRIFT_MARGIN));
+  if (mcg->true_checks)
+    PetscCall(PetscViewerASCIIPrintf(viewer,
+                                     "  last solve: %" PetscInt_FMT " true-residual checks, %" PetscInt_FMT
+                                     " restarts, true residual norm %g\n",
+                                     mcg->true_checks, mcg->restarts, (double)mcg->true_rnorm));
   PetscFunctionReturn(0);
 }
 
@@ -82,7 +128,8 @@ static PetscErrorCode KSPMCGSetFixedIterations_MCG(KSP ksp, PetscInt n)
   KSP_MCG *mcg = (KSP_MCG *)ksp->data;
 
   PetscFunctionBegin;
-  PetscCheck(n >= 0, PetscObjectComm((PetscObject)ksp), PETSC_ERR_ARG_OUTOFRANGE, "Fixed iteration count must be >= 0 (0 turns it off), not %" PetscInt_FMT, n);
+  PetscCheck(n >= 0, PetscObjectComm((PetscObject)ksp), PETSC_ERR_ARG_OUTOFRANGE,
+             "Fixed iteration count must be >= 0 (0 turns it off), not %" PetscInt_FMT, n);
   mcg->fixed_its = n;
   PetscFunctionReturn(0);
 }
@@ -102,13 +149,28 @@ static PetscErrorCode KSPSetFromOptions_MCG(KSP ksp, PetscOptionItems *PetscOpti
 
   PetscFunctionBegin;
   PetscOptionsHeadBegin(PetscOptionsObject, "KSP MCG (merged CG) options");
-  PetscCall(PetscOptionsInt("-ksp_mcg_fixed_iterations", "Run exactly this many iterations per solve, no convergence test (0: off)", "KSPMCGSetFixedIterations", n, &n, &flg));
+  PetscCall(PetscOptionsInt("-ksp_mcg_fixed_iterations",
+                            "Run exactly this many iterations per solve, no convergence test (0: off)",
+                            "KSPMCGSetFixedIterations", n, &n, &flg));
   if (flg) PetscCall(KSPMCGSetFixedIterations(ksp, n));
-  PetscCall(PetscOptionsBool("-ksp_mcg_fused_pc", "Apply PCJACOBI/PCPBJACOBI/PCNONE inside the fused vector pass", "", mcg->allow_fused, &mcg->allow_fused, nullptr));
-  PetscCall(PetscOptionsBool("-ksp_mcg_verify_residual", "Confirm convergence on the true residual b - A x, restarting if it fails", "", mcg->verify, &mcg->verify, nullptr));
-  PetscCall(PetscOptionsReal("-ksp_mcg_stagnation", "Each restart must shrink the true residual by this factor", "", mcg->stagnation, &mcg->stagnation, nullptr));
-  PetscCall(PetscOptionsReal("-ksp_mcg_precision_floor", "Relative rounding u of the operator's products: stop at u ||A|| ||x|| instead of claiming a tolerance below it (-1: from the matrix, 0: off)", "", mcg->floor_set, &mcg->floor_set, nullptr));
-  PetscCheck(mcg->floor_set == MCG_FLOOR_AUTO || (mcg->floor_set >= 0 && mcg->floor_set < 1), PetscObjectComm((PetscObject)ksp), PETSC_ERR_ARG_OUTOFRANGE, "-ksp_mcg_precision_floor must be -1 (from the matrix), 0 (off) or a relative rounding in (0, 1), not %g", (double)mcg->floor_set);
+  PetscCall(PetscOptionsBool("-ksp_mcg_fused_pc",
+                             "Apply PCJACOBI/PCPBJACOBI/PCNONE inside the fused vector pass", "",
+                             mcg->allow_fused, &mcg->allow_fused, nullptr));
+  PetscCall(PetscOptionsBool("-ksp_mcg_verify_residual",
+                             "Confirm convergence on the true residual b - A x, restarting if it fails", "",
+                             mcg->verify, &mcg->verify, nullptr));
+  PetscCall(PetscOptionsReal("-ksp_mcg_stagnation",
+                             "Each restart must shrink the true residual by this factor", "", mcg->stagnation,
+                             &mcg->stagnation, nullptr));
+  PetscCall(PetscOptionsReal(
+    "-ksp_mcg_precision_floor",
+    "Relative rounding u of the operator's products: stop at u ||A|| ||x|| instead of claiming a tolerance below it (-1: from the matrix, 0: off)",
+    "", mcg->floor_set, &mcg->floor_set, nullptr));
+  PetscCheck(
+    mcg->floor_set == MCG_FLOOR_AUTO || (mcg->floor_set >= 0 && mcg->floor_set < 1),
+    PetscObjectComm((PetscObject)ksp), PETSC_ERR_ARG_OUTOFRANGE,
+    "-ksp_mcg_precision_floor must be -1 (from the matrix), 0 (off) or a relative rounding in (0, 1), not %g",
+    (double)mcg->floor_set);
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }
@@ -128,12 +190,18 @@ static PetscErrorCode KSPConvergedReasonView_MCGFloor(KSP ksp, void *)
   if (!ismcg) PetscFunctionReturn(0);
   mcg = (KSP_MCG *)ksp->data;
   if (!mcg->floor_hit || ksp->reason != KSP_DIVERGED_BREAKDOWN) PetscFunctionReturn(0);
-  PetscCall(PetscOptionsCreateViewer(PetscObjectComm((PetscObject)ksp), ((PetscObject)ksp)->options, ((PetscObject)ksp)->prefix, "-ksp_converged_reason", &viewer, &format, &flg));
+  PetscCall(PetscOptionsCreateViewer(PetscObjectComm((PetscObject)ksp), ((PetscObject)ksp)->options,
+                                     ((PetscObject)ksp)->prefix, "-ksp_converged_reason", &viewer, &format,
+                                     &flg));
   if (!flg) PetscFunctionReturn(0);
   PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &iascii));
   if (iascii) {
     PetscCall(PetscViewerASCIIAddTab(viewer, ((PetscObject)ksp)->tablevel));
-    PetscCall(PetscViewerASCIIPrintf(viewer, "KSPMCG reached the precision floor of its operator: ||b - A x|| ~ u ||A|| ||x|| = %g (u = %g%s) before the tolerance; the solve stopped there\n", (double)mcg->floor, (double)mcg->roundoff, mcg->single_storage ? ", values stored in single precision" : ""));
+    PetscCall(PetscViewerASCIIPrintf(
+      viewer,
+      "KSPMCG reached the precision floor of its operator: ||b - A x|| ~ u ||A|| ||x|| = %g (u = %g%s) before the tolerance; the solve stopped there\n",
+      (double)mcg->floor, (double)mcg->roundoff,
+      mcg->single_storage ? ", values stored in single precision" : ""));
     PetscCall(PetscViewerASCIISubtractTab(viewer, ((PetscObject)ksp)->tablevel));
   }
   PetscCall(PetscViewerDestroy(&viewer));
@@ -200,13 +268,16 @@ PetscErrorCode KSPCreate_MCG(KSP ksp)
   ksp->ops->setfromoptions = KSPSetFromOptions_MCG;
   ksp->ops->buildsolution  = KSPBuildSolutionDefault;
   ksp->ops->buildresidual  = KSPBuildResidualDefault;
-  PetscCall(PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGSetFixedIterations_C", KSPMCGSetFixedIterations_MCG));
-  PetscCall(PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGGetFixedIterations_C", KSPMCGGetFixedIterations_MCG));
+  PetscCall(
+    PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGSetFixedIterations_C", KSPMCGSetFixedIterations_MCG));
+  PetscCall(
+    PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGGetFixedIterations_C", KSPMCGGetFixedIterations_MCG));
   {
     PetscBool registered = PETSC_FALSE;
     for (PetscInt k = 0; k < ksp->numberreasonviews; k++)
       if (ksp->reasonview[k] == KSPConvergedReasonView_MCGFloor) registered = PETSC_TRUE;
-    if (!registered) PetscCall(KSPConvergedReasonViewSet(ksp, KSPConvergedReasonView_MCGFloor, nullptr, nullptr));
+    if (!registered)
+      PetscCall(KSPConvergedReasonViewSet(ksp, KSPConvergedReasonView_MCGFloor, nullptr, nullptr));
   }
   PetscFunctionReturn(0);
 }

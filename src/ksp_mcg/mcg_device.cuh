@@ -16,21 +16,22 @@
 #include "mcg_kernels.h"
 #include "../mat_binbcsr/kernels/cuda/binbcsr_cuda.cuh"
 
-namespace binbcsr
-{
-namespace cuda
-{
+namespace binbcsr {
+namespace cuda {
 
 /* Scalars of one merged-CG solve, on the device. */
 struct MCGScalars {
-  double   rz[2];    /* r.z of the current and the next iteration (parity of the iteration picks) */
-  double   pq;       /* p.A p of this iteration */
-  unsigned ticket;   /* finish_sum's counter */
+  double   rz[2];  /* r.z of the current and the next iteration (parity of the iteration picks) */
+  double   pq;     /* p.A p of this iteration */
+  unsigned ticket; /* finish_sum's counter */
 };
 
 /* 2. With a = rz / pq: x += a p, r -= a q, then z = dinv r and r.z of the new residual
    (mcg_precondition_index) into s->rz[1 - cur] (and hist). Grid-stride over the n entries. */
-__global__ void __launch_bounds__(block_threads) mcg_update(int n, int cur, const double *__restrict__ dinv, const double *__restrict__ p, const double *__restrict__ q, double *__restrict__ x, double *__restrict__ r, double *__restrict__ z, double *partials, MCGScalars *s, double *hist)
+__global__ void __launch_bounds__(block_threads)
+  mcg_update(int n, int cur, const double *__restrict__ dinv, const double *__restrict__ p,
+             const double *__restrict__ q, double *__restrict__ x, double *__restrict__ r,
+             double *__restrict__ z, double *partials, MCGScalars *s, double *hist)
 {
   const double a = s->pq > 0.0 ? s->rz[cur] / s->pq : 0.0; /* p = 0: converged exactly, stay */
   double       d = 0.0, rr = 0.0, zz = 0.0;
@@ -43,7 +44,10 @@ __global__ void __launch_bounds__(block_threads) mcg_update(int n, int cur, cons
 }
 
 /* Start from x = 0: r = b, z = dinv b, p = z, r.z into s->rz[0] (and hist). */
-__global__ void __launch_bounds__(block_threads) mcg_start(int n, const double *__restrict__ dinv, const double *__restrict__ rhs, double *__restrict__ x, double *__restrict__ r, double *__restrict__ z, double *__restrict__ p, double *partials, MCGScalars *s, double *hist)
+__global__ void __launch_bounds__(block_threads)
+  mcg_start(int n, const double *__restrict__ dinv, const double *__restrict__ rhs, double *__restrict__ x,
+            double *__restrict__ r, double *__restrict__ z, double *__restrict__ p, double *partials,
+            MCGScalars *s, double *hist)
 {
   double d = 0.0, rr = 0.0, zz = 0.0;
   for (int i = blockIdx.x * blockDim.x + threadIdx.x; i < n; i += gridDim.x * blockDim.x) {
@@ -56,10 +60,12 @@ __global__ void __launch_bounds__(block_threads) mcg_start(int n, const double *
 }
 
 /* 3. p = z + b p with b = rz[next] / rz[cur]. */
-__global__ void __launch_bounds__(block_threads) mcg_direction(int n, int cur, const double *__restrict__ z, double *__restrict__ p, const MCGScalars *s)
+__global__ void __launch_bounds__(block_threads)
+  mcg_direction(int n, int cur, const double *__restrict__ z, double *__restrict__ p, const MCGScalars *s)
 {
   const double beta = s->rz[cur] > 0.0 ? s->rz[1 - cur] / s->rz[cur] : 0.0;
-  for (int i = blockIdx.x * blockDim.x + threadIdx.x; i < n; i += gridDim.x * blockDim.x) p[i] = z[i] + beta * p[i];
+  for (int i = blockIdx.x * blockDim.x + threadIdx.x; i < n; i += gridDim.x * blockDim.x)
+    p[i] = z[i] + beta * p[i];
 }
 
 } // namespace cuda

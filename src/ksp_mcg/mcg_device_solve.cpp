@@ -9,16 +9,17 @@
 #include "mcg_device_solve.h"
 #include "mat_binbcsr/seq/binbcsr_device.h"
 
-namespace
-{
+namespace {
 /* Why the device solve cannot run this solve, or nullptr. */
 const char *DeviceRefusal(KSP ksp, Mat Amat, Mat Pmat)
 {
   KSP_MCG *mcg = (KSP_MCG *)ksp->data;
-  if (mcg->how == MCG_PC_GENERIC) return mcg->why_generic[0] ? mcg->why_generic : "the preconditioner is not applied in the fused pass";
+  if (mcg->how == MCG_PC_GENERIC)
+    return mcg->why_generic[0] ? mcg->why_generic : "the preconditioner is not applied in the fused pass";
   if (ksp->transpose_solve) return "transpose solve";
   if (mcg->how == MCG_PC_JACOBI && Pmat != Amat) return "the preconditioning matrix is not the operator";
-  if (mcg->fixed_its <= 0 && ksp->converged != KSPConvergedDefault) return "a convergence test other than KSPConvergedDefault";
+  if (mcg->fixed_its <= 0 && ksp->converged != KSPConvergedDefault)
+    return "a convergence test other than KSPConvergedDefault";
   if (mcg->fixed_its <= 0 && ksp->normtype == KSP_NORM_NONE) return "norm type none without fixed iterations";
   if (mcg->fixed_its <= 0 && ksp->chknorm >= 0) return "-ksp_check_norm_iteration";
   return nullptr;
@@ -44,7 +45,10 @@ PetscErrorCode KSPSolve_MCG_Device(KSP ksp, Mat Amat, Mat Pmat, PetscBool *done)
   PetscCall(PetscLogEventBegin(KSP_MCG_DeviceSolve, ksp, 0, 0, 0));
   binbcsr::device::SolveSettings st;
   st.jacobi     = mcg->how == MCG_PC_JACOBI;
-  st.norm       = ksp->normtype == KSP_NORM_PRECONDITIONED ? binbcsr::device::Norm::preconditioned : ksp->normtype == KSP_NORM_UNPRECONDITIONED ? binbcsr::device::Norm::unpreconditioned : ksp->normtype == KSP_NORM_NATURAL ? binbcsr::device::Norm::natural : binbcsr::device::Norm::none;
+  st.norm       = ksp->normtype == KSP_NORM_PRECONDITIONED     ? binbcsr::device::Norm::preconditioned
+                  : ksp->normtype == KSP_NORM_UNPRECONDITIONED ? binbcsr::device::Norm::unpreconditioned
+                  : ksp->normtype == KSP_NORM_NATURAL          ? binbcsr::device::Norm::natural
+                                                               : binbcsr::device::Norm::none;
   st.max_its    = (int)ksp->max_it;
   st.fixed_its  = (int)mcg->fixed_its;
   st.guess_zero = ksp->guess_zero ? true : false;
@@ -53,7 +57,7 @@ PetscErrorCode KSPSolve_MCG_Device(KSP ksp, Mat Amat, Mat Pmat, PetscBool *done)
   st.stagnation = mcg->stagnation;
   st.roundoff   = mcg->roundoff;
   PetscErrorCode at_start_err = 0;
-  st.at_start = [&](double dp0, double &ttol, double &divergence) {
+  st.at_start                 = [&](double dp0, double &ttol, double &divergence) {
     KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
     ksp->rnorm                = dp0;
     at_start_err              = (*ksp->converged)(ksp, 0, dp0, &reason, ksp->cnvP);
@@ -83,7 +87,9 @@ PetscErrorCode KSPSolve_MCG_Device(KSP ksp, Mat Amat, Mat Pmat, PetscBool *done)
     PetscCall(KSPLogResidualHistory(ksp, res.history[k]));
     PetscCall(KSPMonitor(ksp, (PetscInt)k, res.history[k]));
   }
-  PetscCall(PetscInfo(ksp, "KSPMCG solved on the %s executor: %d iterations, %d copies of the state to the host\n", E->name(), res.its, res.host_syncs));
+  PetscCall(PetscInfo(ksp,
+                      "KSPMCG solved on the %s executor: %d iterations, %d copies of the state to the host\n",
+                      E->name(), res.its, res.host_syncs));
   PetscCall(PetscLogEventEnd(KSP_MCG_DeviceSolve, ksp, 0, 0, 0));
   *done = PETSC_TRUE;
   PetscFunctionReturn(0);

@@ -10,16 +10,17 @@ typedef enum {
   MCG_PC_GENERIC = 0, /* PCApply between two vector passes */
   MCG_PC_JACOBI  = 1, /* fused: z = D^-1 r with D^-1 built by KSPMCG exactly as PCJACOBI builds it */
   MCG_PC_NONE    = 2, /* fused: z = r */
-  MCG_PC_PBJACOBI = 3 /* fused: z_b = D_b^-1 r_b with the inverses of the 3x3 diagonal blocks (MatInvertBlockDiagonal) */
+  MCG_PC_PBJACOBI =
+    3 /* fused: z_b = D_b^-1 r_b with the inverses of the 3x3 diagonal blocks (MatInvertBlockDiagonal) */
 } MCGPreconditioning;
 
 typedef struct {
   /* user settings */
-  PetscInt  fixed_its;     /* > 0: exactly this many iterations, no convergence test */
-  PetscBool allow_fused;   /* -ksp_mcg_fused_pc: apply jacobi/none inside the vector pass */
-  PetscBool verify;        /* -ksp_mcg_verify_residual: confirm convergence on b - A x */
-  PetscReal stagnation;    /* a restart must shrink the true residual by this factor, else give up */
-  PetscReal floor_set;     /* -ksp_mcg_precision_floor: relative rounding u of the operator's products;
+  PetscInt  fixed_its;   /* > 0: exactly this many iterations, no convergence test */
+  PetscBool allow_fused; /* -ksp_mcg_fused_pc: apply jacobi/none inside the vector pass */
+  PetscBool verify;      /* -ksp_mcg_verify_residual: confirm convergence on b - A x */
+  PetscReal stagnation;  /* a restart must shrink the true residual by this factor, else give up */
+  PetscReal floor_set;   /* -ksp_mcg_precision_floor: relative rounding u of the operator's products;
                               MCG_FLOOR_AUTO: from the matrix (single storage: 2^-24, else none), 0: off */
 
   /* chosen at each solve */
@@ -42,12 +43,12 @@ typedef struct {
   PetscObjectState binv_state;
 
   /* what the last solve did (for KSPView and PetscInfo) */
-  PetscInt  restarts;        /* residual replacements after a failed true-residual check */
-  PetscReal true_rnorm;      /* norm of b - A x at the last check, -1 when none was made */
-  PetscInt  true_checks;     /* number of true-residual checks of the last solve */
-  PetscReal drift;           /* estimated rounding drift of the recursive residual at the last claim */
-  PetscReal floor;           /* precision floor u ||A|| ||x|| (2-norm of b - A x) at the end, 0 when none */
-  PetscBool floor_hit;       /* the last solve's residual fell below the precision floor */
+  PetscInt  restarts;    /* residual replacements after a failed true-residual check */
+  PetscReal true_rnorm;  /* norm of b - A x at the last check, -1 when none was made */
+  PetscInt  true_checks; /* number of true-residual checks of the last solve */
+  PetscReal drift;       /* estimated rounding drift of the recursive residual at the last claim */
+  PetscReal floor;       /* precision floor u ||A|| ||x|| (2-norm of b - A x) at the end, 0 when none */
+  PetscBool floor_hit;   /* the last solve's residual fell below the precision floor */
   PetscReal floor_anorm, floor_xnorm; /* the estimates of ||A|| and ||x|| the floor was made of */
 } KSP_MCG;
 
@@ -65,6 +66,8 @@ PETSC_INTERN PetscErrorCode KSPSolve_MCG(KSP);
 PETSC_INTERN PetscErrorCode MCGUpdateBlockDiagonal(KSP);
 /* Whether KSPMCG's own preconditioner data (built from the Pmat with id/state built_id/built_state; built:
    it exists) must be rebuilt: the Pmat changed and the PC is not told to reuse its preconditioner. */
-PETSC_INTERN PetscErrorCode MCGPreconditionerStale(KSP, PetscBool built, PetscObjectId built_id, PetscObjectState built_state, Mat *Pmat, PetscObjectId *id, PetscObjectState *state, PetscBool *stale);
+PETSC_INTERN PetscErrorCode MCGPreconditionerStale(KSP, PetscBool built, PetscObjectId built_id,
+                                                   PetscObjectState built_state, Mat *Pmat, PetscObjectId *id,
+                                                   PetscObjectState *state, PetscBool *stale);
 
 #endif

@@ -12,7 +12,14 @@
 #include "../binbcsr_hd.h"
 
 /* Order matters: it is the layout of the buffer handed to the global reduction. */
-enum { MCG_DOT_RU = 0, MCG_DOT_UW = 1, MCG_DOT_RR = 2, MCG_DOT_UU = 3, MCG_DOT_XX = 4, MCG_NDOTS = 5 };
+enum {
+  MCG_DOT_RU = 0,
+  MCG_DOT_UW = 1,
+  MCG_DOT_RR = 2,
+  MCG_DOT_UU = 3,
+  MCG_DOT_XX = 4,
+  MCG_NDOTS  = 5
+};
 
 /* Chronopoulos-Gear update of one index, fused with Jacobi and the local dots:
      p = u + beta p        s = w + beta s   (s tracks A p without a product)
@@ -23,18 +30,20 @@ enum { MCG_DOT_RU = 0, MCG_DOT_UW = 1, MCG_DOT_RR = 2, MCG_DOT_UU = 3, MCG_DOT_X
    shared memory). x.x feeds the estimate of the rounding drift of r (see mcg_solve.cpp).
    u is read (old value) before it is written (new value), so it is updated in place. */
 template <bool Jacobi, typename Scalar>
-BINBCSR_HD void mcg_update_index(long i, Scalar alpha, Scalar beta, Scalar *u, const Scalar *w, Scalar *p, Scalar *s, Scalar *x, Scalar *r, const Scalar *dinv, Scalar &ru, Scalar &rr, Scalar &uu, Scalar &xx)
+BINBCSR_HD void mcg_update_index(long i, Scalar alpha, Scalar beta, Scalar *u, const Scalar *w, Scalar *p,
+                                 Scalar *s, Scalar *x, Scalar *r, const Scalar *dinv, Scalar &ru, Scalar &rr,
+                                 Scalar &uu, Scalar &xx)
 {
   const Scalar pi = u[i] + beta * p[i];
   const Scalar si = w[i] + beta * s[i];
   const Scalar ri = r[i] - alpha * si;
   const Scalar ui = Jacobi ? dinv[i] * ri : ri;
   const Scalar xi = x[i] + alpha * pi;
-  p[i] = pi;
-  s[i] = si;
-  x[i] = xi;
-  r[i] = ri;
-  u[i] = ui;
+  p[i]            = pi;
+  s[i]            = si;
+  x[i]            = xi;
+  r[i]            = ri;
+  u[i]            = ui;
   ru += ri * ui;
   rr += ri * ri;
   uu += ui * ui;
@@ -43,7 +52,8 @@ BINBCSR_HD void mcg_update_index(long i, Scalar alpha, Scalar beta, Scalar *u, c
 
 /* y = B x for one 3x3 block B stored column-major (the order of MatInvertBlockDiagonal()). */
 template <typename Scalar>
-BINBCSR_HD void mcg_block3_apply(const Scalar *B, Scalar x0, Scalar x1, Scalar x2, Scalar &y0, Scalar &y1, Scalar &y2)
+BINBCSR_HD void mcg_block3_apply(const Scalar *B, Scalar x0, Scalar x1, Scalar x2, Scalar &y0, Scalar &y1,
+                                 Scalar &y2)
 {
   y0 = B[0] * x0 + B[3] * x1 + B[6] * x2;
   y1 = B[1] * x0 + B[4] * x1 + B[7] * x2;
@@ -54,7 +64,9 @@ BINBCSR_HD void mcg_block3_apply(const Scalar *B, Scalar x0, Scalar x1, Scalar x
    u_b = binv_b r_b, binv_b the inverse of the 3x3 diagonal block of block row b (column-major, 9
    scalars per block row). */
 template <typename Scalar>
-BINBCSR_HD void mcg_update_block3(long b, Scalar alpha, Scalar beta, Scalar *u, const Scalar *w, Scalar *p, Scalar *s, Scalar *x, Scalar *r, const Scalar *binv, Scalar &ru, Scalar &rr, Scalar &uu, Scalar &xx)
+BINBCSR_HD void mcg_update_block3(long b, Scalar alpha, Scalar beta, Scalar *u, const Scalar *w, Scalar *p,
+                                  Scalar *s, Scalar *x, Scalar *r, const Scalar *binv, Scalar &ru, Scalar &rr,
+                                  Scalar &uu, Scalar &xx)
 {
   Scalar rb[3];
   for (int c = 0; c < 3; c++) {
@@ -72,7 +84,7 @@ BINBCSR_HD void mcg_update_block3(long b, Scalar alpha, Scalar beta, Scalar *u, 
   }
   Scalar u0, u1, u2;
   mcg_block3_apply(binv + 9 * b, rb[0], rb[1], rb[2], u0, u1, u2);
-  u[3 * b] = u0;
+  u[3 * b]     = u0;
   u[3 * b + 1] = u1;
   u[3 * b + 2] = u2;
   ru += rb[0] * u0 + rb[1] * u1 + rb[2] * u2;
@@ -81,7 +93,8 @@ BINBCSR_HD void mcg_update_block3(long b, Scalar alpha, Scalar beta, Scalar *u, 
 
 /* u_b = binv_b r_b and the local dots of r and u for block row b: start of a solve with point-block Jacobi. */
 template <typename Scalar>
-BINBCSR_HD void mcg_precondition_block3(long b, const Scalar *r, const Scalar *binv, Scalar *u, Scalar &ru, Scalar &rr, Scalar &uu)
+BINBCSR_HD void mcg_precondition_block3(long b, const Scalar *r, const Scalar *binv, Scalar *u, Scalar &ru,
+                                        Scalar &rr, Scalar &uu)
 {
   const Scalar r0 = r[3 * b], r1 = r[3 * b + 1], r2 = r[3 * b + 2];
   Scalar       u0, u1, u2;
@@ -97,25 +110,27 @@ BINBCSR_HD void mcg_precondition_block3(long b, const Scalar *r, const Scalar *b
 /* Same update without the preconditioner (generic path: the PC is applied afterwards by PCApply);
    adds x.x of the new x to xx. */
 template <typename Scalar>
-BINBCSR_HD void mcg_update_index_nopc(long i, Scalar alpha, Scalar beta, const Scalar *u, const Scalar *w, Scalar *p, Scalar *s, Scalar *x, Scalar *r, Scalar &xx)
+BINBCSR_HD void mcg_update_index_nopc(long i, Scalar alpha, Scalar beta, const Scalar *u, const Scalar *w,
+                                      Scalar *p, Scalar *s, Scalar *x, Scalar *r, Scalar &xx)
 {
   const Scalar pi = u[i] + beta * p[i];
   const Scalar si = w[i] + beta * s[i];
   const Scalar xi = x[i] + alpha * pi;
-  p[i] = pi;
-  s[i] = si;
-  x[i] = xi;
+  p[i]            = pi;
+  s[i]            = si;
+  x[i]            = xi;
   r[i] -= alpha * si;
   xx += xi * xi;
 }
 
 /* u = dinv * r (or u = r) and the local dots of r and u: the start of a solve or a restart. */
 template <bool Jacobi, typename Scalar>
-BINBCSR_HD void mcg_precondition_index(long i, const Scalar *r, const Scalar *dinv, Scalar *u, Scalar &ru, Scalar &rr, Scalar &uu)
+BINBCSR_HD void mcg_precondition_index(long i, const Scalar *r, const Scalar *dinv, Scalar *u, Scalar &ru,
+                                       Scalar &rr, Scalar &uu)
 {
   const Scalar ri = r[i];
   const Scalar ui = Jacobi ? dinv[i] * ri : ri;
-  u[i] = ui;
+  u[i]            = ui;
   ru += ri * ui;
   rr += ri * ri;
   uu += ui * ui;

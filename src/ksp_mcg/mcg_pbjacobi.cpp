@@ -46,7 +46,8 @@ PETSC_INTERN PetscErrorCode MCGUpdateBlockDiagonal(KSP ksp)
   const PetscScalar *inv;
 
   PetscFunctionBegin;
-  PetscCall(MCGPreconditionerStale(ksp, (PetscBool)!!mcg->binv, mcg->binv_id, mcg->binv_state, &Pmat, &id, &state, &stale));
+  PetscCall(MCGPreconditionerStale(ksp, (PetscBool) !!mcg->binv, mcg->binv_id, mcg->binv_state, &Pmat, &id,
+                                   &state, &stale));
   PetscCall(MatGetLocalSize(Pmat, &n, nullptr));
   nb = n / 3;
   if (!stale && mcg->binv_n == nb) PetscFunctionReturn(0);
@@ -69,7 +70,11 @@ PETSC_INTERN PetscErrorCode MCGUpdateBlockDiagonal(KSP ksp)
   if (bad_all) {
     PetscInt row;
     PetscCall(MCGFirstSingularBlock(Pmat, &row));
-    SETERRQ(PetscObjectComm((PetscObject)ksp), PETSC_ERR_MAT_LU_ZRPVT, "KSPMCG point-block Jacobi (-pc_type pbjacobi): the 3x3 diagonal block of block row %" PetscInt_FMT " (rows %" PetscInt_FMT "..%" PetscInt_FMT ") is singular", row, 3 * row, 3 * row + 2);
+    SETERRQ(
+      PetscObjectComm((PetscObject)ksp), PETSC_ERR_MAT_LU_ZRPVT,
+      "KSPMCG point-block Jacobi (-pc_type pbjacobi): the 3x3 diagonal block of block row %" PetscInt_FMT
+      " (rows %" PetscInt_FMT "..%" PetscInt_FMT ") is singular",
+      row, 3 * row, 3 * row + 2);
   }
   PetscCall(PetscArraycpy(mcg->binv, inv, 9 * (size_t)nb));
   mcg->binv_id    = id;

@@ -27,7 +27,7 @@ static PetscErrorCode MCGChoosePath(KSP ksp, Mat Amat)
   KSP_MCG     *mcg = (KSP_MCG *)ksp->data;
   PC           pc  = ksp->pc;
   PetscBool    isjacobi, isnone, ispbjacobi;
-  MatNullSpace nullsp = nullptr;
+  MatNullSpace nullsp                                   = nullptr;
   PetscErrorCode (*fused)(Mat, Vec, Vec, PetscScalar *) = nullptr;
 
   PetscFunctionBegin;
@@ -52,7 +52,9 @@ static PetscErrorCode MCGChoosePath(KSP ksp, Mat Amat)
     PCJacobiType type;
     PetscCall(PCJacobiGetType(pc, &type));
     if (type == PC_JACOBI_DIAGONAL) mcg->how = MCG_PC_JACOBI;
-    else PetscCall(PetscSNPrintf(mcg->why_generic, sizeof(mcg->why_generic), "jacobi type %s is applied with PCApply", PCJacobiTypes[type]));
+    else
+      PetscCall(PetscSNPrintf(mcg->why_generic, sizeof(mcg->why_generic),
+                              "jacobi type %s is applied with PCApply", PCJacobiTypes[type]));
   } else if (ispbjacobi) {
     Mat      Pmat;
     PetscInt bs, n;
@@ -60,9 +62,13 @@ static PetscErrorCode MCGChoosePath(KSP ksp, Mat Amat)
     PetscCall(MatGetBlockSize(Pmat, &bs));
     PetscCall(MatGetLocalSize(Pmat, &n, nullptr));
     if (bs == 3 && n % 3 == 0) mcg->how = MCG_PC_PBJACOBI;
-    else PetscCall(PetscSNPrintf(mcg->why_generic, sizeof(mcg->why_generic), "pbjacobi is fused for block size 3, the matrix has %" PetscInt_FMT ": applied with PCApply", bs));
+    else
+      PetscCall(PetscSNPrintf(
+        mcg->why_generic, sizeof(mcg->why_generic),
+        "pbjacobi is fused for block size 3, the matrix has %" PetscInt_FMT ": applied with PCApply", bs));
   } else {
-    PetscCall(PetscSNPrintf(mcg->why_generic, sizeof(mcg->why_generic), "PC type %s is applied with PCApply", ((PetscObject)pc)->type_name ? ((PetscObject)pc)->type_name : "(unset)"));
+    PetscCall(PetscSNPrintf(mcg->why_generic, sizeof(mcg->why_generic), "PC type %s is applied with PCApply",
+                            ((PetscObject)pc)->type_name ? ((PetscObject)pc)->type_name : "(unset)"));
   }
   PetscFunctionReturn(0);
 }
@@ -71,7 +77,9 @@ static PetscErrorCode MCGChoosePath(KSP ksp, Mat Amat)
    zero), absolute value if -pc_jacobi_abs, and zeros replaced by 1 when -pc_jacobi_fixdiagonal (the
    default) unless the matrix is known to be SPD. Rebuilt when the preconditioning matrix or its state
    changes, except when the PC is told to reuse its preconditioner. */
-PetscErrorCode MCGPreconditionerStale(KSP ksp, PetscBool built, PetscObjectId built_id, PetscObjectState built_state, Mat *Pmat, PetscObjectId *id, PetscObjectState *state, PetscBool *stale)
+PetscErrorCode MCGPreconditionerStale(KSP ksp, PetscBool built, PetscObjectId built_id,
+                                      PetscObjectState built_state, Mat *Pmat, PetscObjectId *id,
+                                      PetscObjectState *state, PetscBool *stale)
 {
   PetscBool reuse;
 
@@ -80,7 +88,7 @@ PetscErrorCode MCGPreconditionerStale(KSP ksp, PetscBool built, PetscObjectId bu
   PetscCall(PetscObjectGetId((PetscObject)*Pmat, id));
   PetscCall(PetscObjectStateGet((PetscObject)*Pmat, state));
   PetscCall(PCGetReusePreconditioner(ksp->pc, &reuse));
-  *stale = (PetscBool)!(built && (reuse || (*id == built_id && *state == built_state)));
+  *stale = (PetscBool) !(built && (reuse || (*id == built_id && *state == built_state)));
   PetscFunctionReturn(0);
 }
 
@@ -91,12 +99,14 @@ static PetscErrorCode MCGUpdateDiagonal(KSP ksp)
   Mat              Pmat;
   PetscObjectId    id;
   PetscObjectState state;
-  PetscBool        stale, useabs, fixdiag, isset = PETSC_FALSE, isspd = PETSC_FALSE; /* MatIsSPDKnown leaves isspd unset when unknown */
-  PetscInt         n, zeros = 0;
-  PetscScalar     *d;
+  PetscBool        stale, useabs, fixdiag, isset = PETSC_FALSE,
+                                    isspd = PETSC_FALSE; /* MatIsSPDKnown leaves isspd unset when unknown */
+  PetscInt     n, zeros = 0;
+  PetscScalar *d;
 
   PetscFunctionBegin;
-  PetscCall(MCGPreconditionerStale(ksp, (PetscBool)!!mcg->dinv, mcg->dinv_id, mcg->dinv_state, &Pmat, &id, &state, &stale));
+  PetscCall(MCGPreconditionerStale(ksp, (PetscBool) !!mcg->dinv, mcg->dinv_id, mcg->dinv_state, &Pmat, &id,
+                                   &state, &stale));
   if (!stale) PetscFunctionReturn(0);
   if (mcg->dinv) {
     PetscInt nd, nm;
@@ -120,8 +130,13 @@ static PetscErrorCode MCGUpdateDiagonal(KSP ksp)
     }
   }
   PetscCall(VecRestoreArray(mcg->dinv, &d));
-  PetscCall(MPIU_Allreduce(&zeros, &mcg->dinv_zeros, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)ksp)));
-  if (mcg->dinv_zeros) PetscCall(PetscInfo(ksp, "Zero detected in diagonal of matrix (%" PetscInt_FMT " entries), using %s at those locations as PCJACOBI does\n", mcg->dinv_zeros, fixdiag && (!isset || !isspd) ? "1" : "0"));
+  PetscCall(
+    MPIU_Allreduce(&zeros, &mcg->dinv_zeros, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)ksp)));
+  if (mcg->dinv_zeros)
+    PetscCall(PetscInfo(ksp,
+                        "Zero detected in diagonal of matrix (%" PetscInt_FMT
+                        " entries), using %s at those locations as PCJACOBI does\n",
+                        mcg->dinv_zeros, fixdiag && (!isset || !isspd) ? "1" : "0"));
   mcg->dinv_id    = id;
   mcg->dinv_state = state;
   PetscFunctionReturn(0);
@@ -132,7 +147,8 @@ static PetscErrorCode MCGReduce(KSP ksp, PetscScalar *dots, PetscMPIInt count)
 {
   PetscFunctionBegin;
   PetscCall(PetscLogEventBegin(KSP_MCG_Reduction, ksp, 0, 0, 0));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, dots, count, MPIU_SCALAR, MPIU_SUM, PetscObjectComm((PetscObject)ksp)));
+  PetscCallMPI(
+    MPI_Allreduce(MPI_IN_PLACE, dots, count, MPIU_SCALAR, MPIU_SUM, PetscObjectComm((PetscObject)ksp)));
   PetscCall(PetscLogEventEnd(KSP_MCG_Reduction, ksp, 0, 0, 0));
   PetscFunctionReturn(0);
 }
@@ -193,7 +209,8 @@ static PetscErrorCode MCGPrecondition(KSP ksp, Vec R, Vec U, PetscScalar *dots)
       for (PetscInt b = 0; b < n / 3; b++) mcg_precondition_block3<PetscScalar>(b, r, binv, u, ru, rr, uu);
     } else {
 #pragma omp simd reduction(+ : ru, rr, uu)
-      for (PetscInt i = 0; i < n; i++) mcg_precondition_index<false, PetscScalar>(i, r, nullptr, u, ru, rr, uu);
+      for (PetscInt i = 0; i < n; i++)
+        mcg_precondition_index<false, PetscScalar>(i, r, nullptr, u, ru, rr, uu);
     }
     PetscCall(VecRestoreArrayWrite(U, &u));
   }
@@ -207,7 +224,8 @@ static PetscErrorCode MCGPrecondition(KSP ksp, Vec R, Vec U, PetscScalar *dots)
 }
 
 /* The vector pass of an iteration: p, s, x, r updated, u = M^-1 r, local r.u, r.r, u.u. */
-static PetscErrorCode MCGUpdate(KSP ksp, PetscScalar alpha, PetscScalar beta, Vec X, Vec R, Vec U, Vec W, Vec P, Vec S, PetscScalar *dots)
+static PetscErrorCode MCGUpdate(KSP ksp, PetscScalar alpha, PetscScalar beta, Vec X, Vec R, Vec U, Vec W,
+                                Vec P, Vec S, PetscScalar *dots)
 {
   KSP_MCG           *mcg = (KSP_MCG *)ksp->data;
   const PetscScalar *w;
@@ -230,14 +248,17 @@ static PetscErrorCode MCGUpdate(KSP ksp, PetscScalar alpha, PetscScalar beta, Ve
     const PetscScalar *dinv;
     PetscCall(VecGetArrayRead(mcg->dinv, &dinv));
 #pragma omp simd reduction(+ : ru, rr, uu, xx)
-    for (PetscInt i = 0; i < n; i++) mcg_update_index<true, PetscScalar>(i, alpha, beta, u, w, p, s, x, r, dinv, ru, rr, uu, xx);
+    for (PetscInt i = 0; i < n; i++)
+      mcg_update_index<true, PetscScalar>(i, alpha, beta, u, w, p, s, x, r, dinv, ru, rr, uu, xx);
     PetscCall(VecRestoreArrayRead(mcg->dinv, &dinv));
   } else if (mcg->how == MCG_PC_PBJACOBI) {
     const PetscScalar *binv = mcg->binv;
-    for (PetscInt b = 0; b < n / 3; b++) mcg_update_block3<PetscScalar>(b, alpha, beta, u, w, p, s, x, r, binv, ru, rr, uu, xx);
+    for (PetscInt b = 0; b < n / 3; b++)
+      mcg_update_block3<PetscScalar>(b, alpha, beta, u, w, p, s, x, r, binv, ru, rr, uu, xx);
   } else {
 #pragma omp simd reduction(+ : ru, rr, uu, xx)
-    for (PetscInt i = 0; i < n; i++) mcg_update_index<false, PetscScalar>(i, alpha, beta, u, w, p, s, x, r, nullptr, ru, rr, uu, xx);
+    for (PetscInt i = 0; i < n; i++)
+      mcg_update_index<false, PetscScalar>(i, alpha, beta, u, w, p, s, x, r, nullptr, ru, rr, uu, xx);
   }
   PetscCall(VecRestoreArray(S, &s));
   PetscCall(VecRestoreArray(P, &p));
@@ -245,7 +266,10 @@ static PetscErrorCode MCGUpdate(KSP ksp, PetscScalar alpha, PetscScalar beta, Ve
   PetscCall(VecRestoreArray(U, &u));
   PetscCall(VecRestoreArray(R, &r));
   PetscCall(VecRestoreArray(X, &x));
-  PetscCall(PetscLogFlops((mcg->how == MCG_PC_GENERIC ? 10.0 : mcg->how == MCG_PC_PBJACOBI ? 26.0 : 17.0) * n));
+  PetscCall(PetscLogFlops((mcg->how == MCG_PC_GENERIC    ? 10.0
+                           : mcg->how == MCG_PC_PBJACOBI ? 26.0
+                                                         : 17.0) *
+                          n));
   PetscCall(PetscLogEventEnd(KSP_MCG_FusedUpdate, ksp, 0, 0, 0));
   if (mcg->how == MCG_PC_GENERIC) {
     /* the PC is applied to the new r, then one more pass for the local dots */
@@ -286,12 +310,12 @@ static PetscReal MCGNonfiniteNorm(KSP ksp, const PetscScalar *dots, int k)
 /* NaN or Inf in any reduced dot: KSP_DIVERGED_NANORINF (or KSP_DIVERGED_PC_FAILED when the PC
    reports a failure), as KSPCG reports it, with the nonfinite norm as the residual norm. A macro
    because KSPCheckDot() returns from the solve. */
-#define MCGCheckDots(ksp, dots) \
-  do { \
-    for (int k_ = 0; k_ < MCG_NDOTS; k_++) { \
+#define MCGCheckDots(ksp, dots)                                                            \
+  do {                                                                                     \
+    for (int k_ = 0; k_ < MCG_NDOTS; k_++) {                                               \
       if (PetscIsInfOrNanScalar((dots)[k_])) ksp->rnorm = MCGNonfiniteNorm(ksp, dots, k_); \
-      KSPCheckDot(ksp, (dots)[k_]); \
-    } \
+      KSPCheckDot(ksp, (dots)[k_]);                                                        \
+    }                                                                                      \
   } while (0)
 
 /* r = b - A x computed from scratch, u = M^-1 r, and the reduced r.u, r.r, u.u (no product yet). */
@@ -315,7 +339,8 @@ static void MCGTrackNorm(const PetscScalar *dots, PetscReal *anorm)
 }
 
 /* Accumulates the terms of the rounding-drift estimate from the reduced dots of one iteration. */
-static void MCGTrackDrift(const PetscScalar *dots, PetscReal *anorm, PetscReal *sum_x, PetscReal *sum_r, PetscReal *xnorm)
+static void MCGTrackDrift(const PetscScalar *dots, PetscReal *anorm, PetscReal *sum_x, PetscReal *sum_r,
+                          PetscReal *xnorm)
 {
   MCGTrackNorm(dots, anorm);
   if (dots[MCG_DOT_XX] != (PetscScalar)0.0) *xnorm = PetscSqrtReal(PetscAbsScalar(dots[MCG_DOT_XX]));
@@ -325,7 +350,10 @@ static void MCGTrackDrift(const PetscScalar *dots, PetscReal *anorm, PetscReal *
 
 static PetscBool MCGIsToleranceClaim(KSPConvergedReason reason)
 {
-  return (reason == KSP_CONVERGED_RTOL || reason == KSP_CONVERGED_ATOL || reason == KSP_CONVERGED_RTOL_NORMAL || reason == KSP_CONVERGED_ATOL_NORMAL) ? PETSC_TRUE : PETSC_FALSE;
+  return (reason == KSP_CONVERGED_RTOL || reason == KSP_CONVERGED_ATOL ||
+          reason == KSP_CONVERGED_RTOL_NORMAL || reason == KSP_CONVERGED_ATOL_NORMAL)
+           ? PETSC_TRUE
+           : PETSC_FALSE;
 }
 
 PetscErrorCode KSPSolve_MCG(KSP ksp)
@@ -339,13 +367,14 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
   PetscReal   dp, last_true = PETSC_MAX_REAL;
   PetscReal   anorm = 0, sum_x = 0, sum_r = 0, xnorm = 0; /* for the rounding-drift estimate */
   PetscReal   norm_ratio = 0;                             /* KSP norm / 2-norm of the latest nonzero r */
-  PetscBool   fresh = PETSC_TRUE; /* p and s start from zero: first iteration or after a restart */
+  PetscBool   fresh      = PETSC_TRUE; /* p and s start from zero: first iteration or after a restart */
   PetscInt    i, max_its;
   PetscBool   defer_product; /* one process, convergence tested: the next w = A u after the test */
 
   PetscFunctionBegin;
   PetscCall(PCGetDiagonalScale(ksp->pc, &diagonalscale));
-  PetscCheck(!diagonalscale, PetscObjectComm((PetscObject)ksp), PETSC_ERR_SUP, "Krylov method %s does not support diagonal scaling", ((PetscObject)ksp)->type_name);
+  PetscCheck(!diagonalscale, PetscObjectComm((PetscObject)ksp), PETSC_ERR_SUP,
+             "Krylov method %s does not support diagonal scaling", ((PetscObject)ksp)->type_name);
   X = ksp->vec_sol;
   B = ksp->vec_rhs;
   R = ksp->work[0];
@@ -360,9 +389,14 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
     MatBinBCSRPrecision precision;
     PetscCall(MatBinBCSRGetPrecision(Amat, &precision));
     mcg->single_storage = precision == MAT_BINBCSR_PRECISION_SINGLE ? PETSC_TRUE : PETSC_FALSE;
-    mcg->roundoff       = mcg->floor_set != MCG_FLOOR_AUTO ? mcg->floor_set : (mcg->single_storage ? MCG_SINGLE_ROUNDOFF : 0.0);
-    if (mcg->fixed_its > 0 || ksp->normtype == KSP_NORM_NONE) mcg->roundoff = 0.0; /* no tolerance is claimed */
-    if (mcg->roundoff > 0) PetscCall(PetscInfo(ksp, "operator products rounded at u = %g%s: no tolerance is claimed below u ||A|| ||x||\n", (double)mcg->roundoff, mcg->single_storage ? " (single-precision storage)" : ""));
+    mcg->roundoff =
+      mcg->floor_set != MCG_FLOOR_AUTO ? mcg->floor_set : (mcg->single_storage ? MCG_SINGLE_ROUNDOFF : 0.0);
+    if (mcg->fixed_its > 0 || ksp->normtype == KSP_NORM_NONE)
+      mcg->roundoff = 0.0; /* no tolerance is claimed */
+    if (mcg->roundoff > 0)
+      PetscCall(
+        PetscInfo(ksp, "operator products rounded at u = %g%s: no tolerance is claimed below u ||A|| ||x||\n",
+                  (double)mcg->roundoff, mcg->single_storage ? " (single-precision storage)" : ""));
   }
   if (mcg->how == MCG_PC_JACOBI) PetscCall(MCGUpdateDiagonal(ksp));
   if (mcg->how == MCG_PC_PBJACOBI) PetscCall(MCGUpdateBlockDiagonal(ksp));
@@ -371,14 +405,14 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
     PetscCall(KSPSolve_MCG_Device(ksp, Amat, Pmat, &on_device));
     if (on_device) PetscFunctionReturn(0);
   }
-  max_its           = mcg->fixed_its > 0 ? mcg->fixed_its : ksp->max_it;
-  mcg->restarts     = 0;
-  mcg->true_checks  = 0;
-  mcg->true_rnorm   = -1.0;
-  mcg->drift        = 0.0;
-  mcg->floor        = 0.0;
-  mcg->floor_hit    = PETSC_FALSE;
-  ksp->its          = 0;
+  max_its          = mcg->fixed_its > 0 ? mcg->fixed_its : ksp->max_it;
+  mcg->restarts    = 0;
+  mcg->true_checks = 0;
+  mcg->true_rnorm  = -1.0;
+  mcg->drift       = 0.0;
+  mcg->floor       = 0.0;
+  mcg->floor_hit   = PETSC_FALSE;
+  ksp->its         = 0;
 
   /* r = b - A x, u = M^-1 r, w = A u, and the first reduction */
   if (!ksp->guess_zero) {
@@ -427,9 +461,15 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
     if (mcg->fixed_its > 0 || ksp->normtype == KSP_NORM_NONE) {
       const PetscReal drift = PETSC_MACHINE_EPSILON * (anorm * sum_x + sum_r);
       const PetscReal r_un  = PetscSqrtReal(PetscAbsScalar(dots[MCG_DOT_RR]));
-      if (i > 0 && r_un <= drift && (!(PetscRealPart(gamma) > 0.0) || !(PetscRealPart(delta) > 0.0) || !(PetscRealPart(delta - (gamma / gamma_old) * (gamma / gamma_old) * pAp) > 0.0))) {
+      if (i > 0 && r_un <= drift &&
+          (!(PetscRealPart(gamma) > 0.0) || !(PetscRealPart(delta) > 0.0) ||
+           !(PetscRealPart(delta - (gamma / gamma_old) * (gamma / gamma_old) * pAp) > 0.0))) {
         ksp->reason = KSP_CONVERGED_ATOL;
-        PetscCall(PetscInfo(ksp, "Converged: recursive residual %g below its rounding drift %g at iteration %" PetscInt_FMT " (r.M^-1 r or p.Ap lost to rounding)\n", (double)r_un, (double)drift, i));
+        PetscCall(
+          PetscInfo(ksp,
+                    "Converged: recursive residual %g below its rounding drift %g at iteration %" PetscInt_FMT
+                    " (r.M^-1 r or p.Ap lost to rounding)\n",
+                    (double)r_un, (double)drift, i));
         break;
       }
     }
@@ -439,24 +479,29 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
         ksp->reason = KSP_CONVERGED_ATOL;
         PetscCall(PetscInfo(ksp, "Converged: the residual is exactly zero\n"));
       } else {
-        PetscCheck(!ksp->errorifnotconverged, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "KSPMCG breakdown: r.M^-1 r = 0 with r != 0 (singular preconditioner)");
+        PetscCheck(!ksp->errorifnotconverged, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED,
+                   "KSPMCG breakdown: r.M^-1 r = 0 with r != 0 (singular preconditioner)");
         ksp->reason = KSP_DIVERGED_BREAKDOWN;
         PetscCall(PetscInfo(ksp, "Breakdown: r.M^-1 r = 0 with r != 0 (singular preconditioner)\n"));
       }
       break;
     }
     if (PetscRealPart(gamma) < 0.0) {
-      PetscCheck(!ksp->errorifnotconverged, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "Diverged due to indefinite preconditioner, r.M^-1 r = %g", (double)PetscRealPart(gamma));
+      PetscCheck(!ksp->errorifnotconverged, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED,
+                 "Diverged due to indefinite preconditioner, r.M^-1 r = %g", (double)PetscRealPart(gamma));
       ksp->reason = KSP_DIVERGED_INDEFINITE_PC;
-      PetscCall(PetscInfo(ksp, "Diverging due to indefinite preconditioner, r.M^-1 r = %g\n", (double)PetscRealPart(gamma)));
+      PetscCall(PetscInfo(ksp, "Diverging due to indefinite preconditioner, r.M^-1 r = %g\n",
+                          (double)PetscRealPart(gamma)));
       break;
     }
     beta = fresh ? 0.0 : gamma / gamma_old;
     pAp  = fresh ? delta : delta - beta * beta * pAp;
     if (!(PetscRealPart(pAp) > 0.0)) { /* also catches NaN */
-      PetscCheck(!ksp->errorifnotconverged, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "Diverged due to indefinite matrix, p.Ap = %g", (double)PetscRealPart(pAp));
+      PetscCheck(!ksp->errorifnotconverged, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED,
+                 "Diverged due to indefinite matrix, p.Ap = %g", (double)PetscRealPart(pAp));
       ksp->reason = KSP_DIVERGED_INDEFINITE_MAT;
-      PetscCall(PetscInfo(ksp, "Diverging due to indefinite or negative definite matrix, p.Ap = %g\n", (double)PetscRealPart(pAp)));
+      PetscCall(PetscInfo(ksp, "Diverging due to indefinite or negative definite matrix, p.Ap = %g\n",
+                          (double)PetscRealPart(pAp)));
       break;
     }
     alpha = gamma / pAp;
@@ -499,20 +544,33 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
        lower) and stops with KSP_DIVERGED_BREAKDOWN, reporting the floor as the residual norm. */
     if (mcg->roundoff > 0 && (ksp->reason == KSP_CONVERGED_ITERATING || MCGIsToleranceClaim(ksp->reason))) {
       const PetscReal r_un = PetscSqrtReal(PetscAbsScalar(dots[MCG_DOT_RR]));
-      mcg->floor       = mcg->roundoff * anorm * xnorm;
-      mcg->floor_anorm = anorm;
-      mcg->floor_xnorm = xnorm;
+      mcg->floor           = mcg->roundoff * anorm * xnorm;
+      mcg->floor_anorm     = anorm;
+      mcg->floor_xnorm     = xnorm;
       if (r_un > 0) norm_ratio = dp / r_un;
-      if (r_un <= mcg->floor && !mcg_floor_below_tolerance(mcg->floor, norm_ratio, ksp->converged == KSPConvergedDefault ? ksp->ttol : 0)) {
+      if (r_un <= mcg->floor &&
+          !mcg_floor_below_tolerance(mcg->floor, norm_ratio,
+                                     ksp->converged == KSPConvergedDefault ? ksp->ttol : 0)) {
         if (ksp->reason) {
-          if (!mcg->floor_hit) PetscCall(PetscInfo(ksp, "Tolerance met at residual norm %g, at or below the precision floor u ||A|| ||x|| = %g (u %g, ||A|| >= %g, ||x|| %g): claim withheld\n", (double)r_un, (double)mcg->floor, (double)mcg->roundoff, (double)anorm, (double)xnorm));
+          if (!mcg->floor_hit)
+            PetscCall(PetscInfo(
+              ksp,
+              "Tolerance met at residual norm %g, at or below the precision floor u ||A|| ||x|| = %g (u %g, ||A|| >= %g, ||x|| %g): claim withheld\n",
+              (double)r_un, (double)mcg->floor, (double)mcg->roundoff, (double)anorm, (double)xnorm));
           ksp->reason = KSP_CONVERGED_ITERATING;
         }
         mcg->floor_hit = PETSC_TRUE;
       }
       if (mcg->floor_hit && r_un <= MCG_FLOOR_DEPTH * mcg->floor) {
-        PetscCheck(!ksp->errorifnotconverged, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "KSPMCG: the tolerance is below the precision floor u ||A|| ||x|| = %g of the operator (u = %g)", (double)mcg->floor, (double)mcg->roundoff);
-        PetscCall(PetscInfo(ksp, "Precision floor u ||A|| ||x|| = %g (u %g, ||A|| >= %g, ||x|| %g) reached at iteration %" PetscInt_FMT " before the tolerance: stopping\n", (double)mcg->floor, (double)mcg->roundoff, (double)anorm, (double)xnorm, i));
+        PetscCheck(
+          !ksp->errorifnotconverged, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED,
+          "KSPMCG: the tolerance is below the precision floor u ||A|| ||x|| = %g of the operator (u = %g)",
+          (double)mcg->floor, (double)mcg->roundoff);
+        PetscCall(PetscInfo(
+          ksp,
+          "Precision floor u ||A|| ||x|| = %g (u %g, ||A|| >= %g, ||x|| %g) reached at iteration %" PetscInt_FMT
+          " before the tolerance: stopping\n",
+          (double)mcg->floor, (double)mcg->roundoff, (double)anorm, (double)xnorm, i));
         ksp->reason = KSP_DIVERGED_BREAKDOWN;
         /* the floor in the KSP's norm: scaled by the ratio of the KSP's norm to the 2-norm of r */
         ksp->rnorm = r_un > 0 ? dp * (mcg->floor / r_un) : mcg->floor;
@@ -546,13 +604,22 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
         break;
       }
       if (!(true_dp < mcg->stagnation * last_true)) {
-        PetscCheck(!ksp->errorifnotconverged, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "KSPMCG: true residual norm %g stagnates above the tolerance (attainable accuracy reached)", (double)true_dp);
+        PetscCheck(
+          !ksp->errorifnotconverged, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED,
+          "KSPMCG: true residual norm %g stagnates above the tolerance (attainable accuracy reached)",
+          (double)true_dp);
         ksp->reason = KSP_DIVERGED_BREAKDOWN;
         ksp->rnorm  = true_dp;
-        PetscCall(PetscInfo(ksp, "True residual norm %g stagnates above the tolerance after %" PetscInt_FMT " restarts: attainable accuracy reached\n", (double)true_dp, mcg->restarts));
+        PetscCall(PetscInfo(ksp,
+                            "True residual norm %g stagnates above the tolerance after %" PetscInt_FMT
+                            " restarts: attainable accuracy reached\n",
+                            (double)true_dp, mcg->restarts));
         break;
       }
-      PetscCall(PetscInfo(ksp, "Recursive residual %g met the tolerance but the true residual is %g: restarting from the true residual\n", (double)dp, (double)true_dp));
+      PetscCall(PetscInfo(
+        ksp,
+        "Recursive residual %g met the tolerance but the true residual is %g: restarting from the true residual\n",
+        (double)dp, (double)true_dp));
       last_true   = true_dp;
       ksp->reason = KSP_CONVERGED_ITERATING;
       ksp->rnorm  = true_dp;

@@ -4,28 +4,34 @@
 
 namespace physics {
 
-static bool finite(const Eigen::Vector3d &v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
+static bool finite(const Eigen::Vector3d &v)
+{
+  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
+}
 
 std::string validate_scene(const ArticulatedScene &scene)
 {
   const int nb = static_cast<int>(scene.bodies.size());
   for (int i = 0; i < nb; ++i) {
-    const RigidBody &b = scene.bodies[i];
+    const RigidBody  &b   = scene.bodies[i];
     const std::string who = "body " + std::to_string(i);
     if (!(b.mass > 0) || !std::isfinite(b.mass)) return who + ": mass must be positive and finite";
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(b.inertia_body);
-    if (!b.inertia_body.allFinite() || (b.inertia_body - b.inertia_body.transpose()).norm() > 1e-12 * b.inertia_body.norm() ||
+    if (!b.inertia_body.allFinite() ||
+        (b.inertia_body - b.inertia_body.transpose()).norm() > 1e-12 * b.inertia_body.norm() ||
         !(eig.eigenvalues().minCoeff() > 0))
       return who + ": inertia tensor must be symmetric positive definite";
-    if (!finite(b.position) || !finite(b.velocity) || !finite(b.angular_velocity) || !b.orientation.coeffs().allFinite() ||
-        std::abs(b.orientation.norm() - 1) > 1e-6)
+    if (!finite(b.position) || !finite(b.velocity) || !finite(b.angular_velocity) ||
+        !b.orientation.coeffs().allFinite() || std::abs(b.orientation.norm() - 1) > 1e-6)
       return who + ": state must be finite with a unit quaternion";
   }
   for (size_t j = 0; j < scene.joints.size(); ++j) {
-    const BallJoint &jt = scene.joints[j];
+    const BallJoint  &jt  = scene.joints[j];
     const std::string who = "joint " + std::to_string(j);
     for (int b : {jt.body_a, jt.body_b})
-      if (b != kWorld && (b < 0 || b >= nb)) return who + ": names body " + std::to_string(b) + " but the scene has " + std::to_string(nb) + " bodies";
+      if (b != kWorld && (b < 0 || b >= nb))
+        return who + ": names body " + std::to_string(b) + " but the scene has " + std::to_string(nb) +
+               " bodies";
     if (jt.body_a == jt.body_b) return who + ": joins a body to itself";
     if (!finite(jt.anchor_a) || !finite(jt.anchor_b)) return who + ": anchors must be finite";
   }
@@ -49,8 +55,9 @@ void joint_errors(const ArticulatedScene &scene, std::vector<double> &errors)
 {
   errors.resize(3 * scene.joints.size());
   for (size_t j = 0; j < scene.joints.size(); ++j) {
-    const BallJoint &jt = scene.joints[j];
-    const Eigen::Vector3d e = connector_position(scene, jt.body_a, jt.anchor_a) - connector_position(scene, jt.body_b, jt.anchor_b);
+    const BallJoint      &jt = scene.joints[j];
+    const Eigen::Vector3d e =
+      connector_position(scene, jt.body_a, jt.anchor_a) - connector_position(scene, jt.body_b, jt.anchor_b);
     for (int k = 0; k < 3; ++k) errors[3 * j + k] = e[k];
   }
 }
@@ -59,7 +66,9 @@ double max_joint_error(const ArticulatedScene &scene)
 {
   double worst = 0;
   for (const BallJoint &jt : scene.joints)
-    worst = std::max(worst, (connector_position(scene, jt.body_a, jt.anchor_a) - connector_position(scene, jt.body_b, jt.anchor_b)).norm());
+    worst = std::max(worst, (connector_position(scene, jt.body_a, jt.anchor_a) -
+                             connector_position(scene, jt.body_b, jt.anchor_b))
+                              .norm());
   return worst;
 }
 
@@ -74,8 +83,9 @@ void joint_velocity_errors(const ArticulatedScene &scene, std::vector<double> &e
 {
   errors.resize(3 * scene.joints.size());
   for (size_t j = 0; j < scene.joints.size(); ++j) {
-    const BallJoint &jt = scene.joints[j];
-    const Eigen::Vector3d u = point_velocity(scene, jt.body_a, jt.anchor_a) - point_velocity(scene, jt.body_b, jt.anchor_b);
+    const BallJoint      &jt = scene.joints[j];
+    const Eigen::Vector3d u =
+      point_velocity(scene, jt.body_a, jt.anchor_a) - point_velocity(scene, jt.body_b, jt.anchor_b);
     for (int k = 0; k < 3; ++k) errors[3 * j + k] = u[k];
   }
 }

@@ -14,7 +14,8 @@ constexpr int kWorld = -1;
 struct BallJoint {
   int             body_a = kWorld;
   int             body_b = kWorld;
-  Eigen::Vector3d anchor_a = Eigen::Vector3d::Zero(); // body_a's frame, or a world point if body_a is the world
+  Eigen::Vector3d anchor_a =
+    Eigen::Vector3d::Zero(); // body_a's frame, or a world point if body_a is the world
   Eigen::Vector3d anchor_b = Eigen::Vector3d::Zero();
 };
 

@@ -6,9 +6,10 @@
 namespace physics {
 
 // A box body whose local x axis runs from p to q (the bar between two joint points).
-static RigidBody bar_between(const Eigen::Vector3d &p, const Eigen::Vector3d &q, double mass, const Eigen::Vector3d &cross_size, Eigen::Vector3d &size)
+static RigidBody bar_between(const Eigen::Vector3d &p, const Eigen::Vector3d &q, double mass,
+                             const Eigen::Vector3d &cross_size, Eigen::Vector3d &size)
 {
-  RigidBody b;
+  RigidBody             b;
   const Eigen::Vector3d d = q - p;
   size                    = Eigen::Vector3d(d.norm(), cross_size.y(), cross_size.z());
   b.mass                  = mass;
@@ -22,17 +23,19 @@ ArticulatedScene make_chain(const ChainOptions &opt)
 {
   if (opt.links < 1) throw std::invalid_argument("a chain needs at least one link");
   // checked here, where the option is named: a zero-length bar would surface later as a degenerate body
-  if (!(opt.link_length > 0) || !std::isfinite(opt.link_length) || !(opt.link_width > 0) || !std::isfinite(opt.link_width))
+  if (!(opt.link_length > 0) || !std::isfinite(opt.link_length) || !(opt.link_width > 0) ||
+      !std::isfinite(opt.link_width))
     throw std::invalid_argument("the chain's link length and width must be positive and finite");
   if (!std::isfinite(opt.angle)) throw std::invalid_argument("the chain's angle must be finite");
-  ArticulatedScene scene;
+  ArticulatedScene      scene;
   const Eigen::Vector3d down(std::sin(opt.angle), -std::cos(opt.angle), 0);
   Eigen::Vector3d       top = Eigen::Vector3d::Zero();
   for (int i = 0; i < opt.links; ++i) {
     const double    t    = opt.links > 1 ? double(i) / (opt.links - 1) : 0.0;
     const double    mass = opt.mass_first * std::pow(opt.mass_last / opt.mass_first, t);
     Eigen::Vector3d size;
-    scene.bodies.push_back(bar_between(top, top + opt.link_length * down, mass, Eigen::Vector3d(0, opt.link_width, opt.link_width), size));
+    scene.bodies.push_back(bar_between(top, top + opt.link_length * down, mass,
+                                       Eigen::Vector3d(0, opt.link_width, opt.link_width), size));
     scene.body_sizes.push_back(size);
     BallJoint j;
     j.body_a   = i - 1; // kWorld for the first link
@@ -47,18 +50,19 @@ ArticulatedScene make_chain(const ChainOptions &opt)
 
 ArticulatedScene make_bridge(const BridgeOptions &opt)
 {
-  if (opt.chains < 1 || opt.links < 2 || opt.tie_every < 1) throw std::invalid_argument("a bridge needs chains >= 1, links >= 2, tie_every >= 1");
+  if (opt.chains < 1 || opt.links < 2 || opt.tie_every < 1)
+    throw std::invalid_argument("a bridge needs chains >= 1, links >= 2, tie_every >= 1");
   ArticulatedScene scene;
   // Circular arc through the nodes with equal chords plank_length, lowest point `sag` below the anchors.
-  const int    n = opt.links;
-  double       half_angle = 0.5; // solve sag = R (1 - cos a) with R = l / (2 sin(a / n)) by bisection
-  double       lo = 1e-6, hi = 3.0;
+  const int n          = opt.links;
+  double    half_angle = 0.5; // solve sag = R (1 - cos a) with R = l / (2 sin(a / n)) by bisection
+  double    lo = 1e-6, hi = 3.0;
   for (int it = 0; it < 200; ++it) {
-    half_angle      = 0.5 * (lo + hi);
-    const double R  = opt.plank_length / (2 * std::sin(half_angle / n));
+    half_angle                                           = 0.5 * (lo + hi);
+    const double R                                       = opt.plank_length / (2 * std::sin(half_angle / n));
     (R * (1 - std::cos(half_angle)) < opt.sag ? lo : hi) = half_angle;
   }
-  const double R = opt.plank_length / (2 * std::sin(half_angle / n));
+  const double                 R = opt.plank_length / (2 * std::sin(half_angle / n));
   std::vector<Eigen::Vector3d> nodes(n + 1);
   for (int i = 0; i <= n; ++i) {
     const double phi = -half_angle + 2 * half_angle * i / n;
@@ -70,7 +74,8 @@ ArticulatedScene make_bridge(const BridgeOptions &opt)
     const int             first = static_cast<int>(scene.bodies.size());
     for (int i = 0; i < n; ++i) {
       Eigen::Vector3d size;
-      scene.bodies.push_back(bar_between(nodes[i] + offset, nodes[i + 1] + offset, opt.plank_mass, Eigen::Vector3d(0, thickness, 0.9 * opt.plank_width), size));
+      scene.bodies.push_back(bar_between(nodes[i] + offset, nodes[i + 1] + offset, opt.plank_mass,
+                                         Eigen::Vector3d(0, thickness, 0.9 * opt.plank_width), size));
       scene.body_sizes.push_back(size);
     }
     const Eigen::Vector3d half(opt.plank_length / 2, 0, 0);
@@ -97,8 +102,8 @@ ArticulatedScene make_bridge(const BridgeOptions &opt)
 
 ArticulatedScene make_four_bar()
 {
-  ArticulatedScene            scene;
-  const Eigen::Vector3d       p[4] = {{0, 0, 0}, {0.4, 1.0, 0}, {2.0, 1.3, 0}, {2.2, 0, 0}};
+  ArticulatedScene      scene;
+  const Eigen::Vector3d p[4] = {{0, 0, 0}, {0.4, 1.0, 0}, {2.0, 1.3, 0}, {2.2, 0, 0}};
   for (int i = 0; i < 3; ++i) {
     Eigen::Vector3d size;
     scene.bodies.push_back(bar_between(p[i], p[i + 1], 1.0, Eigen::Vector3d(0, 0.05, 0.05), size));

@@ -13,9 +13,11 @@ ArticulatedSolver make_articulated_solver(const ArticulatedScene &scene, const A
   return s;
 }
 
-ArticulatedWorkSplit split_articulated_work(const ArticulatedScene &scene, const std::vector<int> &joint_process, int process)
+ArticulatedWorkSplit split_articulated_work(const ArticulatedScene &scene,
+                                            const std::vector<int> &joint_process, int process)
 {
-  if (joint_process.size() != scene.joints.size()) throw std::invalid_argument("split_articulated_work: one process per joint needed");
+  if (joint_process.size() != scene.joints.size())
+    throw std::invalid_argument("split_articulated_work: one process per joint needed");
   ArticulatedWorkSplit w;
   const size_t         nb = scene.bodies.size();
   std::vector<int>     first_joint_process(nb, -1);
@@ -37,7 +39,9 @@ ArticulatedWorkSplit split_articulated_work(const ArticulatedScene &scene, const
   }
   for (size_t j = 0; j < scene.joints.size(); ++j) {
     const BallJoint &jt = scene.joints[j];
-    if ((jt.body_a != kWorld && w.body_active[jt.body_a]) || (jt.body_b != kWorld && w.body_active[jt.body_b])) w.impulse_joints.push_back((int)j);
+    if ((jt.body_a != kWorld && w.body_active[jt.body_a]) ||
+        (jt.body_b != kWorld && w.body_active[jt.body_b]))
+      w.impulse_joints.push_back((int)j);
   }
   return w;
 }
@@ -54,22 +58,29 @@ std::string validate_params(const ArticulatedParams &p)
 
 namespace {
 
-void apply_joint_impulses(ArticulatedScene &scene, const ArticulatedSolver &s, const ArticulatedWorkSplit &w, const std::vector<double> &impulses)
+void apply_joint_impulses(ArticulatedScene &scene, const ArticulatedSolver &s, const ArticulatedWorkSplit &w,
+                          const std::vector<double> &impulses)
 {
   const std::vector<char> &active = w.body_active;
   for (int j : w.impulse_joints) {
     const BallJoint      &jt = scene.joints[j];
     const Eigen::Vector3d p(impulses[3 * j], impulses[3 * j + 1], impulses[3 * j + 2]);
-    if (jt.body_a != kWorld && active[jt.body_a]) apply_impulse(scene.bodies[jt.body_a], s.inverse_inertia[jt.body_a], s.arm_a[j], p);
-    if (jt.body_b != kWorld && active[jt.body_b]) apply_impulse(scene.bodies[jt.body_b], s.inverse_inertia[jt.body_b], s.arm_b[j], -p);
+    if (jt.body_a != kWorld && active[jt.body_a])
+      apply_impulse(scene.bodies[jt.body_a], s.inverse_inertia[jt.body_a], s.arm_a[j], p);
+    if (jt.body_b != kWorld && active[jt.body_b])
+      apply_impulse(scene.bodies[jt.body_b], s.inverse_inertia[jt.body_b], s.arm_b[j], -p);
   }
 }
 
-double global_max(const ArticulatedWorkSplit &w, double local) { return w.max_over_processes ? w.max_over_processes(local) : local; }
+double global_max(const ArticulatedWorkSplit &w, double local)
+{
+  return w.max_over_processes ? w.max_over_processes(local) : local;
+}
 
 // C(x~): joint errors at the positions the bodies would reach after dt with their current velocities.
 // Returns max |C| over all processes.
-double predicted_errors(const ArticulatedScene &scene, double dt, ArticulatedSolver &s, const ArticulatedWorkSplit &w)
+double predicted_errors(const ArticulatedScene &scene, double dt, ArticulatedSolver &s,
+                        const ArticulatedWorkSplit &w)
 {
   for (int i : w.active_bodies) {
     const RigidBody &b         = scene.bodies[i];
@@ -77,7 +88,9 @@ double predicted_errors(const ArticulatedScene &scene, double dt, ArticulatedSol
     s.predicted_orientation[i] = rotated(b.orientation, b.angular_velocity, dt);
   }
   auto at = [&](int body, const Eigen::Vector3d &anchor) -> Eigen::Vector3d {
-    return body == kWorld ? anchor : Eigen::Vector3d(s.predicted_position[body] + s.predicted_orientation[body] * anchor);
+    return body == kWorld
+             ? anchor
+             : Eigen::Vector3d(s.predicted_position[body] + s.predicted_orientation[body] * anchor);
   };
   double worst2 = 0;
   for (int j : w.own_joints) {
@@ -91,15 +104,17 @@ double predicted_errors(const ArticulatedScene &scene, double dt, ArticulatedSol
 
 // Rotation, world inverse inertia and joint arms for the given orientations (the bodies' own when null),
 // for the active bodies and the active ends of their joints.
-void update_frames(const ArticulatedScene &scene, ArticulatedSolver &s, const ArticulatedWorkSplit &w, const std::vector<Eigen::Quaterniond> *orientations)
+void update_frames(const ArticulatedScene &scene, ArticulatedSolver &s, const ArticulatedWorkSplit &w,
+                   const std::vector<Eigen::Quaterniond> *orientations)
 {
   if (s.inverse_inertia_body.size() != scene.bodies.size()) {
     s.inverse_inertia_body.resize(scene.bodies.size());
-    for (size_t i = 0; i < scene.bodies.size(); ++i) s.inverse_inertia_body[i] = scene.bodies[i].inertia_body.inverse();
+    for (size_t i = 0; i < scene.bodies.size(); ++i)
+      s.inverse_inertia_body[i] = scene.bodies[i].inertia_body.inverse();
   }
   for (int i : w.active_bodies) {
-    const RigidBody &b = scene.bodies[i];
-    s.rotation[i]      = (orientations ? (*orientations)[i] : b.orientation).toRotationMatrix();
+    const RigidBody &b   = scene.bodies[i];
+    s.rotation[i]        = (orientations ? (*orientations)[i] : b.orientation).toRotationMatrix();
     s.inverse_inertia[i] = s.rotation[i] * s.inverse_inertia_body[i] * s.rotation[i].transpose();
   }
   const std::vector<char> &active = w.body_active;
@@ -131,7 +146,8 @@ double velocity_errors(const ArticulatedScene &scene, ArticulatedSolver &s, cons
 }
 
 // The initial guess for a solve: `guess` if warm starting with one of the right size, otherwise zero.
-void set_initial_guess(const ArticulatedParams &params, const std::vector<double> &guess, std::vector<double> &x)
+void set_initial_guess(const ArticulatedParams &params, const std::vector<double> &guess,
+                       std::vector<double> &x)
 {
   if (params.warm_start && guess.size() == x.size()) std::copy(guess.begin(), guess.end(), x.begin());
   else std::fill(x.begin(), x.end(), 0.0);
@@ -139,7 +155,9 @@ void set_initial_guess(const ArticulatedParams &params, const std::vector<double
 
 } // namespace
 
-ArticulatedStepReport articulated_step(ArticulatedScene &scene, ArticulatedSolver &s, const ArticulatedParams &params, const BlockLinearSolver &linear_solver)
+ArticulatedStepReport articulated_step(ArticulatedScene &scene, ArticulatedSolver &s,
+                                       const ArticulatedParams &params,
+                                       const BlockLinearSolver &linear_solver)
 {
   ArticulatedStepReport report;
   const double          dt = params.dt;
@@ -147,12 +165,14 @@ ArticulatedStepReport articulated_step(ArticulatedScene &scene, ArticulatedSolve
   const size_t          nb = scene.bodies.size();
 
   if (nj == 0) {
-    for (RigidBody &b : scene.bodies) apply_unconstrained_velocity_update(b, scene.gravity, dt), advance_positions(b, dt);
+    for (RigidBody &b : scene.bodies)
+      apply_unconstrained_velocity_update(b, scene.gravity, dt), advance_positions(b, dt);
     report.converged = true;
     return report;
   }
 
-  s.rotation.resize(nb), s.inverse_inertia.resize(nb), s.predicted_position.resize(nb), s.predicted_orientation.resize(nb);
+  s.rotation.resize(nb), s.inverse_inertia.resize(nb), s.predicted_position.resize(nb),
+    s.predicted_orientation.resize(nb);
   s.arm_a.resize(nj), s.arm_b.resize(nj);
   s.rhs.resize(3 * nj), s.impulses.resize(3 * nj), s.errors.resize(3 * nj);
   s.correction_sum.assign(3 * nj, 0.0);
@@ -165,7 +185,8 @@ ArticulatedStepReport articulated_step(ArticulatedScene &scene, ArticulatedSolve
   if (!linear_solver.needed_rows.empty() && s.fill_groups.size() != s.pattern.body_of_group.size())
     s.fill_groups = joint_groups_of_rows(s.pattern, linear_solver.needed_rows);
   auto refill = [&]() {
-    fill_joint_matrix(scene, s.pattern, s.regularised ? params.regularisation : 0.0, s.inverse_inertia, s.arm_a, s.arm_b, s.block_values,
+    fill_joint_matrix(scene, s.pattern, s.regularised ? params.regularisation : 0.0, s.inverse_inertia,
+                      s.arm_a, s.arm_b, s.block_values,
                       linear_solver.needed_rows.empty() ? nullptr : &s.fill_groups);
     linear_solver.set_matrix(s.block_values);
   };
@@ -203,7 +224,8 @@ ArticulatedStepReport articulated_step(ArticulatedScene &scene, ArticulatedSolve
     s.last_stabilisation = s.impulses;
   }
 
-  for (int i : w.active_bodies) apply_unconstrained_velocity_update(scene.bodies[i], s.rotation[i], scene.gravity, dt);
+  for (int i : w.active_bodies)
+    apply_unconstrained_velocity_update(scene.bodies[i], s.rotation[i], scene.gravity, dt);
 
   double error = predicted_errors(scene, dt, s, w);
   while (error >= params.joint_tol && report.corrections < params.max_corrections) {

@@ -27,13 +27,13 @@ struct ArticulatedParams {
   double regularisation         = 1e-6; // relative to the diagonal, used once A is found singular
   bool   velocity_stabilisation = true;
   bool   regularise_from_start  = false;
-  bool   refresh_matrix         = true;  // refill A at the predicted orientations for every correction after the first
+  bool   refresh_matrix = true; // refill A at the predicted orientations for every correction after the first
   // Initial guesses from the previous step: its stabilisation impulses for the stabilisation solve, the sum
   // of its correction impulses for the first correction, zero for later corrections. Only used if the
   // linear solver takes the incoming solution as its initial guess (the PETSc drivers then set
   // KSPSetInitialGuessNonzero). Off by default: it pays when the structure hangs nearly at rest (the same
   // impulses hold it up every step) and costs iterations when it swings (see docs/articulated.md).
-  bool   warm_start             = false;
+  bool warm_start = false;
 };
 
 struct ArticulatedStepReport {
@@ -57,34 +57,35 @@ struct ArticulatedStepReport {
 // decisions (another correction, a halving). Each body is counted (for energies and output) by exactly one
 // process. Empty lists and masks: one process does everything.
 struct ArticulatedWorkSplit {
-  std::vector<int>                    own_joints;      // increasing
-  std::vector<int>                    active_bodies;   // increasing
-  std::vector<int>                    impulse_joints;  // joints with an active end, increasing
-  std::vector<char>                   body_active, body_counted; // per body
-  std::function<double(double)>       max_over_processes;
+  std::vector<int>              own_joints;                // increasing
+  std::vector<int>              active_bodies;             // increasing
+  std::vector<int>              impulse_joints;            // joints with an active end, increasing
+  std::vector<char>             body_active, body_counted; // per body
+  std::function<double(double)> max_over_processes;
 };
 
 // The split for process `process` when joint j belongs to process joint_process[j]: the active bodies are
 // those of its joints, a body is counted by the process of its lowest-numbered joint, and bodies without
 // joints are active and counted on process 0. Throws std::invalid_argument on a wrong-sized list.
-ArticulatedWorkSplit split_articulated_work(const ArticulatedScene &scene, const std::vector<int> &joint_process, int process);
+ArticulatedWorkSplit split_articulated_work(const ArticulatedScene &scene,
+                                            const std::vector<int> &joint_process, int process);
 
 struct ArticulatedSolver {
-  JointMatrixPattern  pattern;
+  JointMatrixPattern   pattern;
   ArticulatedWorkSplit split;       // empty: this process does the whole scene
   ArticulatedWorkSplit whole_scene; // the lists for that case, built at the first step
-  std::vector<double> block_values;
-  bool                regularised = false;
+  std::vector<double>  block_values;
+  bool                 regularised = false;
   // Warm start: the previous step's stabilisation impulses and summed correction impulses (3 per joint).
   std::vector<double> last_stabilisation, last_correction;
   // Scratch, sized at the first step and reused: no allocation per step after it.
-  std::vector<double>             rhs, impulses, errors, correction_sum;
-  std::vector<Eigen::Matrix3d>    rotation, inverse_inertia;       // per body, start-of-step (or predicted) frame
-  std::vector<char>               fill_groups;                     // bodies whose blocks the solver needs (empty: all)
-  std::vector<Eigen::Matrix3d>    inverse_inertia_body;            // per body, body frame: inertias are fixed, so
-                                                                   // inverted once (at the first step)
-  std::vector<Eigen::Vector3d>    arm_a, arm_b;                    // per joint, world arms of its two ends
-  std::vector<Eigen::Vector3d>    predicted_position;              // per body, after dt with the current velocities
+  std::vector<double>          rhs, impulses, errors, correction_sum;
+  std::vector<Eigen::Matrix3d> rotation, inverse_inertia; // per body, start-of-step (or predicted) frame
+  std::vector<char>            fill_groups;               // bodies whose blocks the solver needs (empty: all)
+  std::vector<Eigen::Matrix3d> inverse_inertia_body;      // per body, body frame: inertias are fixed, so
+                                                          // inverted once (at the first step)
+  std::vector<Eigen::Vector3d>    arm_a, arm_b;           // per joint, world arms of its two ends
+  std::vector<Eigen::Vector3d>    predicted_position;     // per body, after dt with the current velocities
   std::vector<Eigen::Quaterniond> predicted_orientation;
 };
 
@@ -93,7 +94,8 @@ ArticulatedSolver make_articulated_solver(const ArticulatedScene &scene, const A
 // Empty string if the parameters are usable, otherwise what is wrong.
 std::string validate_params(const ArticulatedParams &params);
 
-ArticulatedStepReport articulated_step(ArticulatedScene &scene, ArticulatedSolver &solver, const ArticulatedParams &params,
+ArticulatedStepReport articulated_step(ArticulatedScene &scene, ArticulatedSolver &solver,
+                                       const ArticulatedParams &params,
                                        const BlockLinearSolver &linear_solver);
 
 } // namespace physics

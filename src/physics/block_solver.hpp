@@ -14,7 +14,7 @@ struct LinearSolveResult {
 
 struct BlockLinearSolver {
   // New values for the pattern the solver was built with: 9 per COO block, row-major.
-  std::function<void(const std::vector<double> &block_values)> set_matrix;
+  std::function<void(const std::vector<double> &block_values)>                                    set_matrix;
   std::function<LinearSolveResult(const std::vector<double> &rhs, std::vector<double> &solution)> solve;
   // The block rows whose values set_matrix passes on (this process's rows when the physics is replicated
   // over processes); empty: all. The physics may leave the other rows' values unset.

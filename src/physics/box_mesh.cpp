@@ -26,7 +26,7 @@ TetMesh make_box_mesh(double lx, double ly, double lz, int nx, int ny, int nz)
       for (int i = 0; i < nx; ++i)
         for (const auto &p : perms) {
           int c[3] = {i, j, k}, t[4];
-          t[0] = id(c[0], c[1], c[2]);
+          t[0]     = id(c[0], c[1], c[2]);
           for (int s = 0; s < 3; ++s) {
             ++c[p[s]];
             t[s + 1] = id(c[0], c[1], c[2]);

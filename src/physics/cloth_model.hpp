@@ -7,19 +7,23 @@
 
 namespace physics {
 
-enum class SpringKind : int { Stretch = 0, Shear = 1, Bend = 2 };
+enum class SpringKind : int {
+  Stretch = 0,
+  Shear   = 1,
+  Bend    = 2
+};
 
 struct Spring {
   int        a = 0, b = 0;
   double     rest_length = 0;
-  double     stiffness = 0; // N/m
-  SpringKind kind = SpringKind::Stretch;
+  double     stiffness   = 0; // N/m
+  SpringKind kind        = SpringKind::Stretch;
 };
 
 struct SphereCollider {
   bool            enabled = false;
-  Eigen::Vector3d centre = Eigen::Vector3d(0, -0.5, 0);
-  double          radius = 0.3;
+  Eigen::Vector3d centre  = Eigen::Vector3d(0, -0.5, 0);
+  double          radius  = 0.3;
 };
 
 struct Cloth {
@@ -31,16 +35,21 @@ struct Cloth {
   Eigen::Vector3d              gravity = Eigen::Vector3d(0, -9.81, 0);
   double                       damping = 0; // N s/m along each spring
   SphereCollider               sphere;
-  int particle_count() const { return static_cast<int>(position.size()); }
+  int                          particle_count() const { return static_cast<int>(position.size()); }
 };
 
-enum class ClothPins { TwoCorners, FourCorners, TopRow, None };
+enum class ClothPins {
+  TwoCorners,
+  FourCorners,
+  TopRow,
+  None
+};
 
 struct ClothOptions {
   int       n          = 160;
-  double    size       = 1.0;   // side length, m
-  double    total_mass = 0.5;   // kg
-  double    k_stretch  = 1000;  // N/m per spring
+  double    size       = 1.0;  // side length, m
+  double    total_mass = 0.5;  // kg
+  double    k_stretch  = 1000; // N/m per spring
   double    k_shear    = 100;
   double    k_bend     = 10;
   double    damping    = 0.0;

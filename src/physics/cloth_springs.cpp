@@ -2,8 +2,9 @@
 
 namespace physics {
 
-SpringLinearisation linearise_spring(const Spring &s, const Eigen::Vector3d &xa, const Eigen::Vector3d &xb, const Eigen::Vector3d &va, const Eigen::Vector3d &vb,
-                                     double damping, bool choi_ko)
+SpringLinearisation linearise_spring(const Spring &s, const Eigen::Vector3d &xa, const Eigen::Vector3d &xb,
+                                     const Eigen::Vector3d &va, const Eigen::Vector3d &vb, double damping,
+                                     bool choi_ko)
 {
   const SpringTerms     t  = spring_terms(s, xa, xb, va, vb, damping, choi_ko);
   const Eigen::Matrix3d dd = t.direction * t.direction.transpose();

@@ -10,12 +10,15 @@ namespace physics {
 
 ClothSystem make_cloth_system(const Cloth &cloth)
 {
-  return make_cloth_system(cloth, std::vector<char>(cloth.particle_count(), 1), [](int, int) { return true; });
+  return make_cloth_system(cloth, std::vector<char>(cloth.particle_count(), 1),
+                           [](int, int) { return true; });
 }
 
-ClothSystem make_cloth_system(const Cloth &cloth, const std::vector<char> &own, const std::function<bool(int row, int col)> &keep)
+ClothSystem make_cloth_system(const Cloth &cloth, const std::vector<char> &own,
+                              const std::function<bool(int row, int col)> &keep)
 {
-  if ((int)own.size() != cloth.particle_count()) throw std::invalid_argument("make_cloth_system: one ownership flag per particle needed");
+  if ((int)own.size() != cloth.particle_count())
+    throw std::invalid_argument("make_cloth_system: one ownership flag per particle needed");
   ClothSystem s;
   s.n_particles = cloth.particle_count();
   s.diagonal_block.assign(s.n_particles, -1);
@@ -54,15 +57,17 @@ namespace {
 // One spring's share of the system: its block alpha I + beta d d^T on both diagonal blocks and (negated)
 // on its off-diagonal blocks that are listed (ab, ba: COO block indices or -1), and h f - h^2 K dv to the
 // right-hand side of its assembled ends.
-inline void add_spring(const Cloth &cloth, ClothSystem &sys, const Spring &sp, const SpringTerms &t, double h, int block_ab, int block_ba)
+inline void add_spring(const Cloth &cloth, ClothSystem &sys, const Spring &sp, const SpringTerms &t, double h,
+                       int block_ab, int block_ba)
 {
   const double h2 = h * h;
   // The spring's block of M + h D + h^2 K: alpha I + beta d d^T (symmetric).
   const double           alpha = h2 * t.k_iso, beta = h2 * t.k_dir + h * t.damping;
-  const Eigen::Vector3d &d     = t.direction;
+  const Eigen::Vector3d &d = t.direction;
   double                 block[9]; // computed once per pair and mirrored: exactly symmetric, so a
   for (int r = 0; r < 3; ++r)      // type that keeps one triangle sees the same matrix as one keeping both
-    for (int c = r; c < 3; ++c) block[3 * r + c] = block[3 * c + r] = beta * d[r] * d[c] + (r == c ? alpha : 0.0);
+    for (int c = r; c < 3; ++c)
+      block[3 * r + c] = block[3 * c + r] = beta * d[r] * d[c] + (r == c ? alpha : 0.0);
   // The spring's K acts on dv_a - dv_b; a pinned end has dv = 0, so its row, column and rhs stay out.
   // An end whose row is assembled elsewhere (diagonal_block < 0) is skipped the same way here.
   const bool   fa = cloth.fixed[sp.a], fb = cloth.fixed[sp.b];
@@ -82,7 +87,7 @@ inline void add_spring(const Cloth &cloth, ClothSystem &sys, const Spring &sp, c
   // h f_a - h^2 K (v_a - v_b), K = k_iso I + k_dir d d^T
   const Eigen::Vector3d dvel    = cloth.velocity[sp.a] - cloth.velocity[sp.b];
   const Eigen::Vector3d fa_term = h * t.force_on_a - h2 * (t.k_iso * dvel + t.k_dir * d.dot(dvel) * d);
-  double *rhs = sys.rhs.data();
+  double               *rhs     = sys.rhs.data();
   if (ia >= 0)
     for (int k = 0; k < 3; ++k) rhs[3 * sp.a + k] += fa_term[k];
   if (ib >= 0)
@@ -107,16 +112,19 @@ void assemble_cloth_system(const Cloth &cloth, const ClothParams &params, ClothS
   // then the sums into blocks and right-hand side, spring by spring. In one pass the stores of one spring
   // stood between the loads of the next and the loop ran at the latency of the square root.
   static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double), "positions are read as packed triples");
-  constexpr int  chunk = 64;
-  double         rest[chunk], stiffness[chunk], sep[3][chunk], rel[3][chunk], dir[3][chunk], force[3][chunk], k_iso[chunk], k_dir[chunk];
-  const double  *x = reinterpret_cast<const double *>(cloth.position.data()), *v = reinterpret_cast<const double *>(cloth.velocity.data());
-  const Spring  *springs = cloth.springs.data();
-  const double   damping = cloth.damping;
-  const bool     choi_ko = params.choi_ko;
+  constexpr int chunk = 64;
+  double        rest[chunk], stiffness[chunk], sep[3][chunk], rel[3][chunk], dir[3][chunk], force[3][chunk],
+    k_iso[chunk], k_dir[chunk];
+  const double *x       = reinterpret_cast<const double *>(cloth.position.data()),
+               *v       = reinterpret_cast<const double *>(cloth.velocity.data());
+  const Spring *springs = cloth.springs.data();
+  const double  damping = cloth.damping;
+  const bool    choi_ko = params.choi_ko;
   for (size_t s0 = 0; s0 < sys.springs.size(); s0 += chunk) {
     const int  n   = (int)std::min(sys.springs.size() - s0, (size_t)chunk);
     const int *idx = sys.springs.data() + s0;
-    for (int i = 0; i < n; ++i) { // the chunk's inputs side by side: GCC 12 does not gather them for the vector loop below
+    for (int i = 0; i < n;
+         ++i) { // the chunk's inputs side by side: GCC 12 does not gather them for the vector loop below
       const Spring &sp = springs[idx[i]];
       rest[i] = sp.rest_length, stiffness[i] = sp.stiffness;
       for (int k = 0; k < 3; ++k) {
@@ -126,8 +134,9 @@ void assemble_cloth_system(const Cloth &cloth, const ClothParams &params, ClothS
     }
 #pragma omp simd
     for (int i = 0; i < n; ++i)
-      spring_terms_lane(rest[i], stiffness[i], sep[0][i], sep[1][i], sep[2][i], rel[0][i], rel[1][i], rel[2][i], damping, choi_ko, dir[0][i], dir[1][i],
-                        dir[2][i], force[0][i], force[1][i], force[2][i], k_iso[i], k_dir[i]);
+      spring_terms_lane(rest[i], stiffness[i], sep[0][i], sep[1][i], sep[2][i], rel[0][i], rel[1][i],
+                        rel[2][i], damping, choi_ko, dir[0][i], dir[1][i], dir[2][i], force[0][i],
+                        force[1][i], force[2][i], k_iso[i], k_dir[i]);
     for (int i = 0; i < n; ++i) {
       SpringTerms t;
       t.direction  = Eigen::Vector3d(dir[0][i], dir[1][i], dir[2][i]);
@@ -146,7 +155,9 @@ void cloth_forces(const Cloth &cloth, std::vector<Eigen::Vector3d> &forces)
   forces.resize(cloth.particle_count());
   for (int p = 0; p < cloth.particle_count(); ++p) forces[p] = cloth.mass[p] * cloth.gravity;
   for (const Spring &sp : cloth.springs) {
-    const SpringLinearisation lin = linearise_spring(sp, cloth.position[sp.a], cloth.position[sp.b], cloth.velocity[sp.a], cloth.velocity[sp.b], cloth.damping);
+    const SpringLinearisation lin =
+      linearise_spring(sp, cloth.position[sp.a], cloth.position[sp.b], cloth.velocity[sp.a],
+                       cloth.velocity[sp.b], cloth.damping);
     forces[sp.a] += lin.force_on_a;
     forces[sp.b] -= lin.force_on_a;
   }
@@ -154,16 +165,18 @@ void cloth_forces(const Cloth &cloth, std::vector<Eigen::Vector3d> &forces)
     if (cloth.fixed[p]) forces[p].setZero();
 }
 
-ClothStepReport cloth_step(Cloth &cloth, ClothSystem &sys, const ClothParams &params, const BlockLinearSolver &solver)
+ClothStepReport cloth_step(Cloth &cloth, ClothSystem &sys, const ClothParams &params,
+                           const BlockLinearSolver &solver)
 {
   ClothStepReport report;
   assemble_cloth_system(cloth, params, sys);
   solver.set_matrix(sys.block_values);
-  const LinearSolveResult r = solver.solve(sys.rhs, sys.dv); // sys.dv: last step's dv, a warm start if asked for
-  report.iterations         = r.iterations;
-  report.converged          = r.converged;
-  report.breakdown          = r.breakdown;
-  const double h            = params.dt;
+  const LinearSolveResult r =
+    solver.solve(sys.rhs, sys.dv); // sys.dv: last step's dv, a warm start if asked for
+  report.iterations = r.iterations;
+  report.converged  = r.converged;
+  report.breakdown  = r.breakdown;
+  const double h    = params.dt;
   for (int p = 0; p < sys.n_particles; ++p) {
     if (cloth.fixed[p]) continue;
     cloth.velocity[p] += Eigen::Vector3d(sys.dv[3 * p], sys.dv[3 * p + 1], sys.dv[3 * p + 2]);

@@ -16,9 +16,9 @@
 namespace physics {
 
 struct ClothParams {
-  double dt      = 1.0 / 60.0;
-  bool   choi_ko = true; // false keeps the exact (possibly indefinite) Jacobian of compressed springs
-  StrainLimit strain_limit; // off by default: applied after the position update and the sphere
+  double      dt      = 1.0 / 60.0;
+  bool        choi_ko = true; // false keeps the exact (possibly indefinite) Jacobian of compressed springs
+  StrainLimit strain_limit;   // off by default: applied after the position update and the sphere
 };
 
 // The blocks one process assembles. On one process: every row and both triangles. With replicated state
@@ -26,20 +26,21 @@ struct ClothParams {
 // so it visits only the springs that touch them, and lists only the off-diagonal blocks its matrix type
 // stores (one per spring with upper-triangle storage), which is all the COO refill then reads.
 struct ClothSystem {
-  int                 n_particles = 0;
-  std::vector<int>    block_row, block_col;   // the COO list: own particles' diagonal blocks, then the kept spring blocks
-  std::vector<int>    diagonal_block;         // per particle: its diagonal block, -1 when its row is not assembled here
-  std::vector<int>    springs;                // springs with at least one end in an assembled row
-  std::vector<int>    stretch_springs;        // those of them along grid edges (for the stretch check)
-  std::vector<int>    block_ab, block_ba;     // per listed spring: block of (a, b) and of (b, a), -1 when not listed
-  std::vector<double> block_values, rhs, dv;  // rhs: 3 per particle, meaningful in assembled rows only
+  int              n_particles = 0;
+  std::vector<int> block_row,
+    block_col; // the COO list: own particles' diagonal blocks, then the kept spring blocks
+  std::vector<int> diagonal_block;  // per particle: its diagonal block, -1 when its row is not assembled here
+  std::vector<int> springs;         // springs with at least one end in an assembled row
+  std::vector<int> stretch_springs; // those of them along grid edges (for the stretch check)
+  std::vector<int> block_ab, block_ba; // per listed spring: block of (a, b) and of (b, a), -1 when not listed
+  std::vector<double> block_values, rhs, dv; // rhs: 3 per particle, meaningful in assembled rows only
 };
 struct ClothStepReport {
-  int    iterations = 0;
-  bool   converged  = true;
-  bool   breakdown  = false;
-  int    contacts   = 0; // particles projected out of the sphere
-  double max_stretch = 0; // over the stretch springs this process assembles (all of them on one process)
+  int    iterations    = 0;
+  bool   converged     = true;
+  bool   breakdown     = false;
+  int    contacts      = 0; // particles projected out of the sphere
+  double max_stretch   = 0; // over the stretch springs this process assembles (all of them on one process)
   int    strain_sweeps = 0; // strain-limiting sweeps made (0 when off)
 };
 
@@ -48,7 +49,8 @@ ClothSystem make_cloth_system(const Cloth &cloth);
 
 // The rows of particles with own[p] != 0; of their off-diagonal blocks, those with keep(row, col) true
 // (physics numbering). Throws std::invalid_argument if own has the wrong size.
-ClothSystem make_cloth_system(const Cloth &cloth, const std::vector<char> &own, const std::function<bool(int row, int col)> &keep);
+ClothSystem make_cloth_system(const Cloth &cloth, const std::vector<char> &own,
+                              const std::function<bool(int row, int col)> &keep);
 
 std::string validate_params(const ClothParams &params);
 
@@ -58,6 +60,7 @@ void assemble_cloth_system(const Cloth &cloth, const ClothParams &params, ClothS
 // Net force on every particle (gravity, springs, damping), zero on pinned particles.
 void cloth_forces(const Cloth &cloth, std::vector<Eigen::Vector3d> &forces);
 
-ClothStepReport cloth_step(Cloth &cloth, ClothSystem &sys, const ClothParams &params, const BlockLinearSolver &solver);
+ClothStepReport cloth_step(Cloth &cloth, ClothSystem &sys, const ClothParams &params,
+                           const BlockLinearSolver &solver);
 
 } // namespace physics

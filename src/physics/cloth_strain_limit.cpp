@@ -8,7 +8,8 @@ namespace physics {
 
 std::string validate_strain_limit(const StrainLimit &limit)
 {
-  if (!(limit.max_strain >= 0) || !std::isfinite(limit.max_strain)) return "strain limit must be non-negative and finite (0: off)";
+  if (!(limit.max_strain >= 0) || !std::isfinite(limit.max_strain))
+    return "strain limit must be non-negative and finite (0: off)";
   if (limit.max_sweeps < 1) return "strain limiting needs at least one sweep";
   return "";
 }
@@ -21,7 +22,8 @@ void project_out_of_sphere(Cloth &cloth)
     if (cloth.fixed[p]) continue;
     const Eigen::Vector3d d    = cloth.position[p] - cloth.sphere.centre;
     const double          dist = d.norm();
-    if (dist < cloth.sphere.radius && dist > 0) cloth.position[p] = cloth.sphere.centre + cloth.sphere.radius / dist * d;
+    if (dist < cloth.sphere.radius && dist > 0)
+      cloth.position[p] = cloth.sphere.centre + cloth.sphere.radius / dist * d;
   }
 }
 
@@ -31,9 +33,9 @@ StrainLimitReport limit_strain(Cloth &cloth, const StrainLimit &limit, double dt
 {
   StrainLimitReport report;
   if (limit.max_strain <= 0) return report;
-  const int                    np = cloth.particle_count();
+  const int                          np     = cloth.particle_count();
   const std::vector<Eigen::Vector3d> before = cloth.position;
-  std::vector<int>             stretch;
+  std::vector<int>                   stretch;
   for (size_t k = 0; k < cloth.springs.size(); ++k)
     if (cloth.springs[k].kind == SpringKind::Stretch) stretch.push_back((int)k);
   const double bound = 1 + limit.max_strain;
@@ -47,9 +49,10 @@ StrainLimitReport limit_strain(Cloth &cloth, const StrainLimit &limit, double dt
     for (size_t q = 0; q < count; ++q) {
       const Spring   &sp = cloth.springs[stretch[sweep % 2 ? count - 1 - q : q]];
       Eigen::Vector3d d  = cloth.position[sp.b] - cloth.position[sp.a];
-      const double    l  = d.norm(), lmax = bound * sp.rest_length;
+      const double    l = d.norm(), lmax = bound * sp.rest_length;
       if (!(l > lmax * (1 + slack))) continue;
-      const double wa = cloth.fixed[sp.a] ? 0.0 : 1.0 / cloth.mass[sp.a], wb = cloth.fixed[sp.b] ? 0.0 : 1.0 / cloth.mass[sp.b];
+      const double wa = cloth.fixed[sp.a] ? 0.0 : 1.0 / cloth.mass[sp.a],
+                   wb = cloth.fixed[sp.b] ? 0.0 : 1.0 / cloth.mass[sp.b];
       if (wa + wb == 0) continue;
       const Eigen::Vector3d corr = (l - lmax) / (l * (wa + wb)) * d;
       cloth.position[sp.a] += wa * corr;
@@ -67,7 +70,7 @@ StrainLimitReport limit_strain(Cloth &cloth, const StrainLimit &limit, double dt
     cloth.velocity[p] += (cloth.position[p] - before[p]) / dt;
     if (!cloth.sphere.enabled) continue;
     // on the sphere: no velocity into it (as the collider's own projection leaves it)
-    const Eigen::Vector3d d = cloth.position[p] - cloth.sphere.centre;
+    const Eigen::Vector3d d    = cloth.position[p] - cloth.sphere.centre;
     const double          dist = d.norm();
     if (dist > 0 && dist <= cloth.sphere.radius * (1 + 1e-12)) {
       const double vn = cloth.velocity[p].dot(d) / dist;
@@ -76,7 +79,8 @@ StrainLimitReport limit_strain(Cloth &cloth, const StrainLimit &limit, double dt
   }
   for (int k : stretch) {
     const Spring &sp = cloth.springs[k];
-    report.max_ratio = std::max(report.max_ratio, (cloth.position[sp.b] - cloth.position[sp.a]).norm() / sp.rest_length);
+    report.max_ratio =
+      std::max(report.max_ratio, (cloth.position[sp.b] - cloth.position[sp.a]).norm() / sp.rest_length);
   }
   return report;
 }

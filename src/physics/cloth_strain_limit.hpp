@@ -16,7 +16,7 @@
 namespace physics {
 
 struct StrainLimit {
-  double max_strain = 0;  // 0: off; else the largest relative elongation a stretch spring keeps
+  double max_strain = 0;   // 0: off; else the largest relative elongation a stretch spring keeps
   int    max_sweeps = 200; // Gauss-Seidel sweeps over the stretch springs at most (they stop when within)
 };
 

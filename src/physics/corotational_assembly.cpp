@@ -18,16 +18,18 @@ StepCoefficients implicit_euler_coefficients(double dt, double alpha, double bet
   return c;
 }
 
-BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &elements, const std::vector<char> &fixed,
-                                int owned_begin, int owned_end, bool merge, const LowerTriangle &lower)
+BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &elements,
+                                const std::vector<char> &fixed, int owned_begin, int owned_end, bool merge,
+                                const LowerTriangle &lower)
 {
   BlockPattern p;
   p.merged      = merge;
   const int npe = model.npe;
-  if (static_cast<int>(fixed.size()) != model.node_count()) throw std::invalid_argument("fixed flags: wrong size");
+  if (static_cast<int>(fixed.size()) != model.node_count())
+    throw std::invalid_argument("fixed flags: wrong size");
   p.element_slots.assign(elements.size() * npe * npe, -1);
   std::vector<std::pair<long long, size_t>> keyed; // (row * n + col, position in element_slots)
-  const long long n = model.node_count();
+  const long long                           n = model.node_count();
   std::vector<int> part; // part of each node, when lower blocks across parts are kept
   if (lower.drop && !lower.part_offsets.empty()) {
     part.assign(n, 0);
@@ -59,7 +61,8 @@ BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &e
   for (size_t i = 0; i < elements.size(); ++i)
     for (int a = 0; a < npe; ++a)
       for (int b = a; b < npe; ++b)
-        for (int *s : {&p.element_slots[(i * npe + a) * npe + b], &p.element_slots[(i * npe + b) * npe + a]}) {
+        for (int *s :
+             {&p.element_slots[(i * npe + a) * npe + b], &p.element_slots[(i * npe + b) * npe + a]}) {
           if (*s < 0 || written[*s & kSlotIndexMask]) continue; // (a == b: the same entry twice)
           written[*s] = 1;
           *s |= kFirstContribution;
@@ -84,10 +87,10 @@ namespace {
 
 // Adds B (a 3x3 expression) into the row-major block of element slot s, or stores it where s is the
 // first write to that block.
-template <typename Block>
-inline void write_block(double *values, int s, const Block &B)
+template <typename Block> inline void write_block(double *values, int s, const Block &B)
 {
-  Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> out(values + 9 * static_cast<size_t>(s & kSlotIndexMask));
+  Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> out(values +
+                                                               9 * static_cast<size_t>(s & kSlotIndexMask));
   if (s & kFirstContribution) out = B;
   else out += B;
 }
@@ -98,7 +101,8 @@ constexpr size_t kRotationChunk = 64;
 
 // R[j] for elements[j], j < n (at most kRotationChunk): the rotation of the corner deformation
 // gradient F = Ds Dm^-1, or I for plain linear elasticity.
-void element_rotations(const FemModel &model, const int *elements, size_t n, const double *x, Eigen::Matrix3d *R)
+void element_rotations(const FemModel &model, const int *elements, size_t n, const double *x,
+                       Eigen::Matrix3d *R)
 {
   using Vec3 = Eigen::Vector3d;
   if (!model.settings.corotational) {
@@ -117,21 +121,22 @@ void element_rotations(const FemModel &model, const int *elements, size_t n, con
 }
 
 template <int N>
-void assemble_kernel(const FemModel &model, const std::vector<int> &elements, const double *x, const double *v,
-                     const StepCoefficients &c, const BlockPattern *pattern, double *values, double *rhs,
-                     Eigen::Matrix3d *rotations)
+void assemble_kernel(const FemModel &model, const std::vector<int> &elements, const double *x,
+                     const double *v, const StepCoefficients &c, const BlockPattern *pattern, double *values,
+                     double *rhs, Eigen::Matrix3d *rotations)
 {
-  using Vec3                 = Eigen::Vector3d;
-  using Mat3                 = Eigen::Matrix3d;
-  constexpr int NB           = packed_block_count(N);
-  const double *X            = model.mesh.nodes.data();
-  const bool    corotational = model.settings.corotational;
-  const bool    mass_damping = c.mass_rhs != 0;
-  const Eigen::Matrix<double, N, N> Mref = model.reference_mass;
-  Mat3 chunk_rotations[kRotationChunk];
+  using Vec3                                     = Eigen::Vector3d;
+  using Mat3                                     = Eigen::Matrix3d;
+  constexpr int                     NB           = packed_block_count(N);
+  const double                     *X            = model.mesh.nodes.data();
+  const bool                        corotational = model.settings.corotational;
+  const bool                        mass_damping = c.mass_rhs != 0;
+  const Eigen::Matrix<double, N, N> Mref         = model.reference_mass;
+  Mat3                              chunk_rotations[kRotationChunk];
   for (size_t i = 0; i < elements.size(); ++i) {
     if (i % kRotationChunk == 0)
-      element_rotations(model, &elements[i], std::min(kRotationChunk, elements.size() - i), x, chunk_rotations);
+      element_rotations(model, &elements[i], std::min(kRotationChunk, elements.size() - i), x,
+                        chunk_rotations);
     const int     e     = elements[i];
     const int    *nodes = &model.mesh.elements[static_cast<size_t>(e) * N];
     const double *K0    = &model.stiffness[static_cast<size_t>(e) * NB * 9];
@@ -140,7 +145,8 @@ void assemble_kernel(const FemModel &model, const std::vector<int> &elements, co
     // z = a_f (R^T x - X) + a_K R^T v, so that rhs_a = -R sum_b K0_ab z_b in one product with K0.
     Vec3 z[N], s[N];
     for (int b = 0; b < N; ++b) {
-      z[b] = R.transpose() * (c.force * Vec3::Map(x + 3 * nodes[b]) + c.stiffness_rhs * Vec3::Map(v + 3 * nodes[b])) -
+      z[b] = R.transpose() *
+               (c.force * Vec3::Map(x + 3 * nodes[b]) + c.stiffness_rhs * Vec3::Map(v + 3 * nodes[b])) -
              c.force * Vec3::Map(X + 3 * nodes[b]);
       s[b].setZero();
     }
@@ -182,19 +188,20 @@ void assemble_kernel(const FemModel &model, const std::vector<int> &elements, co
 // sum_b K0_ab z_b = V sigma g_a with sigma = lambda tr(G) I + mu (G + G^T), G = sum_b z_b g_b^T
 // (the stress of the displacement z). Same results as assemble_kernel<4>, about a third of the work,
 // and K0 is not read.
-void assemble_kernel_p1(const FemModel &model, const std::vector<int> &elements, const double *x, const double *v,
-                        const StepCoefficients &c, const BlockPattern *pattern, double *values, double *rhs,
-                        Eigen::Matrix3d *rotations)
+void assemble_kernel_p1(const FemModel &model, const std::vector<int> &elements, const double *x,
+                        const double *v, const StepCoefficients &c, const BlockPattern *pattern,
+                        double *values, double *rhs, Eigen::Matrix3d *rotations)
 {
-  using Vec3                 = Eigen::Vector3d;
-  using Mat3                 = Eigen::Matrix3d;
-  const double *X            = model.mesh.nodes.data();
+  using Vec3           = Eigen::Vector3d;
+  using Mat3           = Eigen::Matrix3d;
+  const double *X      = model.mesh.nodes.data();
   const double  lambda = model.lame.lambda, mu = model.lame.mu;
   const double  mass_per_node = 0.25; // lumped: reference_mass = I / 4
-  Mat3 chunk_rotations[kRotationChunk];
+  Mat3          chunk_rotations[kRotationChunk];
   for (size_t i = 0; i < elements.size(); ++i) {
     if (i % kRotationChunk == 0)
-      element_rotations(model, &elements[i], std::min(kRotationChunk, elements.size() - i), x, chunk_rotations);
+      element_rotations(model, &elements[i], std::min(kRotationChunk, elements.size() - i), x,
+                        chunk_rotations);
     const int     e     = elements[i];
     const int    *nodes = &model.mesh.elements[static_cast<size_t>(e) * 4];
     const double *grad  = &model.gradients[static_cast<size_t>(e) * 12];
@@ -205,7 +212,8 @@ void assemble_kernel_p1(const FemModel &model, const std::vector<int> &elements,
     for (int a = 0; a < 4; ++a) g[a] = Vec3::Map(grad + 3 * a);
     Mat3 G = Mat3::Zero();
     for (int b = 0; b < 4; ++b) {
-      const Vec3 z = R.transpose() * (c.force * Vec3::Map(x + 3 * nodes[b]) + c.stiffness_rhs * Vec3::Map(v + 3 * nodes[b])) -
+      const Vec3 z = R.transpose() * (c.force * Vec3::Map(x + 3 * nodes[b]) +
+                                      c.stiffness_rhs * Vec3::Map(v + 3 * nodes[b])) -
                      c.force * Vec3::Map(X + 3 * nodes[b]);
       G.noalias() += z * g[b].transpose();
     }
@@ -237,17 +245,21 @@ void assemble_kernel_p1(const FemModel &model, const std::vector<int> &elements,
 
 } // namespace
 
-long long assemble_elements(const FemModel &model, const std::vector<int> &elements, const double *x, const double *v,
-                            const StepCoefficients &c, const BlockPattern *pattern, double *block_values, double *rhs,
-                            Eigen::Matrix3d *rotations, ElementKernel kernel)
+long long assemble_elements(const FemModel &model, const std::vector<int> &elements, const double *x,
+                            const double *v, const StepCoefficients &c, const BlockPattern *pattern,
+                            double *block_values, double *rhs, Eigen::Matrix3d *rotations,
+                            ElementKernel kernel)
 {
   if (block_values && !pattern) throw std::invalid_argument("assemble_elements: block values need a pattern");
   if (pattern && pattern->element_slots.size() != elements.size() * model.npe * model.npe)
     throw std::invalid_argument("assemble_elements: pattern was built for another element list");
   if (kernel == ElementKernel::Batched)
-    return assemble_elements_batched(model, elements, x, v, c, block_values ? pattern : nullptr, block_values, rhs, rotations);
-  if (model.npe == 4 && !model.gradients.empty()) assemble_kernel_p1(model, elements, x, v, c, pattern, block_values, rhs, rotations);
-  else if (model.npe == 4) assemble_kernel<4>(model, elements, x, v, c, pattern, block_values, rhs, rotations);
+    return assemble_elements_batched(model, elements, x, v, c, block_values ? pattern : nullptr, block_values,
+                                     rhs, rotations);
+  if (model.npe == 4 && !model.gradients.empty())
+    assemble_kernel_p1(model, elements, x, v, c, pattern, block_values, rhs, rotations);
+  else if (model.npe == 4)
+    assemble_kernel<4>(model, elements, x, v, c, pattern, block_values, rhs, rotations);
   else assemble_kernel<10>(model, elements, x, v, c, pattern, block_values, rhs, rotations);
   return 0;
 }

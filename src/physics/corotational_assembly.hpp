@@ -59,14 +59,15 @@ constexpr int kSlotIndexMask     = kFirstContribution - 1;
 // upper triangle; binbcsr with symmetric storage keeps the upper triangle of each rank's diagonal part
 // and its off-rank part in full. Dropped blocks get no COO entry and the element loop skips them.
 struct LowerTriangle {
-  bool             drop = false;  // leave out blocks with row > column ...
-  std::vector<int> part_offsets;  // ... except those whose row and column lie in different parts
-                                  // [part_offsets[p], part_offsets[p+1]) (empty: no exception)
+  bool             drop = false; // leave out blocks with row > column ...
+  std::vector<int> part_offsets; // ... except those whose row and column lie in different parts
+                                 // [part_offsets[p], part_offsets[p+1]) (empty: no exception)
 };
 // merge_duplicates: rows/cols are unique (sorted by row, then column) and elements add into shared
 // blocks; otherwise every element block has its own COO entry and the Mat type sums duplicates.
-BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &elements, const std::vector<char> &fixed,
-                                int owned_begin, int owned_end, bool merge_duplicates, const LowerTriangle &lower = {});
+BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &elements,
+                                const std::vector<char> &fixed, int owned_begin, int owned_end,
+                                bool merge_duplicates, const LowerTriangle &lower = {});
 
 // Sizes block_values for the pattern and sets the identity blocks (fixed nodes), which the element
 // loop does not write. Call before assemble_elements (once is enough while the array is kept).
@@ -75,7 +76,10 @@ void reset_block_values(const BlockPattern &pattern, std::vector<double> &block_
 // Which element loop runs: Batched (element_batch.hpp: the kernels of element_kernels.hpp over SIMD
 // lanes, P2 from the barycentric gradients) or Scalar (one element at a time, P2 from the stored K0:
 // the reference the batched kernels are tested against).
-enum class ElementKernel { Batched, Scalar };
+enum class ElementKernel {
+  Batched,
+  Scalar
+};
 
 // The element loop. x, v: 3 per node (all nodes). rhs: 3 per node, accumulated (+=). block_values:
 // 9 per COO block of `pattern`, row-major: every element block is overwritten with the sum of its
@@ -83,9 +87,10 @@ enum class ElementKernel { Batched, Scalar };
 // pattern may then be null too). rotations (optional): one per listed element. Returns the number of
 // elements whose rotation took the scalar SVD path (inverted or flat; Batched also counts elements
 // that the fixed Newton steps did not converge; Scalar returns 0).
-long long assemble_elements(const FemModel &model, const std::vector<int> &elements, const double *x, const double *v,
-                            const StepCoefficients &c, const BlockPattern *pattern, double *block_values, double *rhs,
-                            Eigen::Matrix3d *rotations = nullptr, ElementKernel kernel = ElementKernel::Batched);
+long long assemble_elements(const FemModel &model, const std::vector<int> &elements, const double *x,
+                            const double *v, const StepCoefficients &c, const BlockPattern *pattern,
+                            double *block_values, double *rhs, Eigen::Matrix3d *rotations = nullptr,
+                            ElementKernel kernel = ElementKernel::Batched);
 
 // Elastic forces only (a_f = 1): f = sum_e f_e over all elements, 3 per node, overwritten.
 std::vector<double> elastic_forces(const FemModel &model, const double *x);

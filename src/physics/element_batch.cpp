@@ -11,14 +11,13 @@ namespace {
 constexpr int W = kElementLanes;
 
 // One batch as structure of arrays: entry k of lane l at [k * W + l].
-template <int N>
-struct alignas(64) Batch {
+template <int N> struct alignas(64) Batch {
   static constexpr int NB = packed_block_count(N);
   double               x[3 * N * W], v[3 * N * W], X[3 * N * W];
   double               Dinv[9 * W], F[9 * W], R[9 * W], vol[W];
   double               rhs[3 * N * W], blocks[NB * 9 * W];
   double               Q[N == 10 ? 16 * 9 * W : 1]; // P2: the rotated gradient pairs
-  double               ok[W]; // polar_rotation's acceptance per lane
+  double               ok[W];                       // polar_rotation's acceptance per lane
 };
 
 // Lane l <- element e: its nodes' positions, velocities and rest positions, Dm^-1 and volume.
@@ -45,8 +44,9 @@ void gather(const FemModel &model, int e, int l, const double *x, const double *
 // linear_38k): one batch ahead took the loop from 12-14 to 10.3-10.7 ms there (further ahead: no
 // better).
 template <int N, bool Blocks>
-void prefetch_batch(const FemModel &model, const std::vector<int> &elements, size_t start, int m, const double *x, const double *v,
-                    const double *rhs, const BlockPattern *pattern, const double *values)
+void prefetch_batch(const FemModel &model, const std::vector<int> &elements, size_t start, int m,
+                    const double *x, const double *v, const double *rhs, const BlockPattern *pattern,
+                    const double *values)
 {
   const double *X = model.mesh.nodes.data();
   for (int l = 0; l < m; ++l) {
@@ -84,9 +84,9 @@ inline void write_block(double *values, int s, const double *B, bool transposed)
 }
 
 template <int N, bool Blocks, bool MassDamping>
-long long assemble_batched(const FemModel &model, const std::vector<int> &elements, const double *x, const double *v,
-                           const kernels::ElementConstants &k, const BlockPattern *pattern, double *values, double *rhs,
-                           Eigen::Matrix3d *rotations)
+long long assemble_batched(const FemModel &model, const std::vector<int> &elements, const double *x,
+                           const double *v, const kernels::ElementConstants &k, const BlockPattern *pattern,
+                           double *values, double *rhs, Eigen::Matrix3d *rotations)
 {
   double Mref[N * N];
   for (int a = 0; a < N; ++a)
@@ -101,7 +101,8 @@ long long assemble_batched(const FemModel &model, const std::vector<int> &elemen
   for (size_t start = 0; start < n; start += W) {
     const int m = static_cast<int>(std::min<size_t>(W, n - start));
     if (start + W < n)
-      prefetch_batch<N, Blocks>(model, elements, start + W, static_cast<int>(std::min<size_t>(W, n - start - W)), x, v, rhs, pattern,
+      prefetch_batch<N, Blocks>(model, elements, start + W,
+                                static_cast<int>(std::min<size_t>(W, n - start - W)), x, v, rhs, pattern,
                                 values);
     // Lanes past the end repeat the last element; nothing of theirs is written out.
     for (int l = 0; l < W; ++l) gather<N>(model, elements[start + std::min(l, m - 1)], l, x, v, b);
@@ -122,18 +123,20 @@ long long assemble_batched(const FemModel &model, const std::vector<int> &elemen
     if constexpr (N == 4) {
 #pragma omp simd
       for (int l = 0; l < W; ++l)
-        kernels::p1_element<W, Blocks, MassDamping>(b.x + l, b.v + l, b.X + l, b.Dinv + l, b.R + l, b.vol[l], k, b.rhs + l,
-                                                    b.blocks + l);
+        kernels::p1_element<W, Blocks, MassDamping>(b.x + l, b.v + l, b.X + l, b.Dinv + l, b.R + l, b.vol[l],
+                                                    k, b.rhs + l, b.blocks + l);
     } else {
 #pragma omp simd
       for (int l = 0; l < W; ++l)
-        kernels::p2_forces<W, MassDamping>(b.x + l, b.v + l, b.X + l, b.Dinv + l, b.R + l, b.vol[l], k, Mref, b.rhs + l);
+        kernels::p2_forces<W, MassDamping>(b.x + l, b.v + l, b.X + l, b.Dinv + l, b.R + l, b.vol[l], k, Mref,
+                                           b.rhs + l);
       if (Blocks) {
 #pragma omp simd
         for (int l = 0; l < W; ++l) kernels::p2_gradient_pairs<W>(b.Dinv + l, b.R + l, b.vol[l], k, b.Q + l);
         for (int p = 0; p < 55; ++p) {
 #pragma omp simd
-          for (int l = 0; l < W; ++l) kernels::p2_block<W>(p, b.Q + l, b.vol[l], k, Mref, b.blocks + 9 * p * W + l);
+          for (int l = 0; l < W; ++l)
+            kernels::p2_block<W>(p, b.Q + l, b.vol[l], k, Mref, b.blocks + 9 * p * W + l);
         }
       }
     }
@@ -160,26 +163,30 @@ long long assemble_batched(const FemModel &model, const std::vector<int> &elemen
 }
 
 template <int N>
-long long assemble_order(const FemModel &model, const std::vector<int> &elements, const double *x, const double *v,
-                         const kernels::ElementConstants &k, const BlockPattern *pattern, double *values, double *rhs,
-                         Eigen::Matrix3d *rotations)
+long long assemble_order(const FemModel &model, const std::vector<int> &elements, const double *x,
+                         const double *v, const kernels::ElementConstants &k, const BlockPattern *pattern,
+                         double *values, double *rhs, Eigen::Matrix3d *rotations)
 {
   const bool damping = k.mass_rhs != 0;
-  if (values && damping) return assemble_batched<N, true, true>(model, elements, x, v, k, pattern, values, rhs, rotations);
-  if (values) return assemble_batched<N, true, false>(model, elements, x, v, k, pattern, values, rhs, rotations);
-  if (damping) return assemble_batched<N, false, true>(model, elements, x, v, k, pattern, values, rhs, rotations);
+  if (values && damping)
+    return assemble_batched<N, true, true>(model, elements, x, v, k, pattern, values, rhs, rotations);
+  if (values)
+    return assemble_batched<N, true, false>(model, elements, x, v, k, pattern, values, rhs, rotations);
+  if (damping)
+    return assemble_batched<N, false, true>(model, elements, x, v, k, pattern, values, rhs, rotations);
   return assemble_batched<N, false, false>(model, elements, x, v, k, pattern, values, rhs, rotations);
 }
 
 } // namespace
 
-long long assemble_elements_batched(const FemModel &model, const std::vector<int> &elements, const double *x, const double *v,
-                                    const StepCoefficients &c, const BlockPattern *pattern, double *values, double *rhs,
-                                    Eigen::Matrix3d *rotations)
+long long assemble_elements_batched(const FemModel &model, const std::vector<int> &elements, const double *x,
+                                    const double *v, const StepCoefficients &c, const BlockPattern *pattern,
+                                    double *values, double *rhs, Eigen::Matrix3d *rotations)
 {
   if (elements.empty()) return 0;
-  const kernels::ElementConstants k{c.force,        c.stiffness_rhs,   c.mass_rhs,           c.mass_matrix,
-                                    c.stiffness_matrix, model.lame.lambda, model.lame.mu, model.settings.density};
+  const kernels::ElementConstants k{c.force,       c.stiffness_rhs,       c.mass_rhs,
+                                    c.mass_matrix, c.stiffness_matrix,    model.lame.lambda,
+                                    model.lame.mu, model.settings.density};
   if (model.npe == 4) return assemble_order<4>(model, elements, x, v, k, pattern, values, rhs, rotations);
   return assemble_order<10>(model, elements, x, v, k, pattern, values, rhs, rotations);
 }

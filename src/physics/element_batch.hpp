@@ -13,9 +13,9 @@ constexpr int kElementLanes = 8;
 // assemble_elements' batched body (same contract; the checks are the caller's). Returns the number
 // of elements whose rotation took the scalar path (inverted, flat or not converged in the fixed
 // Newton steps).
-long long assemble_elements_batched(const FemModel &model, const std::vector<int> &elements, const double *x, const double *v,
-                                    const StepCoefficients &c, const BlockPattern *pattern, double *block_values, double *rhs,
-                                    Eigen::Matrix3d *rotations);
+long long assemble_elements_batched(const FemModel &model, const std::vector<int> &elements, const double *x,
+                                    const double *v, const StepCoefficients &c, const BlockPattern *pattern,
+                                    double *block_values, double *rhs, Eigen::Matrix3d *rotations);
 
 // Estimated floating-point operations per element of the batched kernels (for -log_view's rates).
 double element_kernel_flops(int order, bool with_blocks);

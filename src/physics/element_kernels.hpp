@@ -16,11 +16,11 @@
 #include <cmath>
 
 #if defined(__CUDACC__)
-#define BINBCSR_PHYS_HD __host__ __device__ __forceinline__
-#define BINBCSR_PHYS_UNROLL _Pragma("unroll")
+  #define BINBCSR_PHYS_HD     __host__ __device__ __forceinline__
+  #define BINBCSR_PHYS_UNROLL _Pragma("unroll")
 #else
-#define BINBCSR_PHYS_HD inline __attribute__((always_inline))
-#define BINBCSR_PHYS_UNROLL _Pragma("GCC unroll 64")
+  #define BINBCSR_PHYS_HD     inline __attribute__((always_inline))
+  #define BINBCSR_PHYS_UNROLL _Pragma("GCC unroll 64")
 #endif
 
 namespace physics {
@@ -36,19 +36,17 @@ struct ElementConstants {
 // ---- deformation gradient -------------------------------------------------------------------------
 
 // F = Ds Dm^-1, Ds = (x1 - x0, x2 - x0, x3 - x0) from the corner positions xc (node-major, 12 entries).
-template <int S>
-BINBCSR_PHYS_HD void deformation_gradient(const double *xc, const double *Dinv, double *F)
+template <int S> BINBCSR_PHYS_HD void deformation_gradient(const double *xc, const double *Dinv, double *F)
 {
   double Ds[9];
   BINBCSR_PHYS_UNROLL
-  for (int k = 0; k < 3; ++k)
-    BINBCSR_PHYS_UNROLL
-    for (int r = 0; r < 3; ++r) Ds[3 * k + r] = xc[(3 * (k + 1) + r) * S] - xc[r * S];
+  for (int k = 0; k < 3; ++k) BINBCSR_PHYS_UNROLL
+  for (int r = 0; r < 3; ++r) Ds[3 * k + r] = xc[(3 * (k + 1) + r) * S] - xc[r * S];
   BINBCSR_PHYS_UNROLL
-  for (int c = 0; c < 3; ++c)
-    BINBCSR_PHYS_UNROLL
-    for (int r = 0; r < 3; ++r)
-      F[(3 * c + r) * S] = Ds[r] * Dinv[(3 * c) * S] + Ds[3 + r] * Dinv[(3 * c + 1) * S] + Ds[6 + r] * Dinv[(3 * c + 2) * S];
+  for (int c = 0; c < 3; ++c) BINBCSR_PHYS_UNROLL
+  for (int r = 0; r < 3; ++r)
+    F[(3 * c + r) * S] =
+      Ds[r] * Dinv[(3 * c) * S] + Ds[3 + r] * Dinv[(3 * c + 1) * S] + Ds[6 + r] * Dinv[(3 * c + 2) * S];
 }
 
 // ---- rotation -------------------------------------------------------------------------------------
@@ -87,8 +85,7 @@ BINBCSR_PHYS_HD void cofactor3(const double *X, double *C, double &det)
 // path (rotation_from_deformation: inverted or flat elements get the sign-corrected SVD rotation,
 // broken F the identity). R is then the identity, and no lane divides by zero or makes NaN on the way.
 // (A double, not a flag type: in the lane loop a 32-bit result would halve the vector width.)
-template <int S>
-BINBCSR_PHYS_HD double polar_rotation(const double *F, double *R)
+template <int S> BINBCSR_PHYS_HD double polar_rotation(const double *F, double *R)
 {
   double X[9], C[9], det, s2 = 0;
   BINBCSR_PHYS_UNROLL
@@ -116,7 +113,7 @@ BINBCSR_PHYS_HD double polar_rotation(const double *F, double *R)
       g = std::sqrt(std::sqrt(c2 / (det * det * x2))); // (|X^-1| / |X|)^(1/2), |X^-1| = |cof X| / |det X|
     }
     const double a = 0.5 * g, b = 0.5 / (g * det);
-    change         = 0;
+    change = 0;
     BINBCSR_PHYS_UNROLL
     for (int j = 0; j < 9; ++j) {
       const double next = a * X[j] + b * C[j];
@@ -136,8 +133,7 @@ BINBCSR_PHYS_HD double polar_rotation(const double *F, double *R)
 // ---- shared element pieces ------------------------------------------------------------------------
 
 // Barycentric gradients g_a (4 x 3, node-major) from Dm^-1: g_{k+1} = row k, g_0 = -(g_1 + g_2 + g_3).
-template <int S>
-BINBCSR_PHYS_HD void barycentric_gradients(const double *Dinv, double g[4][3])
+template <int S> BINBCSR_PHYS_HD void barycentric_gradients(const double *Dinv, double g[4][3])
 {
   BINBCSR_PHYS_UNROLL
   for (int d = 0; d < 3; ++d) {
@@ -150,8 +146,8 @@ BINBCSR_PHYS_HD void barycentric_gradients(const double *Dinv, double g[4][3])
 // z_b = R^T (a_f x_b + a_K v_b) - a_f X_b for n nodes: the displacement in the element's rest frame
 // (plus the stiffness-damping velocity term), so that rhs_a = -R sum_b K0_ab z_b in one pass.
 template <int S, int N>
-BINBCSR_PHYS_HD void rest_frame_displacements(const double *x, const double *v, const double *X, const double *R,
-                                              const ElementConstants &k, double z[N][3])
+BINBCSR_PHYS_HD void rest_frame_displacements(const double *x, const double *v, const double *X,
+                                              const double *R, const ElementConstants &k, double z[N][3])
 {
   BINBCSR_PHYS_UNROLL
   for (int b = 0; b < N; ++b) {
@@ -160,13 +156,13 @@ BINBCSR_PHYS_HD void rest_frame_displacements(const double *x, const double *v, 
     for (int d = 0; d < 3; ++d) y[d] = k.force * x[(3 * b + d) * S] + k.stiffness_rhs * v[(3 * b + d) * S];
     BINBCSR_PHYS_UNROLL
     for (int i = 0; i < 3; ++i)
-      z[b][i] = R[(3 * i) * S] * y[0] + R[(3 * i + 1) * S] * y[1] + R[(3 * i + 2) * S] * y[2] - k.force * X[(3 * b + i) * S];
+      z[b][i] = R[(3 * i) * S] * y[0] + R[(3 * i + 1) * S] * y[1] + R[(3 * i + 2) * S] * y[2] -
+                k.force * X[(3 * b + i) * S];
   }
 }
 
 // r = R g (R column-major at stride S).
-template <int S>
-BINBCSR_PHYS_HD void rotate(const double *R, const double g[3], double r[3])
+template <int S> BINBCSR_PHYS_HD void rotate(const double *R, const double g[3], double r[3])
 {
   BINBCSR_PHYS_UNROLL
   for (int i = 0; i < 3; ++i) r[i] = R[i * S] * g[0] + R[(3 + i) * S] * g[1] + R[(6 + i) * S] * g[2];
@@ -177,9 +173,9 @@ BINBCSR_PHYS_HD void linear_stress(const double G[9], double lambda, double mu, 
 {
   const double tr = G[0] + G[4] + G[8];
   BINBCSR_PHYS_UNROLL
-  for (int i = 0; i < 3; ++i)
-    BINBCSR_PHYS_UNROLL
-    for (int j = 0; j < 3; ++j) sigma[3 * i + j] = mu * (G[3 * i + j] + G[3 * j + i]) + (i == j ? lambda * tr : 0.0);
+  for (int i = 0; i < 3; ++i) BINBCSR_PHYS_UNROLL
+  for (int j = 0; j < 3; ++j)
+    sigma[3 * i + j] = mu * (G[3 * i + j] + G[3 * j + i]) + (i == j ? lambda * tr : 0.0);
 }
 
 // ---- P1 -------------------------------------------------------------------------------------------
@@ -189,17 +185,18 @@ BINBCSR_PHYS_HD void linear_stress(const double G[9], double lambda, double mu, 
 //   rhs_a = -V R sigma g_a - a_M m v_a,   sigma = stress of G = sum_b z_b g_b^T,   m = rho V / 4.
 // x, v, X: 12 entries; rhs: 12; blocks: 10 x 9 (written only when Blocks).
 template <int S, bool Blocks, bool MassDamping>
-BINBCSR_PHYS_HD void p1_element(const double *x, const double *v, const double *X, const double *Dinv, const double *R,
-                                double vol, const ElementConstants &k, double *rhs, double *blocks)
+BINBCSR_PHYS_HD void p1_element(const double *x, const double *v, const double *X, const double *Dinv,
+                                const double *R, double vol, const ElementConstants &k, double *rhs,
+                                double *blocks)
 {
   double g[4][3], z[4][3];
   barycentric_gradients<S>(Dinv, g);
   rest_frame_displacements<S, 4>(x, v, X, R, k, z);
   double G[9];
   BINBCSR_PHYS_UNROLL
-  for (int i = 0; i < 3; ++i)
-    BINBCSR_PHYS_UNROLL
-    for (int j = 0; j < 3; ++j) G[3 * i + j] = z[0][i] * g[0][j] + z[1][i] * g[1][j] + z[2][i] * g[2][j] + z[3][i] * g[3][j];
+  for (int i = 0; i < 3; ++i) BINBCSR_PHYS_UNROLL
+  for (int j = 0; j < 3; ++j)
+    G[3 * i + j] = z[0][i] * g[0][j] + z[1][i] * g[1][j] + z[2][i] * g[2][j] + z[3][i] * g[3][j];
   double sigma[9];
   linear_stress(G, k.lambda, k.mu, sigma);
   const double m = k.density * vol * 0.25; // lumped: reference_mass = I / 4
@@ -207,29 +204,31 @@ BINBCSR_PHYS_HD void p1_element(const double *x, const double *v, const double *
   for (int a = 0; a < 4; ++a) {
     double sg[3];
     BINBCSR_PHYS_UNROLL
-    for (int i = 0; i < 3; ++i) sg[i] = sigma[3 * i] * g[a][0] + sigma[3 * i + 1] * g[a][1] + sigma[3 * i + 2] * g[a][2];
+    for (int i = 0; i < 3; ++i)
+      sg[i] = sigma[3 * i] * g[a][0] + sigma[3 * i + 1] * g[a][1] + sigma[3 * i + 2] * g[a][2];
     double f[3];
     rotate<S>(R, sg, f);
     BINBCSR_PHYS_UNROLL
-    for (int d = 0; d < 3; ++d) rhs[(3 * a + d) * S] = -vol * f[d] - (MassDamping ? k.mass_rhs * m * v[(3 * a + d) * S] : 0.0);
+    for (int d = 0; d < 3; ++d)
+      rhs[(3 * a + d) * S] = -vol * f[d] - (MassDamping ? k.mass_rhs * m * v[(3 * a + d) * S] : 0.0);
   }
   if (!Blocks) return;
   double rg[4][3];
   BINBCSR_PHYS_UNROLL
   for (int a = 0; a < 4; ++a) rotate<S>(R, g[a], rg[a]);
   const double kv = k.stiffness_matrix * vol, kl = kv * k.lambda, km = kv * k.mu;
-  int          p  = 0;
+  int          p = 0;
   BINBCSR_PHYS_UNROLL
-  for (int a = 0; a < 4; ++a)
+  for (int a = 0; a < 4; ++a) BINBCSR_PHYS_UNROLL
+  for (int b = a; b < 4; ++b, ++p) {
+    const double diag =
+      km * (g[a][0] * g[b][0] + g[a][1] * g[b][1] + g[a][2] * g[b][2]) + (a == b ? k.mass_matrix * m : 0.0);
     BINBCSR_PHYS_UNROLL
-    for (int b = a; b < 4; ++b, ++p) {
-      const double diag = km * (g[a][0] * g[b][0] + g[a][1] * g[b][1] + g[a][2] * g[b][2]) + (a == b ? k.mass_matrix * m : 0.0);
-      BINBCSR_PHYS_UNROLL
-      for (int i = 0; i < 3; ++i)
-        BINBCSR_PHYS_UNROLL
-        for (int j = 0; j < 3; ++j)
-          blocks[(9 * p + 3 * i + j) * S] = kl * rg[a][i] * rg[b][j] + km * rg[b][i] * rg[a][j] + (i == j ? diag : 0.0);
-    }
+    for (int i = 0; i < 3; ++i) BINBCSR_PHYS_UNROLL
+    for (int j = 0; j < 3; ++j)
+      blocks[(9 * p + 3 * i + j) * S] =
+        kl * rg[a][i] * rg[b][j] + km * rg[b][i] * rg[a][j] + (i == j ? diag : 0.0);
+  }
 }
 
 } // namespace kernels

@@ -38,7 +38,7 @@ struct P2BlockTerms {
     for (int i = 0; i < 10; ++i)
       for (int j = i; j < 10; ++j, ++p) {
         a[p] = i, b[p] = j;
-        int n = 0;
+        int  n   = 0;
         auto add = [&](int c, int d, double w) { cd[p][n] = 4 * c + d, coef[p][n] = w, ++n; };
         if (j < 4) { // corner-corner
           add(i, j, i == j ? 3.0 / 5 : -1.0 / 5);
@@ -63,8 +63,9 @@ constexpr P2BlockTerms kP2Blocks{};
 // One quadratic tetrahedron's forces: rhs (30) = -R sum_b K0_ab z_b - a_M m sum_b Mref_ab v_b, m = rho V;
 // Mref: 10 x 10 reference mass.
 template <int S, bool MassDamping>
-BINBCSR_PHYS_HD void p2_forces(const double *x, const double *v, const double *X, const double *Dinv, const double *R, double vol,
-                               const ElementConstants &k, const double *Mref, double *rhs)
+BINBCSR_PHYS_HD void p2_forces(const double *x, const double *v, const double *X, const double *Dinv,
+                               const double *R, double vol, const ElementConstants &k, const double *Mref,
+                               double *rhs)
 {
   double g[4][3], z[10][3];
   barycentric_gradients<S>(Dinv, g);
@@ -80,32 +81,30 @@ BINBCSR_PHYS_HD void p2_forces(const double *x, const double *v, const double *X
       BINBCSR_PHYS_UNROLL
       for (int i = 0; i < 3; ++i) w[i] = kk == d ? 3.0 * z[d][i] : 4.0 * z[4 + kP2EdgeOf[d][kk]][i] - z[d][i];
       BINBCSR_PHYS_UNROLL
-      for (int i = 0; i < 3; ++i)
-        BINBCSR_PHYS_UNROLL
-        for (int j = 0; j < 3; ++j) G[3 * i + j] += w[i] * g[d][j];
+      for (int i = 0; i < 3; ++i) BINBCSR_PHYS_UNROLL
+      for (int j = 0; j < 3; ++j) G[3 * i + j] += w[i] * g[d][j];
     }
     double sigma[9];
     linear_stress(G, k.lambda, k.mu, sigma);
     BINBCSR_PHYS_UNROLL
-    for (int c = 0; c < 4; ++c)
-      BINBCSR_PHYS_UNROLL
-      for (int i = 0; i < 3; ++i) y[kk][c][i] = sigma[3 * i] * g[c][0] + sigma[3 * i + 1] * g[c][1] + sigma[3 * i + 2] * g[c][2];
+    for (int c = 0; c < 4; ++c) BINBCSR_PHYS_UNROLL
+    for (int i = 0; i < 3; ++i)
+      y[kk][c][i] = sigma[3 * i] * g[c][0] + sigma[3 * i + 1] * g[c][1] + sigma[3 * i + 2] * g[c][2];
   }
   const double m = k.density * vol;
   BINBCSR_PHYS_UNROLL
   for (int a = 0; a < 10; ++a) {
     double s[3] = {0, 0, 0};
     BINBCSR_PHYS_UNROLL
-    for (int kk = 0; kk < 4; ++kk)
-      BINBCSR_PHYS_UNROLL
-      for (int i = 0; i < 3; ++i) {
-        if (a < 4) {
-          s[i] += (kk == a ? 3.0 / 20 : -1.0 / 20) * y[kk][a][i];
-        } else {
-          const int ci = kP2EdgeCorners[a - 4][0], cj = kP2EdgeCorners[a - 4][1];
-          s[i] += (kk == cj ? 2.0 / 5 : 1.0 / 5) * y[kk][ci][i] + (kk == ci ? 2.0 / 5 : 1.0 / 5) * y[kk][cj][i];
-        }
+    for (int kk = 0; kk < 4; ++kk) BINBCSR_PHYS_UNROLL
+    for (int i = 0; i < 3; ++i) {
+      if (a < 4) {
+        s[i] += (kk == a ? 3.0 / 20 : -1.0 / 20) * y[kk][a][i];
+      } else {
+        const int ci = kP2EdgeCorners[a - 4][0], cj = kP2EdgeCorners[a - 4][1];
+        s[i] += (kk == cj ? 2.0 / 5 : 1.0 / 5) * y[kk][ci][i] + (kk == ci ? 2.0 / 5 : 1.0 / 5) * y[kk][cj][i];
       }
+    }
     double f[3];
     rotate<S>(R, s, f);
     BINBCSR_PHYS_UNROLL
@@ -122,7 +121,8 @@ BINBCSR_PHYS_HD void p2_forces(const double *x, const double *v, const double *X
 
 // Its rotated gradient pairs Q_cd (16 x 9, row-major, at (9 (4 c + d) + e) S), scaled by c_K V.
 template <int S>
-BINBCSR_PHYS_HD void p2_gradient_pairs(const double *Dinv, const double *R, double vol, const ElementConstants &k, double *Q)
+BINBCSR_PHYS_HD void p2_gradient_pairs(const double *Dinv, const double *R, double vol,
+                                       const ElementConstants &k, double *Q)
 {
   double g[4][3], rg[4][3];
   barycentric_gradients<S>(Dinv, g);
@@ -130,21 +130,21 @@ BINBCSR_PHYS_HD void p2_gradient_pairs(const double *Dinv, const double *R, doub
   for (int c = 0; c < 4; ++c) rotate<S>(R, g[c], rg[c]);
   const double kv = k.stiffness_matrix * vol, kl = kv * k.lambda, km = kv * k.mu;
   BINBCSR_PHYS_UNROLL
-  for (int c = 0; c < 4; ++c)
+  for (int c = 0; c < 4; ++c) BINBCSR_PHYS_UNROLL
+  for (int d = 0; d < 4; ++d) {
+    const double diag = km * (g[c][0] * g[d][0] + g[c][1] * g[d][1] + g[c][2] * g[d][2]);
     BINBCSR_PHYS_UNROLL
-    for (int d = 0; d < 4; ++d) {
-      const double diag = km * (g[c][0] * g[d][0] + g[c][1] * g[d][1] + g[c][2] * g[d][2]);
-      BINBCSR_PHYS_UNROLL
-      for (int i = 0; i < 3; ++i)
-        BINBCSR_PHYS_UNROLL
-        for (int j = 0; j < 3; ++j)
-          Q[(9 * (4 * c + d) + 3 * i + j) * S] = kl * rg[c][i] * rg[d][j] + km * rg[d][i] * rg[c][j] + (i == j ? diag : 0.0);
-    }
+    for (int i = 0; i < 3; ++i) BINBCSR_PHYS_UNROLL
+    for (int j = 0; j < 3; ++j)
+      Q[(9 * (4 * c + d) + 3 * i + j) * S] =
+        kl * rg[c][i] * rg[d][j] + km * rg[d][i] * rg[c][j] + (i == j ? diag : 0.0);
+  }
 }
 
 // Block p of its 55 upper blocks: c_K R K0_ab R^T + c_M m Mref_ab I, m = rho V, from the pairs Q.
 template <int S>
-BINBCSR_PHYS_HD void p2_block(int p, const double *Q, double vol, const ElementConstants &k, const double *Mref, double *block)
+BINBCSR_PHYS_HD void p2_block(int p, const double *Q, double vol, const ElementConstants &k,
+                              const double *Mref, double *block)
 {
   double B[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
   BINBCSR_PHYS_UNROLL
@@ -161,8 +161,9 @@ BINBCSR_PHYS_HD void p2_block(int p, const double *Q, double vol, const ElementC
 
 // Both, for a caller that owns one element (S = 1, a GPU thread).
 template <int S, bool Blocks, bool MassDamping>
-BINBCSR_PHYS_HD void p2_element(const double *x, const double *v, const double *X, const double *Dinv, const double *R,
-                                double vol, const ElementConstants &k, const double *Mref, double *rhs, double *blocks)
+BINBCSR_PHYS_HD void p2_element(const double *x, const double *v, const double *X, const double *Dinv,
+                                const double *R, double vol, const ElementConstants &k, const double *Mref,
+                                double *rhs, double *blocks)
 {
   p2_forces<S, MassDamping>(x, v, X, Dinv, R, vol, k, Mref, rhs);
   if (!Blocks) return;

@@ -12,7 +12,7 @@ namespace {
 Eigen::Matrix<double, 3, 4> corner_matrix(const TetMesh &mesh, const double *pos, int e)
 {
   Eigen::Matrix<double, 3, 4> X;
-  const int *n = &mesh.elements[static_cast<size_t>(e) * mesh.nodes_per_element()];
+  const int                  *n = &mesh.elements[static_cast<size_t>(e) * mesh.nodes_per_element()];
   for (int k = 0; k < 4; ++k)
     for (int d = 0; d < 3; ++d) X(d, k) = pos[3 * n[k] + d];
   return X;
@@ -26,10 +26,10 @@ FemModel make_fem_model(const TetMesh &mesh, const FemSettings &settings)
   const LameParameters lame = lame_from_young_poisson(settings.young, settings.poisson);
   if (!(settings.density > 0)) throw std::invalid_argument("material: density must be > 0");
   FemModel m;
-  m.mesh     = mesh;
-  m.settings = settings;
-  m.npe      = mesh.nodes_per_element();
-  m.lame     = lame;
+  m.mesh       = mesh;
+  m.settings   = settings;
+  m.npe        = mesh.nodes_per_element();
+  m.lame       = lame;
   const int ne = mesh.element_count(), nb = packed_block_count(m.npe);
   m.rest_shape_inverse.resize(ne);
   m.volume.resize(ne);
@@ -47,10 +47,11 @@ FemModel make_fem_model(const TetMesh &mesh, const FemSettings &settings)
           len += std::pow(mesh.nodes[3 * a + d] - mesh.nodes[3 * b + d], 2);
         }
         if (dev > 1e-12 * len)
-          throw std::runtime_error("mesh: element " + std::to_string(e) +
-                                   " is a curved 10-node tetrahedron (edge node off its edge's midpoint); only straight-sided "
-                                   "elements are supported: mesh with order 1 and use -fem_order 2, or set "
-                                   "Mesh.SecondOrderLinear = 1 in gmsh");
+          throw std::runtime_error(
+            "mesh: element " + std::to_string(e) +
+            " is a curved 10-node tetrahedron (edge node off its edge's midpoint); only straight-sided "
+            "elements are supported: mesh with order 1 and use -fem_order 2, or set "
+            "Mesh.SecondOrderLinear = 1 in gmsh");
       }
     }
     m.rest_shape_inverse[e] = g.rest_shape_inverse;
@@ -58,10 +59,11 @@ FemModel make_fem_model(const TetMesh &mesh, const FemSettings &settings)
     if (mesh.order == 1)
       for (int a = 0; a < 4; ++a)
         for (int d = 0; d < 3; ++d) m.gradients.push_back(g.grad_barycentric(a, d));
-    const Eigen::MatrixXd K = element_stiffness(g, mesh.order, lame);
-    double *out = &m.stiffness[static_cast<size_t>(e) * nb * 9];
+    const Eigen::MatrixXd K   = element_stiffness(g, mesh.order, lame);
+    double               *out = &m.stiffness[static_cast<size_t>(e) * nb * 9];
     for (int a = 0; a < m.npe; ++a)
-      for (int b = a; b < m.npe; ++b) Eigen::Map<Eigen::Matrix3d>(out + 9 * packed_block(a, b, m.npe)) = K.block<3, 3>(3 * a, 3 * b);
+      for (int b = a; b < m.npe; ++b)
+        Eigen::Map<Eigen::Matrix3d>(out + 9 * packed_block(a, b, m.npe)) = K.block<3, 3>(3 * a, 3 * b);
   }
   m.reference_mass = reference_mass(mesh.order, settings.mass);
   m.diagonal_mass  = m.reference_mass.isDiagonal();
@@ -103,12 +105,12 @@ double total_mass(const FemModel &model)
 
 FemEnergy fem_energy(const FemModel &model, const double *x, const double *v)
 {
-  FemEnergy  E;
-  const int  npe = model.npe;
-  const auto &X  = model.mesh.nodes;
+  FemEnergy       E;
+  const int       npe = model.npe;
+  const auto     &X   = model.mesh.nodes;
   Eigen::VectorXd u(3 * npe), Ku(3 * npe);
   for (int e = 0; e < model.element_count(); ++e) {
-    const int *n = &model.mesh.elements[static_cast<size_t>(e) * npe];
+    const int      *n = &model.mesh.elements[static_cast<size_t>(e) * npe];
     Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
     if (model.settings.corotational) {
       Eigen::Matrix3d Ds;

@@ -11,10 +11,10 @@
 namespace physics {
 
 struct FemSettings {
-  double      young        = 1e6;  // Pa
+  double      young        = 1e6; // Pa
   double      poisson      = 0.3;
-  double      density      = 1000; // kg/m^3
-  bool        corotational = true; // false: plain linear elasticity (R = I)
+  double      density      = 1000;                    // kg/m^3
+  bool        corotational = true;                    // false: plain linear elasticity (R = I)
   MassLumping mass         = MassLumping::Consistent; // order 2 only; order 1 is always lumped
 };
 

@@ -16,7 +16,7 @@ struct JointMatrixPattern {
   // index of each (joint p, joint q) pair, p-major. Flattened over bodies.
   std::vector<int> body_of_group, group_start; // group g covers joints group_start[g]..group_start[g+1]-1
   std::vector<int> group_joint, group_sign;
-  std::vector<int> pair_start, pair_block;     // pair_block[pair_start[g] + p*n_g + q]
+  std::vector<int> pair_start, pair_block; // pair_block[pair_start[g] + p*n_g + q]
   // 1 where a pair is the first (in group order) to reach its block: the fill writes there instead of
   // adding, so the 9 values per block need no zeroing pass first. Blocks that no body reaches are listed.
   std::vector<char> pair_first;
@@ -30,24 +30,25 @@ JointMatrixPattern build_joint_matrix_pattern(const ArticulatedScene &scene);
 // world arm r_p per unit impulse at arm r_q (s = +1 at end a, -1 at end b). regularisation > 0
 // adds regularisation * (mean diagonal entry of the block) * I to each diagonal block.
 // `orientations`, when given, replaces the bodies' orientations (the matrix at predicted positions).
-void fill_joint_matrix(const ArticulatedScene &scene, const JointMatrixPattern &pattern, double regularisation,
-                       std::vector<double> &block_values, const std::vector<Eigen::Quaterniond> *orientations = nullptr);
+void fill_joint_matrix(const ArticulatedScene &scene, const JointMatrixPattern &pattern,
+                       double regularisation, std::vector<double> &block_values,
+                       const std::vector<Eigen::Quaterniond> *orientations = nullptr);
 
 // The same from what a time step has at hand already: every body's world inverse inertia and every joint's
 // world arms (arm_a of end a, arm_b of end b; ignored for the world). Allocates nothing once block_values
 // has its size. group_mask (one entry per body group of the pattern), when given, skips the bodies whose
 // group is 0: the block rows of joints in marked groups are still complete (every body adding to block
 // (p, q) carries joint p), the others are left unset (see joint_groups_of_rows).
-void fill_joint_matrix(const ArticulatedScene &scene, const JointMatrixPattern &pattern, double regularisation,
-                       const std::vector<Eigen::Matrix3d> &inverse_inertia_world, const std::vector<Eigen::Vector3d> &arm_a,
-                       const std::vector<Eigen::Vector3d> &arm_b, std::vector<double> &block_values,
-                       const std::vector<char> *group_mask = nullptr);
+void fill_joint_matrix(const ArticulatedScene &scene, const JointMatrixPattern &pattern,
+                       double regularisation, const std::vector<Eigen::Matrix3d> &inverse_inertia_world,
+                       const std::vector<Eigen::Vector3d> &arm_a, const std::vector<Eigen::Vector3d> &arm_b,
+                       std::vector<double> &block_values, const std::vector<char> *group_mask = nullptr);
 
 // The group mask that fills exactly the block rows `rows` (joints) completely: the bodies of those joints.
 std::vector<char> joint_groups_of_rows(const JointMatrixPattern &pattern, const std::vector<int> &rows);
 
 // y = A x with the block values (reference product for tests and diagnostics).
-void joint_matrix_multiply(const JointMatrixPattern &pattern, const std::vector<double> &block_values, const std::vector<double> &x,
-                           std::vector<double> &y);
+void joint_matrix_multiply(const JointMatrixPattern &pattern, const std::vector<double> &block_values,
+                           const std::vector<double> &x, std::vector<double> &y);
 
 } // namespace physics

@@ -49,7 +49,8 @@ public:
   {
     std::string line;
     if (!next_line(line)) fail("missing $End" + section);
-    if (line.rfind("$End" + section, 0) != 0) fail("expected $End" + section + ", found '" + line + "' (count mismatch?)");
+    if (line.rfind("$End" + section, 0) != 0)
+      fail("expected $End" + section + ", found '" + line + "' (count mismatch?)");
   }
 
   void skip_section(const std::string &section)
@@ -58,26 +59,31 @@ public:
     const int   start = line_no_;
     while (next_line(line))
       if (line.rfind("$End" + section, 0) == 0) return;
-    fail("section $" + section + " opened at line " + std::to_string(start) + " is not terminated (no $End" + section + ")");
+    fail("section $" + section + " opened at line " + std::to_string(start) + " is not terminated (no $End" +
+         section + ")");
   }
 
   TetMesh parse()
   {
     std::string line;
-    double      version = 0;
+    double      version     = 0;
     bool        have_format = false, have_nodes = false, have_elements = false;
     while (next_line(line)) {
       if (line[0] != '$') fail("expected a section header, found '" + line + "'");
-      const std::string section = line.substr(1, line.find_first_of(" \t") == std::string::npos ? std::string::npos
-                                                                                                 : line.find_first_of(" \t") - 1);
+      const std::string section =
+        line.substr(1, line.find_first_of(" \t") == std::string::npos ? std::string::npos
+                                                                      : line.find_first_of(" \t") - 1);
       // gmsh files open with $MeshFormat: anything else (a misspelt header) is named here, not
       // skipped to the end of the file as an unknown section
-      if (!have_format && section != "MeshFormat") fail("expected $MeshFormat as the first section, found '" + line + "'");
+      if (!have_format && section != "MeshFormat")
+        fail("expected $MeshFormat as the first section, found '" + line + "'");
       if (section == "MeshFormat") {
-        auto s  = data_line("$MeshFormat");
-        version = get<double>(s, "format version");
+        auto s              = data_line("$MeshFormat");
+        version             = get<double>(s, "format version");
         const int file_type = get<int>(s, "file type");
-        if (file_type != 0) fail("binary .msh files are not supported: save the mesh as ASCII (gmsh -format msh22 or msh41, Mesh.Binary = 0)");
+        if (file_type != 0)
+          fail(
+            "binary .msh files are not supported: save the mesh as ASCII (gmsh -format msh22 or msh41, Mesh.Binary = 0)");
         if (version != 2.2 && version != 4.1)
           fail("unsupported .msh version " + std::to_string(version) + " (supported: 2.2 and 4.1 ASCII)");
         expect_end("MeshFormat");
@@ -105,13 +111,14 @@ public:
 private:
   void add_node(long long tag, double x, double y, double z)
   {
-    if (!node_index_.emplace(tag, static_cast<int>(coords_.size() / 3)).second) fail("duplicate node tag " + std::to_string(tag));
+    if (!node_index_.emplace(tag, static_cast<int>(coords_.size() / 3)).second)
+      fail("duplicate node tag " + std::to_string(tag));
     coords_.insert(coords_.end(), {x, y, z});
   }
 
   void read_nodes_2()
   {
-    auto      s = data_line("node count");
+    auto            s = data_line("node count");
     const long long n = get<long long>(s, "node count");
     if (n < 0) fail("negative node count");
     for (long long i = 0; i < n; ++i) {
@@ -124,7 +131,8 @@ private:
 
   // Format 4.1 sections ($Nodes, $Elements) share one shape: a header "blocks total ...", then per
   // entity block "dim tag <kind> count" and its lines. One walker checks the counts for both.
-  template <class ReadBlock> void read_entity_blocks(const char *section, const char *items, const char *kind, ReadBlock read_block)
+  template <class ReadBlock>
+  void read_entity_blocks(const char *section, const char *items, const char *kind, ReadBlock read_block)
   {
     auto            s      = data_line((std::string(section) + " header").c_str());
     const long long blocks = get<long long>(s, "number of entity blocks");
@@ -140,7 +148,9 @@ private:
       read_block(block_kind, count);
       seen += count;
     }
-    if (seen != n) fail(std::string(section) + " announces " + std::to_string(n) + " " + items + "s but its blocks hold " + std::to_string(seen));
+    if (seen != n)
+      fail(std::string(section) + " announces " + std::to_string(n) + " " + items + "s but its blocks hold " +
+           std::to_string(seen));
   }
 
   void read_nodes_4()
@@ -207,7 +217,8 @@ private:
 
   TetMesh build()
   {
-    if (tets_.empty()) fail("the mesh has no tetrahedra (gmsh types 4 or 11); was it meshed in 3D (gmsh -3)?");
+    if (tets_.empty())
+      fail("the mesh has no tetrahedra (gmsh types 4 or 11); was it meshed in 3D (gmsh -3)?");
     TetMesh m;
     m.order = order_;
     std::vector<int> new_index(coords_.size() / 3, -1);
@@ -223,14 +234,14 @@ private:
     return m;
   }
 
-  std::istream                           &in_;
-  std::string                             name_;
-  int                                     line_no_ = 0;
-  int                                     order_   = 0;
-  std::vector<double>                     coords_;
-  std::unordered_map<long long, int>      node_index_;
-  std::vector<int>                        tets_;
-  std::vector<long long>                  tet_tags_; // the file's tag of each tetrahedron, for messages
+  std::istream                      &in_;
+  std::string                        name_;
+  int                                line_no_ = 0;
+  int                                order_   = 0;
+  std::vector<double>                coords_;
+  std::unordered_map<long long, int> node_index_;
+  std::vector<int>                   tets_;
+  std::vector<long long>             tet_tags_; // the file's tag of each tetrahedron, for messages
 };
 
 } // namespace

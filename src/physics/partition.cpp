@@ -31,13 +31,14 @@ Renumbering identity_renumbering(int n)
   Renumbering r;
   r.new_of_old.resize(n);
   std::iota(r.new_of_old.begin(), r.new_of_old.end(), 0);
-  r.old_of_new = r.new_of_old;
+  r.old_of_new   = r.new_of_old;
   r.part_offsets = {0, n};
   return r;
 }
 
 // Subgraph induced by `vertices` (old numbers), numbered by their position in `vertices`.
-AdjacencyGraph induced_subgraph(const AdjacencyGraph &g, const std::vector<int> &vertices, std::vector<int> &local_of)
+AdjacencyGraph induced_subgraph(const AdjacencyGraph &g, const std::vector<int> &vertices,
+                                std::vector<int> &local_of)
 {
   for (std::size_t k = 0; k < vertices.size(); ++k) local_of[vertices[k]] = static_cast<int>(k);
   AdjacencyGraph s;
@@ -67,7 +68,7 @@ int bfs_far_vertex(const AdjacencyGraph &g, int root, std::vector<int> &level, i
         queue.push_back(g.adjncy[e]);
       }
   }
-  depth = level[queue.back()];
+  depth    = level[queue.back()];
   int best = queue.back();
   for (int v : queue) {
     if (level[v] == depth && g.xadj[v + 1] - g.xadj[v] < g.xadj[best + 1] - g.xadj[best]) best = v;
@@ -83,7 +84,7 @@ std::vector<int> rcm_old_of_new(const AdjacencyGraph &g)
   order.reserve(n);
   std::vector<int>  level(n, -1);
   std::vector<char> placed(n, 0);
-  auto degree = [&](int v) { return g.xadj[v + 1] - g.xadj[v]; };
+  auto              degree = [&](int v) { return g.xadj[v + 1] - g.xadj[v]; };
   for (int start = 0; start < n; ++start) {
     if (placed[start]) continue;
     // George-Liu pseudo-peripheral vertex: walk to the far end of the BFS until the depth stops growing.
@@ -129,8 +130,10 @@ std::vector<int> nested_dissection_old_of_new(const AdjacencyGraph &g)
   idx_t              options[METIS_NOPTIONS];
   METIS_SetDefaultOptions(options);
   options[METIS_OPTION_NUMBERING] = 0;
-  const int status = METIS_NodeND(&n, xadj.data(), adjncy.data(), nullptr, options, perm.data(), iperm.data());
-  if (status != METIS_OK) throw std::runtime_error("METIS_NodeND failed with status " + std::to_string(status));
+  const int status =
+    METIS_NodeND(&n, xadj.data(), adjncy.data(), nullptr, options, perm.data(), iperm.data());
+  if (status != METIS_OK)
+    throw std::runtime_error("METIS_NodeND failed with status " + std::to_string(status));
   // METIS: row i of the permuted matrix is row perm[i] of the original.
   return std::vector<int>(perm.begin(), perm.end());
 }
@@ -172,10 +175,14 @@ std::vector<int> metis_parts(const AdjacencyGraph &g, int parts, const Partition
   options[METIS_OPTION_NUMBERING] = 0;
   options[METIS_OPTION_SEED]      = opt.seed;
   options[METIS_OPTION_CONTIG]    = 0;
-  idx_t *w                        = vwgt.empty() ? nullptr : vwgt.data();
-  const int status = parts <= 8 ? METIS_PartGraphRecursive(&nv, &ncon, xadj.data(), adjncy.data(), w, nullptr, nullptr, &np, nullptr, nullptr, options, &objval, where.data())
-                                : METIS_PartGraphKway(&nv, &ncon, xadj.data(), adjncy.data(), w, nullptr, nullptr, &np, nullptr, nullptr, options, &objval, where.data());
-  if (status != METIS_OK) throw std::runtime_error("METIS partitioning failed with status " + std::to_string(status));
+  idx_t    *w                     = vwgt.empty() ? nullptr : vwgt.data();
+  const int status                = parts <= 8
+                                      ? METIS_PartGraphRecursive(&nv, &ncon, xadj.data(), adjncy.data(), w, nullptr, nullptr,
+                                                                 &np, nullptr, nullptr, options, &objval, where.data())
+                                      : METIS_PartGraphKway(&nv, &ncon, xadj.data(), adjncy.data(), w, nullptr, nullptr, &np,
+                                                            nullptr, nullptr, options, &objval, where.data());
+  if (status != METIS_OK)
+    throw std::runtime_error("METIS partitioning failed with status " + std::to_string(status));
   for (int v = 0; v < n; ++v) part[v] = static_cast<int>(where[v]);
   return part;
 }
@@ -186,29 +193,39 @@ void validate_graph(const AdjacencyGraph &g)
 {
   const int n = g.vertex_count();
   if (n < 0 || g.xadj.empty() || g.xadj[0] != 0) throw std::invalid_argument("graph: xadj must start with 0");
-  if (static_cast<std::size_t>(g.xadj.back()) != g.adjncy.size()) throw std::invalid_argument("graph: xadj[n] != adjncy size");
+  if (static_cast<std::size_t>(g.xadj.back()) != g.adjncy.size())
+    throw std::invalid_argument("graph: xadj[n] != adjncy size");
   for (int v = 0; v < n; ++v) {
-    if (g.xadj[v + 1] < g.xadj[v]) throw std::invalid_argument("graph: xadj not monotone at vertex " + std::to_string(v));
+    if (g.xadj[v + 1] < g.xadj[v])
+      throw std::invalid_argument("graph: xadj not monotone at vertex " + std::to_string(v));
     for (int e = g.xadj[v]; e < g.xadj[v + 1]; ++e) {
       const int u = g.adjncy[e];
-      if (u < 0 || u >= n) throw std::invalid_argument("graph: neighbour " + std::to_string(u) + " of vertex " + std::to_string(v) + " out of range");
+      if (u < 0 || u >= n)
+        throw std::invalid_argument("graph: neighbour " + std::to_string(u) + " of vertex " +
+                                    std::to_string(v) + " out of range");
       if (u == v) throw std::invalid_argument("graph: self loop at vertex " + std::to_string(v));
-      if (e > g.xadj[v] && g.adjncy[e - 1] >= u) throw std::invalid_argument("graph: neighbours of vertex " + std::to_string(v) + " not sorted/unique");
+      if (e > g.xadj[v] && g.adjncy[e - 1] >= u)
+        throw std::invalid_argument("graph: neighbours of vertex " + std::to_string(v) +
+                                    " not sorted/unique");
       if (!std::binary_search(g.adjncy.begin() + g.xadj[u], g.adjncy.begin() + g.xadj[u + 1], v))
-        throw std::invalid_argument("graph: edge (" + std::to_string(v) + "," + std::to_string(u) + ") stored in one direction only");
+        throw std::invalid_argument("graph: edge (" + std::to_string(v) + "," + std::to_string(u) +
+                                    ") stored in one direction only");
     }
   }
 }
 
-AdjacencyGraph graph_from_elements(int node_count, int nodes_per_element, const std::vector<int> &connectivity)
+AdjacencyGraph graph_from_elements(int node_count, int nodes_per_element,
+                                   const std::vector<int> &connectivity)
 {
   if (node_count < 0 || nodes_per_element < 1 || connectivity.size() % nodes_per_element)
-    throw std::invalid_argument("graph_from_elements: connectivity size is not a multiple of nodes_per_element");
+    throw std::invalid_argument(
+      "graph_from_elements: connectivity size is not a multiple of nodes_per_element");
   std::vector<std::vector<int>> nbrs(node_count);
   for (std::size_t e = 0; e < connectivity.size(); e += nodes_per_element) {
     for (int a = 0; a < nodes_per_element; ++a) {
       const int u = connectivity[e + a];
-      if (u < 0 || u >= node_count) throw std::invalid_argument("graph_from_elements: node " + std::to_string(u) + " out of range");
+      if (u < 0 || u >= node_count)
+        throw std::invalid_argument("graph_from_elements: node " + std::to_string(u) + " out of range");
       for (int b = 0; b < nodes_per_element; ++b)
         if (connectivity[e + b] != u) nbrs[u].push_back(connectivity[e + b]);
     }
@@ -221,7 +238,9 @@ AdjacencyGraph graph_from_edges(int vertex_count, const std::vector<std::pair<in
   if (vertex_count < 0) throw std::invalid_argument("graph_from_edges: negative vertex count");
   std::vector<std::vector<int>> nbrs(vertex_count);
   for (const auto &[a, b] : edges) {
-    if (a < 0 || b < 0 || a >= vertex_count || b >= vertex_count) throw std::invalid_argument("graph_from_edges: edge (" + std::to_string(a) + "," + std::to_string(b) + ") out of range");
+    if (a < 0 || b < 0 || a >= vertex_count || b >= vertex_count)
+      throw std::invalid_argument("graph_from_edges: edge (" + std::to_string(a) + "," + std::to_string(b) +
+                                  ") out of range");
     if (a == b) continue;
     nbrs[a].push_back(b);
     nbrs[b].push_back(a);
@@ -231,13 +250,15 @@ AdjacencyGraph graph_from_edges(int vertex_count, const std::vector<std::pair<in
 
 AdjacencyGraph graph_from_csr(int n, const std::vector<int> &row_start, const std::vector<int> &col)
 {
-  if (n < 0 || row_start.size() != static_cast<std::size_t>(n) + 1 || row_start[0] != 0 || static_cast<std::size_t>(row_start[n]) != col.size())
+  if (n < 0 || row_start.size() != static_cast<std::size_t>(n) + 1 || row_start[0] != 0 ||
+      static_cast<std::size_t>(row_start[n]) != col.size())
     throw std::invalid_argument("graph_from_csr: malformed row_start");
   std::vector<std::vector<int>> nbrs(n);
   for (int i = 0; i < n; ++i)
     for (int k = row_start[i]; k < row_start[i + 1]; ++k) {
       const int j = col[k];
-      if (j < 0 || j >= n) throw std::invalid_argument("graph_from_csr: column " + std::to_string(j) + " out of range");
+      if (j < 0 || j >= n)
+        throw std::invalid_argument("graph_from_csr: column " + std::to_string(j) + " out of range");
       if (j == i) continue;
       nbrs[i].push_back(j);
       nbrs[j].push_back(i);
@@ -266,7 +287,8 @@ Renumbering partition_graph(const AdjacencyGraph &g, int parts, const PartitionO
   if (options.local_order != LocalOrder::Keep) {
     std::vector<int> local_of(n, -1);
     for (int p = 0; p < parts; ++p) {
-      std::vector<int>     members(r.old_of_new.begin() + r.part_offsets[p], r.old_of_new.begin() + r.part_offsets[p + 1]);
+      std::vector<int>     members(r.old_of_new.begin() + r.part_offsets[p],
+                                   r.old_of_new.begin() + r.part_offsets[p + 1]);
       const AdjacencyGraph sub   = induced_subgraph(g, members, local_of);
       const auto           order = local_old_of_new(sub, options.local_order);
       for (std::size_t k = 0; k < order.size(); ++k) r.old_of_new[r.part_offsets[p] + k] = members[order[k]];
@@ -291,7 +313,8 @@ AdjacencyGraph renumber_graph(const AdjacencyGraph &g, const Renumbering &r)
   const int                     n = g.vertex_count();
   std::vector<std::vector<int>> nbrs(n);
   for (int v = 0; v < n; ++v)
-    for (int e = g.xadj[v]; e < g.xadj[v + 1]; ++e) nbrs[r.new_of_old[v]].push_back(r.new_of_old[g.adjncy[e]]);
+    for (int e = g.xadj[v]; e < g.xadj[v + 1]; ++e)
+      nbrs[r.new_of_old[v]].push_back(r.new_of_old[g.adjncy[e]]);
   return graph_from_neighbour_lists(nbrs);
 }
 
@@ -312,22 +335,29 @@ long long cut_edges(const AdjacencyGraph &g, const Renumbering &r)
   return cut;
 }
 
-std::vector<int> assign_elements_to_parts(const std::vector<int> &connectivity, int npe, const std::vector<int> &part_offsets)
+std::vector<int> assign_elements_to_parts(const std::vector<int> &connectivity, int npe,
+                                          const std::vector<int> &part_offsets)
 {
-  if (npe <= 0 || connectivity.size() % npe) throw std::invalid_argument("assign_elements_to_parts: bad element size");
-  if (part_offsets.size() < 2) throw std::invalid_argument("assign_elements_to_parts: need at least one part");
-  const int parts = static_cast<int>(part_offsets.size()) - 1;
-  const int ne    = static_cast<int>(connectivity.size() / npe);
-  auto part_of = [&](int v) {
-    if (v < part_offsets.front() || v >= part_offsets.back()) throw std::invalid_argument("assign_elements_to_parts: node outside the parts");
-    return static_cast<int>(std::upper_bound(part_offsets.begin(), part_offsets.end(), v) - part_offsets.begin()) - 1;
+  if (npe <= 0 || connectivity.size() % npe)
+    throw std::invalid_argument("assign_elements_to_parts: bad element size");
+  if (part_offsets.size() < 2)
+    throw std::invalid_argument("assign_elements_to_parts: need at least one part");
+  const int parts   = static_cast<int>(part_offsets.size()) - 1;
+  const int ne      = static_cast<int>(connectivity.size() / npe);
+  auto      part_of = [&](int v) {
+    if (v < part_offsets.front() || v >= part_offsets.back())
+      throw std::invalid_argument("assign_elements_to_parts: node outside the parts");
+    return static_cast<int>(std::upper_bound(part_offsets.begin(), part_offsets.end(), v) -
+                            part_offsets.begin()) -
+           1;
   };
   std::vector<int>       owner(ne, -1);
   std::vector<long long> load(parts, 0);
   for (int e = 0; e < ne; ++e) {
-    const int p = part_of(connectivity[static_cast<size_t>(e) * npe]);
+    const int p        = part_of(connectivity[static_cast<size_t>(e) * npe]);
     bool      one_part = true;
-    for (int k = 1; k < npe && one_part; ++k) one_part = part_of(connectivity[static_cast<size_t>(e) * npe + k]) == p;
+    for (int k = 1; k < npe && one_part; ++k)
+      one_part = part_of(connectivity[static_cast<size_t>(e) * npe + k]) == p;
     if (one_part) owner[e] = p, ++load[p];
   }
   for (int e = 0; e < ne; ++e) {

@@ -24,7 +24,7 @@ namespace physics {
 struct AdjacencyGraph {
   std::vector<int> xadj{0};
   std::vector<int> adjncy;
-  int vertex_count() const { return static_cast<int>(xadj.size()) - 1; }
+  int              vertex_count() const { return static_cast<int>(xadj.size()) - 1; }
 };
 
 // A permutation of the vertices. new_of_old[v] is the new number of old vertex v, old_of_new its
@@ -36,13 +36,14 @@ struct Renumbering {
   std::vector<int> old_of_new;
   std::vector<int> part_of_old;  // empty for a pure reordering
   std::vector<int> part_offsets; // parts + 1 entries; {0, n} for a pure reordering
-  int part_count() const { return static_cast<int>(part_offsets.size()) - 1; }
-  int part_size(int p) const { return part_offsets[p + 1] - part_offsets[p]; }
+  int              part_count() const { return static_cast<int>(part_offsets.size()) - 1; }
+  int              part_size(int p) const { return part_offsets[p + 1] - part_offsets[p]; }
 };
 
 // Graph of a mesh: nodes that share an element are neighbours. `connectivity` holds
 // nodes_per_element node numbers per element (0-based, < node_count).
-AdjacencyGraph graph_from_elements(int node_count, int nodes_per_element, const std::vector<int> &connectivity);
+AdjacencyGraph graph_from_elements(int node_count, int nodes_per_element,
+                                   const std::vector<int> &connectivity);
 
 // Graph from explicit edges (e.g. rigid bodies joined by joints). Duplicates and self loops are dropped.
 AdjacencyGraph graph_from_edges(int vertex_count, const std::vector<std::pair<int, int>> &edges);
@@ -51,7 +52,11 @@ AdjacencyGraph graph_from_edges(int vertex_count, const std::vector<std::pair<in
 // (i,j) or (j,i) is stored, i != j.
 AdjacencyGraph graph_from_csr(int n, const std::vector<int> &row_start, const std::vector<int> &col);
 
-enum class LocalOrder { Keep, ReverseCuthillMcKee, NestedDissection };
+enum class LocalOrder {
+  Keep,
+  ReverseCuthillMcKee,
+  NestedDissection
+};
 
 struct PartitionOptions {
   // Optional vertex weights (work per vertex, e.g. 1 + degree); empty = all 1.

@@ -21,8 +21,8 @@ constexpr double kDetTolerance     = 1e-8;  // |det X - 1| accepted as a rotatio
 Eigen::Matrix3d rotation_by_svd(const Eigen::Matrix3d &F)
 {
   Eigen::JacobiSVD<Eigen::Matrix3d> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d U = svd.matrixU();
-  const Eigen::Matrix3d V = svd.matrixV();
+  Eigen::Matrix3d                   U = svd.matrixU();
+  const Eigen::Matrix3d             V = svd.matrixV();
   // Singular values are sorted decreasingly: column 2 belongs to the smallest.
   if ((U * V.transpose()).determinant() < 0) U.col(2) *= -1.0;
   return U * V.transpose();
@@ -32,7 +32,7 @@ Eigen::Matrix3d rotation_by_svd(const Eigen::Matrix3d &F)
 
 Eigen::Matrix3d rotation_from_deformation(const Eigen::Matrix3d &F)
 {
-  using Mat3 = Eigen::Matrix3d;
+  using Mat3          = Eigen::Matrix3d;
   const double scale2 = F.squaredNorm();
   if (!(scale2 > 0) || !std::isfinite(scale2)) return Mat3::Identity();
   // Scaled to Frobenius norm sqrt 3 (a rotation's), so the thresholds below are scale-free and the
@@ -41,10 +41,10 @@ Eigen::Matrix3d rotation_from_deformation(const Eigen::Matrix3d &F)
   // cof(X) = det(X) X^-T: its columns are cross products of the other two columns. Building the
   // Newton step from it (no general inverse, one division) halved the cost of a call (300 -> 140 ns
   // at 1% strain): the iteration is a serial chain, so its latency is what counts.
-  Mat3   C;
-  C.col(0) = X.col(1).cross(X.col(2));
-  C.col(1) = X.col(2).cross(X.col(0));
-  C.col(2) = X.col(0).cross(X.col(1));
+  Mat3 C;
+  C.col(0)   = X.col(1).cross(X.col(2));
+  C.col(1)   = X.col(2).cross(X.col(0));
+  C.col(2)   = X.col(0).cross(X.col(1));
   double det = X.col(0).dot(C.col(0));
   if (det > kMinStartDet) {
     for (int it = 0; it < kMaxNewtonSteps; ++it) {
@@ -98,7 +98,7 @@ void rotations_from_deformations(const Eigen::Matrix3d *F, Eigen::Matrix3d *R, s
     for (int j = 0; j < 9; ++j) X[j][l] = j % 4 == 0 ? 1.0 : 0.0;
   };
   for (std::size_t start = 0; start < n; start += kLanes) {
-    const int m = static_cast<int>(std::min<std::size_t>(kLanes, n - start));
+    const int m      = static_cast<int>(std::min<std::size_t>(kLanes, n - start));
     Lanes     scale2 = Lanes::Zero();
     for (int l = 0; l < kLanes; ++l) { // lanes past the end hold the identity
       if (l < m)
@@ -135,7 +135,8 @@ void rotations_from_deformations(const Eigen::Matrix3d *F, Eigen::Matrix3d *R, s
       // or after 30 steps, and then checks det(X) = 1 and X finite. The mask is built without
       // branches: which lanes stop in which step is unpredictable.
       unsigned stopping = 0;
-      for (int l = 0; l < kLanes; ++l) stopping |= static_cast<unsigned>((change[l] < kConvergedChange2) | !(det[l] > 0)) << l;
+      for (int l = 0; l < kLanes; ++l)
+        stopping |= static_cast<unsigned>((change[l] < kConvergedChange2) | !(det[l] > 0)) << l;
       stopping = it == kMaxNewtonSteps - 1 ? pending : stopping & pending;
       pending &= ~stopping;
       for (; stopping; stopping &= stopping - 1) {

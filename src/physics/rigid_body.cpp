@@ -25,8 +25,12 @@ Eigen::Quaterniond rotated(const Eigen::Quaterniond &q, const Eigen::Vector3d &a
   const double h2 = 0.25 * dt * dt * angular_velocity.squaredNorm();
   double       s, c;
   if (h2 < 0.01) {
-    s = 0.5 * dt * (1 + h2 * (-1.0 / 6 + h2 * (1.0 / 120 + h2 * (-1.0 / 5040 + h2 * (1.0 / 362880 + h2 * (-1.0 / 39916800))))));
-    c = 1 + h2 * (-0.5 + h2 * (1.0 / 24 + h2 * (-1.0 / 720 + h2 * (1.0 / 40320 + h2 * (-1.0 / 3628800 + h2 * (1.0 / 479001600))))));
+    s = 0.5 * dt *
+        (1 + h2 * (-1.0 / 6 +
+                   h2 * (1.0 / 120 + h2 * (-1.0 / 5040 + h2 * (1.0 / 362880 + h2 * (-1.0 / 39916800))))));
+    c = 1 + h2 * (-0.5 + h2 * (1.0 / 24 +
+                               h2 * (-1.0 / 720 +
+                                     h2 * (1.0 / 40320 + h2 * (-1.0 / 3628800 + h2 * (1.0 / 479001600))))));
   } else {
     const double speed = angular_velocity.norm(), half = 0.5 * speed * dt;
     s = std::sin(half) / speed, c = std::cos(half);
@@ -49,18 +53,19 @@ void apply_unconstrained_velocity_update(RigidBody &body, const Eigen::Vector3d 
   apply_unconstrained_velocity_update(body, body.orientation.toRotationMatrix(), gravity, dt);
 }
 
-void apply_unconstrained_velocity_update(RigidBody &body, const Eigen::Matrix3d &R, const Eigen::Vector3d &gravity, double dt)
+void apply_unconstrained_velocity_update(RigidBody &body, const Eigen::Matrix3d &R,
+                                         const Eigen::Vector3d &gravity, double dt)
 {
   body.velocity += dt * gravity;
   // Solve I (w' - w) + dt w' x (I w') = 0 in the body frame with one Newton step from w (Catto 2015):
   // explicit treatment of the gyroscopic term adds energy to bodies spinning about unstable axes.
-  const Eigen::Matrix3d &I  = body.inertia_body;
-  const Eigen::Vector3d  wb = R.transpose() * body.angular_velocity;
+  const Eigen::Matrix3d &I        = body.inertia_body;
+  const Eigen::Vector3d  wb       = R.transpose() * body.angular_velocity;
   const Eigen::Vector3d  residual = dt * wb.cross(I * wb);
   const Eigen::Matrix3d  jacobian = I + dt * (cross_matrix(wb) * I - cross_matrix(I * wb));
   // The Jacobian is I plus O(dt |w|) terms: far from singular, and the closed-form 3x3 inverse is cheap.
-  const Eigen::Vector3d  wb_new   = wb - jacobian.inverse() * residual;
-  body.angular_velocity           = R * wb_new;
+  const Eigen::Vector3d wb_new = wb - jacobian.inverse() * residual;
+  body.angular_velocity        = R * wb_new;
 }
 
 void advance_positions(RigidBody &body, double dt)
@@ -71,12 +76,14 @@ void advance_positions(RigidBody &body, double dt)
 
 double mechanical_energy(const RigidBody &body, const Eigen::Vector3d &gravity)
 {
-  const Eigen::Matrix3d R = body.orientation.toRotationMatrix();
+  const Eigen::Matrix3d R  = body.orientation.toRotationMatrix();
   const Eigen::Vector3d wb = R.transpose() * body.angular_velocity;
-  return 0.5 * body.mass * body.velocity.squaredNorm() + 0.5 * wb.dot(body.inertia_body * wb) - body.mass * gravity.dot(body.position);
+  return 0.5 * body.mass * body.velocity.squaredNorm() + 0.5 * wb.dot(body.inertia_body * wb) -
+         body.mass * gravity.dot(body.position);
 }
 
-void apply_impulse(RigidBody &body, const Eigen::Matrix3d &inverse_inertia_world, const Eigen::Vector3d &arm, const Eigen::Vector3d &impulse)
+void apply_impulse(RigidBody &body, const Eigen::Matrix3d &inverse_inertia_world, const Eigen::Vector3d &arm,
+                   const Eigen::Vector3d &impulse)
 {
   body.velocity += impulse / body.mass;
   body.angular_velocity += inverse_inertia_world * arm.cross(impulse);

@@ -6,11 +6,11 @@
 namespace physics {
 
 struct RigidBody {
-  double             mass = 1.0;
-  Eigen::Matrix3d    inertia_body = Eigen::Matrix3d::Identity(); // about the centre of mass, body frame
-  Eigen::Vector3d    position = Eigen::Vector3d::Zero();         // centre of mass, world frame
-  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
-  Eigen::Vector3d    velocity = Eigen::Vector3d::Zero();
+  double             mass             = 1.0;
+  Eigen::Matrix3d    inertia_body     = Eigen::Matrix3d::Identity(); // about the centre of mass, body frame
+  Eigen::Vector3d    position         = Eigen::Vector3d::Zero();     // centre of mass, world frame
+  Eigen::Quaterniond orientation      = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d    velocity         = Eigen::Vector3d::Zero();
   Eigen::Vector3d    angular_velocity = Eigen::Vector3d::Zero(); // world frame
 };
 
@@ -26,7 +26,8 @@ Eigen::Quaterniond rotated(const Eigen::Quaterniond &q, const Eigen::Vector3d &a
 // implicitly (one Newton step in the body frame) so that fast spinning bodies do not gain energy.
 void apply_unconstrained_velocity_update(RigidBody &body, const Eigen::Vector3d &gravity, double dt);
 // The same with the body's rotation matrix already at hand (R = orientation.toRotationMatrix()).
-void apply_unconstrained_velocity_update(RigidBody &body, const Eigen::Matrix3d &R, const Eigen::Vector3d &gravity, double dt);
+void apply_unconstrained_velocity_update(RigidBody &body, const Eigen::Matrix3d &R,
+                                         const Eigen::Vector3d &gravity, double dt);
 
 // Where position/orientation go after dt with the current velocities (symplectic Euler position step).
 void advance_positions(RigidBody &body, double dt);

@@ -13,11 +13,13 @@ Renumbering group_by_row_length(const std::vector<int> &row_length_old, const Re
     throw std::invalid_argument("group_by_row_length: row lengths and renumbering differ in size");
   std::vector<char> seen(n, 0);
   for (int v : base.old_of_new) {
-    if (v < 0 || v >= n || seen[v]) throw std::invalid_argument("group_by_row_length: base is not a permutation");
+    if (v < 0 || v >= n || seen[v])
+      throw std::invalid_argument("group_by_row_length: base is not a permutation");
     seen[v] = 1;
   }
   std::vector<int> offsets = base.part_offsets;
-  if (offsets.size() < 2 || offsets.front() != 0 || offsets.back() != n || !std::is_sorted(offsets.begin(), offsets.end()))
+  if (offsets.size() < 2 || offsets.front() != 0 || offsets.back() != n ||
+      !std::is_sorted(offsets.begin(), offsets.end()))
     throw std::invalid_argument("group_by_row_length: base has malformed part offsets");
 
   Renumbering r = base;
@@ -41,7 +43,8 @@ Renumbering group_by_degree(const AdjacencyGraph &g, const Renumbering &base, in
 
 std::vector<int> row_lengths_without_fixed(const AdjacencyGraph &g, const std::vector<char> &fixed)
 {
-  if (static_cast<int>(fixed.size()) != g.vertex_count()) throw std::invalid_argument("row_lengths_without_fixed: fixed flags: wrong size");
+  if (static_cast<int>(fixed.size()) != g.vertex_count())
+    throw std::invalid_argument("row_lengths_without_fixed: fixed flags: wrong size");
   std::vector<int> length(g.vertex_count(), 1);
   for (int v = 0; v < g.vertex_count(); ++v)
     if (!fixed[v])
@@ -55,7 +58,8 @@ double bin_padding_overhead(const std::vector<int> &row_length_new, int bin_widt
   long long slots = 0, stored = 0;
   for (std::size_t begin = 0; begin < row_length_new.size(); begin += bin_width) {
     const std::size_t end = std::min(row_length_new.size(), begin + bin_width);
-    slots += static_cast<long long>(bin_width) * *std::max_element(row_length_new.begin() + begin, row_length_new.begin() + end);
+    slots += static_cast<long long>(bin_width) *
+             *std::max_element(row_length_new.begin() + begin, row_length_new.begin() + end);
     for (std::size_t i = begin; i < end; ++i) stored += row_length_new[i];
   }
   return stored ? static_cast<double>(slots) / stored - 1.0 : 0.0;
@@ -63,13 +67,15 @@ double bin_padding_overhead(const std::vector<int> &row_length_new, int bin_widt
 
 std::vector<int> row_lengths_in_new_order(const std::vector<int> &row_length_old, const Renumbering &r)
 {
-  if (row_length_old.size() != r.new_of_old.size()) throw std::invalid_argument("row_lengths_in_new_order: sizes differ");
+  if (row_length_old.size() != r.new_of_old.size())
+    throw std::invalid_argument("row_lengths_in_new_order: sizes differ");
   std::vector<int> out(row_length_old.size());
   for (std::size_t v = 0; v < row_length_old.size(); ++v) out[r.new_of_old[v]] = row_length_old[v];
   return out;
 }
 
-std::vector<int> upper_row_lengths(const AdjacencyGraph &g, const std::vector<char> &fixed, const Renumbering &r)
+std::vector<int> upper_row_lengths(const AdjacencyGraph &g, const std::vector<char> &fixed,
+                                   const Renumbering &r)
 {
   const int n = g.vertex_count();
   if (static_cast<int>(fixed.size()) != n || static_cast<int>(r.new_of_old.size()) != n)
@@ -90,8 +96,8 @@ std::vector<int> upper_row_lengths(const AdjacencyGraph &g, const std::vector<ch
   return length;
 }
 
-Renumbering group_by_upper_row_length(const AdjacencyGraph &g, const std::vector<char> &fixed, const Renumbering &base,
-                                      int window, int bin_width, int sweeps)
+Renumbering group_by_upper_row_length(const AdjacencyGraph &g, const std::vector<char> &fixed,
+                                      const Renumbering &base, int window, int bin_width, int sweeps)
 {
   validate_graph(g);
   // the lengths counted to measure one order are the ones the next sweep sorts by

@@ -49,12 +49,13 @@ std::vector<int> row_lengths_in_new_order(const std::vector<int> &row_length_old
 // degree leaves rows of very different upper lengths side by side (42-45% padding on the FE bodies).
 // Upper row length of every vertex (old numbering) under r: 1 + its free neighbours in the same part
 // with a higher new number; 1 for a fixed vertex (its row keeps only the diagonal).
-std::vector<int> upper_row_lengths(const AdjacencyGraph &g, const std::vector<char> &fixed, const Renumbering &r);
+std::vector<int> upper_row_lengths(const AdjacencyGraph &g, const std::vector<char> &fixed,
+                                   const Renumbering &r);
 
 // group_by_row_length on upper row lengths. Sorting moves rows and so changes the lengths it sorted
 // by; it is repeated `sweeps` times and the order with the least padding for bins of bin_width rows
 // is kept (base included).
-Renumbering group_by_upper_row_length(const AdjacencyGraph &g, const std::vector<char> &fixed, const Renumbering &base,
-                                      int window, int bin_width, int sweeps = 4);
+Renumbering group_by_upper_row_length(const AdjacencyGraph &g, const std::vector<char> &fixed,
+                                      const Renumbering &base, int window, int bin_width, int sweeps = 4);
 
 } // namespace physics

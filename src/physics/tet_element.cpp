@@ -17,7 +17,7 @@ LameParameters lame_from_young_poisson(double young, double poisson)
 
 TetGeometry tet_geometry(const Eigen::Matrix<double, 3, 4> &X)
 {
-  TetGeometry g;
+  TetGeometry     g;
   Eigen::Matrix3d Dm;
   for (int k = 0; k < 3; ++k) Dm.col(k) = X.col(k + 1) - X.col(0);
   g.volume             = Dm.determinant() / 6.0;
@@ -44,7 +44,8 @@ Eigen::MatrixXd shape_gradients(const TetGeometry &g, int order, const std::arra
   return dN;
 }
 
-void add_stiffness_at_point(const Eigen::MatrixXd &dN, double weight, const LameParameters &p, Eigen::MatrixXd &K)
+void add_stiffness_at_point(const Eigen::MatrixXd &dN, double weight, const LameParameters &p,
+                            Eigen::MatrixXd &K)
 {
   const int n = static_cast<int>(dN.rows());
   for (int a = 0; a < n; ++a)

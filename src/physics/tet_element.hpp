@@ -29,7 +29,10 @@ Eigen::MatrixXd element_stiffness(const TetGeometry &g, int order, const LamePar
 // diagonal 1/4; for order 2 the consistent matrix (exact integrals of products of shape functions) or
 // its HRZ lumping (diagonal scaled to the total mass; row-sum lumping would give corners a
 // negative mass of -1/20, so it is never used).
-enum class MassLumping { Consistent, Lumped };
+enum class MassLumping {
+  Consistent,
+  Lumped
+};
 Eigen::MatrixXd reference_mass(int order, MassLumping lumping);
 
 // Integral of each shape function divided by the volume (order 2: corners -1/20, edges 1/5).

@@ -14,7 +14,8 @@ double element_signed_volume(const TetMesh &mesh, const double *pos, int e)
   double     d[3][3];
   for (int k = 0; k < 3; ++k)
     for (int c = 0; c < 3; ++c) d[k][c] = pos[3 * n[k + 1] + c] - pos[3 * n[0] + c];
-  const double det = d[0][0] * (d[1][1] * d[2][2] - d[1][2] * d[2][1]) - d[0][1] * (d[1][0] * d[2][2] - d[1][2] * d[2][0]) +
+  const double det = d[0][0] * (d[1][1] * d[2][2] - d[1][2] * d[2][1]) -
+                     d[0][1] * (d[1][0] * d[2][2] - d[1][2] * d[2][0]) +
                      d[0][2] * (d[1][0] * d[2][1] - d[1][1] * d[2][0]);
   return det / 6.0;
 }
@@ -23,8 +24,8 @@ TetMesh promote_to_quadratic(const TetMesh &mesh)
 {
   if (mesh.order == 2) return mesh;
   TetMesh out;
-  out.order = 2;
-  out.nodes = mesh.nodes;
+  out.order    = 2;
+  out.nodes    = mesh.nodes;
   const int ne = mesh.element_count();
   out.elements.resize(static_cast<size_t>(ne) * 10);
   std::unordered_map<unsigned long long, int> edge_node;
@@ -34,13 +35,14 @@ TetMesh promote_to_quadratic(const TetMesh &mesh)
     int       *o = &out.elements[10 * static_cast<size_t>(e)];
     for (int k = 0; k < 4; ++k) o[k] = c[k];
     for (int k = 0; k < 6; ++k) {
-      const int a = c[kTetEdges[k][0]], b = c[kTetEdges[k][1]];
+      const int                a = c[kTetEdges[k][0]], b = c[kTetEdges[k][1]];
       const unsigned long long key =
         (static_cast<unsigned long long>(std::min(a, b)) << 32) | static_cast<unsigned>(std::max(a, b));
       auto it = edge_node.find(key);
       if (it == edge_node.end()) {
         const int id = out.node_count();
-        for (int d = 0; d < 3; ++d) out.nodes.push_back(0.5 * (mesh.nodes[3 * a + d] + mesh.nodes[3 * b + d]));
+        for (int d = 0; d < 3; ++d)
+          out.nodes.push_back(0.5 * (mesh.nodes[3 * a + d] + mesh.nodes[3 * b + d]));
         it = edge_node.emplace(key, id).first;
       }
       o[4 + k] = it->second;
@@ -52,7 +54,8 @@ TetMesh promote_to_quadratic(const TetMesh &mesh)
 void renumber_nodes(TetMesh &mesh, const std::vector<int> &new_of_old)
 {
   const int n = mesh.node_count();
-  if (static_cast<int>(new_of_old.size()) != n) throw std::invalid_argument("renumber_nodes: permutation has wrong size");
+  if (static_cast<int>(new_of_old.size()) != n)
+    throw std::invalid_argument("renumber_nodes: permutation has wrong size");
   std::vector<double> nodes(mesh.nodes.size());
   for (int i = 0; i < n; ++i)
     for (int d = 0; d < 3; ++d) nodes[3 * new_of_old[i] + d] = mesh.nodes[3 * i + d];
@@ -65,13 +68,15 @@ void sort_elements_by_lowest_node(TetMesh &mesh)
   const int        npe = mesh.nodes_per_element(), ne = mesh.element_count();
   std::vector<int> lowest(ne), order(ne);
   for (int e = 0; e < ne; ++e) {
-    lowest[e] = *std::min_element(mesh.elements.begin() + static_cast<size_t>(e) * npe, mesh.elements.begin() + static_cast<size_t>(e + 1) * npe);
+    lowest[e] = *std::min_element(mesh.elements.begin() + static_cast<size_t>(e) * npe,
+                                  mesh.elements.begin() + static_cast<size_t>(e + 1) * npe);
     order[e]  = e;
   }
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return lowest[a] < lowest[b]; });
   std::vector<int> sorted(mesh.elements.size());
   for (int k = 0; k < ne; ++k)
-    std::copy_n(mesh.elements.begin() + static_cast<size_t>(order[k]) * npe, npe, sorted.begin() + static_cast<size_t>(k) * npe);
+    std::copy_n(mesh.elements.begin() + static_cast<size_t>(order[k]) * npe, npe,
+                sorted.begin() + static_cast<size_t>(k) * npe);
   mesh.elements.swap(sorted);
 }
 
@@ -79,11 +84,14 @@ void validate_mesh(const TetMesh &mesh, const std::string &what, const std::vect
 {
   const int n = mesh.node_count(), npe = mesh.nodes_per_element();
   auto      name = [&](size_t e) {
-    return (int)element_tags.size() == mesh.element_count() ? "element with tag " + std::to_string(element_tags[e]) : "element " + std::to_string(e);
+    return (int)element_tags.size() == mesh.element_count()
+                  ? "element with tag " + std::to_string(element_tags[e])
+                  : "element " + std::to_string(e);
   };
   if (mesh.order != 1 && mesh.order != 2) throw std::runtime_error(what + ": element order must be 1 or 2");
   if (mesh.element_count() == 0) throw std::runtime_error(what + ": mesh has no tetrahedra");
-  if (mesh.elements.size() % npe) throw std::runtime_error(what + ": element list length is not a multiple of the element size");
+  if (mesh.elements.size() % npe)
+    throw std::runtime_error(what + ": element list length is not a multiple of the element size");
   std::vector<char> used(n, 0);
   for (size_t k = 0; k < mesh.elements.size(); ++k) {
     const int v = mesh.elements[k];
@@ -95,7 +103,7 @@ void validate_mesh(const TetMesh &mesh, const std::string &what, const std::vect
   const int unused = static_cast<int>(std::count(used.begin(), used.end(), 0));
   if (unused) throw std::runtime_error(what + ": " + std::to_string(unused) + " nodes belong to no element");
   // Relative to the element's size, so that a tiny but well-shaped element passes.
-  int bad = 0, first_bad = -1;
+  int    bad = 0, first_bad = -1;
   double first_volume = 0;
   for (int e = 0; e < mesh.element_count(); ++e) {
     const double vol = element_signed_volume(mesh, mesh.nodes.data(), e);
@@ -110,22 +118,27 @@ void validate_mesh(const TetMesh &mesh, const std::string &what, const std::vect
       h2 = std::max(h2, l2);
     }
     if (!(vol > 1e-12 * h2 * std::sqrt(h2))) {
-      if (first_bad < 0) { first_bad = e; first_volume = vol; }
+      if (first_bad < 0) {
+        first_bad    = e;
+        first_volume = vol;
+      }
       ++bad;
     }
   }
   if (bad)
-    throw std::runtime_error(what + ": " + std::to_string(bad) + " element(s) inverted or of zero volume; first: " +
-                             name(first_bad) + " with signed volume " + std::to_string(first_volume));
+    throw std::runtime_error(what + ": " + std::to_string(bad) +
+                             " element(s) inverted or of zero volume; first: " + name(first_bad) +
+                             " with signed volume " + std::to_string(first_volume));
 }
 
-std::vector<int> nodes_in_box(const TetMesh &mesh, const std::array<double, 3> &lo, const std::array<double, 3> &hi,
-                              double tol)
+std::vector<int> nodes_in_box(const TetMesh &mesh, const std::array<double, 3> &lo,
+                              const std::array<double, 3> &hi, double tol)
 {
   std::vector<int> out;
   for (int i = 0; i < mesh.node_count(); ++i) {
     bool in = true;
-    for (int d = 0; d < 3; ++d) in = in && mesh.nodes[3 * i + d] >= lo[d] - tol && mesh.nodes[3 * i + d] <= hi[d] + tol;
+    for (int d = 0; d < 3; ++d)
+      in = in && mesh.nodes[3 * i + d] >= lo[d] - tol && mesh.nodes[3 * i + d] <= hi[d] + tol;
     if (in) out.push_back(i);
   }
   return out;
@@ -143,7 +156,7 @@ std::vector<int> nodes_beyond_plane(const TetMesh &mesh, int axis, double value,
 
 std::array<double, 6> bounding_box(const TetMesh &mesh)
 {
-  const double inf = std::numeric_limits<double>::infinity();
+  const double          inf = std::numeric_limits<double>::infinity();
   std::array<double, 6> b{inf, inf, inf, -inf, -inf, -inf};
   for (int i = 0; i < mesh.node_count(); ++i)
     for (int d = 0; d < 3; ++d) {

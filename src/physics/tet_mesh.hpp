@@ -44,11 +44,12 @@ void sort_elements_by_lowest_node(TetMesh &mesh);
 // positive (inverted or flat) or a node index is out of range, and when nodes are unused. With
 // element_tags (one per element, e.g. the tags of a .msh file) elements are named by their tag, so
 // that the user finds them in the file; otherwise by their index.
-void validate_mesh(const TetMesh &mesh, const std::string &what, const std::vector<long long> &element_tags = {});
+void validate_mesh(const TetMesh &mesh, const std::string &what,
+                   const std::vector<long long> &element_tags = {});
 
 // Nodes whose rest position lies in the axis-aligned box [lo, hi] (inclusive, tolerance tol).
-std::vector<int> nodes_in_box(const TetMesh &mesh, const std::array<double, 3> &lo, const std::array<double, 3> &hi,
-                              double tol = 1e-9);
+std::vector<int> nodes_in_box(const TetMesh &mesh, const std::array<double, 3> &lo,
+                              const std::array<double, 3> &hi, double tol = 1e-9);
 
 // Nodes with rest coordinate `axis` (0,1,2) <= value + tol (side < 0) or >= value - tol (side > 0).
 std::vector<int> nodes_beyond_plane(const TetMesh &mesh, int axis, double value, int side, double tol);

@@ -6,7 +6,14 @@
 
 namespace physics {
 
-enum class VtkCellType : int { Vertex = 1, Line = 3, Triangle = 5, Tetra = 10, Hexahedron = 12, QuadraticTetra = 24 };
+enum class VtkCellType : int {
+  Vertex         = 1,
+  Line           = 3,
+  Triangle       = 5,
+  Tetra          = 10,
+  Hexahedron     = 12,
+  QuadraticTetra = 24
+};
 
 struct VtkPointField {
   std::string         name;
@@ -15,8 +22,8 @@ struct VtkPointField {
 };
 
 struct VtkScene {
-  std::vector<double>        points;       // 3 per point
-  VtkCellType                cell_type = VtkCellType::Vertex;
+  std::vector<double>        points; // 3 per point
+  VtkCellType                cell_type      = VtkCellType::Vertex;
   int                        nodes_per_cell = 1;
   std::vector<int>           connectivity; // nodes_per_cell per cell, VTK node order
   std::vector<VtkPointField> point_fields;

@@ -16,8 +16,7 @@ std::string LastErrorText();
 
 // Runs f with errors returned instead of printed and aborted; a format that is not there (yet), or
 // refuses the matrix, becomes a row with a note instead of ending the benchmark.
-template <class F>
-PetscErrorCode Try(F f, std::string *note)
+template <class F> PetscErrorCode Try(F f, std::string *note)
 {
   PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, nullptr));
   const PetscErrorCode ierr = f();

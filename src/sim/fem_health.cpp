@@ -14,7 +14,7 @@ double FemTotalEnergy(const FemSimulation &sim)
 
 double FemInvertedFraction(const FemSimulation &sim)
 {
-  const int n = sim.model.element_count();
+  const int n   = sim.model.element_count();
   long long bad = 0;
   for (int e = 0; e < n; ++e) bad += !(physics::element_signed_volume(sim.model.mesh, sim.x.data(), e) > 0);
   return n ? (double)bad / n : 0.0;
@@ -26,11 +26,13 @@ HealthBounds FemHealthBounds(const FemSimulation &sim)
   for (int i = 0; i < sim.model.node_count(); ++i)
     if (!sim.fixed[i])
       for (int d = 0; d < 3; ++d) weight[d] += sim.f_gravity[3 * i + d];
-  const auto               bb   = physics::bounding_box(sim.model.mesh);
-  const double             diag = std::sqrt(std::pow(bb[3] - bb[0], 2) + std::pow(bb[4] - bb[1], 2) + std::pow(bb[5] - bb[2], 2));
-  const physics::FemEnergy e0   = physics::fem_energy(sim.model, sim.x.data(), sim.v.data());
+  const auto   bb = physics::bounding_box(sim.model.mesh);
+  const double diag =
+    std::sqrt(std::pow(bb[3] - bb[0], 2) + std::pow(bb[4] - bb[1], 2) + std::pow(bb[5] - bb[2], 2));
+  const physics::FemEnergy e0 = physics::fem_energy(sim.model, sim.x.data(), sim.v.data());
   HealthBounds             hb;
-  hb.energy_scale      = std::sqrt(weight[0] * weight[0] + weight[1] * weight[1] + weight[2] * weight[2]) * diag + std::abs(e0.kinetic) + std::abs(e0.elastic);
+  hb.energy_scale = std::sqrt(weight[0] * weight[0] + weight[1] * weight[1] + weight[2] * weight[2]) * diag +
+                    std::abs(e0.kinetic) + std::abs(e0.elastic);
   hb.energy_growth     = 0.5;
   hb.inverted_fraction = 0;
   return hb;

@@ -37,16 +37,18 @@ PetscErrorCode FemSimulationCreate(MPI_Comm comm, const FemScene &scene, FemSimu
   // What the Mat stores decides the row grouping and the blocks listed below: upper-triangle storage
   // wants rows grouped by their upper length, which the order itself decides.
   PetscBool upper_only = PETSC_FALSE, offrank_full = PETSC_FALSE, lower_mirrored = PETSC_FALSE;
-  PetscInt  bin_width  = 0;
+  PetscInt  bin_width = 0;
   PetscCall(BlockSystemStoredTriangle(comm, &upper_only, &offrank_full, &bin_width, &lower_mirrored));
   if (bin_width < 1) bin_width = 8; // sbaij has no bins; measure padding as binbcsr's default would
   try {
     physics::TetMesh mesh = scene.mesh;
     sim->fixed            = scene.fixed.empty() ? std::vector<char>(mesh.node_count(), 0) : scene.fixed;
-    if ((int)sim->fixed.size() != mesh.node_count()) throw std::invalid_argument("fixed-node flags do not match the mesh");
+    if ((int)sim->fixed.size() != mesh.node_count())
+      throw std::invalid_argument("fixed-node flags do not match the mesh");
     if (scene.reorder) {
-      const physics::AdjacencyGraph g = physics::graph_from_elements(mesh.node_count(), mesh.nodes_per_element(), mesh.elements);
-      physics::Renumbering          r;
+      const physics::AdjacencyGraph g =
+        physics::graph_from_elements(mesh.node_count(), mesh.nodes_per_element(), mesh.elements);
+      physics::Renumbering r;
       if (size > 1) {
         physics::PartitionOptions po;
         po.local_order = physics::LocalOrder::ReverseCuthillMcKee;
@@ -55,8 +57,11 @@ PetscErrorCode FemSimulationCreate(MPI_Comm comm, const FemScene &scene, FemSimu
         r = physics::reorder_for_locality(g, physics::LocalOrder::ReverseCuthillMcKee);
       }
       if (scene.bin_order_window > 0) {
-        if (upper_only) r = physics::group_by_upper_row_length(g, sim->fixed, r, scene.bin_order_window, (int)bin_width);
-        else r = physics::group_by_row_length(physics::row_lengths_without_fixed(g, sim->fixed), r, scene.bin_order_window);
+        if (upper_only)
+          r = physics::group_by_upper_row_length(g, sim->fixed, r, scene.bin_order_window, (int)bin_width);
+        else
+          r = physics::group_by_row_length(physics::row_lengths_without_fixed(g, sim->fixed), r,
+                                           scene.bin_order_window);
       }
       physics::renumber_nodes(mesh, r.new_of_old);
       physics::sort_elements_by_lowest_node(mesh);
@@ -76,37 +81,43 @@ PetscErrorCode FemSimulationCreate(MPI_Comm comm, const FemScene &scene, FemSimu
     error = ex.what();
   }
   PetscCheck(error.empty(), comm, PETSC_ERR_USER_INPUT, "%s", error.c_str());
-  PetscCheck(scene.dt > 0 && std::isfinite(scene.dt), comm, PETSC_ERR_ARG_OUTOFRANGE, "time step must be positive");
+  PetscCheck(scene.dt > 0 && std::isfinite(scene.dt), comm, PETSC_ERR_ARG_OUTOFRANGE,
+             "time step must be positive");
 
   const int n_nodes = sim->model.node_count(), npe = sim->model.npe;
   sim->own_begin = sim->part_offsets[rank];
   sim->own_end   = sim->part_offsets[rank + 1];
   {
-    const std::vector<int> owner = physics::assign_elements_to_parts(sim->model.mesh.elements, npe, sim->part_offsets);
+    const std::vector<int> owner =
+      physics::assign_elements_to_parts(sim->model.mesh.elements, npe, sim->part_offsets);
     for (int e = 0; e < sim->model.element_count(); ++e)
       if (owner[e] == rank) sim->elements.push_back(e);
   }
   physics::LowerTriangle lower; // list and compute only the blocks the Mat type stores or cannot mirror
   lower.drop = upper_only || lower_mirrored;
   if (upper_only && offrank_full && !lower_mirrored) lower.part_offsets = sim->part_offsets;
-  sim->pattern = physics::make_block_pattern(sim->model, sim->elements, sim->fixed, sim->own_begin, sim->own_end, scene.merge_blocks,
-                                             lower);
-  PetscCall(BlockSystemCreate(comm, n_nodes, sim->own_end - sim->own_begin, sim->pattern.rows, sim->pattern.cols, &sim->sys));
-  PetscCheck(sim->sys.row_begin == 3 * sim->own_begin && sim->sys.row_end == 3 * sim->own_end, PETSC_COMM_SELF, PETSC_ERR_PLIB,
-             "matrix ownership does not match the node partition");
+  sim->pattern = physics::make_block_pattern(sim->model, sim->elements, sim->fixed, sim->own_begin,
+                                             sim->own_end, scene.merge_blocks, lower);
+  PetscCall(BlockSystemCreate(comm, n_nodes, sim->own_end - sim->own_begin, sim->pattern.rows,
+                              sim->pattern.cols, &sim->sys));
+  PetscCheck(sim->sys.row_begin == 3 * sim->own_begin && sim->sys.row_end == 3 * sim->own_end,
+             PETSC_COMM_SELF, PETSC_ERR_PLIB, "matrix ownership does not match the node partition");
 
   /* the rest positions' rigid body modes: PCGAMG's near null space (on linear_38k, rtol 1e-8, 17 CG
      iterations per solve instead of 46-48 with GAMG's default, the translations alone) */
-  if (scene.rigid_body_modes) PetscCall(BlockSystemSetRigidBodyModes(&sim->sys, sim->model.mesh.nodes.data() + 3 * (size_t)sim->own_begin));
-  sim->x         = sim->model.mesh.nodes;
+  if (scene.rigid_body_modes)
+    PetscCall(
+      BlockSystemSetRigidBodyModes(&sim->sys, sim->model.mesh.nodes.data() + 3 * (size_t)sim->own_begin));
+  sim->x = sim->model.mesh.nodes;
   sim->v.assign(sim->x.size(), 0.0);
-  sim->f_gravity = physics::gravity_forces(sim->model, scene.gravity);
-  sim->dt        = scene.dt;
-  sim->is_static = scene.is_static;
-  sim->coefficients = scene.is_static ? physics::StepCoefficients{1, 0, 0, 0, 1}
-                                      : physics::implicit_euler_coefficients(scene.dt, scene.rayleigh_alpha, scene.rayleigh_beta);
+  sim->f_gravity         = physics::gravity_forces(sim->model, scene.gravity);
+  sim->dt                = scene.dt;
+  sim->is_static         = scene.is_static;
+  sim->coefficients      = scene.is_static ? physics::StepCoefficients{1, 0, 0, 0, 1}
+                                           : physics::implicit_euler_coefficients(scene.dt, scene.rayleigh_alpha,
+                                                                                  scene.rayleigh_beta);
   sim->rhs_gravity_scale = scene.is_static ? 1.0 : scene.dt;
-  const size_t n_own = (size_t)(sim->own_end - sim->own_begin);
+  const size_t n_own     = (size_t)(sim->own_end - sim->own_begin);
   sim->rhs_full.assign(3 * (size_t)n_nodes, 0.0);
   sim->dv_full.assign(3 * (size_t)n_nodes, 0.0);
   sim->rhs_local.assign(3 * n_own, 0.0);
@@ -128,13 +139,16 @@ PetscErrorCode FemSimulationStep(FemSimulation *sim, FemStepInfo *info)
   physics::reset_block_values(sim->pattern, sim->values);
   std::fill(sim->rhs_full.begin(), sim->rhs_full.end(), 0.0);
   PetscCall(PetscLogEventBegin(FEM_Elements, 0, 0, 0, 0));
-  info->svd_rotations = physics::assemble_elements(sim->model, sim->elements, sim->x.data(), sim->v.data(), sim->coefficients,
-                                                   &sim->pattern, sim->values.data(), sim->rhs_full.data(), nullptr, sim->element_kernel);
-  PetscCall(PetscLogFlops(physics::element_kernel_flops(sim->model.mesh.order, true) * (PetscLogDouble)sim->elements.size()));
+  info->svd_rotations = physics::assemble_elements(sim->model, sim->elements, sim->x.data(), sim->v.data(),
+                                                   sim->coefficients, &sim->pattern, sim->values.data(),
+                                                   sim->rhs_full.data(), nullptr, sim->element_kernel);
+  PetscCall(PetscLogFlops(physics::element_kernel_flops(sim->model.mesh.order, true) *
+                          (PetscLogDouble)sim->elements.size()));
   PetscCall(PetscLogEventEnd(FEM_Elements, 0, 0, 0, 0));
   const double t1 = now();
   if (sim->size > 1)
-    PetscCallMPI(MPI_Reduce_scatter(sim->rhs_full.data(), sim->rhs_local.data(), sim->counts.data(), MPI_DOUBLE, MPI_SUM, sim->comm));
+    PetscCallMPI(MPI_Reduce_scatter(sim->rhs_full.data(), sim->rhs_local.data(), sim->counts.data(),
+                                    MPI_DOUBLE, MPI_SUM, sim->comm));
   else std::copy(sim->rhs_full.begin(), sim->rhs_full.end(), sim->rhs_local.begin());
   for (int i = sim->own_begin; i < sim->own_end; ++i)
     for (int d = 0; d < 3; ++d) {
@@ -147,8 +161,9 @@ PetscErrorCode FemSimulationStep(FemSimulation *sim, FemStepInfo *info)
   PetscCall(BlockSystemSolve(&sim->sys, sim->rhs_local.data(), sim->dv_local.data(), &info->stats));
   const double t4 = now();
   if (sim->size > 1)
-    PetscCallMPI(MPI_Allgatherv(sim->dv_local.data(), (int)sim->dv_local.size(), MPI_DOUBLE, sim->dv_full.data(),
-                                sim->counts.data(), sim->displs.data(), MPI_DOUBLE, sim->comm));
+    PetscCallMPI(MPI_Allgatherv(sim->dv_local.data(), (int)sim->dv_local.size(), MPI_DOUBLE,
+                                sim->dv_full.data(), sim->counts.data(), sim->displs.data(), MPI_DOUBLE,
+                                sim->comm));
   else std::copy(sim->dv_local.begin(), sim->dv_local.end(), sim->dv_full.begin());
   info->finite = true;
   for (double d : sim->dv_full) info->finite = info->finite && std::isfinite(d);

@@ -17,47 +17,49 @@
 #include <vector>
 
 struct FemScene {
-  physics::TetMesh      mesh;    // order 1 or 2, in the input numbering
+  physics::TetMesh      mesh; // order 1 or 2, in the input numbering
   physics::FemSettings  settings;
-  std::vector<char>     fixed;   // per node of mesh (input numbering); empty = none
+  std::vector<char>     fixed; // per node of mesh (input numbering); empty = none
   std::array<double, 3> gravity{0, 0, -9.81};
-  double                dt = 0.01;
+  double                dt             = 0.01;
   double                rayleigh_alpha = 0, rayleigh_beta = 0;
-  bool                  is_static = false; // Newton steps on K(x) dx = f(x) + f_ext instead of time steps
+  bool                  is_static    = false; // Newton steps on K(x) dx = f(x) + f_ext instead of time steps
   bool                  merge_blocks = true;
-  bool                  rigid_body_modes = true; // the rest shape's rigid body modes as the matrix's near null space (PCGAMG)
-  bool                  reorder = true;
-  int                   bin_order_window = 256; // with reorder: sort rows by length in windows of this many nodes (physics/row_order.hpp); 0 = off
+  bool rigid_body_modes = true; // the rest shape's rigid body modes as the matrix's near null space (PCGAMG)
+  bool reorder          = true;
+  int  bin_order_window =
+    256; // with reorder: sort rows by length in windows of this many nodes (physics/row_order.hpp); 0 = off
 };
 
 struct FemStepInfo {
   SolveStats stats;
-  bool       finite = true; // dv had no NaN/Inf (else the state was left unchanged)
+  bool       finite     = true; // dv had no NaN/Inf (else the state was left unchanged)
   double     element_ms = 0, setvalues_ms = 0, comm_ms = 0, solve_ms = 0, total_ms = 0;
-  long long  svd_rotations = 0; // this rank's elements whose rotation took the scalar SVD path (inverted, flat)
+  long long  svd_rotations =
+    0; // this rank's elements whose rotation took the scalar SVD path (inverted, flat)
 };
 
 struct FemSimulation {
-  MPI_Comm              comm = MPI_COMM_NULL;
-  int                   rank = 0, size = 1;
-  physics::FemModel     model;       // renumbered mesh
-  std::vector<char>     fixed;       // renumbered
-  std::vector<int>      new_of_old;  // input node -> simulation node
-  std::vector<int>      part_offsets;
-  int                   own_begin = 0, own_end = 0;
-  std::vector<int>      elements;    // elements this rank assembles
-  physics::BlockPattern pattern;
+  MPI_Comm                  comm = MPI_COMM_NULL;
+  int                       rank = 0, size = 1;
+  physics::FemModel         model;      // renumbered mesh
+  std::vector<char>         fixed;      // renumbered
+  std::vector<int>          new_of_old; // input node -> simulation node
+  std::vector<int>          part_offsets;
+  int                       own_begin = 0, own_end = 0;
+  std::vector<int>          elements; // elements this rank assembles
+  physics::BlockPattern     pattern;
   physics::StepCoefficients coefficients;
-  BlockSystem           sys;
-  std::vector<double>   x, v;        // all nodes, simulation numbering, 3 per node
-  std::vector<double>   f_gravity;
-  double                dt = 0, rhs_gravity_scale = 0;
-  bool                  is_static = false;
-  bool                  cpu_timer = false; // FemStepInfo times in process CPU time instead of wall time
-  physics::ElementKernel element_kernel = physics::ElementKernel::Batched; // Scalar: the reference loop
+  BlockSystem               sys;
+  std::vector<double>       x, v; // all nodes, simulation numbering, 3 per node
+  std::vector<double>       f_gravity;
+  double                    dt = 0, rhs_gravity_scale = 0;
+  bool                      is_static = false;
+  bool                      cpu_timer = false; // FemStepInfo times in process CPU time instead of wall time
+  physics::ElementKernel    element_kernel = physics::ElementKernel::Batched; // Scalar: the reference loop
   // work arrays
-  std::vector<double>   values, rhs_full, rhs_local, dv_local, dv_full;
-  std::vector<int>      counts, displs;
+  std::vector<double> values, rhs_full, rhs_local, dv_local, dv_full;
+  std::vector<int>    counts, displs;
 };
 
 // Builds the model and the linear system; x = rest positions, v = 0. Errors in the scene (mesh,

@@ -17,7 +17,8 @@ PetscErrorCode DriverComparePositions(MPI_Comm comm, const std::vector<double> &
     if (!rank) {
       FILE *f = std::fopen(path, "w");
       ok      = f != nullptr;
-      for (size_t i = 0; ok && i + 2 < xyz.size(); i += 3) ok = std::fprintf(f, "%.17g %.17g %.17g\n", xyz[i], xyz[i + 1], xyz[i + 2]) > 0;
+      for (size_t i = 0; ok && i + 2 < xyz.size(); i += 3)
+        ok = std::fprintf(f, "%.17g %.17g %.17g\n", xyz[i], xyz[i + 1], xyz[i + 2]) > 0;
       if (f) ok &= std::fclose(f) == 0;
     }
     PetscCallMPI(MPI_Bcast(&ok, 1, MPI_INT, 0, comm));
@@ -32,10 +33,14 @@ PetscErrorCode DriverComparePositions(MPI_Comm comm, const std::vector<double> &
   double v;
   while (ref.size() <= xyz.size() && std::fscanf(f, "%lf", &v) == 1) ref.push_back(v);
   std::fclose(f);
-  PetscCheck(ref.size() == xyz.size(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "-reference_positions %s: %zu numbers, this run has %zu positions (%zu numbers)", path, ref.size(), xyz.size() / 3, xyz.size());
+  PetscCheck(ref.size() == xyz.size(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED,
+             "-reference_positions %s: %zu numbers, this run has %zu positions (%zu numbers)", path,
+             ref.size(), xyz.size() / 3, xyz.size());
   double sum = 0, worst = 0;
   for (size_t i = 0; i < xyz.size(); i += 3) {
-    const double d2 = (xyz[i] - ref[i]) * (xyz[i] - ref[i]) + (xyz[i + 1] - ref[i + 1]) * (xyz[i + 1] - ref[i + 1]) + (xyz[i + 2] - ref[i + 2]) * (xyz[i + 2] - ref[i + 2]);
+    const double d2 = (xyz[i] - ref[i]) * (xyz[i] - ref[i]) +
+                      (xyz[i + 1] - ref[i + 1]) * (xyz[i + 1] - ref[i + 1]) +
+                      (xyz[i + 2] - ref[i + 2]) * (xyz[i + 2] - ref[i + 2]);
     sum += d2;
     worst = std::fmax(worst, std::sqrt(d2));
   }

@@ -4,8 +4,7 @@
 #include <immintrin.h>
 #include <mpi.h>
 
-namespace
-{
+namespace {
 
 volatile double sink; // keeps every sum observable
 
@@ -24,8 +23,7 @@ __attribute__((noinline)) double SumPlain(const double *__restrict a, PetscInt n
 
 // K parts of n / K doubles; chunk c of part p (8 doubles, one cache line) is read in the order
 // c = 0: parts 0..K-1, c = 1: parts 0..K-1, ...
-template <int K>
-__attribute__((noinline)) double SumInterleaved(const double *__restrict a, PetscInt n)
+template <int K> __attribute__((noinline)) double SumInterleaved(const double *__restrict a, PetscInt n)
 {
   const PetscInt part = n / K;
   double         s[8] = {0, 0, 0, 0, 0, 0, 0, 0};
@@ -89,7 +87,7 @@ PetscErrorCode ReadArrayCreate(MPI_Comm comm, double bytes_per_rank, ReadArray *
   PetscCallMPI(MPI_Comm_size(comm, &size));
   if (bytes_per_rank <= 0) bytes_per_rank = std::max(8.0 * (double)LastLevelCacheBytes(), 256.0 * (1 << 20));
   r->n = (PetscInt)(bytes_per_rank / sizeof(double)) / 64 * 64;
-  PetscCall(PetscMalloc1(r->n, &r->a)); // PetscMalloc aligns to 64 bytes here (PETSC_MEMALIGN)
+  PetscCall(PetscMalloc1(r->n, &r->a));              // PetscMalloc aligns to 64 bytes here (PETSC_MEMALIGN)
   for (PetscInt i = 0; i < r->n; i++) r->a[i] = 1.0; // first touch by the rank that reads it
   r->bytes = (double)r->n * sizeof(double) * size;
   r->patterns.clear();

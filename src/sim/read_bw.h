@@ -14,17 +14,17 @@
 
 struct ReadPattern {
   std::string name;
-  int         streams = 1; // K of the interleaved pattern; 1 for the sums
-  int         simd    = 0; // 0: plain C++, 512 / 256: explicit AVX-512 / AVX2
+  int         streams  = 1; // K of the interleaved pattern; 1 for the sums
+  int         simd     = 0; // 0: plain C++, 512 / 256: explicit AVX-512 / AVX2
   double      best_GBs = 0;
 };
 
 struct ReadArray {
-  double                  *a = nullptr;
-  PetscInt                 n = 0;     // doubles on this rank (a multiple of 64)
-  double                   bytes = 0; // one pass, all ranks together
+  double                  *a         = nullptr;
+  PetscInt                 n         = 0; // doubles on this rank (a multiple of 64)
+  double                   bytes     = 0; // one pass, all ranks together
   bool                     cpu_clock = false;
-  std::vector<ReadPattern> patterns;  // those this CPU can run, with their best so far
+  std::vector<ReadPattern> patterns; // those this CPU can run, with their best so far
 };
 
 // bytes_per_rank <= 0: max(8 x the last-level cache, 256 MiB). Allocates and first-touches.

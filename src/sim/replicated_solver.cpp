@@ -7,8 +7,8 @@
 #include <cstring>
 #include <numeric>
 
-PetscErrorCode ReplicatedSolverNumber(MPI_Comm comm, PetscInt n_blocks, const std::vector<int> &block_row, const std::vector<int> &block_col,
-                                      ReplicatedSolver *rs)
+PetscErrorCode ReplicatedSolverNumber(MPI_Comm comm, PetscInt n_blocks, const std::vector<int> &block_row,
+                                      const std::vector<int> &block_col, ReplicatedSolver *rs)
 {
   PetscFunctionBegin;
   rs->comm     = comm;
@@ -21,12 +21,16 @@ PetscErrorCode ReplicatedSolverNumber(MPI_Comm comm, PetscInt n_blocks, const st
   char mat_type[64] = "", pc_type[64] = "", sub_pc_type[64] = "";
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-mat_type", mat_type, sizeof mat_type, nullptr));
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-pc_type", pc_type, sizeof pc_type, nullptr));
-  PetscCall(PetscOptionsGetString(nullptr, nullptr, "-sub_pc_type", sub_pc_type, sizeof sub_pc_type, nullptr));
-  const bool point_pc = !pc_type[0] || !std::strcmp(pc_type, "jacobi") || !std::strcmp(pc_type, "pbjacobi") || !std::strcmp(pc_type, "none") ||
-                        (!std::strcmp(pc_type, "bjacobi") && (!std::strcmp(sub_pc_type, "jacobi") || !std::strcmp(sub_pc_type, "pbjacobi")));
+  PetscCall(
+    PetscOptionsGetString(nullptr, nullptr, "-sub_pc_type", sub_pc_type, sizeof sub_pc_type, nullptr));
+  const bool point_pc = !pc_type[0] || !std::strcmp(pc_type, "jacobi") || !std::strcmp(pc_type, "pbjacobi") ||
+                        !std::strcmp(pc_type, "none") ||
+                        (!std::strcmp(pc_type, "bjacobi") &&
+                         (!std::strcmp(sub_pc_type, "jacobi") || !std::strcmp(sub_pc_type, "pbjacobi")));
   PetscInt window = point_pc && (std::strstr(mat_type, "binbcsr") || std::strstr(mat_type, "sell")) ? 256 : 0;
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-rows_group_window", &window, nullptr));
-  PetscCheck(window >= 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-rows_group_window must be >= 0 (0 = off), got %" PetscInt_FMT, window);
+  PetscCheck(window >= 0, comm, PETSC_ERR_ARG_OUTOFRANGE,
+             "-rows_group_window must be >= 0 (0 = off), got %" PetscInt_FMT, window);
   std::vector<std::pair<int, int>> edges;
   for (size_t k = 0; k < block_row.size(); ++k)
     if (block_row[k] < block_col[k]) edges.push_back({block_row[k], block_col[k]});
@@ -53,7 +57,9 @@ PetscErrorCode ReplicatedSolverNumber(MPI_Comm comm, PetscInt n_blocks, const st
   {
     PetscBool mirrored;
     PetscCall(BlockSystemStoredTriangle(comm, &rs->upper_only, &rs->offrank_full, nullptr, &mirrored));
-    if (mirrored) rs->upper_only = PETSC_TRUE, rs->offrank_full = PETSC_FALSE; // the Mat fills the lower triangle from the upper one, across ranks too
+    if (mirrored)
+      rs->upper_only   = PETSC_TRUE,
+      rs->offrank_full = PETSC_FALSE; // the Mat fills the lower triangle from the upper one, across ranks too
   }
   PetscFunctionReturn(0);
 }
@@ -70,20 +76,23 @@ bool ReplicatedSolverStoresBlock(const ReplicatedSolver *rs, int row, int col)
   return rs->offrank_full && !ReplicatedSolverOwnsRow(rs, col);
 }
 
-PetscErrorCode ReplicatedSolverSetLocalPattern(ReplicatedSolver *rs, const std::vector<int> &block_row, const std::vector<int> &block_col)
+PetscErrorCode ReplicatedSolverSetLocalPattern(ReplicatedSolver *rs, const std::vector<int> &block_row,
+                                               const std::vector<int> &block_col)
 {
   PetscFunctionBegin;
   const int begin = rs->row_offsets[rs->rank], end = rs->row_offsets[rs->rank + 1];
-  PetscCheck(block_row.size() == block_col.size(), PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "COO block lists differ in length: %zu rows, %zu columns",
-             block_row.size(), block_col.size());
+  PetscCheck(block_row.size() == block_col.size(), PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+             "COO block lists differ in length: %zu rows, %zu columns", block_row.size(), block_col.size());
   std::vector<PetscInt> rows(block_row.size()), cols(block_col.size());
   for (size_t k = 0; k < block_row.size(); ++k) {
-    PetscCheck(block_row[k] >= 0 && block_row[k] < rs->n_blocks && block_col[k] >= 0 && block_col[k] < rs->n_blocks, PETSC_COMM_SELF,
-               PETSC_ERR_ARG_OUTOFRANGE, "COO block %zu is (%d, %d), outside [0, %" PetscInt_FMT ")", k, block_row[k], block_col[k], rs->n_blocks);
+    PetscCheck(
+      block_row[k] >= 0 && block_row[k] < rs->n_blocks && block_col[k] >= 0 && block_col[k] < rs->n_blocks,
+      PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "COO block %zu is (%d, %d), outside [0, %" PetscInt_FMT ")",
+      k, block_row[k], block_col[k], rs->n_blocks);
     rows[k] = rs->new_of_old[block_row[k]];
     cols[k] = rs->new_of_old[block_col[k]];
-    PetscCheck(rows[k] >= begin && rows[k] < end, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "COO block %zu is in row %d, which rank %d does not own", k,
-               block_row[k], rs->rank);
+    PetscCheck(rows[k] >= begin && rows[k] < end, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+               "COO block %zu is in row %d, which rank %d does not own", k, block_row[k], rs->rank);
   }
   PetscCall(BlockSystemCreate(rs->comm, rs->n_blocks, end - begin, rows, cols, &rs->sys));
   rs->rhs_local.resize(3 * (end - begin));
@@ -97,12 +106,14 @@ PetscErrorCode ReplicatedSolverSetLocalPattern(ReplicatedSolver *rs, const std::
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode ReplicatedSolverCreate(MPI_Comm comm, PetscInt n_blocks, const std::vector<int> &block_row, const std::vector<int> &block_col,
-                                      ReplicatedSolver *rs)
+PetscErrorCode ReplicatedSolverCreate(MPI_Comm comm, PetscInt n_blocks, const std::vector<int> &block_row,
+                                      const std::vector<int> &block_col, ReplicatedSolver *rs)
 {
   PetscFunctionBegin;
   PetscCall(ReplicatedSolverNumber(comm, n_blocks, block_row, block_col, rs));
-  if (rs->size == 1) PetscCall(ReplicatedSolverSetLocalPattern(rs, block_row, block_col)); // identical order: values need no copy
+  if (rs->size == 1)
+    PetscCall(
+      ReplicatedSolverSetLocalPattern(rs, block_row, block_col)); // identical order: values need no copy
   else {
     std::vector<int> rows, cols;
     for (size_t k = 0; k < block_row.size(); ++k) {
@@ -128,8 +139,8 @@ static PetscErrorCode SetMatrix(ReplicatedSolver *rs, const std::vector<double> 
       for (int k = 0; k < 9; ++k) rs->local_values[9 * i + k] = values[9 * rs->local_blocks[i] + k];
     PetscCall(BlockSystemSetValues(&rs->sys, rs->local_values.data()));
   } else {
-    PetscCheck(values.size() == 9 * (size_t)rs->sys.n_coo_blocks, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "%zu block values for %" PetscInt_FMT " COO blocks",
-               values.size(), rs->sys.n_coo_blocks);
+    PetscCheck(values.size() == 9 * (size_t)rs->sys.n_coo_blocks, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+               "%zu block values for %" PetscInt_FMT " COO blocks", values.size(), rs->sys.n_coo_blocks);
     PetscCall(BlockSystemSetValues(&rs->sys, values.data()));
   }
   rs->setvalues_ms += 1e3 * (now() - t0);
@@ -142,8 +153,8 @@ static PetscErrorCode Solve(ReplicatedSolver *rs, const std::vector<double> &rhs
 
   PetscFunctionBegin;
   const auto now = rs->cpu_timer ? ProcessCpuTime : WallTime;
-  double     t0  = 0, t1 = 0;
-  const int begin = rs->row_offsets[rs->rank], end = rs->row_offsets[rs->rank + 1];
+  double     t0 = 0, t1 = 0;
+  const int  begin = rs->row_offsets[rs->rank], end = rs->row_offsets[rs->rank + 1];
   PetscCall(KSPGetInitialGuessNonzero(rs->sys.ksp, &nonzero_guess));
   if (sol.size() != (size_t)(3 * rs->n_blocks)) sol.assign(3 * rs->n_blocks, 0.0);
   if (rs->size == 1 && !rs->renumbered) {
@@ -163,8 +174,8 @@ static PetscErrorCode Solve(ReplicatedSolver *rs, const std::vector<double> &rhs
       for (PetscInt i = 0; i < rs->n_blocks; ++i)
         for (int k = 0; k < 3; ++k) sol[3 * rs->old_of_new[i] + k] = rs->sol_local[3 * i + k];
     } else {
-      PetscCallMPI(MPI_Allgatherv(rs->sol_local.data(), 3 * (end - begin), MPIU_SCALAR, rs->sol_all.data(), rs->counts.data(), rs->displs.data(),
-                                  MPIU_SCALAR, rs->comm));
+      PetscCallMPI(MPI_Allgatherv(rs->sol_local.data(), 3 * (end - begin), MPIU_SCALAR, rs->sol_all.data(),
+                                  rs->counts.data(), rs->displs.data(), MPIU_SCALAR, rs->comm));
       for (PetscInt i = 0; i < rs->n_blocks; ++i)
         for (int k = 0; k < 3; ++k) sol[3 * i + k] = rs->sol_all[3 * rs->new_of_old[i] + k];
     }
@@ -180,7 +191,8 @@ physics::BlockLinearSolver ReplicatedSolverAdapter(ReplicatedSolver *rs)
 {
   physics::BlockLinearSolver s;
   if (rs->size > 1) // SetMatrix passes on only this rank's rows
-    for (int i = rs->row_offsets[rs->rank]; i < rs->row_offsets[rs->rank + 1]; ++i) s.needed_rows.push_back(rs->old_of_new[i]);
+    for (int i = rs->row_offsets[rs->rank]; i < rs->row_offsets[rs->rank + 1]; ++i)
+      s.needed_rows.push_back(rs->old_of_new[i]);
   s.set_matrix = [rs](const std::vector<double> &values) {
     if (!rs->error) rs->error = SetMatrix(rs, values);
   };
@@ -196,9 +208,10 @@ physics::BlockLinearSolver ReplicatedSolverAdapter(ReplicatedSolver *rs)
     r.converged  = rs->last.reason > 0;
     // Breakdown or indefiniteness of CG on J M^-1 J^T is how a singular (loop) matrix shows up; running
     // out of iterations is not (fixed-iteration runs end that way on purpose).
-    r.breakdown = rs->last.reason == KSP_DIVERGED_BREAKDOWN || rs->last.reason == KSP_DIVERGED_BREAKDOWN_BICG ||
-                  rs->last.reason == KSP_DIVERGED_INDEFINITE_PC || rs->last.reason == KSP_DIVERGED_INDEFINITE_MAT ||
-                  rs->last.reason == KSP_DIVERGED_NANORINF || rs->last.reason == KSP_DIVERGED_DTOL;
+    r.breakdown =
+      rs->last.reason == KSP_DIVERGED_BREAKDOWN || rs->last.reason == KSP_DIVERGED_BREAKDOWN_BICG ||
+      rs->last.reason == KSP_DIVERGED_INDEFINITE_PC || rs->last.reason == KSP_DIVERGED_INDEFINITE_MAT ||
+      rs->last.reason == KSP_DIVERGED_NANORINF || rs->last.reason == KSP_DIVERGED_DTOL;
     return r;
   };
   return s;

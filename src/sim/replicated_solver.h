@@ -23,26 +23,28 @@
 #include <vector>
 
 struct ReplicatedSolver {
-  BlockSystem              sys;
-  MPI_Comm                 comm = MPI_COMM_NULL;
-  int                      size = 1, rank = 0;
-  PetscInt                 n_blocks = 0;                  // block rows
-  std::vector<int>         new_of_old, old_of_new;        // physics block row -> solver block row and back
-  bool                     renumbered = false;            // new_of_old is not the identity
-  std::vector<int>         row_offsets;                   // block rows per rank, size + 1 entries
-  std::vector<size_t>      local_blocks;                  // indices into the physics COO list, this rank's rows
-  bool                     copy_local = false;            // set_matrix gets the whole list and copies out local_blocks
-  PetscBool                upper_only = PETSC_FALSE, offrank_full = PETSC_FALSE; // what the Mat type stores (BlockSystemStoredTriangle)
+  BlockSystem         sys;
+  MPI_Comm            comm = MPI_COMM_NULL;
+  int                 size = 1, rank = 0;
+  PetscInt            n_blocks = 0;           // block rows
+  std::vector<int>    new_of_old, old_of_new; // physics block row -> solver block row and back
+  bool                renumbered = false;     // new_of_old is not the identity
+  std::vector<int>    row_offsets;            // block rows per rank, size + 1 entries
+  std::vector<size_t> local_blocks;           // indices into the physics COO list, this rank's rows
+  bool                copy_local = false;     // set_matrix gets the whole list and copies out local_blocks
+  PetscBool           upper_only = PETSC_FALSE,
+            offrank_full         = PETSC_FALSE; // what the Mat type stores (BlockSystemStoredTriangle)
   std::vector<PetscScalar> local_values, rhs_local, sol_local, sol_all;
-  std::vector<int>         counts, displs;                // scalars per rank for the gather
-  bool      cpu_timer = false; // solve_ms and setvalues_ms in process CPU time instead of wall time (a shared machine)
+  std::vector<int>         counts, displs; // scalars per rank for the gather
+  bool                     cpu_timer =
+    false; // solve_ms and setvalues_ms in process CPU time instead of wall time (a shared machine)
   // Totals since creation (or the last reset by the caller).
-  long long solves = 0, iterations = 0;
-  double    solve_ms = 0, setvalues_ms = 0;
-  SolveStats last;
-  KSPConvergedReason worst_reason = KSP_CONVERGED_ITERATING; // most recent negative reason, if any
-  long long diverged_solves = 0;
-  PetscErrorCode error = 0; // first PETSc error inside a callback (the physics API has no error codes)
+  long long          solves = 0, iterations = 0;
+  double             solve_ms = 0, setvalues_ms = 0;
+  SolveStats         last;
+  KSPConvergedReason worst_reason    = KSP_CONVERGED_ITERATING; // most recent negative reason, if any
+  long long          diverged_solves = 0;
+  PetscErrorCode     error = 0; // first PETSc error inside a callback (the physics API has no error codes)
 };
 
 // block_row/block_col: the physics COO list of 3x3 blocks (both triangles, physics numbering).
@@ -59,7 +61,8 @@ bool ReplicatedSolverOwnsRow(const ReplicatedSolver *rs, int row);
 // coupling two ranks where the type keeps them (binbcsr).
 bool ReplicatedSolverStoresBlock(const ReplicatedSolver *rs, int row, int col);
 // This rank's COO list (rows it owns, physics numbering); set_matrix then takes values in this order.
-PetscErrorCode ReplicatedSolverSetLocalPattern(ReplicatedSolver *rs, const std::vector<int> &block_row, const std::vector<int> &block_col);
+PetscErrorCode ReplicatedSolverSetLocalPattern(ReplicatedSolver *rs, const std::vector<int> &block_row,
+                                               const std::vector<int> &block_col);
 // The callbacks for the physics step; check rs->error after each step.
 physics::BlockLinearSolver ReplicatedSolverAdapter(ReplicatedSolver *rs);
-PetscErrorCode ReplicatedSolverDestroy(ReplicatedSolver *rs);
+PetscErrorCode             ReplicatedSolverDestroy(ReplicatedSolver *rs);

@@ -58,8 +58,11 @@ PetscErrorCode RunGuardCheckStep(MPI_Comm comm, RunGuard *g, long long step, con
     g->exit_code = 3;
     std::snprintf(msg, sizeof msg, "nonfinite_state@step%lld", step);
     g->ended = msg;
-    PetscCall(PetscPrintf(comm, "error: step %lld left a nonfinite state (NaN or Inf)%s; stopping\n", step,
-                          h.solver_reason < 0 ? (std::string(" after the solver's ") + KSPConvergedReasons[h.solver_reason]).c_str() : ""));
+    PetscCall(
+      PetscPrintf(comm, "error: step %lld left a nonfinite state (NaN or Inf)%s; stopping\n", step,
+                  h.solver_reason < 0
+                    ? (std::string(" after the solver's ") + KSPConvergedReasons[h.solver_reason]).c_str()
+                    : ""));
     *stop = true;
     PetscFunctionReturn(0);
   }
@@ -71,8 +74,10 @@ PetscErrorCode RunGuardCheckStep(MPI_Comm comm, RunGuard *g, long long step, con
       g->exit_code = 2;
       std::snprintf(msg, sizeof msg, "solver_failure@step%lld", step);
       g->ended = msg;
-      PetscCall(PetscPrintf(comm, "error: the linear solve of step %lld failed (%s); stopping (-on_solver_failure continue integrates on)\n", step,
-                            KSPConvergedReasons[h.solver_reason]));
+      PetscCall(PetscPrintf(
+        comm,
+        "error: the linear solve of step %lld failed (%s); stopping (-on_solver_failure continue integrates on)\n",
+        step, KSPConvergedReasons[h.solver_reason]));
       *stop = true;
       PetscFunctionReturn(0);
     }
@@ -80,25 +85,31 @@ PetscErrorCode RunGuardCheckStep(MPI_Comm comm, RunGuard *g, long long step, con
   // the health check: the first bound broken, with its figures
   const HealthBounds &b = g->bounds;
   msg[0]                = 0;
-  if (std::isfinite(b.energy_growth) && std::isfinite(b.energy_scale) && b.energy_scale > 0 && std::isfinite(h.energy) &&
-      std::isfinite(g->energy0) && h.energy - g->energy0 > b.energy_growth * b.energy_scale)
-    std::snprintf(msg, sizeof msg, "energy grew by %.4g J (from %.4g), more than %.3g x the scene's %.4g J", h.energy - g->energy0, g->energy0,
-                  b.energy_growth, b.energy_scale);
-  else if (std::isfinite(b.inverted_fraction) && std::isfinite(h.inverted_fraction) && h.inverted_fraction > g->inverted0 + b.inverted_fraction)
-    std::snprintf(msg, sizeof msg, "%.3g%% of the elements are inverted (%.3g%% at the start)", 100 * h.inverted_fraction, 100 * g->inverted0);
+  if (std::isfinite(b.energy_growth) && std::isfinite(b.energy_scale) && b.energy_scale > 0 &&
+      std::isfinite(h.energy) && std::isfinite(g->energy0) &&
+      h.energy - g->energy0 > b.energy_growth * b.energy_scale)
+    std::snprintf(msg, sizeof msg, "energy grew by %.4g J (from %.4g), more than %.3g x the scene's %.4g J",
+                  h.energy - g->energy0, g->energy0, b.energy_growth, b.energy_scale);
+  else if (std::isfinite(b.inverted_fraction) && std::isfinite(h.inverted_fraction) &&
+           h.inverted_fraction > g->inverted0 + b.inverted_fraction)
+    std::snprintf(msg, sizeof msg, "%.3g%% of the elements are inverted (%.3g%% at the start)",
+                  100 * h.inverted_fraction, 100 * g->inverted0);
   else if (std::isfinite(b.max_stretch) && std::isfinite(h.max_stretch) && h.max_stretch > b.max_stretch)
-    std::snprintf(msg, sizeof msg, "a spring is stretched to %.4g x its rest length (bound %.3g)", h.max_stretch, b.max_stretch);
+    std::snprintf(msg, sizeof msg, "a spring is stretched to %.4g x its rest length (bound %.3g)",
+                  h.max_stretch, b.max_stretch);
   if (msg[0]) {
     ++g->unstable_steps;
     if (g->status == "ok") g->status = "unstable";
     if (g->stop_on_unstable) {
       g->exit_code = 4;
-      PetscCall(PetscPrintf(comm, "error: unstable at step %lld: %s; stopping (-on_unstable stop)\n", step, msg));
+      PetscCall(
+        PetscPrintf(comm, "error: unstable at step %lld: %s; stopping (-on_unstable stop)\n", step, msg));
       std::snprintf(msg, sizeof msg, "unstable@step%lld", step);
       g->ended = msg;
       *stop    = true;
     } else if (g->unstable_steps == 1) {
-      PetscCall(PetscPrintf(comm, "warning: unstable at step %lld: %s (-on_unstable stop ends the run there)\n", step, msg));
+      PetscCall(PetscPrintf(
+        comm, "warning: unstable at step %lld: %s (-on_unstable stop ends the run there)\n", step, msg));
     }
   }
   PetscFunctionReturn(0);

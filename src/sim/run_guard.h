@@ -33,11 +33,12 @@ struct HealthBounds {
 
 // What a driver saw in one step (NaN: not measured).
 struct StepHealth {
-  KSPConvergedReason solver_reason     = KSP_CONVERGED_ITERATING; // negative: the step's result rests on a failed solve
-  bool               finite            = true;
-  double             energy            = NAN;
-  double             inverted_fraction = NAN;
-  double             max_stretch       = NAN;
+  KSPConvergedReason solver_reason =
+    KSP_CONVERGED_ITERATING; // negative: the step's result rests on a failed solve
+  bool   finite            = true;
+  double energy            = NAN;
+  double inverted_fraction = NAN;
+  double max_stretch       = NAN;
 };
 
 struct RunGuard {
@@ -47,7 +48,7 @@ struct RunGuard {
   std::string        status = "ok", ended = "completed";
   long long          solver_failures = 0, unstable_steps = 0;
   KSPConvergedReason first_failure = KSP_CONVERGED_ITERATING;
-  int                exit_code = 0;
+  int                exit_code     = 0;
 };
 
 // Reads -on_solver_failure, -on_unstable and the -health_* overrides of the scene's bounds.

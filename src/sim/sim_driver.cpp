@@ -10,15 +10,18 @@ PetscErrorCode DriverOutputFromOptions(MPI_Comm comm, DriverOutput *out)
   PetscFunctionBegin;
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-steps", &out->steps, nullptr));
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-progress_every", &out->progress_every, nullptr));
-  PetscCall(PetscOptionsGetString(nullptr, nullptr, "-vtk", out->vtk_prefix, sizeof out->vtk_prefix, &out->vtk));
+  PetscCall(
+    PetscOptionsGetString(nullptr, nullptr, "-vtk", out->vtk_prefix, sizeof out->vtk_prefix, &out->vtk));
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-vtk_every", &out->vtk_every, nullptr));
-  PetscCall(PetscOptionsGetString(nullptr, nullptr, "-dump_matrix", out->dump_path, sizeof out->dump_path, &out->dump));
-  PetscCheck(out->steps >= 0 && out->progress_every >= 1 && out->vtk_every >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE,
-             "-steps must be >= 0, -progress_every and -vtk_every >= 1");
+  PetscCall(PetscOptionsGetString(nullptr, nullptr, "-dump_matrix", out->dump_path, sizeof out->dump_path,
+                                  &out->dump));
+  PetscCheck(out->steps >= 0 && out->progress_every >= 1 && out->vtk_every >= 1, comm,
+             PETSC_ERR_ARG_OUTOFRANGE, "-steps must be >= 0, -progress_every and -vtk_every >= 1");
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode DriverWriteFrame(MPI_Comm comm, DriverOutput *out, PetscInt step, double time, const std::function<bool(const std::string &path)> &write)
+PetscErrorCode DriverWriteFrame(MPI_Comm comm, DriverOutput *out, PetscInt step, double time,
+                                const std::function<bool(const std::string &path)> &write)
 {
   int rank;
 
@@ -30,8 +33,8 @@ PetscErrorCode DriverWriteFrame(MPI_Comm comm, DriverOutput *out, PetscInt step,
   PetscCheck(write(path), PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "cannot write %s", path);
   const char *base = std::strrchr(path, '/');
   out->frames.push_back({base ? base + 1 : path, time});
-  PetscCheck(physics::write_pvd(std::string(out->vtk_prefix) + ".pvd", out->frames), PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "cannot write %s.pvd",
-             out->vtk_prefix);
+  PetscCheck(physics::write_pvd(std::string(out->vtk_prefix) + ".pvd", out->frames), PETSC_COMM_SELF,
+             PETSC_ERR_FILE_OPEN, "cannot write %s.pvd", out->vtk_prefix);
   PetscFunctionReturn(0);
 }
 

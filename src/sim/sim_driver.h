@@ -22,8 +22,10 @@ PetscErrorCode DriverOutputFromOptions(MPI_Comm comm, DriverOutput *out);
 
 // On rank 0, every vtk_every steps: writes PREFIX_<step>.vtu with `write` (false = failure) and rewrites
 // PREFIX.pvd. No-op without -vtk.
-PetscErrorCode DriverWriteFrame(MPI_Comm comm, DriverOutput *out, PetscInt step, double time, const std::function<bool(const std::string &path)> &write);
+PetscErrorCode DriverWriteFrame(MPI_Comm comm, DriverOutput *out, PetscInt step, double time,
+                                const std::function<bool(const std::string &path)> &write);
 
 // Timing and solver fields of the summary: ms_per_step, solve_ms, setvalues_ms, physics_ms (the rest),
 // cg_its (per solve), diverged_solves, timer (wall or cpu, rs.cpu_timer).
-void DriverAddSolverSummary(SummaryLine &s, const ReplicatedSolver &rs, long long steps, double step_ms_total);
+void DriverAddSolverSummary(SummaryLine &s, const ReplicatedSolver &rs, long long steps,
+                            double step_ms_total);

@@ -17,10 +17,10 @@ PetscErrorCode CheckMatTypeAvailable(MPI_Comm comm)
   PetscFunctionBegin;
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-mat_type", type, sizeof type, &set));
   if (!set) PetscFunctionReturn(0);
-  const std::string t = type;
-  const bool cuda = t.find("cusparse") != std::string::npos || t.find("cuda") != std::string::npos;
-  const bool hip  = t.find("hipsparse") != std::string::npos || t.find("hip") == 0;
-  const bool kokkos = t.find("kokkos") != std::string::npos;
+  const std::string t      = type;
+  const bool        cuda   = t.find("cusparse") != std::string::npos || t.find("cuda") != std::string::npos;
+  const bool        hip    = t.find("hipsparse") != std::string::npos || t.find("hip") == 0;
+  const bool        kokkos = t.find("kokkos") != std::string::npos;
 #if !defined(PETSC_HAVE_CUDA)
   PetscCheck(!cuda, comm, PETSC_ERR_SUP,
              "-mat_type %s needs a PETSc configured with CUDA, and this PETSc has no CUDA support; "
@@ -39,7 +39,9 @@ PetscErrorCode CheckMatTypeAvailable(MPI_Comm comm)
              "use -mat_type aij, baij, sell or binbcsr",
              type);
 #endif
-  (void)cuda; (void)hip; (void)kokkos;
+  (void)cuda;
+  (void)hip;
+  (void)kokkos;
   PetscFunctionReturn(0);
 }
 
@@ -48,8 +50,8 @@ PetscErrorCode CheckMatTypeAvailable(MPI_Comm comm)
 // routines of every family (each is a no-op for the other families).
 // Also returns the number of distinct blocks over all ranks (nnz / 9). A may be null (count only).
 PetscErrorCode PreallocateFromBlockPattern(MPI_Comm comm, PetscInt n_local, PetscInt n_global,
-                                           const std::vector<PetscInt> &rows, const std::vector<PetscInt> &cols, Mat A,
-                                           PetscInt *n_blocks)
+                                           const std::vector<PetscInt> &rows,
+                                           const std::vector<PetscInt> &cols, Mat A, PetscInt *n_blocks)
 {
   Mat      graph;
   PetscInt bstart, bend;
@@ -77,7 +79,7 @@ PetscErrorCode PreallocateFromBlockPattern(MPI_Comm comm, PetscInt n_local, Pets
   // sbaij stores the upper triangle only: it gets its own (upper) counts.
   std::vector<PetscInt> d_blocks(n_local), o_blocks(n_local), du_blocks(n_local), ou_blocks(n_local);
   std::vector<PetscInt> d_rows(3 * n_local), o_rows(3 * n_local);
-  PetscInt d_max = 0, o_max = 0;
+  PetscInt              d_max = 0, o_max = 0;
   for (PetscInt i = bstart; i < bend; ++i) {
     PetscInt        ncols;
     const PetscInt *c;
@@ -101,7 +103,8 @@ PetscErrorCode PreallocateFromBlockPattern(MPI_Comm comm, PetscInt n_local, Pets
     o_max = std::max(o_max, 3 * o);
   }
   PetscCall(MatDestroy(&graph));
-  PetscCall(MatXAIJSetPreallocation(A, 3, d_blocks.data(), o_blocks.data(), du_blocks.data(), ou_blocks.data()));
+  PetscCall(
+    MatXAIJSetPreallocation(A, 3, d_blocks.data(), o_blocks.data(), du_blocks.data(), ou_blocks.data()));
   {
     // The drivers hand over both triangles of their symmetric systems; sbaij keeps the upper one.
     PetscBool is_sbaij;
@@ -130,8 +133,8 @@ PetscErrorCode MatStoredTriangle(Mat A, PetscBool *upper_only, PetscBool *offran
 
 } // namespace
 
-PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, PetscBool *offrank_full, PetscInt *bin_width,
-                                         PetscBool *lower_mirrored)
+PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, PetscBool *offrank_full,
+                                         PetscInt *bin_width, PetscBool *lower_mirrored)
 {
   Mat       probe;
   PetscBool mirrored;
@@ -157,12 +160,14 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
 {
   PetscFunctionBegin;
   PetscCheck(sys, comm, PETSC_ERR_ARG_NULL, "BlockSystem pointer is null");
-  PetscCheck(n_block_rows_global > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "need at least one block row, got %" PetscInt_FMT,
-             n_block_rows_global);
+  PetscCheck(n_block_rows_global > 0, comm, PETSC_ERR_ARG_OUTOFRANGE,
+             "need at least one block row, got %" PetscInt_FMT, n_block_rows_global);
   PetscCheck(coo_block_row.size() == coo_block_col.size(), PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
-             "COO block lists differ in length: %zu rows, %zu columns", coo_block_row.size(), coo_block_col.size());
+             "COO block lists differ in length: %zu rows, %zu columns", coo_block_row.size(),
+             coo_block_col.size());
   PetscCheck(coo_block_row.size() * 9 < (size_t)PETSC_MAX_INT, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
-             "%zu COO blocks expand to more scalar entries than 32-bit PetscInt can index", coo_block_row.size());
+             "%zu COO blocks expand to more scalar entries than 32-bit PetscInt can index",
+             coo_block_row.size());
   for (size_t k = 0; k < coo_block_row.size(); ++k) {
     PetscCheck(coo_block_row[k] >= 0 && coo_block_row[k] < n_block_rows_global && coo_block_col[k] >= 0 &&
                  coo_block_col[k] < n_block_rows_global,
@@ -192,10 +197,12 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
     PetscCall(MatStoredTriangle(sys->A, &sys->upper_only, &offrank_full, &mirrored));
     if (mirrored) sys->upper_only = PETSC_TRUE; // the caller lists the upper triangle, the Mat mirrors it
     for (size_t k = 0; mirrored && k < coo_block_row.size(); ++k)
-      PetscCheck(coo_block_row[k] <= coo_block_col[k], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
-                 "COO block %zu is (%" PetscInt_FMT ", %" PetscInt_FMT "), below the diagonal, but -mat_binbcsr_coo_mirror "
-                 "fills the lower triangle from the upper one: list the upper triangle only (see BlockSystemStoredTriangle)",
-                 k, coo_block_row[k], coo_block_col[k]);
+      PetscCheck(
+        coo_block_row[k] <= coo_block_col[k], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
+        "COO block %zu is (%" PetscInt_FMT ", %" PetscInt_FMT
+        "), below the diagonal, but -mat_binbcsr_coo_mirror "
+        "fills the lower triangle from the upper one: list the upper triangle only (see BlockSystemStoredTriangle)",
+        k, coo_block_row[k], coo_block_col[k]);
   }
 
   // The block graph for the structural count (and the row lengths): an upper-triangle list stands
@@ -214,7 +221,7 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
   }
   if (sys->native_coo) {
     // 9 scalar entries per block, row-major, so block values need no reordering.
-    const size_t nb = coo_block_row.size();
+    const size_t          nb = coo_block_row.size();
     std::vector<PetscInt> ci(9 * nb), cj(9 * nb);
     for (size_t k = 0; k < nb; ++k)
       for (int r = 0; r < 3; ++r)
@@ -223,11 +230,13 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
           cj[9 * k + 3 * r + c] = 3 * coo_block_col[k] + c;
         }
     PetscCall(MatSetPreallocationCOO(sys->A, (PetscCount)ci.size(), ci.data(), cj.data()));
-    PetscCall(PreallocateFromBlockPattern(comm, n_local, n_block_rows_global, graph_row, graph_col, nullptr, &sys->n_blocks));
+    PetscCall(PreallocateFromBlockPattern(comm, n_local, n_block_rows_global, graph_row, graph_col, nullptr,
+                                          &sys->n_blocks));
   } else {
     // PETSc 3.18's generic COO preallocation cannot preallocate sell; preallocate every other type
     // from the exact row lengths instead.
-    PetscCall(PreallocateFromBlockPattern(comm, n_local, n_block_rows_global, graph_row, graph_col, sys->A, &sys->n_blocks));
+    PetscCall(PreallocateFromBlockPattern(comm, n_local, n_block_rows_global, graph_row, graph_col, sys->A,
+                                          &sys->n_blocks));
     PetscCall(MatSetOption(sys->A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
   }
   PetscCall(MatSetOption(sys->A, MAT_SYMMETRIC, PETSC_TRUE));
@@ -303,7 +312,7 @@ PetscErrorCode BlockSystemSolve(BlockSystem *sys, const PetscScalar *rhs_local, 
   }
   const double t0 = MPI_Wtime();
   PetscCall(KSPSolve(sys->ksp, sys->b, sys->x));
-  const double t1 = MPI_Wtime();
+  const double       t1 = MPI_Wtime();
   const PetscScalar *xa;
   PetscCall(VecGetArrayRead(sys->x, &xa));
   std::memcpy(sol_local, xa, n * sizeof(PetscScalar));
@@ -329,8 +338,8 @@ PetscErrorCode BlockSystemDumpMatrix(BlockSystem *sys, const char *path)
   // Rebuilt as aij from the same COO list, so the dump works for every type (binbcsr has no MatView
   // to binary of its own) and loads anywhere.
   PetscCall(MatCreate(comm, &aij));
-  PetscCall(MatSetSizes(aij, sys->row_end - sys->row_begin, sys->row_end - sys->row_begin, 3 * sys->n_block_rows_global,
-                        3 * sys->n_block_rows_global));
+  PetscCall(MatSetSizes(aij, sys->row_end - sys->row_begin, sys->row_end - sys->row_begin,
+                        3 * sys->n_block_rows_global, 3 * sys->n_block_rows_global));
   PetscCall(MatSetBlockSize(aij, 3));
   PetscCall(MatSetType(aij, MATAIJ));
   {
@@ -360,7 +369,8 @@ PetscErrorCode BlockSystemDumpMatrix(BlockSystem *sys, const char *path)
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode BlockSystemGetInfo(BlockSystem *sys, PetscInt *nnz, const char **mat_type, const char **ksp_type)
+PetscErrorCode BlockSystemGetInfo(BlockSystem *sys, PetscInt *nnz, const char **mat_type,
+                                  const char **ksp_type)
 {
   PetscFunctionBegin;
   if (nnz) *nnz = 9 * sys->n_blocks;

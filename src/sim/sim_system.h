@@ -25,25 +25,26 @@
 #include <vector>
 
 struct BlockSystem {
-  Mat      A   = nullptr; // block size 3, rows [row_begin, row_end) (scalar rows) on this rank
-  KSP      ksp = nullptr;
-  Vec      x = nullptr, b = nullptr;
-  PetscInt n_block_rows_global = 0, n_block_rows_local = 0;
-  PetscInt row_begin = 0, row_end = 0;  // scalar row range owned by this rank
-  PetscInt n_coo_blocks = 0;            // blocks this rank contributes (length of the COO list)
-  PetscInt n_blocks = 0;                // distinct blocks of the pattern over all ranks
-  PetscBool native_coo = PETSC_FALSE;   // the type implements MatSetValuesCOO itself
-  PetscBool upper_only = PETSC_FALSE;   // blocks below the diagonal are ignored or mirrored from above (sbaij, binbcsr
-                                        // symmetric storage or COO mirror): the caller lists the upper triangle
+  Mat       A   = nullptr; // block size 3, rows [row_begin, row_end) (scalar rows) on this rank
+  KSP       ksp = nullptr;
+  Vec       x = nullptr, b = nullptr;
+  PetscInt  n_block_rows_global = 0, n_block_rows_local = 0;
+  PetscInt  row_begin = 0, row_end = 0; // scalar row range owned by this rank
+  PetscInt  n_coo_blocks = 0;           // blocks this rank contributes (length of the COO list)
+  PetscInt  n_blocks     = 0;           // distinct blocks of the pattern over all ranks
+  PetscBool native_coo   = PETSC_FALSE; // the type implements MatSetValuesCOO itself
+  PetscBool upper_only =
+    PETSC_FALSE; // blocks below the diagonal are ignored or mirrored from above (sbaij, binbcsr
+                 // symmetric storage or COO mirror): the caller lists the upper triangle
   std::vector<PetscInt> coo_block_row, coo_block_col; // kept for the fallback path and for dumps
-  const PetscScalar *last_values = nullptr; // the caller's array from the last SetValues (for dumps)
+  const PetscScalar    *last_values = nullptr; // the caller's array from the last SetValues (for dumps)
 };
 
 struct SolveStats {
-  PetscInt           iterations = 0;
-  PetscReal          residual_norm = 0;  // as the KSP reports it (0 when the KSP computes none)
-  KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
-  double             ms = 0;             // wall-clock milliseconds of KSPSolve
+  PetscInt           iterations    = 0;
+  PetscReal          residual_norm = 0; // as the KSP reports it (0 when the KSP computes none)
+  KSPConvergedReason reason        = KSP_CONVERGED_ITERATING;
+  double             ms            = 0; // wall-clock milliseconds of KSPSolve
 };
 
 // n_block_rows_local may be PETSC_DECIDE. Call after PetscInitialize and plug-in registration.
@@ -59,8 +60,8 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
 // lower_mirrored (may be null): the Mat fills every block below the diagonal from the COO entries of
 // its upper twin (binbcsr with -mat_binbcsr_coo_mirror), so the caller lists only blocks on or above
 // the diagonal (also those coupling two ranks), whatever the Mat stores.
-PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, PetscBool *offrank_full, PetscInt *bin_width = nullptr,
-                                         PetscBool *lower_mirrored = nullptr);
+PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, PetscBool *offrank_full,
+                                         PetscInt *bin_width = nullptr, PetscBool *lower_mirrored = nullptr);
 
 // The rigid body modes (3 translations, 3 rotations) of this rank's nodes (coords_local: 3 per block
 // row, in the rows' order) as the matrix's near null space, from which PCGAMG (and ML) build their
@@ -82,6 +83,7 @@ PetscErrorCode BlockSystemSolve(BlockSystem *sys, const PetscScalar *rhs_local, 
 PetscErrorCode BlockSystemDumpMatrix(BlockSystem *sys, const char *path);
 
 // Structural nonzeros (9 per distinct block of the pattern, over all ranks; padding not counted) and the Mat type's name.
-PetscErrorCode BlockSystemGetInfo(BlockSystem *sys, PetscInt *nnz, const char **mat_type, const char **ksp_type);
+PetscErrorCode BlockSystemGetInfo(BlockSystem *sys, PetscInt *nnz, const char **mat_type,
+                                  const char **ksp_type);
 
 PetscErrorCode BlockSystemDestroy(BlockSystem *sys);

@@ -8,14 +8,18 @@
 namespace {
 
 // Varies the coupling strength from node to node so that rows are not all alike (values in [1, 1.5]).
-PetscReal NodeCoefficient(PetscInt i, PetscInt j, PetscInt k) { return 1.0 + 0.05 * (PetscReal)((7 * i + 13 * j + 29 * k) % 11); }
+PetscReal NodeCoefficient(PetscInt i, PetscInt j, PetscInt k)
+{
+  return 1.0 + 0.05 * (PetscReal)((7 * i + 13 * j + 29 * k) % 11);
+}
 
 } // namespace
 
-void StencilBlockRow(const StencilGrid &g, PetscInt node, PetscInt *ncols, PetscInt cols[27], PetscScalar vals[27 * 9])
+void StencilBlockRow(const StencilGrid &g, PetscInt node, PetscInt *ncols, PetscInt cols[27],
+                     PetscScalar vals[27 * 9])
 {
   const PetscInt  i = node % g.nx, j = (node / g.nx) % g.ny, k = node / (g.nx * g.ny);
-  const PetscReal cp = NodeCoefficient(i, j, k);
+  const PetscReal cp        = NodeCoefficient(i, j, k);
   PetscReal       offsum[3] = {0, 0, 0}; // absolute off-diagonal sum of each of the block row's 3 rows
   PetscInt        n = 0, diag_slot = -1;
   PetscScalar     blocks[27][3][3];
@@ -36,7 +40,8 @@ void StencilBlockRow(const StencilGrid &g, PetscInt node, PetscInt *ncols, Petsc
         // |d| / |d| componentwise: every off-diagonal entry is <= 0, so with the diagonal below the
         // matrix is a shifted M-matrix whose smallest eigenvalue falls like n^-2 (as a stiffness
         // matrix's), not a trivially well-conditioned one.
-        const PetscReal u[3] = {std::abs(dx) / std::sqrt(d2), std::abs(dy) / std::sqrt(d2), std::abs(dz) / std::sqrt(d2)};
+        const PetscReal u[3] = {std::abs(dx) / std::sqrt(d2), std::abs(dy) / std::sqrt(d2),
+                                std::abs(dz) / std::sqrt(d2)};
         for (int a = 0; a < 3; ++a)
           for (int b = 0; b < 3; ++b) {
             blocks[n][a][b] = -w * ((a == b ? 1.0 : 0.0) + 0.5 * u[a] * u[b]);
@@ -54,7 +59,8 @@ void StencilBlockRow(const StencilGrid &g, PetscInt node, PetscInt *ncols, Petsc
       for (int b = 0; b < 3; ++b) vals[a * 3 * n + 3 * c + b] = blocks[c][a][b];
 }
 
-PetscErrorCode CreateStencilMatrix(MPI_Comm comm, const StencilGrid &grid, MatType type, const char *prefix, Mat *A)
+PetscErrorCode CreateStencilMatrix(MPI_Comm comm, const StencilGrid &grid, MatType type, const char *prefix,
+                                   Mat *A)
 {
   const PetscInt bs = 3, nodes = grid.nodes();
   PetscInt       rstart, rend, cols[27], ncols;
@@ -63,8 +69,12 @@ PetscErrorCode CreateStencilMatrix(MPI_Comm comm, const StencilGrid &grid, MatTy
   MatType        actual;
 
   PetscFunctionBegin;
-  PetscCheck(grid.nx > 0 && grid.ny > 0 && grid.nz > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "Stencil grid must have at least one node per direction, got %" PetscInt_FMT " x %" PetscInt_FMT " x %" PetscInt_FMT, grid.nx, grid.ny, grid.nz);
-  PetscCheck(grid.shift > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "Stencil shift must be positive for an SPD matrix");
+  PetscCheck(grid.nx > 0 && grid.ny > 0 && grid.nz > 0, comm, PETSC_ERR_ARG_OUTOFRANGE,
+             "Stencil grid must have at least one node per direction, got %" PetscInt_FMT " x %" PetscInt_FMT
+             " x %" PetscInt_FMT,
+             grid.nx, grid.ny, grid.nz);
+  PetscCheck(grid.shift > 0, comm, PETSC_ERR_ARG_OUTOFRANGE,
+             "Stencil shift must be positive for an SPD matrix");
   // PETSc's default row layout (whole blocks per rank), computed up front to count the preallocation.
   PetscLayout map;
   PetscInt    nlocal;
@@ -84,7 +94,8 @@ PetscErrorCode CreateStencilMatrix(MPI_Comm comm, const StencilGrid &grid, MatTy
   PetscCall(MatSetBlockSize(*A, bs));
   if (type) {
     PetscCall(MatSetType(*A, type));
-    PetscCall(MatBinBCSRSetFromOptions(*A)); /* -mat_binbcsr_bin_width, ... (not -mat_type: the caller chose the type) */
+    PetscCall(MatBinBCSRSetFromOptions(
+      *A)); /* -mat_binbcsr_bin_width, ... (not -mat_type: the caller chose the type) */
   } else PetscCall(MatSetFromOptions(*A));
 
   // Exact preallocation, in blocks (d/o: diagonal/off-diagonal part; u: upper triangle for SBAIJ).
@@ -98,7 +109,10 @@ PetscErrorCode CreateStencilMatrix(MPI_Comm comm, const StencilGrid &grid, MatTy
       (local ? d : o)++;
       if (cols[c] >= r) (local ? du : ou)++;
     }
-    dnnz[r - rstart] = d; onnz[r - rstart] = o; dnnzu[r - rstart] = du; onnzu[r - rstart] = ou;
+    dnnz[r - rstart]  = d;
+    onnz[r - rstart]  = o;
+    dnnzu[r - rstart] = du;
+    onnzu[r - rstart] = ou;
     for (PetscInt a = 0; a < bs; ++a) {
       sd[bs * (r - rstart) + a] = bs * d;
       so[bs * (r - rstart) + a] = bs * o;

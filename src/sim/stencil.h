@@ -16,20 +16,22 @@
 struct StencilGrid {
   PetscInt  nx = 10, ny = 10, nz = 10;
   PetscReal shift = 1e-2; // diagonal margin relative to the coupling: smaller = worse conditioned
-  PetscInt nodes() const { return nx * ny * nz; }
+  PetscInt  nodes() const { return nx * ny * nz; }
 };
 
 // The blocks of one block row (node): *ncols block column indices in increasing order, and
 // vals[27*9] holding the blocks side by side as a 3 x (3*ncols) row-major array
 // (the layout MatSetValuesBlocked takes).
-void StencilBlockRow(const StencilGrid &grid, PetscInt node, PetscInt *ncols, PetscInt cols[27], PetscScalar vals[27 * 9]);
+void StencilBlockRow(const StencilGrid &grid, PetscInt node, PetscInt *ncols, PetscInt cols[27],
+                     PetscScalar vals[27 * 9]);
 
 // Creates and assembles the matrix on comm (rows distributed by PETSc's default layout).
 // type == nullptr: the type comes from the options database (-[prefix]mat_type, default aij),
 // otherwise any MatType (aij, baij, sbaij, sell, binbcsr, ... and their seq/mpi forms).
 // Preallocated exactly through MatXAIJSetPreallocation (+ the SELL setters), block size 3,
 // marked symmetric and SPD. For SBAIJ types only the upper triangle is inserted.
-PetscErrorCode CreateStencilMatrix(MPI_Comm comm, const StencilGrid &grid, MatType type, const char *prefix, Mat *A);
+PetscErrorCode CreateStencilMatrix(MPI_Comm comm, const StencilGrid &grid, MatType type, const char *prefix,
+                                   Mat *A);
 
 // Reads -stencil_n N (all three) or -stencil_nx/-stencil_ny/-stencil_nz and -stencil_shift.
 PetscErrorCode StencilGridFromOptions(const char *prefix, StencilGrid *grid);

@@ -18,7 +18,8 @@ double ProcessCpuSeconds()
 namespace {
 
 // Kept out of line so the compiler cannot fuse or drop repetitions.
-__attribute__((noinline)) void Triad(double *__restrict a, const double *__restrict b, const double *__restrict c, double s, PetscInt n)
+__attribute__((noinline)) void Triad(double *__restrict a, const double *__restrict b,
+                                     const double *__restrict c, double s, PetscInt n)
 {
   for (PetscInt i = 0; i < n; ++i) a[i] = b[i] + s * c[i];
 }
@@ -32,8 +33,9 @@ PetscErrorCode TriadArraysCreate(MPI_Comm comm, PetscInt n, TriadArrays *t)
   PetscFunctionBegin;
   PetscCallMPI(MPI_Comm_size(comm, &size));
   if (n <= 0) {
-    const size_t llc   = LastLevelCacheBytes();
-    const size_t total = std::max<size_t>(4 * llc / sizeof(double), (size_t)32 << 20); // elements per array, all ranks
+    const size_t llc = LastLevelCacheBytes();
+    const size_t total =
+      std::max<size_t>(4 * llc / sizeof(double), (size_t)32 << 20); // elements per array, all ranks
     n = (PetscInt)(total / (size_t)size);
   }
   PetscCall(PetscMalloc3(n, &t->a, n, &t->b, n, &t->c));

@@ -7,19 +7,19 @@
 #include <petscsys.h>
 
 struct StreamResult {
-  double   best_GBs   = 0; // aggregate over ranks, best repetition (as STREAM reports)
-  double   median_GBs = 0;
+  double   best_GBs          = 0; // aggregate over ranks, best repetition (as STREAM reports)
+  double   median_GBs        = 0;
   PetscInt elements_per_rank = 0;
-  PetscInt repeats   = 0;
-  int      ranks     = 1;
+  PetscInt repeats           = 0;
+  int      ranks             = 1;
 };
 
 // The arrays of one rank, for callers that interleave triad passes with other measurements (so that
 // both see the same load from other processes).
 struct TriadArrays {
   double  *a = nullptr, *b = nullptr, *c = nullptr;
-  PetscInt n = 0;      // elements per array on this rank
-  double   bytes = 0;  // bytes one pass moves, all ranks together
+  PetscInt n         = 0;     // elements per array on this rank
+  double   bytes     = 0;     // bytes one pass moves, all ranks together
   bool     cpu_clock = false; // time passes with ProcessCpuSeconds instead of the wall clock
 };
 // n <= 0: the default size below. Allocates and first-touches.
@@ -30,7 +30,8 @@ PetscErrorCode TriadArraysDestroy(TriadArrays *t);
 
 // elements_per_rank <= 0: each of the three arrays, summed over the ranks, is 4x the last-level
 // cache (at least 32 Mi doubles in all), as STREAM's rules ask. repeats <= 0: 10.
-PetscErrorCode MeasureStreamTriad(MPI_Comm comm, PetscInt elements_per_rank, PetscInt repeats, StreamResult *result);
+PetscErrorCode MeasureStreamTriad(MPI_Comm comm, PetscInt elements_per_rank, PetscInt repeats,
+                                  StreamResult *result);
 
 // Same, sizes from options -stream_elements N and -stream_repeats R.
 PetscErrorCode MeasureStreamTriadFromOptions(MPI_Comm comm, StreamResult *result);

@@ -11,7 +11,10 @@ void SummaryLine::add(const std::string &key, double value)
   fields.emplace_back(key, buf);
 }
 
-void SummaryLine::add(const std::string &key, long long value) { fields.emplace_back(key, std::to_string(value)); }
+void SummaryLine::add(const std::string &key, long long value)
+{
+  fields.emplace_back(key, std::to_string(value));
+}
 
 void SummaryLine::add(const std::string &key, const std::string &value) { fields.emplace_back(key, value); }
 

@@ -7,9 +7,9 @@
 
 struct SummaryLine {
   std::vector<std::pair<std::string, std::string>> fields;
-  void add(const std::string &key, double value);
-  void add(const std::string &key, long long value);
-  void add(const std::string &key, const std::string &value);
+  void                                             add(const std::string &key, double value);
+  void                                             add(const std::string &key, long long value);
+  void                                             add(const std::string &key, const std::string &value);
 };
 
 // Prints on rank 0 of comm.

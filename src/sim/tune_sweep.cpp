@@ -5,7 +5,8 @@
 #include <cstring>
 #include <vector>
 
-PetscErrorCode MakeBinBCSR(Mat src, PetscInt bs, PetscInt bw, PetscInt streams, MatBinBCSRPrecision prec, PetscBool sym, PetscBool tune, Mat *A)
+PetscErrorCode MakeBinBCSR(Mat src, PetscInt bs, PetscInt bw, PetscInt streams, MatBinBCSRPrecision prec,
+                           PetscBool sym, PetscBool tune, Mat *A)
 {
   PetscInt m, n;
 
@@ -34,15 +35,14 @@ PetscErrorCode MakeBinBCSR(Mat src, PetscInt bs, PetscInt bw, PetscInt streams, 
   PetscFunctionReturn(0);
 }
 
-namespace
-{
+namespace {
 
 struct Variant {
-  Mat              A       = nullptr;
-  PetscInt         bw      = 0, streams = 0; // streams set before each batch (0: the matrix's own)
-  MatBinBCSRKernel kernel  = MAT_BINBCSR_KERNEL_AUTO; // set before each batch
-  bool     owner   = false;
-  double   best    = 1e300;
+  Mat              A  = nullptr;
+  PetscInt         bw = 0, streams = 0;              // streams set before each batch (0: the matrix's own)
+  MatBinBCSRKernel kernel = MAT_BINBCSR_KERNEL_AUTO; // set before each batch
+  bool             owner  = false;
+  double           best   = 1e300;
 };
 
 // The "cost X ms" of the tuner's line in -mat_view ::ascii_info, or -1.
@@ -68,7 +68,8 @@ PetscErrorCode TuneCost(Mat A, double *ms, std::string *line)
   *ms            = -1;
   const size_t c = line->find("cost "), e = line->find(" ms)");
   if (c != std::string::npos) *ms = atof(line->c_str() + c + 5);
-  else if (e != std::string::npos) *ms = atof(line->c_str() + line->rfind('(', e) + 1); // from the cache (X ms)
+  else if (e != std::string::npos)
+    *ms = atof(line->c_str() + line->rfind('(', e) + 1); // from the cache (X ms)
   PetscFunctionReturn(0);
 }
 
@@ -108,7 +109,8 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
       Mat A;
       PetscCall(MakeBinBCSR(aij, bs, bw, 0, prec, sym, PETSC_FALSE, &A));
       for (PetscInt K : {1, 2, 4, 8})
-        for (MatBinBCSRKernel k : {MAT_BINBCSR_KERNEL_PORTABLE, MAT_BINBCSR_KERNEL_AVX2, MAT_BINBCSR_KERNEL_AVX512}) {
+        for (MatBinBCSRKernel k :
+             {MAT_BINBCSR_KERNEL_PORTABLE, MAT_BINBCSR_KERNEL_AVX2, MAT_BINBCSR_KERNEL_AVX512}) {
           PetscBool avail;
           PetscCall(MatBinBCSRKernelAvailable(k, &avail));
           if (!avail) continue;
@@ -139,12 +141,24 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
     double      cost;
     std::string line;
     PetscCall(TuneCost(tuned.A, &cost, &line));
-    const char *storage = sym ? "symmetric" : "whole", *p = prec == MAT_BINBCSR_PRECISION_SINGLE ? "single" : "double";
+    const char *storage = sym ? "symmetric" : "whole",
+               *p       = prec == MAT_BINBCSR_PRECISION_SINGLE ? "single" : "double";
     if (s.verbose) {
-      for (const Variant &v : vars) PetscCall(PetscPrintf(PETSC_COMM_SELF, "  %-14s %-9s %-6s bw %2" PetscInt_FMT " K %" PetscInt_FMT " %-8s %9.4f ms\n", name.c_str(), storage, p, v.bw, v.streams, MatBinBCSRKernels[v.kernel], 1e3 * v.best));
+      for (const Variant &v : vars)
+        PetscCall(PetscPrintf(
+          PETSC_COMM_SELF, "  %-14s %-9s %-6s bw %2" PetscInt_FMT " K %" PetscInt_FMT " %-8s %9.4f ms\n",
+          name.c_str(), storage, p, v.bw, v.streams, MatBinBCSRKernels[v.kernel], 1e3 * v.best));
       PetscCall(PetscPrintf(PETSC_COMM_SELF, "  tuner: %s\n", line.c_str()));
     }
-    PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-14s %-9s %-6s best %2" PetscInt_FMT "/%" PetscInt_FMT "/%-8s %8.4f   tuned %2" PetscInt_FMT "/%" PetscInt_FMT "/%-8s %8.4f   tuned/best %5.3f   %s %8.4f  tuned x %s %5.2f   tuning %6.1f ms (build %.0f ms)\n", name.c_str(), storage, p, best->bw, best->streams, MatBinBCSRKernels[best->kernel], 1e3 * best->best, tuned.bw, tuned.streams, MatBinBCSRKernels[tuned.kernel], 1e3 * tuned.best, tuned.best / best->best, bs > 1 ? "baij" : "aij", 1e3 * base.best, bs > 1 ? "baij" : "aij", base.best / tuned.best, cost, 1e3 * (t1 - t0)));
+    PetscCall(PetscPrintf(
+      PETSC_COMM_SELF,
+      "%-14s %-9s %-6s best %2" PetscInt_FMT "/%" PetscInt_FMT "/%-8s %8.4f   tuned %2" PetscInt_FMT
+      "/%" PetscInt_FMT
+      "/%-8s %8.4f   tuned/best %5.3f   %s %8.4f  tuned x %s %5.2f   tuning %6.1f ms (build %.0f ms)\n",
+      name.c_str(), storage, p, best->bw, best->streams, MatBinBCSRKernels[best->kernel], 1e3 * best->best,
+      tuned.bw, tuned.streams, MatBinBCSRKernels[tuned.kernel], 1e3 * tuned.best, tuned.best / best->best,
+      bs > 1 ? "baij" : "aij", 1e3 * base.best, bs > 1 ? "baij" : "aij", base.best / tuned.best, cost,
+      1e3 * (t1 - t0)));
     for (Variant &v : vars)
       if (v.owner) PetscCall(MatDestroy(&v.A));
     PetscCall(MatDestroy(&tuned.A));

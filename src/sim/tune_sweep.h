@@ -7,8 +7,8 @@
 #include <string>
 
 struct SweepSettings {
-  PetscInt  repeats    = 5;  // rounds
-  PetscInt  batch      = 5;  // MatMults per variant per round
+  PetscInt  repeats    = 5;           // rounds
+  PetscInt  batch      = 5;           // MatMults per variant per round
   PetscBool tune_cache = PETSC_FALSE; // the tuned matrix may use the cache file (default: it measures)
   PetscBool verbose    = PETSC_FALSE; // every variant's time, not only the summary line
   double (*now)()      = nullptr;     // the clock
@@ -16,7 +16,8 @@ struct SweepSettings {
 
 // A MATSEQBINBCSR copy of the assembled seq matrix src (its rows through MatSetValues) with block size
 // bs; bw, streams: 0 = not set; tune: whether the layout build may tune.
-PetscErrorCode MakeBinBCSR(Mat src, PetscInt bs, PetscInt bw, PetscInt streams, MatBinBCSRPrecision prec, PetscBool sym, PetscBool tune, Mat *A);
+PetscErrorCode MakeBinBCSR(Mat src, PetscInt bs, PetscInt bw, PetscInt streams, MatBinBCSRPrecision prec,
+                           PetscBool sym, PetscBool tune, Mat *A);
 
 // The sweep on one matrix (seq aij, block size set), named name in the output.
 PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &s);

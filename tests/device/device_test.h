@@ -10,8 +10,7 @@
   #include <functional>
   #include <string>
   #include <vector>
-namespace mini_catch
-{
+namespace mini_catch {
 struct Case {
   const char           *name;
   std::function<void()> fn;
@@ -24,30 +23,33 @@ inline std::vector<Case> &cases()
 struct Add {
   Add(const char *n, std::function<void()> f) { cases().push_back({n, f}); }
 };
-struct Failure { };
+struct Failure {};
 inline int &checks_failed()
 {
   static int n = 0;
   return n;
 }
-inline void report(const char *expr, const char *file, int line) { std::printf("%s:%d: FAILED: %s\n", file, line, expr), checks_failed()++; }
+inline void report(const char *expr, const char *file, int line)
+{
+  std::printf("%s:%d: FAILED: %s\n", file, line, expr), checks_failed()++;
+}
 } // namespace mini_catch
   #define MC_CAT2(a, b) a##b
   #define MC_CAT(a, b)  MC_CAT2(a, b)
-  #define TEST_CASE(name, tags) \
-    static void MC_CAT(mc_test_, __LINE__)(); \
+  #define TEST_CASE(name, tags)                                                         \
+    static void            MC_CAT(mc_test_, __LINE__)();                                \
     static mini_catch::Add MC_CAT(mc_add_, __LINE__)(name, MC_CAT(mc_test_, __LINE__)); \
-    static void MC_CAT(mc_test_, __LINE__)()
-  #define CHECK(e) \
-    do { \
+    static void            MC_CAT(mc_test_, __LINE__)()
+  #define CHECK(e)                                          \
+    do {                                                    \
       if (!(e)) mini_catch::report(#e, __FILE__, __LINE__); \
     } while (0)
-  #define REQUIRE(e) \
-    do { \
-      if (!(e)) { \
+  #define REQUIRE(e)                                \
+    do {                                            \
+      if (!(e)) {                                   \
         mini_catch::report(#e, __FILE__, __LINE__); \
-        throw mini_catch::Failure{}; \
-      } \
+        throw mini_catch::Failure{};                \
+      }                                             \
     } while (0)
   #define INFO(x) (void)0
 #endif

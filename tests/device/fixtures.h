@@ -10,8 +10,7 @@
 #include <string>
 #include <vector>
 
-namespace dt
-{
+namespace dt {
 using namespace binbcsr::device;
 
 inline double rnd(uint64_t k)
@@ -65,7 +64,7 @@ inline BlockCSR random_spd(int bs, int mbs, uint64_t seed, double shift = 1.0)
       const int q = find(c, r);
       for (int i = 0; i < bs; i++)
         for (int j = 0; j < bs; j++) {
-          const double v          = rnd(seed * 1000003 + (uint64_t)p * bs2 + i * bs + j);
+          const double v              = rnd(seed * 1000003 + (uint64_t)p * bs2 + i * bs + j);
           A.val[p * bs2 + i * bs + j] = v;
           A.val[q * bs2 + j * bs + i] = v;
           rowsum[r * bs + i] += std::fabs(v);
@@ -86,7 +85,8 @@ inline BlockCSR random_spd(int bs, int mbs, uint64_t seed, double shift = 1.0)
 }
 
 /* y = A x by point rows of the block CSR, and sum_j |a_ij x_j| (the scale of a product's rounding). */
-inline void csr_mult(const BlockCSR &A, const std::vector<double> &x, std::vector<double> &y, std::vector<double> *scale = nullptr)
+inline void csr_mult(const BlockCSR &A, const std::vector<double> &x, std::vector<double> &y,
+                     std::vector<double> *scale = nullptr)
 {
   const int bs = A.bs, bs2 = bs * bs;
   y.assign((size_t)A.mbs * bs, 0.0);
@@ -107,7 +107,8 @@ inline std::vector<double> inverse_diagonal(const BlockCSR &A)
   for (int r = 0; r < A.mbs; r++)
     for (int p = A.ptr[r]; p < A.ptr[r + 1]; p++)
       if (A.col[p] == r)
-        for (int i = 0; i < A.bs; i++) d[(size_t)r * A.bs + i] = 1.0 / A.val[(size_t)p * A.bs * A.bs + i * A.bs + i];
+        for (int i = 0; i < A.bs; i++)
+          d[(size_t)r * A.bs + i] = 1.0 / A.val[(size_t)p * A.bs * A.bs + i * A.bs + i];
   return d;
 }
 
@@ -141,7 +142,10 @@ inline std::unique_ptr<Executor> reference()
 struct Shape {
   int bs, bw, mbs;
 };
-inline std::vector<Shape> shapes() { return {{3, 8, 37}, {3, 32, 70}, {3, 4, 5}, {1, 16, 101}, {1, 8, 64}, {1, 32, 33}, {3, 8, 1}}; }
+inline std::vector<Shape> shapes()
+{
+  return {{3, 8, 37}, {3, 32, 70}, {3, 4, 5}, {1, 16, 101}, {1, 8, 64}, {1, 32, 33}, {3, 8, 1}};
+}
 
 inline std::vector<double> download(const Vector &v)
 {

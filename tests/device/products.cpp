@@ -6,10 +6,10 @@
 
 using namespace dt;
 
-namespace
-{
+namespace {
 /* max_i |y_i - ref_i| / (sum_j |a_ij x_j| + tiny) */
-double product_error(const std::vector<double> &y, const std::vector<double> &ref, const std::vector<double> &scale)
+double product_error(const std::vector<double> &y, const std::vector<double> &ref,
+                     const std::vector<double> &scale)
 {
   double e = 0;
   for (size_t i = 0; i < y.size(); i++) {
@@ -28,7 +28,7 @@ TEST_CASE("device products match CSR: whole and symmetric storage, double and si
       for (int single = 0; single < 2; single++) {
         const BlockCSR A = random_spd(sh.bs, sh.mbs, 11 + sh.bw + sh.mbs);
         const HostBins B = bins_from_bcsr(A.bs, A.mbs, A.ptr.data(), A.col.data(), A.val.data(), sh.bw, sym);
-        auto           M = E->matrix(B.layout(), single ? Precision::single_values : Precision::double_values);
+        auto M = E->matrix(B.layout(), single ? Precision::single_values : Precision::double_values);
         M->set_values(B.val.data());
         const std::vector<double> x = random_vector((long)A.mbs * A.bs, 5);
         std::vector<double>       ref, scale;
@@ -40,7 +40,7 @@ TEST_CASE("device products match CSR: whole and symmetric storage, double and si
         const double tol = single ? 1.2e-7 : 1e-14;
         CHECK(product_error(download(*Y), ref, scale) <= tol);
         Y->upload(nan.data());
-        const double d = M->mult_dot(*X, *Y);
+        const double d    = M->mult_dot(*X, *Y);
         double       dref = 0, dscale = 0;
         for (size_t i = 0; i < x.size(); i++) dref += x[i] * ref[i], dscale += std::fabs(x[i]) * scale[i];
         CHECK(product_error(download(*Y), ref, scale) <= tol);
@@ -49,7 +49,8 @@ TEST_CASE("device products match CSR: whole and symmetric storage, double and si
         std::vector<double> back(B.val.size());
         M->get_values(back.data());
         double verr = 0;
-        for (size_t i = 0; i < back.size(); i++) verr = std::max(verr, std::fabs(back[i] - B.val[i]) - (single ? std::fabs(B.val[i]) * 6e-8 : 0.0));
+        for (size_t i = 0; i < back.size(); i++)
+          verr = std::max(verr, std::fabs(back[i] - B.val[i]) - (single ? std::fabs(B.val[i]) * 6e-8 : 0.0));
         CHECK(verr <= 0.0);
       }
 }
@@ -76,8 +77,8 @@ TEST_CASE("device refill gathers the COO values of each stored value, padding st
               cv.push_back(pass == 0 ? 0.25 * v : 0.75 * v);
             }
       ci.push_back(0), cj.push_back(A.mbs * bs + 5), cv.push_back(1e300); /* outside the matrix: ignored */
-      const HostGather G = gather_from_coo(B, (long)cv.size(), ci.data(), cj.data());
-      auto             M = E->matrix(B.layout(), Precision::double_values);
+      const HostGather          G = gather_from_coo(B, (long)cv.size(), ci.data(), cj.data());
+      auto                      M = E->matrix(B.layout(), Precision::double_values);
       const std::vector<double> junk(B.val.size(), 7.0);
       M->set_values(junk.data());
       M->set_gather_map(G.map());
@@ -85,13 +86,16 @@ TEST_CASE("device refill gathers the COO values of each stored value, padding st
       std::vector<double> got(B.val.size());
       M->get_values(got.data());
       double err = 0;
-      for (size_t i = 0; i < got.size(); i++) err = std::max(err, std::fabs(got[i] - B.val[i]) / (std::fabs(B.val[i]) + 1e-300) * (B.val[i] != 0) + std::fabs(got[i]) * (B.val[i] == 0));
+      for (size_t i = 0; i < got.size(); i++)
+        err = std::max(err, std::fabs(got[i] - B.val[i]) / (std::fabs(B.val[i]) + 1e-300) * (B.val[i] != 0) +
+                              std::fabs(got[i]) * (B.val[i] == 0));
       CHECK(err <= 2.3e-16);
       /* ADD_VALUES: twice the matrix */
       M->refill(cv.data(), true);
       M->get_values(got.data());
       err = 0;
-      for (size_t i = 0; i < got.size(); i++) err = std::max(err, std::fabs(got[i] - 2 * B.val[i]) - 4.5e-16 * std::fabs(B.val[i]));
+      for (size_t i = 0; i < got.size(); i++)
+        err = std::max(err, std::fabs(got[i] - 2 * B.val[i]) - 4.5e-16 * std::fabs(B.val[i]));
       CHECK(err <= 0.0);
       /* the refilled matrix multiplies as CSR */
       M->refill(cv.data());

@@ -7,8 +7,7 @@
 
 using namespace dt;
 
-namespace
-{
+namespace {
 /* Hestenes-Stiefel PCG with Jacobi on the CSR matrix; stops when ||D^-1 r|| <= rtol ||D^-1 b|| or after
    max_its; returns the iterations. */
 int csr_pcg(const BlockCSR &A, const std::vector<double> &b, std::vector<double> &x, double rtol, int max_its)
@@ -26,10 +25,11 @@ int csr_pcg(const BlockCSR &A, const std::vector<double> &b, std::vector<double>
     csr_mult(A, p, q);
     double pq = 0;
     for (size_t i = 0; i < n; i++) pq += p[i] * q[i];
-    const double a = rz / pq;
+    const double a   = rz / pq;
     double       rz1 = 0;
     zz               = 0;
-    for (size_t i = 0; i < n; i++) x[i] += a * p[i], r[i] -= a * q[i], z[i] = d[i] * r[i], rz1 += r[i] * z[i], zz += z[i] * z[i];
+    for (size_t i = 0; i < n; i++)
+      x[i] += a * p[i], r[i] -= a * q[i], z[i] = d[i] * r[i], rz1 += r[i] * z[i], zz += z[i] * z[i];
     for (size_t i = 0; i < n; i++) p[i] = z[i] + rz1 / rz * p[i];
     rz = rz1;
     k++;
@@ -57,7 +57,9 @@ Problem problem(int bs, int bw, int mbs, bool sym, double shift = 1.0)
   P.dinv = inverse_diagonal(P.A);
   return P;
 }
-SolveResult run(Executor &E, const Problem &P, const SolveSettings &st, std::vector<double> &x, Precision prec = Precision::double_values, const std::vector<double> *b = nullptr, const std::vector<double> *dinv = nullptr)
+SolveResult run(Executor &E, const Problem &P, const SolveSettings &st, std::vector<double> &x,
+                Precision prec = Precision::double_values, const std::vector<double> *b = nullptr,
+                const std::vector<double> *dinv = nullptr)
 {
   auto M = E.matrix(P.B.layout(), prec);
   M->set_values(P.B.val.data());
@@ -76,8 +78,8 @@ TEST_CASE("device merged CG converges as a plain PCG and as the reference execut
   for (const Shape &sh : shapes())
     for (int sym = 0; sym < 2; sym++) {
       if (sh.mbs < 5) continue;
-      const Problem       P = problem(sh.bs, sh.bw, sh.mbs, sym);
-      SolveSettings       st;
+      const Problem P = problem(sh.bs, sh.bw, sh.mbs, sym);
+      SolveSettings st;
       st.rtol = 1e-10;
       std::vector<double> x, xr, xc;
       const SolveResult   res = run(*E, P, st, x), ref = run(*R, P, st, xr);
@@ -92,16 +94,17 @@ TEST_CASE("device merged CG converges as a plain PCG and as the reference execut
          same norms up to the order of the reductions */
       CHECK(res.its == ref.its);
       CHECK(res.reason == ref.reason);
-      for (size_t k = 0; k < std::min(res.history.size(), ref.history.size()); k++) CHECK(std::fabs(res.history[k] - ref.history[k]) <= 1e-8 * ref.history[0]);
+      for (size_t k = 0; k < std::min(res.history.size(), ref.history.size()); k++)
+        CHECK(std::fabs(res.history[k] - ref.history[k]) <= 1e-8 * ref.history[0]);
       CHECK(rel_diff(x, xr) <= 1e-9);
     }
 }
 
 TEST_CASE("device merged CG: fixed iterations, no test, one copy to the host", "[device]")
 {
-  auto                E = tested();
-  const Problem       P = problem(3, 8, 60, false);
-  SolveSettings       st;
+  auto          E = tested();
+  const Problem P = problem(3, 8, 60, false);
+  SolveSettings st;
   st.fixed_its = 7;
   std::vector<double> x, xc;
   const SolveResult   res = run(*E, P, st, x);
@@ -124,9 +127,9 @@ TEST_CASE("device merged CG: initial guess, norm types, tolerances", "[device]")
   const Problem P = problem(3, 8, 50, false);
   for (Norm nt : {Norm::preconditioned, Norm::unpreconditioned, Norm::natural}) {
     SolveSettings st;
-    st.norm       = nt;
-    st.rtol       = 1e-9;
-    st.guess_zero = false;
+    st.norm               = nt;
+    st.rtol               = 1e-9;
+    st.guess_zero         = false;
     std::vector<double> x = P.xtrue, xr;
     for (double &v : x) v *= 0.9; /* close to the solution */
     xr                    = x;
@@ -162,8 +165,8 @@ TEST_CASE("device merged CG: initial guess, norm types, tolerances", "[device]")
 
 TEST_CASE("device merged CG: breakdowns and bad input are reasons, not crashes", "[device]")
 {
-  auto          E = tested();
-  const Problem P = problem(3, 8, 20, false);
+  auto                E = tested();
+  const Problem       P = problem(3, 8, 20, false);
   std::vector<double> x;
   /* zero right-hand side: converged at iteration 0 */
   const std::vector<double> zero(P.b.size(), 0.0);
@@ -177,9 +180,10 @@ TEST_CASE("device merged CG: breakdowns and bad input are reasons, not crashes",
   /* a negative preconditioner: r.M^-1 r < 0 */
   std::vector<double> neg = P.dinv;
   for (double &v : neg) v = -v;
-  CHECK(run(*E, P, SolveSettings{}, x, Precision::double_values, nullptr, &neg).reason == diverged_indefinite_pc);
+  CHECK(run(*E, P, SolveSettings{}, x, Precision::double_values, nullptr, &neg).reason ==
+        diverged_indefinite_pc);
   /* a negative definite matrix without a preconditioner: p.Ap < 0 */
-  const Problem N  = problem(3, 8, 20, false, -1.0);
+  const Problem N = problem(3, 8, 20, false, -1.0);
   SolveSettings nj;
   nj.jacobi = false;
   CHECK(run(*E, N, nj, x).reason == diverged_indefinite_mat);
@@ -193,7 +197,8 @@ TEST_CASE("device merged CG: single storage stops at the precision floor or conv
   st.rtol     = 1e-12;
   st.roundoff = 5.9604644775390625e-08;
   std::vector<double> x, xr;
-  const SolveResult   res = run(*E, P, st, x, Precision::single_values), ref = run(*R, P, st, xr, Precision::single_values);
+  const SolveResult   res = run(*E, P, st, x, Precision::single_values),
+                    ref   = run(*R, P, st, xr, Precision::single_values);
   CHECK((res.reason == diverged_breakdown || res.reason > 0));
   CHECK(res.reason == ref.reason);
   CHECK(std::abs(res.its - ref.its) <= 1);

@@ -6,19 +6,16 @@
 
 #include <petscsys.h>
 
-namespace binbcsr
-{
+namespace binbcsr {
 
-template <class T>
-PetscErrorCode DeleteComposed(void *p)
+template <class T> PetscErrorCode DeleteComposed(void *p)
 {
   delete static_cast<T *>(p);
   return 0;
 }
 
 /* *ptr: the object composed on obj under key, or NULL */
-template <class T>
-PetscErrorCode QueryComposed(PetscObject obj, const char *key, T **ptr)
+template <class T> PetscErrorCode QueryComposed(PetscObject obj, const char *key, T **ptr)
 {
   PetscContainer c;
 
@@ -31,7 +28,8 @@ PetscErrorCode QueryComposed(PetscObject obj, const char *key, T **ptr)
 
 /* composes ptr (owned from now on by obj) under key */
 template <class T>
-PetscErrorCode Compose(PetscObject obj, const char *key, T *ptr, PetscErrorCode (*destroy)(void *) = DeleteComposed<T>)
+PetscErrorCode Compose(PetscObject obj, const char *key, T *ptr,
+                       PetscErrorCode (*destroy)(void *) = DeleteComposed<T>)
 {
   PetscContainer c;
 
@@ -46,7 +44,8 @@ PetscErrorCode Compose(PetscObject obj, const char *key, T *ptr, PetscErrorCode 
 
 /* the object under key, a new T composed there first if there is none */
 template <class T>
-PetscErrorCode GetOrCompose(PetscObject obj, const char *key, T **ptr, PetscErrorCode (*destroy)(void *) = DeleteComposed<T>)
+PetscErrorCode GetOrCompose(PetscObject obj, const char *key, T **ptr,
+                            PetscErrorCode (*destroy)(void *) = DeleteComposed<T>)
 {
   PetscFunctionBegin;
   PetscCall(QueryComposed(obj, key, ptr));

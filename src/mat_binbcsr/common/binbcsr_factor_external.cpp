@@ -11,16 +11,15 @@
 #include "binbcsr_impl.h"
 #include "binbcsr_factor_routing.h"
 
-namespace
-{
+namespace {
 struct ExternalFactor {
   /* the package's ops of the factor, called with the shadow in place of the binbcsr matrix */
-  PetscErrorCode (*lusymbolic)(Mat, Mat, IS, IS, const MatFactorInfo *)      = nullptr;
-  PetscErrorCode (*choleskysymbolic)(Mat, Mat, IS, const MatFactorInfo *)    = nullptr;
-  PetscErrorCode (*lunumeric)(Mat, Mat, const MatFactorInfo *)               = nullptr;
-  PetscErrorCode (*choleskynumeric)(Mat, Mat, const MatFactorInfo *)         = nullptr;
+  PetscErrorCode (*lusymbolic)(Mat, Mat, IS, IS, const MatFactorInfo *)   = nullptr;
+  PetscErrorCode (*choleskysymbolic)(Mat, Mat, IS, const MatFactorInfo *) = nullptr;
+  PetscErrorCode (*lunumeric)(Mat, Mat, const MatFactorInfo *)            = nullptr;
+  PetscErrorCode (*choleskynumeric)(Mat, Mat, const MatFactorInfo *)      = nullptr;
 
-  static const char *key() { return "MatBinBCSR_ExternalFactor"; }
+  static const char    *key() { return "MatBinBCSR_ExternalFactor"; }
   static PetscErrorCode Destroy(void *ctx)
   {
     PetscFunctionBegin;
@@ -34,14 +33,16 @@ struct ExternalFactor {
 PetscErrorCode LUSymbolic(Mat F, Mat A, IS r, IS c, const MatFactorInfo *info)
 {
   PetscFunctionBegin;
-  PetscCall(binbcsr_factor::OnShadow<ExternalFactor>(F, A, [&](ExternalFactor *f, Mat S) { return (*f->lusymbolic)(F, S, r, c, info); }));
+  PetscCall(binbcsr_factor::OnShadow<ExternalFactor>(
+    F, A, [&](ExternalFactor *f, Mat S) { return (*f->lusymbolic)(F, S, r, c, info); }));
   PetscFunctionReturn(0);
 }
 
 PetscErrorCode CholeskySymbolic(Mat F, Mat A, IS r, const MatFactorInfo *info)
 {
   PetscFunctionBegin;
-  PetscCall(binbcsr_factor::OnShadow<ExternalFactor>(F, A, [&](ExternalFactor *f, Mat S) { return (*f->choleskysymbolic)(F, S, r, info); }));
+  PetscCall(binbcsr_factor::OnShadow<ExternalFactor>(
+    F, A, [&](ExternalFactor *f, Mat S) { return (*f->choleskysymbolic)(F, S, r, info); }));
   PetscFunctionReturn(0);
 }
 
@@ -63,7 +64,8 @@ PetscErrorCode GetFactorFrom(Mat A, MatSolverType package, MatFactorType ftype, 
     PetscCall(MatPropagateSymmetryOptions(A, S));
   }
   PetscCall(MatGetFactor(S, package, ftype, F));
-  PetscCheck(*F, PetscObjectComm((PetscObject)A), PETSC_ERR_SUP, "%s has no %s factorisation of %s", package, MatFactorTypes[ftype], ((PetscObject)S)->type_name);
+  PetscCheck(*F, PetscObjectComm((PetscObject)A), PETSC_ERR_SUP, "%s has no %s factorisation of %s", package,
+             MatFactorTypes[ftype], ((PetscObject)S)->type_name);
   if (!A->assembled) PetscCall(MatDestroy(&S));
   f = new ExternalFactor;
   PetscCall(binbcsr_factor::Attach(*F, f));

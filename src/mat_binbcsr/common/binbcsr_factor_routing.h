@@ -16,32 +16,27 @@
 #include <petsc/private/matimpl.h>
 #include "binbcsr_composed.h"
 
-namespace binbcsr_factor
-{
+namespace binbcsr_factor {
 
-template <class Ctx>
-PetscErrorCode Attach(Mat F, Ctx *f)
+template <class Ctx> PetscErrorCode Attach(Mat F, Ctx *f)
 {
   return binbcsr::Compose((PetscObject)F, Ctx::key(), f, Ctx::Destroy);
 }
 
-template <class Ctx>
-PetscErrorCode Get(Mat F, Ctx **f)
+template <class Ctx> PetscErrorCode Get(Mat F, Ctx **f)
 {
   PetscFunctionBegin;
   PetscCall(binbcsr::QueryComposed((PetscObject)F, Ctx::key(), f));
-  PetscCheck(*f, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Factor of a binbcsr matrix without its routing (%s)", Ctx::key());
+  PetscCheck(*f, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Factor of a binbcsr matrix without its routing (%s)",
+             Ctx::key());
   PetscFunctionReturn(0);
 }
 
-template <class Ctx>
-PetscErrorCode LUNumeric(Mat, Mat, const MatFactorInfo *);
-template <class Ctx>
-PetscErrorCode CholeskyNumeric(Mat, Mat, const MatFactorInfo *);
+template <class Ctx> PetscErrorCode LUNumeric(Mat, Mat, const MatFactorInfo *);
+template <class Ctx> PetscErrorCode CholeskyNumeric(Mat, Mat, const MatFactorInfo *);
 
 /* A package's symbolic (or numeric) routine chooses its numeric one: route that through the shadow too. */
-template <class Ctx>
-void RouteNumeric(Mat F, Ctx *f)
+template <class Ctx> void RouteNumeric(Mat F, Ctx *f)
 {
   if (F->ops->lufactornumeric && F->ops->lufactornumeric != LUNumeric<Ctx>) {
     f->lunumeric            = F->ops->lufactornumeric;
@@ -54,8 +49,7 @@ void RouteNumeric(Mat F, Ctx *f)
 }
 
 /* Bring the shadow of A up to date, run routine(f, S), keep the numeric routed. */
-template <class Ctx, class Routine>
-PetscErrorCode OnShadow(Mat F, Mat A, Routine &&routine)
+template <class Ctx, class Routine> PetscErrorCode OnShadow(Mat F, Mat A, Routine &&routine)
 {
   Ctx *f;
   Mat  S;
@@ -69,16 +63,14 @@ PetscErrorCode OnShadow(Mat F, Mat A, Routine &&routine)
   PetscFunctionReturn(0);
 }
 
-template <class Ctx>
-PetscErrorCode LUNumeric(Mat F, Mat A, const MatFactorInfo *info)
+template <class Ctx> PetscErrorCode LUNumeric(Mat F, Mat A, const MatFactorInfo *info)
 {
   PetscFunctionBegin;
   PetscCall(OnShadow<Ctx>(F, A, [&](Ctx *f, Mat S) { return (*f->lunumeric)(F, S, info); }));
   PetscFunctionReturn(0);
 }
 
-template <class Ctx>
-PetscErrorCode CholeskyNumeric(Mat F, Mat A, const MatFactorInfo *info)
+template <class Ctx> PetscErrorCode CholeskyNumeric(Mat F, Mat A, const MatFactorInfo *info)
 {
   PetscFunctionBegin;
   PetscCall(OnShadow<Ctx>(F, A, [&](Ctx *f, Mat S) { return (*f->choleskynumeric)(F, S, info); }));

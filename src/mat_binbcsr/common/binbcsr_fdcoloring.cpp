@@ -17,7 +17,8 @@ PetscErrorCode MatFDColoringCreate_BinBCSR(Mat A, ISColoring iscoloring, MatFDCo
 
   PetscFunctionBegin;
   PetscCall(MatBinBCSRGetAIJShadow_Private(A, &S));
-  PetscCheck(S->ops->fdcoloringcreate, PetscObjectComm((PetscObject)A), PETSC_ERR_SUP, "No finite-difference colouring for the AIJ shadow of type %s", ((PetscObject)S)->type_name);
+  PetscCheck(S->ops->fdcoloringcreate, PetscObjectComm((PetscObject)A), PETSC_ERR_SUP,
+             "No finite-difference colouring for the AIJ shadow of type %s", ((PetscObject)S)->type_name);
   PetscCall((*S->ops->fdcoloringcreate)(S, iscoloring, c));
   PetscFunctionReturn(0);
 }

@@ -12,6 +12,9 @@
    seqaij would read outside x with it). Repeated columns of a row are summed into one entry, sorted
    by column: seqaij stores both and its product sums them, which is the matrix the file means.
    Collective on A. */
-PETSC_INTERN PetscErrorCode MatBinBCSRReadBinaryRows_Private(Mat A, PetscViewer viewer, std::vector<PetscInt> &rowptr, std::vector<PetscInt> &cols, std::vector<PetscScalar> &vals);
+PETSC_INTERN PetscErrorCode MatBinBCSRReadBinaryRows_Private(Mat A, PetscViewer viewer,
+                                                             std::vector<PetscInt>    &rowptr,
+                                                             std::vector<PetscInt>    &cols,
+                                                             std::vector<PetscScalar> &vals);
 
 #endif

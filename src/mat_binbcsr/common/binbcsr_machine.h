@@ -14,8 +14,7 @@
 #include <string>
 #include <unistd.h>
 
-namespace binbcsr
-{
+namespace binbcsr {
 
 /* The "model name" of /proc/cpuinfo (the first core's), tabs and line ends replaced by spaces. */
 inline std::string cpu_model()

@@ -13,7 +13,8 @@
 
 #include <vector>
 
-PetscErrorCode MatBinBCSRCreateEmptyLike_Private(Mat A, PetscInt m, PetscInt n, PetscInt rbs, PetscInt cbs, Mat *C)
+PetscErrorCode MatBinBCSRCreateEmptyLike_Private(Mat A, PetscInt m, PetscInt n, PetscInt rbs, PetscInt cbs,
+                                                 Mat *C)
 {
   PetscBool mpi;
 
@@ -64,8 +65,11 @@ PETSC_INTERN PetscErrorCode MatPermute_BinBCSR(Mat A, IS rowp, IS colp, Mat *B)
   PetscCall(MatBinBCSRGetSymmetricStorage(A, &sym));
   if (sym) {
     PetscBool same = rowp == colp ? PETSC_TRUE : PETSC_FALSE;
-    if (!same) PetscCall(ISEqualUnsorted(rowp, colp, &same)); /* ISEqual compares sets: every permutation would pass */
-    PetscCheck(same, comm, PETSC_ERR_SUP, "MatPermute with symmetric storage (-mat_binbcsr_symmetric_storage) needs the same row and column permutation: P A Q^T is not symmetric");
+    if (!same)
+      PetscCall(ISEqualUnsorted(rowp, colp, &same)); /* ISEqual compares sets: every permutation would pass */
+    PetscCheck(
+      same, comm, PETSC_ERR_SUP,
+      "MatPermute with symmetric storage (-mat_binbcsr_symmetric_storage) needs the same row and column permutation: P A Q^T is not symmetric");
   }
   /* new row of each local row of A; new column of every column */
   PetscCall(ISInvertPermutation(rowp, A->rmap->n, &irow));

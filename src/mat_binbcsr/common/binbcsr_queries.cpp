@@ -58,8 +58,8 @@ PETSC_INTERN PetscErrorCode MatIsSymmetric_BinBCSR(Mat A, PetscReal tol, PetscBo
 
 PETSC_INTERN PetscErrorCode MatFindZeroDiagonals_BinBCSR(Mat A, IS *zrows)
 {
-  Vec                d;
-  const PetscScalar *da;
+  Vec                   d;
+  const PetscScalar    *da;
   std::vector<PetscInt> rows;
 
   PetscFunctionBegin;
@@ -70,7 +70,8 @@ PETSC_INTERN PetscErrorCode MatFindZeroDiagonals_BinBCSR(Mat A, IS *zrows)
     if (da[i] == 0.0) rows.push_back(A->rmap->rstart + i);
   PetscCall(VecRestoreArrayRead(d, &da));
   PetscCall(VecDestroy(&d));
-  PetscCall(ISCreateGeneral(PetscObjectComm((PetscObject)A), (PetscInt)rows.size(), rows.data(), PETSC_COPY_VALUES, zrows));
+  PetscCall(ISCreateGeneral(PetscObjectComm((PetscObject)A), (PetscInt)rows.size(), rows.data(),
+                            PETSC_COPY_VALUES, zrows));
   PetscFunctionReturn(0);
 }
 
@@ -101,6 +102,8 @@ PETSC_INTERN PetscErrorCode MatFindNonzeroRows_BinBCSR(Mat A, IS *keptrows)
   nzero = A->rmap->n - (PetscInt)rows.size();
   PetscCall(MPIU_Allreduce(&nzero, &gzero, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)A)));
   *keptrows = nullptr;
-  if (gzero) PetscCall(ISCreateGeneral(PetscObjectComm((PetscObject)A), (PetscInt)rows.size(), rows.data(), PETSC_COPY_VALUES, keptrows));
+  if (gzero)
+    PetscCall(ISCreateGeneral(PetscObjectComm((PetscObject)A), (PetscInt)rows.size(), rows.data(),
+                              PETSC_COPY_VALUES, keptrows));
   PetscFunctionReturn(0);
 }

@@ -33,7 +33,8 @@ PetscErrorCode MatBinBCSRPreallocateAndFill_Private(Mat src, Mat dst)
 
   PetscFunctionBegin;
   PetscCall(PetscObjectTypeCompareAny((PetscObject)src, &issbaij, MATSEQSBAIJ, MATMPISBAIJ, ""));
-  PetscCheck(!issbaij, PetscObjectComm((PetscObject)src), PETSC_ERR_SUP, "Cannot convert from SBAIJ: its rows hold only the upper triangle");
+  PetscCheck(!issbaij, PetscObjectComm((PetscObject)src), PETSC_ERR_SUP,
+             "Cannot convert from SBAIJ: its rows hold only the upper triangle");
   PetscCall(PetscLayoutSetUp(dst->rmap));
   PetscCall(PetscLayoutSetUp(dst->cmap));
   PetscCall(MatGetOwnershipRange(src, &rstart, &rend));

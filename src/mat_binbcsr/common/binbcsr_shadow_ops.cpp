@@ -21,8 +21,7 @@
 #include <petsc/private/matimpl.h>
 #include "binbcsr_composed.h"
 
-namespace
-{
+namespace {
 PetscErrorCode IsBinBCSR(Mat M, PetscBool *is)
 {
   PetscFunctionBegin;
@@ -33,9 +32,10 @@ PetscErrorCode IsBinBCSR(Mat M, PetscBool *is)
 
 /* What the symbolic phase left for the numeric phases of one product. */
 struct ShadowProduct {
-  PetscObjectId shadow[3] = {0, 0, 0}; /* object ids of the shadows of operands A, B, C (0: not binbcsr); ids, not
+  PetscObjectId shadow[3]        = {0, 0,
+                                    0}; /* object ids of the shadows of operands A, B, C (0: not binbcsr); ids, not
                                           pointers: a rebuilt shadow may get the freed one's address */
-  PetscErrorCode (*numeric)(Mat) = nullptr;   /* the AIJ numeric routine */
+  PetscErrorCode (*numeric)(Mat) = nullptr; /* the AIJ numeric routine */
 };
 
 const char product_key[] = "MatBinBCSR_ShadowProduct";
@@ -82,12 +82,16 @@ PetscErrorCode ProductNumeric_Shadow(Mat C)
 
   PetscFunctionBegin;
   PetscCall(binbcsr::QueryComposed((PetscObject)C, product_key, &sp));
-  PetscCheck(sp, PetscObjectComm((PetscObject)C), PETSC_ERR_PLIB, "binbcsr product: the numeric phase has lost its symbolic phase's context");
+  PetscCheck(sp, PetscObjectComm((PetscObject)C), PETSC_ERR_PLIB,
+             "binbcsr product: the numeric phase has lost its symbolic phase's context");
   PetscCall(SwapInShadows(C, orig, shadow)); /* refreshes each shadow (collective) */
   for (int i = 0; i < 3; i++) {
     if ((shadow[i] ? ((PetscObject)shadow[i])->id : 0) == sp->shadow[i]) continue;
     SwapBack(C, orig);
-    SETERRQ(PetscObjectComm((PetscObject)C), PETSC_ERR_ARG_INCOMP, "binbcsr product: operand %d is not the matrix (or has not the nonzero pattern) the product's symbolic phase was made for; redo the product with MAT_INITIAL_MATRIX", i);
+    SETERRQ(
+      PetscObjectComm((PetscObject)C), PETSC_ERR_ARG_INCOMP,
+      "binbcsr product: operand %d is not the matrix (or has not the nonzero pattern) the product's symbolic phase was made for; redo the product with MAT_INITIAL_MATRIX",
+      i);
   }
   PetscErrorCode ierr = sp->numeric(C);
   SwapBack(C, orig);
@@ -106,18 +110,22 @@ PetscErrorCode ProductSymbolic_Shadow(Mat C)
   PetscErrorCode ierr = MatProductSetFromOptions(C);
   if (!ierr && !C->ops->productsymbolic) {
     SwapBack(C, orig);
-    SETERRQ(PetscObjectComm((PetscObject)C), PETSC_ERR_SUP, "MatProduct %s of binbcsr (through its AIJ copy) with %s: not supported by PETSc's AIJ either", MatProductTypes[C->product->type], orig[1] ? ((PetscObject)orig[1])->type_name : "nothing");
+    SETERRQ(PetscObjectComm((PetscObject)C), PETSC_ERR_SUP,
+            "MatProduct %s of binbcsr (through its AIJ copy) with %s: not supported by PETSc's AIJ either",
+            MatProductTypes[C->product->type], orig[1] ? ((PetscObject)orig[1])->type_name : "nothing");
   }
   if (!ierr) ierr = (*C->ops->productsymbolic)(C);
   SwapBack(C, orig);
   PetscCall(ierr);
-  PetscCheck(C->ops->productnumeric, PetscObjectComm((PetscObject)C), PETSC_ERR_PLIB, "binbcsr product: PETSc's AIJ symbolic phase left no numeric phase");
+  PetscCheck(C->ops->productnumeric, PetscObjectComm((PetscObject)C), PETSC_ERR_PLIB,
+             "binbcsr product: PETSc's AIJ symbolic phase left no numeric phase");
 
   PetscCall(binbcsr::GetOrCompose((PetscObject)C, product_key, &sp));
-  for (int i = 0; i < 3; i++) sp->shadow[i] = shadow[i] ? ((PetscObject)shadow[i])->id : 0; /* the shadows live with their matrices */
-  sp->numeric               = C->ops->productnumeric;
-  C->ops->productnumeric    = ProductNumeric_Shadow;
-  C->ops->productsymbolic   = ProductSymbolic_Shadow; /* MatProductReplaceMats may run it again */
+  for (int i = 0; i < 3; i++)
+    sp->shadow[i] = shadow[i] ? ((PetscObject)shadow[i])->id : 0; /* the shadows live with their matrices */
+  sp->numeric             = C->ops->productnumeric;
+  C->ops->productnumeric  = ProductNumeric_Shadow;
+  C->ops->productsymbolic = ProductSymbolic_Shadow; /* MatProductReplaceMats may run it again */
   PetscFunctionReturn(0);
 }
 } // namespace
@@ -131,7 +139,9 @@ PetscErrorCode MatProductSetFromOptions_BinBCSR(Mat C)
   PetscFunctionBegin;
   if (C->product->type == MATPRODUCT_AB || C->product->type == MATPRODUCT_AtB) {
     PetscCall(IsBinBCSR(C->product->A, &binA));
-    if (binA) PetscCall(PetscObjectBaseTypeCompareAny((PetscObject)C->product->B, &dense, MATSEQDENSE, MATMPIDENSE, ""));
+    if (binA)
+      PetscCall(
+        PetscObjectBaseTypeCompareAny((PetscObject)C->product->B, &dense, MATSEQDENSE, MATMPIDENSE, ""));
   }
   /* binbcsr times a dense block of vectors: PETSc's column-by-column product (MatProductSymbolic_X_Dense)
      with binbcsr's own MatMult / MatMultTranspose, no copy */
@@ -152,7 +162,8 @@ PetscErrorCode MatProductSetFromOptions_BinBCSR(Mat C)
 }
 
 /* ops->creategraph: the shadow's graph (GAMG's aggregation). */
-PetscErrorCode MatCreateGraph_BinBCSR(Mat A, PetscBool sym, PetscBool scale, PetscReal filter BINBCSR_CREATEGRAPH_ARGS, Mat *graph)
+PetscErrorCode MatCreateGraph_BinBCSR(Mat A, PetscBool sym, PetscBool scale,
+                                      PetscReal filter BINBCSR_CREATEGRAPH_ARGS, Mat *graph)
 {
   Mat S;
 

@@ -18,12 +18,12 @@
 #include "../seq/binbcsr.h"
 #include "binbcsr_composed.h"
 
-namespace
-{
+namespace {
 /* A MATSEQBINBCSR matrix (the matrix itself, or a part of the parallel one) and the seqaij matrix of
    the shadow that holds its values, with the value map between them. */
 struct PartMap {
-  Mat                   bin = nullptr, aij = nullptr; /* referenced, but bin not when it is the matrix itself (which owns the shadow) */
+  Mat bin = nullptr,
+      aij = nullptr; /* referenced, but bin not when it is the matrix itself (which owns the shadow) */
   PetscBool             bin_referenced = PETSC_FALSE;
   std::vector<PetscInt> map;
 };
@@ -52,7 +52,8 @@ PetscErrorCode AddPart(AIJShadow *sh, Mat bin, Mat aij, PetscBool reference_bin)
   sh->parts.emplace_back();
   PartMap &p = sh->parts.back();
   PetscCall(MatSeqBinBCSRAIJValueMap(bin, aij, p.map));
-  if (reference_bin) PetscCall(PetscObjectReference((PetscObject)bin)); /* a reference to the matrix itself would be a cycle */
+  if (reference_bin)
+    PetscCall(PetscObjectReference((PetscObject)bin)); /* a reference to the matrix itself would be a cycle */
   PetscCall(PetscObjectReference((PetscObject)aij));
   p.bin            = bin;
   p.bin_referenced = reference_bin;
@@ -80,7 +81,8 @@ PetscErrorCode BuildParts(Mat A, AIJShadow *sh)
   PetscCall(PetscObjectTypeCompare((PetscObject)b->A, MATSEQBINBCSR, &binA));
   if (b->B) PetscCall(PetscObjectTypeCompare((PetscObject)b->B, MATSEQBINBCSR, &binB));
   /* the shadow's off-diagonal columns are B's (it was made from the parts: mpibinbcsr_convert.cpp) */
-  const PetscBool same_cols = (b->B ? Ao->cmap->n == b->B->cmap->n : Ao->cmap->n == 0) ? PETSC_TRUE : PETSC_FALSE;
+  const PetscBool same_cols =
+    (b->B ? Ao->cmap->n == b->B->cmap->n : Ao->cmap->n == 0) ? PETSC_TRUE : PETSC_FALSE;
   if (!binA || !binB || !same_cols) PetscFunctionReturn(0);
   PetscCall(AddPart(sh, b->A, Ad, PETSC_TRUE));
   if (b->B) PetscCall(AddPart(sh, b->B, Ao, PETSC_TRUE));
@@ -95,7 +97,9 @@ PetscBool PartsCurrent(Mat A, const AIJShadow *sh)
   if (!mpi) return sh->parts.size() == 1 && sh->parts[0].bin == A ? PETSC_TRUE : PETSC_FALSE;
   const Mat_MPIBinBCSR *b = MPIBinBCSR(A);
   const size_t          n = b->B ? 2 : 1;
-  return sh->parts.size() == n && sh->parts[0].bin == b->A && (n == 1 || sh->parts[1].bin == b->B) ? PETSC_TRUE : PETSC_FALSE;
+  return sh->parts.size() == n && sh->parts[0].bin == b->A && (n == 1 || sh->parts[1].bin == b->B)
+           ? PETSC_TRUE
+           : PETSC_FALSE;
 }
 
 const char shadow_key[] = "MatBinBCSR_AIJShadow";
@@ -122,11 +126,14 @@ PetscErrorCode MatBinBCSRGetAIJShadow_Private(Mat A, Mat *S)
   PetscMPIInt      todo[2];
 
   PetscFunctionBegin;
-  PetscCheck(A->assembled, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_WRONGSTATE, "Submatrices of an unassembled binbcsr matrix");
+  PetscCheck(A->assembled, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_WRONGSTATE,
+             "Submatrices of an unassembled binbcsr matrix");
   PetscCall(binbcsr::GetOrCompose((PetscObject)A, shadow_key, &sh, DestroyShadow));
   PetscCall(PetscObjectStateGet((PetscObject)A, &state));
-  todo[0] = (!sh->S || sh->nzstate != A->nonzerostate || (!sh->parts.empty() && !PartsCurrent(A, sh))) ? 1 : 0; /* rebuild */
-  todo[1] = (todo[0] || sh->state != state) ? 1 : 0;            /* refill */
+  todo[0] = (!sh->S || sh->nzstate != A->nonzerostate || (!sh->parts.empty() && !PartsCurrent(A, sh)))
+              ? 1
+              : 0;                                   /* rebuild */
+  todo[1] = (todo[0] || sh->state != state) ? 1 : 0; /* refill */
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, todo, 2, MPI_INT, MPI_MAX, PetscObjectComm((PetscObject)A)));
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIBINBCSR, &mpi));
   if (todo[0]) {
@@ -155,17 +162,20 @@ PetscErrorCode MatBinBCSRSetValuesFromAIJShadow_Private(Mat A)
   PetscFunctionBegin;
   PetscCall(binbcsr::QueryComposed((PetscObject)A, shadow_key, &sh));
   PetscCheck(sh, PETSC_COMM_SELF, PETSC_ERR_PLIB, "No AIJ shadow to take the values from");
-  PetscCheck(sh->S && sh->nzstate == A->nonzerostate, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "The matrix's pattern changed after its AIJ shadow was made");
-  PetscCheck(!sh->parts.empty(), PETSC_COMM_SELF, PETSC_ERR_SUP, "Values from the AIJ shadow need MATSEQBINBCSR parts (not -mat_mpibinbcsr_inner_type)");
+  PetscCheck(sh->S && sh->nzstate == A->nonzerostate, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "The matrix's pattern changed after its AIJ shadow was made");
+  PetscCheck(!sh->parts.empty(), PETSC_COMM_SELF, PETSC_ERR_SUP,
+             "Values from the AIJ shadow need MATSEQBINBCSR parts (not -mat_mpibinbcsr_inner_type)");
   for (const PartMap &p : sh->parts) PetscCall(MatSeqBinBCSRAIJScatter(p.aij, p.map, p.bin));
-  if (sh->parts[0].bin != A) PetscCall(PetscObjectStateIncrease((PetscObject)A)); /* the parts' states moved, not the parallel matrix's */
+  if (sh->parts[0].bin != A)
+    PetscCall(
+      PetscObjectStateIncrease((PetscObject)A)); /* the parts' states moved, not the parallel matrix's */
   PetscCall(PetscObjectStateGet((PetscObject)A, &state));
   sh->state = state;
   PetscFunctionReturn(0);
 }
 
-namespace
-{
+namespace {
 /* A new binbcsr matrix (seq or mpi by T's communicator) with T's sizes and values and the storage
    settings of parent. symmetric: T is a symmetric extraction (same rows and columns) of parent. */
 PetscErrorCode NewFromAIJ(Mat parent, Mat T, PetscBool symmetric, Mat *B)
@@ -183,7 +193,8 @@ PetscErrorCode NewFromAIJ(Mat parent, Mat T, PetscBool symmetric, Mat *B)
   PetscCall(MatSetBlockSize(*B, bs));
   PetscCall(MatSetType(*B, size > 1 ? MATMPIBINBCSR : MATSEQBINBCSR));
   PetscCall(MatBinBCSRGetBinWidth(parent, &bw));
-  if (bw > 0 && bs == pbs) PetscCall(MatBinBCSRSetBinWidth(*B, bw)); /* a different block size keeps its own default */
+  if (bw > 0 && bs == pbs)
+    PetscCall(MatBinBCSRSetBinWidth(*B, bw)); /* a different block size keeps its own default */
   PetscCall(MatBinBCSRGetPrecision(parent, &prec));
   PetscCall(MatBinBCSRSetPrecision(*B, prec));
   PetscCall(MatBinBCSRGetSymmetricStorage(parent, &sym));
@@ -233,8 +244,11 @@ PetscErrorCode RefillMPIByParts(Mat T, Mat B, PetscBool *done)
     const PetscInt *colmap;
     const PetscInt  bs = B->cmap->bs;
     PetscCall(MatMPIAIJGetSeqAIJ(T, &Td, &To, &colmap));
-    ok = (To->cmap->n == static_cast<PetscInt>(b->garray.size()) * bs && (b->B || To->cmap->n == 0)) ? PETSC_TRUE : PETSC_FALSE;
-    for (PetscInt k = 0; ok && k < To->cmap->n; k++) ok = colmap[k] == b->garray[k / bs] * bs + k % bs ? PETSC_TRUE : PETSC_FALSE;
+    ok = (To->cmap->n == static_cast<PetscInt>(b->garray.size()) * bs && (b->B || To->cmap->n == 0))
+           ? PETSC_TRUE
+           : PETSC_FALSE;
+    for (PetscInt k = 0; ok && k < To->cmap->n; k++)
+      ok = colmap[k] == b->garray[k / bs] * bs + k % bs ? PETSC_TRUE : PETSC_FALSE;
   }
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &ok, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)B)));
   *done = ok;
@@ -252,9 +266,15 @@ PetscErrorCode RefillFromAIJ(Mat T, Mat B)
 
   PetscFunctionBegin;
   PetscCall(PetscObjectTypeCompareAny((PetscObject)B, &isbin, MATSEQBINBCSR, MATMPIBINBCSR, ""));
-  PetscCheck(isbin, PetscObjectComm((PetscObject)B), PETSC_ERR_ARG_WRONG, "MAT_REUSE_MATRIX: the submatrix to refill is of type %s, not one this binbcsr matrix made", ((PetscObject)B)->type_name);
-  PetscCheck(B->rmap->N == T->rmap->N && B->cmap->N == T->cmap->N && B->rmap->n == T->rmap->n && B->cmap->n == T->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
-             "MAT_REUSE_MATRIX: the submatrix to refill is %" PetscInt_FMT " x %" PetscInt_FMT " (local %" PetscInt_FMT " x %" PetscInt_FMT "), the index sets select %" PetscInt_FMT " x %" PetscInt_FMT " (local %" PetscInt_FMT " x %" PetscInt_FMT ")",
+  PetscCheck(isbin, PetscObjectComm((PetscObject)B), PETSC_ERR_ARG_WRONG,
+             "MAT_REUSE_MATRIX: the submatrix to refill is of type %s, not one this binbcsr matrix made",
+             ((PetscObject)B)->type_name);
+  PetscCheck(B->rmap->N == T->rmap->N && B->cmap->N == T->cmap->N && B->rmap->n == T->rmap->n &&
+               B->cmap->n == T->cmap->n,
+             PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+             "MAT_REUSE_MATRIX: the submatrix to refill is %" PetscInt_FMT " x %" PetscInt_FMT
+             " (local %" PetscInt_FMT " x %" PetscInt_FMT "), the index sets select %" PetscInt_FMT
+             " x %" PetscInt_FMT " (local %" PetscInt_FMT " x %" PetscInt_FMT ")",
              B->rmap->N, B->cmap->N, B->rmap->n, B->cmap->n, T->rmap->N, T->cmap->N, T->rmap->n, T->cmap->n);
   PetscCall(PetscObjectTypeCompare((PetscObject)B, MATSEQBINBCSR, &seq));
   if (seq) PetscCall(PetscObjectTypeCompare((PetscObject)T, MATSEQAIJ, &seq));
@@ -282,14 +302,21 @@ PetscErrorCode CheckReuse(PetscInt n, const IS irow[], const IS icol[], Mat B[])
     PetscCall(ISGetLocalSize(irow[i], &m));
     PetscCall(ISGetLocalSize(icol[i], &k));
     PetscCall(PetscObjectTypeCompare((PetscObject)B[i], MATSEQBINBCSR, &isbin));
-    PetscCheck(isbin, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "MAT_REUSE_MATRIX: submatrix %" PetscInt_FMT " is of type %s, not one this binbcsr matrix made", i, ((PetscObject)B[i])->type_name);
-    PetscCheck(B[i]->rmap->n == m && B[i]->cmap->n == k, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "MAT_REUSE_MATRIX: submatrix %" PetscInt_FMT " is %" PetscInt_FMT " x %" PetscInt_FMT ", its index sets select %" PetscInt_FMT " x %" PetscInt_FMT, i, B[i]->rmap->n, B[i]->cmap->n, m, k);
+    PetscCheck(isbin, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
+               "MAT_REUSE_MATRIX: submatrix %" PetscInt_FMT
+               " is of type %s, not one this binbcsr matrix made",
+               i, ((PetscObject)B[i])->type_name);
+    PetscCheck(B[i]->rmap->n == m && B[i]->cmap->n == k, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+               "MAT_REUSE_MATRIX: submatrix %" PetscInt_FMT " is %" PetscInt_FMT " x %" PetscInt_FMT
+               ", its index sets select %" PetscInt_FMT " x %" PetscInt_FMT,
+               i, B[i]->rmap->n, B[i]->cmap->n, m, k);
   }
   PetscFunctionReturn(0);
 }
 
 /* The binbcsr counterparts of the AIJ matrices T[0..n): created (MAT_INITIAL_MATRIX) or refilled. */
-PetscErrorCode FromAIJ(Mat parent, PetscInt n, const IS irow[], const IS icol[], Mat T[], MatReuse scall, Mat B[])
+PetscErrorCode FromAIJ(Mat parent, PetscInt n, const IS irow[], const IS icol[], Mat T[], MatReuse scall,
+                       Mat B[])
 {
   PetscFunctionBegin;
   for (PetscInt i = 0; i < n; i++) {
@@ -320,7 +347,8 @@ PetscErrorCode MatConvert_BinBCSR_HYPRE(Mat A, MatType type, MatReuse reuse, Mat
   Mat S;
 
   PetscFunctionBegin;
-  PetscCheck(reuse != MAT_INPLACE_MATRIX, PetscObjectComm((PetscObject)A), PETSC_ERR_SUP, "In-place conversion of binbcsr to %s is not supported", type);
+  PetscCheck(reuse != MAT_INPLACE_MATRIX, PetscObjectComm((PetscObject)A), PETSC_ERR_SUP,
+             "In-place conversion of binbcsr to %s is not supported", type);
   PetscCall(MatBinBCSRGetAIJShadow_Private(A, &S));
   PetscCall(MatConvert(S, type, reuse, newmat));
   PetscFunctionReturn(0);
@@ -328,15 +356,18 @@ PetscErrorCode MatConvert_BinBCSR_HYPRE(Mat A, MatType type, MatReuse reuse, Mat
 
 /* Sequential submatrices (PCASM's blocks, PCREDUNDANT's copy): MATSEQBINBCSR. The array has n+1
    entries like PETSc's own (the last one unused), freed by MatDestroySubMatrices or MatDestroyMatrices. */
-PetscErrorCode MatCreateSubMatrices_BinBCSR(Mat A, PetscInt n, const IS irow[], const IS icol[], MatReuse scall, Mat *submat[])
+PetscErrorCode MatCreateSubMatrices_BinBCSR(Mat A, PetscInt n, const IS irow[], const IS icol[],
+                                            MatReuse scall, Mat *submat[])
 {
   Mat S, *T;
 
   PetscFunctionBegin;
-  PetscCheck(scall == MAT_INITIAL_MATRIX || scall == MAT_REUSE_MATRIX, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_WRONG, "MatCreateSubMatrices takes MAT_INITIAL_MATRIX or MAT_REUSE_MATRIX");
+  PetscCheck(scall == MAT_INITIAL_MATRIX || scall == MAT_REUSE_MATRIX, PetscObjectComm((PetscObject)A),
+             PETSC_ERR_ARG_WRONG, "MatCreateSubMatrices takes MAT_INITIAL_MATRIX or MAT_REUSE_MATRIX");
   if (scall == MAT_REUSE_MATRIX) PetscCall(CheckReuse(n, irow, icol, *submat));
   PetscCall(MatBinBCSRGetAIJShadow_Private(A, &S));
-  S->submat_singleis = A->submat_singleis; /* PCASM's hint: one index set on every rank; used once, as MPIAIJ does */
+  S->submat_singleis =
+    A->submat_singleis; /* PCASM's hint: one index set on every rank; used once, as MPIAIJ does */
   A->submat_singleis = PETSC_FALSE;
   PetscCall(MatCreateSubMatrices(S, n, irow, icol, MAT_INITIAL_MATRIX, &T));
   if (scall == MAT_INITIAL_MATRIX) PetscCall(PetscCalloc1(n + 1, submat));
@@ -347,12 +378,14 @@ PetscErrorCode MatCreateSubMatrices_BinBCSR(Mat A, PetscInt n, const IS irow[], 
 
 /* Parallel submatrices on the index sets' subcommunicators (PCGASM): binbcsr of the kind each
    subcommunicator's size calls for. */
-PetscErrorCode MatCreateSubMatricesMPI_BinBCSR(Mat A, PetscInt n, const IS irow[], const IS icol[], MatReuse scall, Mat *submat[])
+PetscErrorCode MatCreateSubMatricesMPI_BinBCSR(Mat A, PetscInt n, const IS irow[], const IS icol[],
+                                               MatReuse scall, Mat *submat[])
 {
   Mat S, *T;
 
   PetscFunctionBegin;
-  PetscCheck(scall == MAT_INITIAL_MATRIX || scall == MAT_REUSE_MATRIX, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_WRONG, "MatCreateSubMatricesMPI takes MAT_INITIAL_MATRIX or MAT_REUSE_MATRIX");
+  PetscCheck(scall == MAT_INITIAL_MATRIX || scall == MAT_REUSE_MATRIX, PetscObjectComm((PetscObject)A),
+             PETSC_ERR_ARG_WRONG, "MatCreateSubMatricesMPI takes MAT_INITIAL_MATRIX or MAT_REUSE_MATRIX");
   PetscCall(MatBinBCSRGetAIJShadow_Private(A, &S));
   PetscCall(MatCreateSubMatricesMPI(S, n, irow, icol, MAT_INITIAL_MATRIX, &T));
   if (scall == MAT_INITIAL_MATRIX) PetscCall(PetscCalloc1(n + 1, submat));
@@ -376,7 +409,8 @@ PetscErrorCode MatCreateSubMatrix_BinBCSR(Mat A, IS isrow, IS iscol, MatReuse cl
 
 /* PCREDUNDANT with fewer subcommunicators than ranks: the sequential copies of the rows joined into
    one matrix on each subcommunicator, through MPIAIJ's own concatenation. */
-PetscErrorCode MatCreateMPIMatConcatenateSeqMat_BinBCSR(MPI_Comm comm, Mat seqmat, PetscInt n, MatReuse reuse, Mat *mpimat)
+PetscErrorCode MatCreateMPIMatConcatenateSeqMat_BinBCSR(MPI_Comm comm, Mat seqmat, PetscInt n, MatReuse reuse,
+                                                        Mat *mpimat)
 {
   Mat Taij, T;
 

@@ -26,7 +26,8 @@ PETSC_INTERN std::string BinBCSRTuneCachePath(void);
 /* The entry for key (machine key + tab + matrix class), found or not. A file that cannot be read is
    a miss; a corrupt one (a line that does not parse, values out of range) is ignored as a whole, with
    one line on stderr the first time (and PetscInfo). Never an error. */
-PETSC_INTERN PetscErrorCode BinBCSRTuneCacheLookup(const std::string &key, BinBCSRTuneChoice *c, PetscBool *found);
+PETSC_INTERN PetscErrorCode BinBCSRTuneCacheLookup(const std::string &key, BinBCSRTuneChoice *c,
+                                                   PetscBool *found);
 /* Adds or replaces the entry for key: the file is rewritten into a temporary file of this process
    and renamed over the old one (atomic on POSIX), so concurrent writers leave one of their files,
    never a mixture. Failures are reported with PetscInfo only. */

@@ -23,7 +23,9 @@ static const char *const cache_header = "# petscbinbcsr tune cache v1";
 const std::string &BinBCSRTuneMachineKey(void)
 {
   static const char       *bodies = binbcsr::body_set_name(binbcsr::best_body_set());
-  static const std::string key = (binbcsr::cpu_model().empty() ? std::string("unknown cpu") : binbcsr::cpu_model()) + " | " + std::to_string(binbcsr::online_cpus()) + " cores | " + bodies;
+  static const std::string key =
+    (binbcsr::cpu_model().empty() ? std::string("unknown cpu") : binbcsr::cpu_model()) + " | " +
+    std::to_string(binbcsr::online_cpus()) + " cores | " + bodies;
   return key;
 }
 
@@ -38,7 +40,8 @@ std::string BinBCSRTuneCachePath(void)
 }
 
 /* Every entry of the file; false when the file exists but does not parse (why says where). */
-static bool ReadCache(const std::string &path, std::map<std::string, BinBCSRTuneChoice> &entries, std::string &why)
+static bool ReadCache(const std::string &path, std::map<std::string, BinBCSRTuneChoice> &entries,
+                      std::string &why)
 {
   std::ifstream in(path);
   std::string   line;
@@ -60,9 +63,13 @@ static bool ReadCache(const std::string &path, std::map<std::string, BinBCSRTune
     int                kernel = -1;
     if (v >> bw >> streams >> body)
       for (int k = 0; k <= (int)binbcsr::BodySet::AVX512; k++)
-        if (body == binbcsr::body_set_name((binbcsr::BodySet)k) && binbcsr::body_set_available((binbcsr::BodySet)k)) kernel = k;
-    if (kernel < 0 || (v >> rest) || bw < 1 || bw > 1024 || (streams != 1 && streams != 2 && streams != 4 && streams != 8)) {
-      why = "line " + std::to_string(n) + ": choice \"" + line.substr(t2 + 1) + "\" is not a bin width in [1, 1024], streams 1, 2, 4 or 8 and a body set this CPU has";
+        if (body == binbcsr::body_set_name((binbcsr::BodySet)k) &&
+            binbcsr::body_set_available((binbcsr::BodySet)k))
+          kernel = k;
+    if (kernel < 0 || (v >> rest) || bw < 1 || bw > 1024 ||
+        (streams != 1 && streams != 2 && streams != 4 && streams != 8)) {
+      why = "line " + std::to_string(n) + ": choice \"" + line.substr(t2 + 1) +
+            "\" is not a bin width in [1, 1024], streams 1, 2, 4 or 8 and a body set this CPU has";
       return false;
     }
     entries[line.substr(0, t2)] = BinBCSRTuneChoice{(PetscInt)bw, (PetscInt)streams, (PetscInt)kernel};
@@ -76,7 +83,11 @@ static PetscErrorCode WarnCorrupt(const std::string &path, const std::string &wh
 
   PetscFunctionBegin;
   PetscCall(PetscInfo(nullptr, "Ignoring the tuning cache %s: %s\n", path.c_str(), why.c_str()));
-  if (!warned) PetscCall(PetscFPrintf(PETSC_COMM_SELF, PETSC_STDERR, "petscbinbcsr: ignoring the corrupt tuning cache %s (%s); it is rewritten by the next tuning\n", path.c_str(), why.c_str()));
+  if (!warned)
+    PetscCall(PetscFPrintf(
+      PETSC_COMM_SELF, PETSC_STDERR,
+      "petscbinbcsr: ignoring the corrupt tuning cache %s (%s); it is rewritten by the next tuning\n",
+      path.c_str(), why.c_str()));
   warned = true;
   PetscFunctionReturn(0);
 }
@@ -121,14 +132,17 @@ PetscErrorCode BinBCSRTuneCacheStore(const std::string &key, const BinBCSRTuneCh
   if (!ReadCache(path, entries, why)) entries.clear(); /* a corrupt file is replaced (the lookup warned) */
   entries[key] = c;
   if (!MakeParents(path)) {
-    PetscCall(PetscInfo(nullptr, "Cannot create the folder of the tuning cache %s: %s\n", path.c_str(), strerror(errno)));
+    PetscCall(PetscInfo(nullptr, "Cannot create the folder of the tuning cache %s: %s\n", path.c_str(),
+                        strerror(errno)));
     PetscFunctionReturn(0);
   }
   const std::string tmp = path + ".tmp." + std::to_string((long)getpid()) + "." + std::to_string(serial++);
   {
     std::ofstream out(tmp, std::ios::trunc);
     out << cache_header << "\n";
-    for (const auto &[k, v] : entries) out << k << "\t" << v.bw << " " << v.streams << " " << binbcsr::body_set_name((binbcsr::BodySet)v.kernel) << "\n";
+    for (const auto &[k, v] : entries)
+      out << k << "\t" << v.bw << " " << v.streams << " "
+          << binbcsr::body_set_name((binbcsr::BodySet)v.kernel) << "\n";
     out.close();
     if (!out) {
       PetscCall(PetscInfo(nullptr, "Cannot write the tuning cache %s\n", tmp.c_str()));

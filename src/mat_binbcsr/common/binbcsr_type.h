@@ -21,14 +21,17 @@ struct BinBCSRComposed {
 };
 
 /* One entry of a list: BINBCSR_COMPOSED("MatBinBCSRSetBinWidth_C", MatBinBCSRSetBinWidth_SeqBinBCSR) */
-#define BINBCSR_COMPOSED(name, fn) BinBCSRComposed{name, reinterpret_cast<BinBCSRComposedFn>(fn)}
+#define BINBCSR_COMPOSED(name, fn) \
+  BinBCSRComposed { name, reinterpret_cast<BinBCSRComposedFn>(fn) }
 
 /* Composes every function of the list on obj, or, with clear, removes every one of them. */
 template <std::size_t N>
-static inline PetscErrorCode BinBCSRComposeList(PetscObject obj, const BinBCSRComposed (&list)[N], PetscBool clear)
+static inline PetscErrorCode BinBCSRComposeList(PetscObject obj, const BinBCSRComposed (&list)[N],
+                                                PetscBool   clear)
 {
   PetscFunctionBegin;
-  for (const BinBCSRComposed &f : list) PetscCall(PetscObjectComposeFunction(obj, f.name, clear ? nullptr : f.fn));
+  for (const BinBCSRComposed &f : list)
+    PetscCall(PetscObjectComposeFunction(obj, f.name, clear ? nullptr : f.fn));
   PetscFunctionReturn(0);
 }
 

@@ -26,8 +26,7 @@
   #error "binbcsr stores real values: PETSc must be built with real scalars"
 #endif
 
-namespace
-{
+namespace {
 
 /* Symmetric storage: the value of a pair of global indices, the same wherever it is stored. */
 struct PairDraw {
@@ -49,7 +48,7 @@ std::uint64_t Mix64(std::uint64_t z)
 PetscReal PairValue(const PairDraw &d, PetscInt i, PetscInt j)
 {
   const std::uint64_t lo = (std::uint64_t)PetscMin(i, j), hi = (std::uint64_t)PetscMax(i, j);
-  const std::uint64_t z  = Mix64(d.key ^ Mix64((lo << 32) | hi));
+  const std::uint64_t z = Mix64(d.key ^ Mix64((lo << 32) | hi));
   return d.low + d.width * (PetscReal)(z >> 11) * 0x1.0p-53;
 }
 
@@ -60,14 +59,18 @@ PetscErrorCode FillPart(Mat P, PetscRandom rctx, const PairDraw *pair)
   const PetscInt  bs = a->bs;
 
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatSetRandom needs the nonzero pattern of the binbcsr matrix: assemble it first (binbcsr does not choose random locations)");
+  PetscCheck(
+    a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+    "MatSetRandom needs the nonzero pattern of the binbcsr matrix: assemble it first (binbcsr does not choose random locations)");
   for (PetscInt r = 0; r < a->mbs; r++)
     for (PetscInt i = 0; i < bs; i++)
       for (PetscInt k = 0; k < a->row_nz[r]; k++) {
         const PetscInt s = BinBCSRSlot(a, r, k), c = a->col[s];
         for (PetscInt j = 0; j < bs; j++) {
           PetscScalar x;
-          if (pair) x = PairValue(*pair, pair->row0 + r * bs + i, (pair->garray ? pair->garray[c] * bs : pair->col0 + c * bs) + j);
+          if (pair)
+            x = PairValue(*pair, pair->row0 + r * bs + i,
+                          (pair->garray ? pair->garray[c] * bs : pair->col0 + c * bs) + j);
           else PetscCall(PetscRandomGetValue(rctx, &x));
           BinBCSRSetValue(a, BinBCSRValueIndex(s, i * bs + j, a->bw, a->bs2), x);
         }
@@ -85,7 +88,9 @@ PetscErrorCode FillMPIPart(Mat P, PetscRandom rctx, const PairDraw *pair)
   PetscCall(PetscObjectTypeCompare((PetscObject)P, MATSEQBINBCSR, &bin));
   if (bin) PetscCall(FillPart(P, rctx, pair));
   else {
-    PetscCheck(!pair, PETSC_COMM_SELF, PETSC_ERR_SUP, "MatSetRandom with symmetric storage needs binbcsr parts, not %s", ((PetscObject)P)->type_name);
+    PetscCheck(!pair, PETSC_COMM_SELF, PETSC_ERR_SUP,
+               "MatSetRandom with symmetric storage needs binbcsr parts, not %s",
+               ((PetscObject)P)->type_name);
     PetscCall(MatSetRandom(P, rctx));
   }
   PetscFunctionReturn(0);
@@ -101,12 +106,16 @@ PetscErrorCode MatSetRandom_BinBCSR(Mat A, PetscRandom rctx)
   PetscFunctionBegin;
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIBINBCSR, &mpi));
   PetscCall(MatBinBCSRGetSymmetricStorage(A, &sym));
-  if (mpi) PetscCheck(MPIBinBCSR(A)->compressed, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_WRONGSTATE, "MatSetRandom needs the nonzero pattern of the binbcsr matrix: assemble it first (binbcsr does not choose random locations)");
+  if (mpi)
+    PetscCheck(
+      MPIBinBCSR(A)->compressed, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_WRONGSTATE,
+      "MatSetRandom needs the nonzero pattern of the binbcsr matrix: assemble it first (binbcsr does not choose random locations)");
   if (sym) {
     PetscScalar u, low, high;
     PetscCall(PetscRandomGetValue(rctx, &u)); /* every rank draws once, rank 0's draw is the key */
     PetscCall(PetscRandomGetInterval(rctx, &low, &high));
-    pair.key = (std::uint64_t)((PetscRealPart(u) - PetscRealPart(low)) / (PetscRealPart(high) - PetscRealPart(low)) * 0x1.0p53);
+    pair.key = (std::uint64_t)((PetscRealPart(u) - PetscRealPart(low)) /
+                               (PetscRealPart(high) - PetscRealPart(low)) * 0x1.0p53);
     PetscCallMPI(MPI_Bcast(&pair.key, 1, MPIU_INT64, 0, PetscObjectComm((PetscObject)A)));
     pair.low   = PetscRealPart(low);
     pair.width = PetscRealPart(high) - PetscRealPart(low);

@@ -348,7 +348,8 @@ PetscErrorCode MatBinBCSRSetStreams(Mat A, PetscInt streams)
   PetscFunctionBegin;
   PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
   PetscValidLogicalCollectiveInt(A, streams, 2);
-  PetscCheck(streams == 1 || streams == 2 || streams == 4 || streams == 8, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_OUTOFRANGE, "Streams %" PetscInt_FMT ": must be 1, 2, 4 or 8", streams);
+  PetscCheck(streams == 1 || streams == 2 || streams == 4 || streams == 8, PetscObjectComm((PetscObject)A),
+             PETSC_ERR_ARG_OUTOFRANGE, "Streams %" PetscInt_FMT ": must be 1, 2, 4 or 8", streams);
   PetscTryMethod(A, "MatBinBCSRSetStreams_C", (Mat, PetscInt), (A, streams));
   PetscFunctionReturn(0);
 }
@@ -412,7 +413,9 @@ PetscErrorCode MatBinBCSRSetTune(Mat A, MatBinBCSRTune t)
   PetscFunctionBegin;
   PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
   PetscValidLogicalCollectiveEnum(A, t, 2);
-  PetscCheck(t == MAT_BINBCSR_TUNE_OFF || t == MAT_BINBCSR_TUNE_AUTO, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_OUTOFRANGE, "Unknown tuning mode %d: MAT_BINBCSR_TUNE_OFF or MAT_BINBCSR_TUNE_AUTO", (int)t);
+  PetscCheck(t == MAT_BINBCSR_TUNE_OFF || t == MAT_BINBCSR_TUNE_AUTO, PetscObjectComm((PetscObject)A),
+             PETSC_ERR_ARG_OUTOFRANGE,
+             "Unknown tuning mode %d: MAT_BINBCSR_TUNE_OFF or MAT_BINBCSR_TUNE_AUTO", (int)t);
   PetscTryMethod(A, "MatBinBCSRSetTune_C", (Mat, MatBinBCSRTune), (A, t));
   PetscFunctionReturn(0);
 }
@@ -487,6 +490,7 @@ PetscErrorCode MatBinBCSRCheckVecLocalSize(Vec v, PetscInt n, const char *what)
 
   PetscFunctionBegin;
   PetscCall(VecGetLocalSize(v, &nv));
-  PetscCheck(nv == n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "%s has %" PetscInt_FMT " local entries, the matrix needs %" PetscInt_FMT, what, nv, n);
+  PetscCheck(nv == n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+             "%s has %" PetscInt_FMT " local entries, the matrix needs %" PetscInt_FMT, what, nv, n);
   PetscFunctionReturn(0);
 }

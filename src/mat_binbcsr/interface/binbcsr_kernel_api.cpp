@@ -3,13 +3,17 @@
 #include "../seq/binbcsr.h"
 #include "../mpi/mpibinbcsr.h"
 
-const char *const MatBinBCSRKernels[] = {"auto", "portable", "avx2", "avx512", "MatBinBCSRKernel", "MAT_BINBCSR_KERNEL_", nullptr};
+const char *const MatBinBCSRKernels[] = {
+  "auto", "portable", "avx2", "avx512", "MatBinBCSRKernel", "MAT_BINBCSR_KERNEL_", nullptr};
 
 PetscErrorCode MatBinBCSRKernelAvailable(MatBinBCSRKernel kernel, PetscBool *avail)
 {
   PetscFunctionBegin;
   PetscValidBoolPointer(avail, 2);
-  *avail = (kernel >= MAT_BINBCSR_KERNEL_AUTO && kernel <= MAT_BINBCSR_KERNEL_AVX512 && binbcsr::body_set_available((binbcsr::BodySet)kernel)) ? PETSC_TRUE : PETSC_FALSE;
+  *avail = (kernel >= MAT_BINBCSR_KERNEL_AUTO && kernel <= MAT_BINBCSR_KERNEL_AVX512 &&
+            binbcsr::body_set_available((binbcsr::BodySet)kernel))
+             ? PETSC_TRUE
+             : PETSC_FALSE;
   PetscFunctionReturn(0);
 }
 
@@ -20,9 +24,15 @@ PetscErrorCode MatBinBCSRSetKernel(Mat A, MatBinBCSRKernel kernel)
   PetscFunctionBegin;
   PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
   PetscValidLogicalCollectiveEnum(A, kernel, 2);
-  PetscCheck(kernel >= MAT_BINBCSR_KERNEL_AUTO && kernel <= MAT_BINBCSR_KERNEL_AVX512, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_OUTOFRANGE, "Unknown MatBinBCSRKernel %d: use auto, portable, avx2 or avx512", (int)kernel);
+  PetscCheck(kernel >= MAT_BINBCSR_KERNEL_AUTO && kernel <= MAT_BINBCSR_KERNEL_AVX512,
+             PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_OUTOFRANGE,
+             "Unknown MatBinBCSRKernel %d: use auto, portable, avx2 or avx512", (int)kernel);
   PetscCall(MatBinBCSRKernelAvailable(kernel, &avail));
-  PetscCheck(avail, PETSC_COMM_SELF, PETSC_ERR_SUP_SYS, "MATBINBCSR kernel %s: this CPU (or this build of the library) lacks it; available: portable%s%s", MatBinBCSRKernels[kernel], binbcsr::body_set_available(binbcsr::BodySet::AVX2) ? ", avx2" : "", binbcsr::body_set_available(binbcsr::BodySet::AVX512) ? ", avx512" : "");
+  PetscCheck(
+    avail, PETSC_COMM_SELF, PETSC_ERR_SUP_SYS,
+    "MATBINBCSR kernel %s: this CPU (or this build of the library) lacks it; available: portable%s%s",
+    MatBinBCSRKernels[kernel], binbcsr::body_set_available(binbcsr::BodySet::AVX2) ? ", avx2" : "",
+    binbcsr::body_set_available(binbcsr::BodySet::AVX512) ? ", avx512" : "");
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATSEQBINBCSR, &seq));
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIBINBCSR, &mpi));
   if (seq) ((Mat_SeqBinBCSR *)A->data)->kernel = kernel;
@@ -49,7 +59,13 @@ PetscErrorCode MatBinBCSRGetKernel(Mat A, MatBinBCSRKernel *kernel)
   else if (mpi) {
     Mat_MPIBinBCSR *b = MPIBinBCSR(A);
     if (b->A) PetscCall(MatBinBCSRGetKernel(b->A, kernel)); /* the diagonal part: the bulk of the work */
-    else *kernel = (MatBinBCSRKernel)binbcsr::select_body({A->rmap->bs, b->bin_width ? (int)b->bin_width : (int)BinBCSRDefaultBinWidth(A->rmap->bs), b->streams ? (int)b->streams : BINBCSR_DEFAULT_STREAMS, b->precision == MAT_BINBCSR_PRECISION_SINGLE, b->sym ? true : false}, (binbcsr::BodySet)b->kernel).set;
+    else
+      *kernel = (MatBinBCSRKernel)binbcsr::select_body(
+                  {A->rmap->bs, b->bin_width ? (int)b->bin_width : (int)BinBCSRDefaultBinWidth(A->rmap->bs),
+                   b->streams ? (int)b->streams : BINBCSR_DEFAULT_STREAMS,
+                   b->precision == MAT_BINBCSR_PRECISION_SINGLE, b->sym ? true : false},
+                  (binbcsr::BodySet)b->kernel)
+                  .set;
   }
   PetscFunctionReturn(0);
 }

@@ -27,39 +27,32 @@
   #define BINBCSR_LANE_LOOP _Pragma("omp simd")
 #endif
 
-namespace binbcsr
-{
-inline namespace BINBCSR_BODY_SET
-{
-namespace drivers
-{
+namespace binbcsr {
+inline namespace BINBCSR_BODY_SET {
+namespace drivers {
 
-template <typename V>
-inline const V *values(const BinMatrix &m)
+template <typename V> inline const V *values(const BinMatrix &m)
 {
   if constexpr (std::is_same<V, float>::value) return m.valf;
   else return m.val;
 }
 
 /* The slices of K bins: values, columns and slot groups (len) of bins[q]. */
-template <int K, typename V>
-struct BinSlices {
+template <int K, typename V> struct BinSlices {
   const V   *t[K];
   const int *c[K];
   int        len[K];
 };
 
 /* nz[q][l]: the real blocks of lane l of bins[q] (0 for a phantom lane), whole storage. */
-template <int K, int BW>
-inline void lane_lengths(const BinMatrix &m, const int *bins, int (*nz)[BW])
+template <int K, int BW> inline void lane_lengths(const BinMatrix &m, const int *bins, int (*nz)[BW])
 {
   for (int q = 0; q < K; q++)
     for (int l = 0; l < BW; l++) nz[q][l] = bins[q] * BW + l < m.mbs ? m.row_nz[bins[q] * BW + l] : 0;
 }
 
 /* kd[q][l]: the slot group of the diagonal block of lane l of bins[q] (-1: none), symmetric storage. */
-template <int K, int BW>
-inline void diagonal_groups(const BinMatrix &m, const int *bins, int (*kd)[BW])
+template <int K, int BW> inline void diagonal_groups(const BinMatrix &m, const int *bins, int (*kd)[BW])
 {
   for (int q = 0; q < K; q++)
     for (int l = 0; l < BW; l++) {
@@ -85,8 +78,7 @@ inline BinSlices<K, V> bin_slices(const BinMatrix &m, const int *bins)
 /* The order of the products' sweeps: the nbins bins cut into K runs of consecutive bins, f(K, bins)
    for bin j of every run together, then f(1, &b) for each of the nbins % K bins left over. K and the
    count passed to f are compile-time constants (std::integral_constant). */
-template <int K, class F>
-inline void for_each_sweep(int nbins, F &&f)
+template <int K, class F> inline void for_each_sweep(int nbins, F &&f)
 {
   const int run = nbins / K;
   int       bins[K];
@@ -135,7 +127,8 @@ inline void group_mult(const V *t, const int *c, const double *x, double (*acc)[
    in flight for several streams than for one (on a Sapphire Rapids core one array read at 9.9-10.5
    GB/s, two at 11.9-12.4 and four at 13.0-14.1 GB/s; docs/mat_binbcsr.md). */
 template <int K, int BS, int BW, typename V>
-inline void bins_sweep(const BinMatrix &m, const int *bins, const double *x, const double *z, double *y, double &d, bool want_dot)
+inline void bins_sweep(const BinMatrix &m, const int *bins, const double *x, const double *z, double *y,
+                       double &d, bool want_dot)
 {
   constexpr int         BS2            = BS * BS;
   double                acc[K][BS][BW] = {};
@@ -149,7 +142,9 @@ inline void bins_sweep(const BinMatrix &m, const int *bins, const double *x, con
     avx512::bins_mult_3x8<K>(s.t, s.c, s.len, nz, x, accq);
   } else
 #endif
-    interleave_groups<K>(s.len, [&](int q, int k) { group_mult<BS, BW, V>(s.t[q] + (size_t)k * BW * BS2, s.c[q] + (size_t)k * BW, x, acc[q], k, nz[q]); });
+    interleave_groups<K>(s.len, [&](int q, int k) {
+      group_mult<BS, BW, V>(s.t[q] + (size_t)k * BW * BS2, s.c[q] + (size_t)k * BW, x, acc[q], k, nz[q]);
+    });
   for (int q = 0; q < K; q++) {
     /* y += A x in place: an empty bin changes nothing (the off-diagonal part of an MPI matrix is
        mostly empty bins; writing their rows back cost a tenth of the diagonal part's product) */
@@ -172,7 +167,9 @@ template <int K, int BS, int BW, typename V>
 void mult_fixed(const BinMatrix &m, const double *x, const double *z, double *y, double *dot, double *)
 {
   double d = 0.0;
-  for_each_sweep<K>(m.nbins, [&](auto KC, const int *bins) { bins_sweep<decltype(KC)::value, BS, BW, V>(m, bins, x, z, y, d, dot != nullptr); });
+  for_each_sweep<K>(m.nbins, [&](auto KC, const int *bins) {
+    bins_sweep<decltype(KC)::value, BS, BW, V>(m, bins, x, z, y, d, dot != nullptr);
+  });
   if (dot) *dot = d;
 }
 
@@ -219,7 +216,8 @@ void sym_mult_fixed(const BinMatrix &m, const double *x, const double *, double 
 #endif
       sym_bins_mult<Kc, BS, BW, V, int>(s.t, s.c, s.len, r0, m.mbs, kd, x, y);
     if (dot && K == 1)
-      for (size_t p = (size_t)r0[0] * BS; p < (size_t)(m.mbs < r0[0] + BW ? m.mbs : r0[0] + BW) * BS; p++) d += x[p] * y[p];
+      for (size_t p = (size_t)r0[0] * BS; p < (size_t)(m.mbs < r0[0] + BW ? m.mbs : r0[0] + BW) * BS; p++)
+        d += x[p] * y[p];
   });
   if (dot && K > 1)
     for (size_t p = 0; p < (size_t)m.mbs * BS; p++) d += x[p] * y[p];
@@ -234,11 +232,13 @@ void sym_mult_any(const BinMatrix &m, const double *x, const double *, double *y
   const V  *val = values<V>(m);
   double    d   = 0.0;
   for (int b = 0; b < m.nbins; b++) {
-    const int s0 = m.bin_start[b], len = (m.bin_start[b + 1] - s0) / bw, r0 = b * bw, r1 = m.mbs < r0 + bw ? m.mbs : r0 + bw;
+    const int s0 = m.bin_start[b], len = (m.bin_start[b + 1] - s0) / bw, r0 = b * bw,
+              r1 = m.mbs < r0 + bw ? m.mbs : r0 + bw;
     for (int r = r0; r < r1; r++) {
       for (int i = 0; i < bs; i++) acc[i] = 0.0;
       const int kd = m.diag_slot[r] >= 0 ? (m.diag_slot[r] - s0) / bw : -1;
-      sym_lane_mult<BS, V, int>(val + (size_t)s0 * bs2, m.col + s0, len, bw, bs, r - r0, r, kd, x, x + (size_t)r * bs, y, acc);
+      sym_lane_mult<BS, V, int>(val + (size_t)s0 * bs2, m.col + s0, len, bw, bs, r - r0, r, kd, x,
+                                x + (size_t)r * bs, y, acc);
       for (int i = 0; i < bs; i++) y[(size_t)r * bs + i] += acc[i];
     }
     if (dot)
@@ -248,8 +248,7 @@ void sym_mult_any(const BinMatrix &m, const double *x, const double *, double *y
 }
 
 /* y += A^T x (y holds z or zero on entry). Scatter: rows are visited lane by lane. */
-template <int BS, typename V>
-void mult_transpose_any(const BinMatrix &m, const double *x, double *y)
+template <int BS, typename V> void mult_transpose_any(const BinMatrix &m, const double *x, double *y)
 {
   const int bs = BS ? BS : m.bs, bs2 = bs * bs, bw = m.bw;
   const V  *val = values<V>(m);
@@ -257,15 +256,15 @@ void mult_transpose_any(const BinMatrix &m, const double *x, double *y)
     const int s0 = m.bin_start[b];
     for (int l = 0; l < bw && b * bw + l < m.mbs; l++) {
       const int r = b * bw + l;
-      lane_mult_transpose<BS, V, int>(val + (size_t)s0 * bs2, m.col + s0, m.row_nz[r], bw, bs, l, x + (size_t)r * bs, y);
+      lane_mult_transpose<BS, V, int>(val + (size_t)s0 * bs2, m.col + s0, m.row_nz[r], bw, bs, l,
+                                      x + (size_t)r * bs, y);
     }
   }
 }
 
 /* Calls f(block size, bin width) with each as a compile-time constant where a specialised sweep exists
    (bs 1 and 3; bin widths 4, 8, 16, 32) and 0 where the generic sweep must take it from the matrix. */
-template <class F>
-inline void with_constant_shape(int bs, int bw, F &&f)
+template <class F> inline void with_constant_shape(int bs, int bw, F &&f)
 {
   using std::integral_constant;
   const auto width = [&](auto BS) {
@@ -292,8 +291,7 @@ inline void with_constant_shape(int bs, int bw, F &&f)
 }
 
 /* Calls f(K) with the run count K (1, 2, 4 or 8) as a compile-time constant. */
-template <class F>
-inline void with_streams(int streams, F &&f)
+template <class F> inline void with_streams(int streams, F &&f)
 {
   using std::integral_constant;
   switch (streams) {
@@ -311,13 +309,12 @@ inline void with_streams(int streams, F &&f)
   }
 }
 
-template <typename V>
-inline bool bodies_of(const Shape &s, Body &b, bool fixed_only)
+template <typename V> inline bool bodies_of(const Shape &s, Body &b, bool fixed_only)
 {
   bool found = false;
   with_constant_shape(s.bs, s.bw, [&](auto BS, auto BW) {
     constexpr int bs_c = decltype(BS)::value, bw_c = decltype(BW)::value;
-    b.mult_transpose   = &mult_transpose_any<bs_c, V>;
+    b.mult_transpose = &mult_transpose_any<bs_c, V>;
     if constexpr (bs_c > 0 && bw_c > 0) {
       with_streams(s.streams, [&](auto K) {
         constexpr int k_c = decltype(K)::value;

@@ -1,8 +1,7 @@
 /* select_body: the one function that chooses a product body (binbcsr_dispatch.h). */
 #include "binbcsr_dispatch.h"
 
-namespace binbcsr
-{
+namespace binbcsr {
 
 /* Whether the CPU runs the set and this build compiled it (a stub's table is empty). */
 static bool probe(BodySet set)
@@ -49,7 +48,9 @@ bool body_set_available(BodySet set)
 
 BodySet best_body_set()
 {
-  static const BodySet best = body_set_available(BodySet::AVX512) ? BodySet::AVX512 : body_set_available(BodySet::AVX2) ? BodySet::AVX2 : BodySet::Portable;
+  static const BodySet best = body_set_available(BodySet::AVX512) ? BodySet::AVX512
+                              : body_set_available(BodySet::AVX2) ? BodySet::AVX2
+                                                                  : BodySet::Portable;
   return best;
 }
 

@@ -15,23 +15,28 @@
 #ifndef BINBCSR_DISPATCH_H
 #define BINBCSR_DISPATCH_H
 
-namespace binbcsr
-{
+namespace binbcsr {
 
 /* The body sets, in the order of MatBinBCSRKernel (include/petscbinbcsr.h). */
-enum class BodySet : int { Auto = 0, Portable = 1, AVX2 = 2, AVX512 = 3 };
+enum class BodySet : int {
+  Auto     = 0,
+  Portable = 1,
+  AVX2     = 2,
+  AVX512   = 3
+};
 
 /* Everything a product reads, as plain pointers (32-bit indices, as the layout). */
 struct BinMatrix {
-  const int      *bin_start; /* [nbins + 1] */
-  const int      *col;       /* [nslots] */
-  const int      *row_nz;    /* [mbs] real blocks of each row */
-  const unsigned *lane_mask; /* [nslots / bw] bit l of group g: slot g * bw + l is real (bw <= 32), else NULL */
-  const int      *diag_slot; /* [mbs] */
-  const double   *val;       /* double values, or NULL */
-  const float    *valf;      /* single values, or NULL */
-  int             nbins, mbs, bs, bw, streams;
-  bool            sym;
+  const int *bin_start; /* [nbins + 1] */
+  const int *col;       /* [nslots] */
+  const int *row_nz;    /* [mbs] real blocks of each row */
+  const unsigned
+               *lane_mask; /* [nslots / bw] bit l of group g: slot g * bw + l is real (bw <= 32), else NULL */
+  const int    *diag_slot; /* [mbs] */
+  const double *val;       /* double values, or NULL */
+  const float  *valf;      /* single values, or NULL */
+  int           nbins, mbs, bs, bw, streams;
+  bool          sym;
 };
 
 /* The shape a body is chosen for. */
@@ -42,7 +47,8 @@ struct Shape {
 
 /* Whole storage: y = z + A x (z may be NULL or alias y). Symmetric storage: y += A x (the caller puts
    z or zero in y first). dot (may be NULL): *dot = x.y. acc: scratch of bs doubles. */
-using MultBody = void (*)(const BinMatrix &, const double *x, const double *z, double *y, double *dot, double *acc);
+using MultBody = void (*)(const BinMatrix &, const double *x, const double *z, double *y, double *dot,
+                          double *acc);
 /* y += A^T x (whole storage). */
 using MultTransposeBody = void (*)(const BinMatrix &, const double *x, double *y);
 

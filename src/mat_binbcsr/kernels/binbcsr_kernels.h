@@ -27,22 +27,20 @@
   #define BINBCSR_BODY_SET baseline
 #endif
 
-namespace binbcsr
-{
-inline namespace BINBCSR_BODY_SET
-{
+namespace binbcsr {
+inline namespace BINBCSR_BODY_SET {
 
 /* Software prefetch of the value stream, CPU only. One core streaming one array out of cache is
    limited by how many cache lines it has in flight, not by the memory: the hardware prefetcher alone
    left the product at 73-79% of the triad bandwidth (27-point stencil, 48^3 nodes, double), 1 KB
    ahead gained nothing for double and about 10 points for single, 4 KB ahead brought both to 85-94%
    and helps the in-cache sizes as well (docs/mat_binbcsr.md). */
-constexpr int prefetch_ahead_bytes = 4096;
-template <typename V>
-BINBCSR_HD void prefetch_values(const V *tile, int nbytes)
+constexpr int                         prefetch_ahead_bytes = 4096;
+template <typename V> BINBCSR_HD void prefetch_values(const V *tile, int nbytes)
 {
 #if !defined(__CUDACC__) && defined(__GNUC__)
-  for (int q = 0; q < nbytes; q += 64) __builtin_prefetch((const char *)tile + prefetch_ahead_bytes + q, 0, 3);
+  for (int q = 0; q < nbytes; q += 64)
+    __builtin_prefetch((const char *)tile + prefetch_ahead_bytes + q, 0, 3);
 #else
   (void)tile;
   (void)nbytes;
@@ -53,8 +51,7 @@ BINBCSR_HD void prefetch_values(const V *tile, int nbytes)
    bin q, one group of each bin in turn while every bin has one left, then the rest of each bin. The
    products sweep several bins at once because the bins are then several streams for the hardware
    prefetcher (bins_sweep in binbcsr_bin_drivers.h says why). */
-template <int K, class G>
-BINBCSR_HD void interleave_groups(const int *len, G &&group)
+template <int K, class G> BINBCSR_HD void interleave_groups(const int *len, G &&group)
 {
   int common = len[0];
   for (int q = 1; q < K; q++) common = len[q] < common ? len[q] : common;
@@ -94,7 +91,8 @@ BINBCSR_HD void slot_mult_transpose(const V *tile, int bw, int bs_rt, const doub
    has no row lengths (the CUDA benchmark) passes the bin's len and reads the padding (zeros, valid
    columns). bin_val / bin_col point at the bin's first tile / slot. */
 template <int BS, typename V, typename I>
-BINBCSR_HD void lane_mult(const V *bin_val, const I *bin_col, int nz, int bw, int bs_rt, int lane, const double *x, double *acc)
+BINBCSR_HD void lane_mult(const V *bin_val, const I *bin_col, int nz, int bw, int bs_rt, int lane,
+                          const double *x, double *acc)
 {
   const int bs  = BS ? BS : bs_rt;
   const int bs2 = bs * bs;
@@ -113,7 +111,8 @@ BINBCSR_HD void lane_mult(const V *bin_val, const I *bin_col, int nz, int bw, in
    computes for acc[i] alone. A GPU runs bs threads per lane with it (a warp per bin and point row,
    still coalesced), which triples the threads of small matrices that would otherwise not fill it. */
 template <int BS, typename V, typename I>
-BINBCSR_HD double lane_row_mult(const V *bin_val, const I *bin_col, int len, int bw, int bs_rt, int lane, int i, const double *x, int k0 = 0, int kstep = 1)
+BINBCSR_HD double lane_row_mult(const V *bin_val, const I *bin_col, int len, int bw, int bs_rt, int lane,
+                                int i, const double *x, int k0 = 0, int kstep = 1)
 {
   const int bs  = BS ? BS : bs_rt;
   const int bs2 = bs * bs;
@@ -122,8 +121,8 @@ BINBCSR_HD double lane_row_mult(const V *bin_val, const I *bin_col, int len, int
   #pragma unroll 4
 #endif
   for (int k = k0; k < len; k += kstep) { /* k0, kstep: a share of the slots, for threads that split a bin */
-    const V      *t  = bin_val + (long)k * bw * bs2 + (long)i * bs * bw + lane;
-    const long    c0 = (long)bin_col[(long)k * bw + lane] * bs;
+    const V   *t  = bin_val + (long)k * bw * bs2 + (long)i * bs * bw + lane;
+    const long c0 = (long)bin_col[(long)k * bw + lane] * bs;
     for (int j = 0; j < bs; j++) s += (double)t[j * bw] * x[c0 + j];
   }
   return s;
@@ -132,7 +131,8 @@ BINBCSR_HD double lane_row_mult(const V *bin_val, const I *bin_col, int len, int
 /* y(cols) += (row at `lane`)^T * xr over the lane's nz real slots (padding skipped: its column may
    be shared with a real entry, and a phantom row has no x). On a GPU the scatter needs atomics. */
 template <int BS, typename V, typename I>
-BINBCSR_HD void lane_mult_transpose(const V *bin_val, const I *bin_col, int nz, int bw, int bs_rt, int lane, const double *xr, double *y)
+BINBCSR_HD void lane_mult_transpose(const V *bin_val, const I *bin_col, int nz, int bw, int bs_rt, int lane,
+                                    const double *xr, double *y)
 {
   const int bs  = BS ? BS : bs_rt;
   const int bs2 = bs * bs;
@@ -152,7 +152,8 @@ BINBCSR_HD void lane_mult_transpose(const V *bin_val, const I *bin_col, int nz, 
    that no two lanes of one slot group scatter to the same column, so no atomics are needed (a GPU
    must keep the lanes of a bin in step per slot, e.g. one warp per bin with __syncwarp per k). */
 template <int BS, typename V, typename I>
-BINBCSR_HD void sym_lane_mult(const V *bin_val, const I *bin_col, int len, int bw, int bs_rt, int lane, I own, int kd, const double *x, const double *xr, double *y, double *acc)
+BINBCSR_HD void sym_lane_mult(const V *bin_val, const I *bin_col, int len, int bw, int bs_rt, int lane, I own,
+                              int kd, const double *x, const double *xr, double *y, double *acc)
 {
   const int bs  = BS ? BS : bs_rt;
   const int bs2 = bs * bs;
@@ -169,26 +170,22 @@ BINBCSR_HD void sym_lane_mult(const V *bin_val, const I *bin_col, int len, int b
 
 /* True when the BW lanes of a slot group read the consecutive block columns c[0], c[0] + 1, ...: a
    structured grid numbered along its rows (cloth, stencils), away from the grid's edges. */
-template <typename I>
-BINBCSR_HD bool unit_stride(const I *c, int bw)
+template <typename I> BINBCSR_HD bool unit_stride(const I *c, int bw)
 {
-  if (c[bw - 1] != c[0] + bw - 1) return false; /* one compare rejects almost every group of an unstructured mesh */
+  if (c[bw - 1] != c[0] + bw - 1)
+    return false; /* one compare rejects almost every group of an unstructured mesh */
   bool unit = true;
   for (int l = 1; l < bw; l++) unit &= c[l] == c[0] + l;
   return unit;
 }
-template <int BW, typename I>
-BINBCSR_HD bool unit_stride(const I *c)
-{
-  return unit_stride(c, BW);
-}
-
+template <int BW, typename I> BINBCSR_HD bool unit_stride(const I *c) { return unit_stride(c, BW); }
 
 /* One slot group of sym_bins_mult whose lanes read the consecutive block columns xs, xs + BS, ...:
    acc += block x_c and, with SCATTER, y_c += block^T x_r, by unit-stride loads and stores. The
    branch is a template argument: a run-time test inside the lane loop stops GCC from vectorising it. */
 template <int BS, int BW, typename V, bool SCATTER>
-BINBCSR_HD void sym_unit_group_mult(const V *t, const double *xs, const double (*xr)[BW], double *ys, double (*acc)[BW], int k, const int *kd)
+BINBCSR_HD void sym_unit_group_mult(const V *t, const double *xs, const double (*xr)[BW], double *ys,
+                                    double (*acc)[BW], int k, const int *kd)
 {
   constexpr int BS2 = BS * BS;
 #pragma omp simd
@@ -216,11 +213,13 @@ BINBCSR_HD void sym_unit_group_mult(const V *t, const double *xs, const double (
    l's diagonal block), and a masked scatter-add of block^T x_r into y_c (conflict-free by the
    colouring). */
 template <int BS, int BW, typename V, typename I>
-BINBCSR_HD void sym_group_mult(const V *t, const I *c, I r0, const I *own, const double (*xr)[BW], const double *x, double *y, double (*acc)[BW], int k, const int *kd)
+BINBCSR_HD void sym_group_mult(const V *t, const I *c, I r0, const I *own, const double (*xr)[BW],
+                               const double *x, double *y, double (*acc)[BW], int k, const int *kd)
 {
   constexpr int BS2 = BS * BS;
   prefetch_values(t, BW * BS2 * (int)sizeof(V));
-  if (unit_stride<BW>(c)) { /* contiguous x_c and y_c: plain loads and stores instead of gathers and scatters */
+  if (unit_stride<BW>(
+        c)) { /* contiguous x_c and y_c: plain loads and stores instead of gathers and scatters */
     const I c0 = c[0];
     /* c0 == r0: the diagonal blocks or padding of every lane, nothing to scatter */
     if (c0 == r0) sym_unit_group_mult<BS, BW, V, false>(t, x + (long)c0 * BS, xr, nullptr, acc, k, kd);
@@ -258,7 +257,8 @@ BINBCSR_HD void sym_group_mult(const V *t, const I *c, I r0, const I *own, const
    lanes of every bin. Scatters of one bin may land in the rows of another bin of the sweep: all are
    additions into y, and a bin's own rows are added only at its end. */
 template <int K, int BS, int BW, typename V, typename I>
-BINBCSR_HD void sym_bins_mult(const V *const *bin_val, const I *const *bin_col, const int *len, const I *r0, I mbs, const int (*kd)[BW], const double *x, double *y)
+BINBCSR_HD void sym_bins_mult(const V *const *bin_val, const I *const *bin_col, const int *len, const I *r0,
+                              I mbs, const int (*kd)[BW], const double *x, double *y)
 {
   constexpr int BS2 = BS * BS;
   double        acc[K][BS][BW], xr[K][BS][BW];
@@ -273,7 +273,10 @@ BINBCSR_HD void sym_bins_mult(const V *const *bin_val, const I *const *bin_col, 
       }
     }
   }
-  interleave_groups<K>(len, [&](int q, int k) { sym_group_mult<BS, BW, V, I>(bin_val[q] + (long)k * BW * BS2, bin_col[q] + (long)k * BW, r0[q], own[q], xr[q], x, y, acc[q], k, kd[q]); });
+  interleave_groups<K>(len, [&](int q, int k) {
+    sym_group_mult<BS, BW, V, I>(bin_val[q] + (long)k * BW * BS2, bin_col[q] + (long)k * BW, r0[q], own[q],
+                                 xr[q], x, y, acc[q], k, kd[q]);
+  });
   for (int q = 0; q < K; q++)
     for (int l = 0; l < BW; l++)
       if (r0[q] + l < mbs)
@@ -285,7 +288,8 @@ BINBCSR_HD void sym_bins_mult(const V *const *bin_val, const I *const *bin_col, 
    received from other ranks, without first copying both into one array). One source: n past every
    index, recv unused. */
 template <typename I>
-BINBCSR_HD double coo_gather(const double *coo_v, long n, const double *recv, const I *jmap, const I *perm, long v)
+BINBCSR_HD double coo_gather(const double *coo_v, long n, const double *recv, const I *jmap, const I *perm,
+                             long v)
 {
   double s = 0.0;
   for (I j = jmap[v]; j < jmap[v + 1]; j++) {

@@ -10,20 +10,19 @@
 #ifndef BINBCSR_LAYOUT_H
 #define BINBCSR_LAYOUT_H
 
-namespace binbcsr
-{
+namespace binbcsr {
 
 /* bin_start[0 .. nbins] for bins of bw rows, each padded to its longest row (a multiple of bw slots per
    bin); returns the number of slots. The caller checks that the total fits its index type. */
-template <typename I>
-inline long bin_starts(const I *row_ptr, I mbs, I bw, I *bin_start)
+template <typename I> inline long bin_starts(const I *row_ptr, I mbs, I bw, I *bin_start)
 {
   const I nbins = (mbs + bw - 1) / bw;
   long    s     = 0;
   bin_start[0]  = 0;
   for (I b = 0; b < nbins; b++) {
     I len = 0;
-    for (I r = b * bw; r < mbs && r < (b + 1) * bw; r++) len = row_ptr[r + 1] - row_ptr[r] > len ? row_ptr[r + 1] - row_ptr[r] : len;
+    for (I r = b * bw; r < mbs && r < (b + 1) * bw; r++)
+      len = row_ptr[r + 1] - row_ptr[r] > len ? row_ptr[r + 1] - row_ptr[r] : len;
     s += (long)len * bw;
     bin_start[b + 1] = (I)s;
   }
@@ -34,7 +33,8 @@ inline long bin_starts(const I *row_ptr, I mbs, I bw, I *bin_start)
    lane's last real column (0 for an empty or phantom lane) so kernels run without branches and read no x
    entry the row does not already read. diag_slot[r] (if non-null): the slot of block (r, r), or -1. */
 template <typename I>
-inline void bin_columns(const I *row_ptr, const I *cols, I mbs, I bw, const I *bin_start, I *col, I *diag_slot)
+inline void bin_columns(const I *row_ptr, const I *cols, I mbs, I bw, const I *bin_start, I *col,
+                        I *diag_slot)
 {
   const I nbins = (mbs + bw - 1) / bw;
   for (I b = 0; b < nbins; b++) {
@@ -64,8 +64,7 @@ inline long value_index(long s, int e, int bw, int bs2)
 }
 
 /* Slot of entry k (k-th stored block of the row, ascending column) of block row r. */
-template <typename I>
-inline long row_slot(const I *bin_start, I bw, I r, I k)
+template <typename I> inline long row_slot(const I *bin_start, I bw, I r, I k)
 {
   return bin_start[r / bw] + (long)k * bw + r % bw;
 }

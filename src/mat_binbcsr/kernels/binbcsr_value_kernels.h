@@ -13,8 +13,7 @@
 
 #include "binbcsr_kernels.h"
 
-namespace binbcsr
-{
+namespace binbcsr {
 
 BINBCSR_HD long value_offset(int k, int e, int bw, int bs2, int lane)
 {
@@ -22,8 +21,7 @@ BINBCSR_HD long value_offset(int k, int e, int bw, int bs2, int lane)
 }
 
 /* v *= a over the lane's real slots. */
-template <typename V>
-BINBCSR_HD void lane_scale(V *bin_val, int nz, int bw, int bs2, int lane, double a)
+template <typename V> BINBCSR_HD void lane_scale(V *bin_val, int nz, int bw, int bs2, int lane, double a)
 {
   for (int k = 0; k < nz; k++)
     for (int e = 0; e < bs2; e++) {
@@ -44,8 +42,7 @@ BINBCSR_HD void lane_axpy(VY *y_bin_val, const VX *x_bin_val, int nz, int bw, in
 }
 
 /* Row i (0 <= i < bs) of every block of the lane set to zero. */
-template <typename V>
-BINBCSR_HD void lane_zero_row(V *bin_val, int nz, int bw, int bs, int lane, int i)
+template <typename V> BINBCSR_HD void lane_zero_row(V *bin_val, int nz, int bw, int bs, int lane, int i)
 {
   const int bs2 = bs * bs;
   for (int k = 0; k < nz; k++)
@@ -57,7 +54,8 @@ BINBCSR_HD void lane_zero_row(V *bin_val, int nz, int bw, int bs, int lane, int 
    With x and b: b[i] -= a_ic x[c] first, so that the eliminated unknowns' known values move to the
    right-hand side (b, zeroed_row point at the lane's rows; x is the whole vector). */
 template <typename V, typename I>
-BINBCSR_HD void lane_zero_columns(V *bin_val, const I *bin_col, int nz, int bw, int bs, int lane, const char *zeroed_col, const char *zeroed_row, const double *x, double *b)
+BINBCSR_HD void lane_zero_columns(V *bin_val, const I *bin_col, int nz, int bw, int bs, int lane,
+                                  const char *zeroed_col, const char *zeroed_row, const double *x, double *b)
 {
   const int bs2 = bs * bs;
   for (int k = 0; k < nz; k++) {
@@ -78,24 +76,21 @@ BINBCSR_HD void lane_zero_columns(V *bin_val, const I *bin_col, int nz, int bw, 
    nothing to a sum and stay zero under a finite factor, and the loops run over contiguous memory. */
 
 /* y += a x over n values (a finite). */
-template <typename VY, typename VX>
-BINBCSR_HD void values_axpy(long n, VY *y, const VX *x, double a)
+template <typename VY, typename VX> BINBCSR_HD void values_axpy(long n, VY *y, const VX *x, double a)
 {
 #pragma omp simd
   for (long i = 0; i < n; i++) y[i] = (VY)((double)y[i] + a * (double)x[i]);
 }
 
 /* v *= a over n values (a finite). */
-template <typename V>
-BINBCSR_HD void values_scale(long n, V *v, double a)
+template <typename V> BINBCSR_HD void values_scale(long n, V *v, double a)
 {
 #pragma omp simd
   for (long i = 0; i < n; i++) v[i] = (V)(a * (double)v[i]);
 }
 
 /* Sum of v^2 over n values. */
-template <typename V>
-BINBCSR_HD double values_sum_squares(long n, const V *v)
+template <typename V> BINBCSR_HD double values_sum_squares(long n, const V *v)
 {
   double s = 0.0;
 #pragma omp simd reduction(+ : s)
@@ -120,9 +115,13 @@ BINBCSR_HD void bin_row_abs_sums(const V *bin_val, int len, int bw, int bs, doub
 
 /* Column reductions (MatGetColumnNorms/Reductions, the 1-norm): red[c] = op over the entries of
    point column c, for op one of: */
-enum reduction_kind { reduce_abs_sum = 0, reduce_square_sum = 1, reduce_abs_max = 2, reduce_sum = 3 };
-template <int KIND>
-BINBCSR_HD double reduce(double acc, double v)
+enum reduction_kind {
+  reduce_abs_sum    = 0,
+  reduce_square_sum = 1,
+  reduce_abs_max    = 2,
+  reduce_sum        = 3
+};
+template <int KIND> BINBCSR_HD double reduce(double acc, double v)
 {
   const double a = v < 0 ? -v : v;
   if constexpr (KIND == reduce_abs_sum) return acc + a;
@@ -137,7 +136,8 @@ BINBCSR_HD double reduce(double acc, double v)
    whose entries lie in the columns of block row r; phantom lanes (r >= mbs) have none. The kind and
    the mirror are template arguments: tested per value they cost the 1-norm 2.4x. */
 template <int KIND, bool MIRROR, typename V, typename I>
-BINBCSR_HD void bin_col_reductions(const V *bin_val, const I *bin_col, int len, int bw, int bs, I r0, I mbs, double *red)
+BINBCSR_HD void bin_col_reductions(const V *bin_val, const I *bin_col, int len, int bw, int bs, I r0, I mbs,
+                                   double *red)
 {
   const int bs2 = bs * bs;
   for (int k = 0; k < len; k++) {
@@ -176,15 +176,23 @@ BINBCSR_HD void slot_diagonal_scale(V *tile, int bw, int bs, const double *l, co
 /* The same over the lane's nz real slots (padding stays zero whatever the factors): l at the lane's
    rows, r the whole column scaling. */
 template <typename V, typename I>
-BINBCSR_HD void lane_diagonal_scale(V *bin_val, const I *bin_col, int nz, int bw, int bs, int lane, const double *l, const double *r)
+BINBCSR_HD void lane_diagonal_scale(V *bin_val, const I *bin_col, int nz, int bw, int bs, int lane,
+                                    const double *l, const double *r)
 {
   const int bs2 = bs * bs;
-  for (int k = 0; k < nz; k++) slot_diagonal_scale(bin_val + value_offset(k, 0, bw, bs2, lane), bw, bs, l, r ? r + (long)bin_col[(long)k * bw + lane] * bs : nullptr);
+  for (int k = 0; k < nz; k++)
+    slot_diagonal_scale(bin_val + value_offset(k, 0, bw, bs2, lane), bw, bs, l,
+                        r ? r + (long)bin_col[(long)k * bw + lane] * bs : nullptr);
 }
 
 /* Row extremes (MatGetRowMaxAbs, MatGetRowMax, MatGetRowMin) with PETSc's AIJ rules: the value and the
    column where it is reached, for each point row. */
-enum row_extreme_kind { extreme_max_abs = 0, extreme_max = 1, extreme_min = 2, extreme_min_abs = 3 };
+enum row_extreme_kind {
+  extreme_max_abs = 0,
+  extreme_max     = 1,
+  extreme_min     = 2,
+  extreme_min_abs = 3
+};
 
 /* The state of a row before its stored entries are seen: for max/min/min-abs, a row that does not store
    every column holds implicit zeros, the first at column first_gap; a row that does starts from
@@ -223,7 +231,8 @@ BINBCSR_HD bool row_extreme_beats(int kind, double v, double best)
    at[i], so ties keep the smallest column. transposed: the block is stored as (c, r) (the lower part of
    symmetric storage), entry (i, j) of the row is its entry (j, i). */
 template <typename V, typename I>
-BINBCSR_HD void slot_row_extremes(const V *tile, int bw, int bs, bool transposed, I c0, int kind, double *best, I *at)
+BINBCSR_HD void slot_row_extremes(const V *tile, int bw, int bs, bool transposed, I c0, int kind,
+                                  double *best, I *at)
 {
   for (int i = 0; i < bs; i++)
     for (int j = 0; j < bs; j++) {
@@ -241,8 +250,7 @@ BINBCSR_HD void slot_row_extremes(const V *tile, int bw, int bs, bool transposed
    seqaij's first maximum in column order. Padding holds zeros, which never beat a start of 0, so all
    len slot groups run. MIRROR (symmetric storage): a stored off-diagonal block (r, c) also offers its
    entries, transposed, to the rows of block c (a scatter: a GPU needs atomics for it). */
-template <typename I>
-BINBCSR_HD void max_abs_offer(double a, I col, double *best, I *at)
+template <typename I> BINBCSR_HD void max_abs_offer(double a, I col, double *best, I *at)
 {
   if (a > *best || (a == *best && a > 0 && col < *at)) {
     *best = a;
@@ -250,7 +258,8 @@ BINBCSR_HD void max_abs_offer(double a, I col, double *best, I *at)
   }
 }
 template <bool MIRROR, typename V, typename I>
-BINBCSR_HD void bin_row_max_abs(const V *bin_val, const I *bin_col, int len, int bw, int bs, I r0, I mbs, double *best, I *at)
+BINBCSR_HD void bin_row_max_abs(const V *bin_val, const I *bin_col, int len, int bw, int bs, I r0, I mbs,
+                                double *best, I *at)
 {
   const int bs2 = bs * bs, lanes = mbs - r0 < bw ? (int)(mbs - r0) : bw; /* phantom lanes hold padding only */
   for (int k = 0; k < len; k++) {

@@ -26,7 +26,9 @@ static PetscErrorCode CreateDiagonalPart(Mat mat)
 
   PetscFunctionBegin;
   PetscCall(MatMPIBinBCSRSetUpLayouts(mat));
-  PetscCheck(mat->rmap->bs == mat->cmap->bs, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_INCOMP, "MATMPIBINBCSR needs equal row and column block sizes (%" PetscInt_FMT " vs %" PetscInt_FMT ")", mat->rmap->bs, mat->cmap->bs);
+  PetscCheck(mat->rmap->bs == mat->cmap->bs, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_INCOMP,
+             "MATMPIBINBCSR needs equal row and column block sizes (%" PetscInt_FMT " vs %" PetscInt_FMT ")",
+             mat->rmap->bs, mat->cmap->bs);
   PetscCall(MatMPIBinBCSRResetParts(mat));
   PetscCall(MatMPIBinBCSRCreatePart(mat, mat->rmap->n, mat->cmap->n, &b->A));
   PetscFunctionReturn(0);
@@ -43,14 +45,20 @@ static PetscErrorCode AllowNewAllocations(Mat part)
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode MatMPIAIJSetPreallocation_MPIBinBCSR(Mat mat, PetscInt d_nz, const PetscInt d_nnz[], PetscInt o_nz, const PetscInt o_nnz[])
+static PetscErrorCode MatMPIAIJSetPreallocation_MPIBinBCSR(Mat mat, PetscInt d_nz, const PetscInt d_nnz[],
+                                                           PetscInt o_nz, const PetscInt o_nnz[])
 {
   Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
 
   PetscFunctionBegin;
   PetscCall(MatMPIBinBCSRSetUpLayouts(mat));
-  if (mat->rmap->bs != mat->cmap->bs) { /* a layout the bins cannot hold (PCGAMG's prolongators, made in the operator's type) */
-    PetscCall(PetscInfo(mat, "Row and column block sizes %" PetscInt_FMT " and %" PetscInt_FMT " differ: the matrix becomes %s\n", mat->rmap->bs, mat->cmap->bs, MATMPIAIJ));
+  if (mat->rmap->bs !=
+      mat->cmap
+        ->bs) { /* a layout the bins cannot hold (PCGAMG's prolongators, made in the operator's type) */
+    PetscCall(PetscInfo(mat,
+                        "Row and column block sizes %" PetscInt_FMT " and %" PetscInt_FMT
+                        " differ: the matrix becomes %s\n",
+                        mat->rmap->bs, mat->cmap->bs, MATMPIAIJ));
     PetscCall(MatSetType(mat, MATMPIAIJ));
     PetscCall(MatMPIAIJSetPreallocation(mat, d_nz, d_nnz, o_nz, o_nnz));
     PetscFunctionReturn(0);
@@ -65,7 +73,9 @@ static PetscErrorCode MatMPIAIJSetPreallocation_MPIBinBCSR(Mat mat, PetscInt d_n
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode MatMPIBAIJSetPreallocation_MPIBinBCSR(Mat mat, PetscInt bs, PetscInt d_nz, const PetscInt d_nnz[], PetscInt o_nz, const PetscInt o_nnz[])
+static PetscErrorCode MatMPIBAIJSetPreallocation_MPIBinBCSR(Mat mat, PetscInt bs, PetscInt d_nz,
+                                                            const PetscInt d_nnz[], PetscInt o_nz,
+                                                            const PetscInt o_nnz[])
 {
   Mat_MPIBinBCSR       *b = MPIBinBCSR(mat);
   std::vector<PetscInt> dnnz;
@@ -75,10 +85,11 @@ static PetscErrorCode MatMPIBAIJSetPreallocation_MPIBinBCSR(Mat mat, PetscInt bs
   (void)o_nnz;
   PetscCall(MatSetBlockSize(mat, PetscAbs(bs)));
   PetscCall(CreateDiagonalPart(mat));
-  bs = mat->rmap->bs;
+  bs                 = mat->rmap->bs;
   const PetscInt mbs = mat->rmap->n / bs, nbs = mat->cmap->n / bs;
   if (d_nnz) dnnz.assign(d_nnz, d_nnz + mbs);
-  else dnnz.assign(mbs, d_nz == PETSC_DEFAULT || d_nz == PETSC_DECIDE ? PetscMin(5, nbs) : PetscMin(d_nz, nbs));
+  else
+    dnnz.assign(mbs, d_nz == PETSC_DEFAULT || d_nz == PETSC_DECIDE ? PetscMin(5, nbs) : PetscMin(d_nz, nbs));
   PetscCall(MatXAIJSetPreallocation(b->A, bs, dnnz.data(), nullptr, nullptr, nullptr));
   PetscCall(AllowNewAllocations(b->A));
   mat->preallocated = PETSC_TRUE;
@@ -89,14 +100,14 @@ static PetscErrorCode MatMPIBAIJSetPreallocation_MPIBinBCSR(Mat mat, PetscInt bs
 static PetscErrorCode MatSetUp_MPIBinBCSR(Mat mat)
 {
   PetscFunctionBegin;
-  if (!mat->preallocated) PetscCall(MatMPIAIJSetPreallocation_MPIBinBCSR(mat, PETSC_DEFAULT, nullptr, PETSC_DEFAULT, nullptr));
+  if (!mat->preallocated)
+    PetscCall(MatMPIAIJSetPreallocation_MPIBinBCSR(mat, PETSC_DEFAULT, nullptr, PETSC_DEFAULT, nullptr));
   PetscFunctionReturn(0);
 }
 
 /* A setting of the matrix applied to each part that exists (the parts made later get it from the
    matrix's own copy, MatMPIBinBCSRCreatePart). */
-template <class T>
-static PetscErrorCode MatMPIBinBCSRSetOnParts(Mat mat, PetscErrorCode (*set)(Mat, T), T v)
+template <class T> static PetscErrorCode MatMPIBinBCSRSetOnParts(Mat mat, PetscErrorCode (*set)(Mat, T), T v)
 {
   Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
 
@@ -111,7 +122,8 @@ static PetscErrorCode MatBinBCSRSetBinWidth_MPIBinBCSR(Mat mat, PetscInt bw)
   Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
 
   PetscFunctionBegin;
-  PetscCheck(bw >= 1, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_OUTOFRANGE, "bin width must be >= 1, got %" PetscInt_FMT, bw);
+  PetscCheck(bw >= 1, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_OUTOFRANGE,
+             "bin width must be >= 1, got %" PetscInt_FMT, bw);
   b->bin_width = bw;
   PetscCall(MatMPIBinBCSRSetOnParts(mat, MatBinBCSRSetBinWidth, bw));
   PetscFunctionReturn(0);
@@ -220,8 +232,13 @@ static PetscErrorCode MatBinBCSRSetSymmetricStorage_MPIBinBCSR(Mat mat, PetscBoo
 
   PetscFunctionBegin;
   if (flg == b->sym) PetscFunctionReturn(0);
-  PetscCheck(!flg || mat->rmap->N < 0 || mat->cmap->N < 0 || mat->rmap->N == mat->cmap->N, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_SIZ, "Symmetric storage needs a square matrix, this one is %" PetscInt_FMT " x %" PetscInt_FMT, mat->rmap->N, mat->cmap->N);
-  PetscCheck(!mat->assembled && !b->compressed, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONGSTATE, "Symmetric storage must be chosen before the layout is built (first final assembly or COO preallocation)");
+  PetscCheck(!flg || mat->rmap->N < 0 || mat->cmap->N < 0 || mat->rmap->N == mat->cmap->N,
+             PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_SIZ,
+             "Symmetric storage needs a square matrix, this one is %" PetscInt_FMT " x %" PetscInt_FMT,
+             mat->rmap->N, mat->cmap->N);
+  PetscCheck(
+    !mat->assembled && !b->compressed, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONGSTATE,
+    "Symmetric storage must be chosen before the layout is built (first final assembly or COO preallocation)");
   if (b->A) PetscCall(MatBinBCSRSetSymmetricStorage(b->A, flg));
   b->sym = flg;
   if (flg) {
@@ -269,12 +286,15 @@ static PetscErrorCode MatSetFromOptions_MPIBinBCSR(Mat mat, PetscOptionItems *Pe
 
   PetscFunctionBegin;
   PetscOptionsHeadBegin(PetscOptionsObject, "MATMPIBINBCSR options");
-  PetscCall(PetscOptionsString("-mat_mpibinbcsr_inner_type", "Type of the diagonal and off-diagonal parts", "MATMPIBINBCSR", b->inner_type, inner, sizeof(inner), &flg));
+  PetscCall(PetscOptionsString("-mat_mpibinbcsr_inner_type", "Type of the diagonal and off-diagonal parts",
+                               "MATMPIBINBCSR", b->inner_type, inner, sizeof(inner), &flg));
   if (flg) {
-    PetscCheck(!b->A, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONGSTATE, "-mat_mpibinbcsr_inner_type must be set before preallocation");
+    PetscCheck(!b->A, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONGSTATE,
+               "-mat_mpibinbcsr_inner_type must be set before preallocation");
     PetscCall(PetscStrncpy(b->inner_type, inner, sizeof(b->inner_type)));
   }
-  PetscCall(MatBinBCSRReadOptions_Private(mat, PetscOptionsObject)); /* the -mat_binbcsr_* options, forwarded to both parts */
+  PetscCall(MatBinBCSRReadOptions_Private(
+    mat, PetscOptionsObject)); /* the -mat_binbcsr_* options, forwarded to both parts */
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }
@@ -342,8 +362,11 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRCreatePart(Mat mat, PetscInt m, PetscIn
   if (b->tune_cache >= 0) PetscCall(MatBinBCSRSetTuneCache(*part, b->tune_cache ? PETSC_TRUE : PETSC_FALSE));
   if (b->sym && part == &b->A) PetscCall(MatBinBCSRSetSymmetricStorage(*part, PETSC_TRUE)); /* B stays full */
   for (const auto &[op, flg] : b->part_options) {
-    const bool wholematrix = op == MAT_SYMMETRIC || op == MAT_SPD || op == MAT_HERMITIAN || op == MAT_STRUCTURALLY_SYMMETRIC || op == MAT_SYMMETRY_ETERNAL || op == MAT_STRUCTURAL_SYMMETRY_ETERNAL || op == MAT_SPD_ETERNAL;
-    if (wholematrix && part != &b->A) continue; /* not a property of the off-diagonal part (even when it happens to be square) */
+    const bool wholematrix = op == MAT_SYMMETRIC || op == MAT_SPD || op == MAT_HERMITIAN ||
+                             op == MAT_STRUCTURALLY_SYMMETRIC || op == MAT_SYMMETRY_ETERNAL ||
+                             op == MAT_STRUCTURAL_SYMMETRY_ETERNAL || op == MAT_SPD_ETERNAL;
+    if (wholematrix && part != &b->A)
+      continue; /* not a property of the off-diagonal part (even when it happens to be square) */
     PetscCall(MatSetOption(*part, op, flg));
   }
   PetscFunctionReturn(0);
@@ -382,9 +405,11 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRSetUpScatter(Mat mat)
   PetscCall(VecScatterDestroy(&b->Mvctx));
   PetscCall(VecCreateSeq(PETSC_COMM_SELF, ng * bs, &b->lvec));
   PetscCall(VecSetBlockSize(b->lvec, bs));
-  PetscCall(ISCreateBlock(PetscObjectComm((PetscObject)mat), bs, ng, b->garray.data(), PETSC_COPY_VALUES, &from));
+  PetscCall(
+    ISCreateBlock(PetscObjectComm((PetscObject)mat), bs, ng, b->garray.data(), PETSC_COPY_VALUES, &from));
   PetscCall(ISCreateStride(PETSC_COMM_SELF, ng * bs, 0, 1, &to));
-  PetscCall(VecCreateMPIWithArray(PetscObjectComm((PetscObject)mat), bs, mat->cmap->n, mat->cmap->N, nullptr, &gvec));
+  PetscCall(
+    VecCreateMPIWithArray(PetscObjectComm((PetscObject)mat), bs, mat->cmap->n, mat->cmap->N, nullptr, &gvec));
   PetscCall(VecScatterCreate(gvec, from, b->lvec, to, &b->Mvctx));
   PetscCall(VecDestroy(&gvec));
   PetscCall(ISDestroy(&from));
@@ -400,11 +425,14 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRGhostIndex(Mat mat, PetscInt gcol, Pets
   const auto      it  = std::lower_bound(b->garray.begin(), b->garray.end(), blk);
 
   PetscFunctionBegin;
-  *lcol = (it != b->garray.end() && *it == blk) ? static_cast<PetscInt>(it - b->garray.begin()) * bs + gcol % bs : -1;
+  *lcol = (it != b->garray.end() && *it == blk)
+            ? static_cast<PetscInt>(it - b->garray.begin()) * bs + gcol % bs
+            : -1;
   PetscFunctionReturn(0);
 }
 
-PETSC_INTERN PetscErrorCode MatMPIBinBCSRBuildSendSF(MPI_Comm comm, PetscInt nsend, const PetscMPIInt dest[], PetscSF *sf, PetscInt *nrecv)
+PETSC_INTERN PetscErrorCode MatMPIBinBCSRBuildSendSF(MPI_Comm comm, PetscInt nsend, const PetscMPIInt dest[],
+                                                     PetscSF *sf, PetscInt *nrecv)
 {
   PetscMPIInt size;
 
@@ -484,13 +512,13 @@ static const struct _MatOps &MatOps_MPIBinBCSR(void)
     o.missingdiagonal     = MatMissingDiagonal_MPIBinBCSR;
     o.equal               = MatEqual_MPIBinBCSR;
     /* new matrices, view, load */
-    o.transpose         = MatTranspose_MPIBinBCSR;
-    o.duplicate         = MatDuplicate_MPIBinBCSR;
-    o.copy              = MatCopy_MPIBinBCSR;
-    o.convertfrom       = MatConvertFrom_MPIBinBCSR;
-    o.destroy           = MatDestroy_MPIBinBCSR;
-    o.view              = MatView_MPIBinBCSR;
-    o.load              = MatLoad_MPIBinBCSR;
+    o.transpose   = MatTranspose_MPIBinBCSR;
+    o.duplicate   = MatDuplicate_MPIBinBCSR;
+    o.copy        = MatCopy_MPIBinBCSR;
+    o.convertfrom = MatConvertFrom_MPIBinBCSR;
+    o.destroy     = MatDestroy_MPIBinBCSR;
+    o.view        = MatView_MPIBinBCSR;
+    o.load        = MatLoad_MPIBinBCSR;
     /* submatrices through the AIJ shadow (common/) */
     o.createsubmatricesmpi = MatCreateSubMatricesMPI_BinBCSR;
     o.createsubmatrix      = MatCreateSubMatrix_BinBCSR;

@@ -35,25 +35,25 @@
 /* COO assembly plan: entries of this rank's rows, from the caller's own list or received from other
    ranks, each routed to the A or B part. */
 struct MPIBinBCSRCoo {
-  PetscCount               n = 0;         /* length of the caller's coo_v[] */
-  PetscSF                  sf = nullptr;  /* leaves: entries sent to other ranks; roots: entries received */
-  std::vector<PetscCount>  send_from;     /* [nsend] index into coo_v of each sent entry */
+  PetscCount               n  = 0;       /* length of the caller's coo_v[] */
+  PetscSF                  sf = nullptr; /* leaves: entries sent to other ranks; roots: entries received */
+  std::vector<PetscCount>  send_from;    /* [nsend] index into coo_v of each sent entry */
   PetscInt                 nrecv = 0;
-  std::vector<PetscCount>  a_from, b_from; /* source of each entry of A's / B's COO list: k < n is
+  std::vector<PetscCount>  a_from, b_from;             /* source of each entry of A's / B's COO list: k < n is
                                               coo_v[k], k >= n is the (k-n)th received value */
-  PetscBool                composed = PETSC_FALSE; /* BIN-BCSR parts hold a_from/b_from composed into
+  PetscBool                composed = PETSC_FALSE;     /* BIN-BCSR parts hold a_from/b_from composed into
                                                      their own maps (then a_from, b_from, a_v, b_v are empty) */
   std::vector<PetscScalar> sendbuf, recvbuf, a_v, b_v; /* a_v, b_v: only for other inner types */
 };
 
 struct Mat_MPIBinBCSR {
-  Mat  A = nullptr, B = nullptr;  /* diagonal and off-diagonal parts */
-  char inner_type[64];            /* type of A and B */
+  Mat  A = nullptr, B = nullptr; /* diagonal and off-diagonal parts */
+  char inner_type[64];           /* type of A and B */
 
   /* off-diagonal columns: valid once compressed */
   PetscBool             compressed = PETSC_FALSE;
-  std::vector<PetscInt> garray;   /* global block column of each local block column of B, sorted */
-  Vec                   lvec = nullptr; /* ghost values, nghost*bs */
+  std::vector<PetscInt> garray;          /* global block column of each local block column of B, sorted */
+  Vec                   lvec  = nullptr; /* ghost values, nghost*bs */
   VecScatter            Mvctx = nullptr;
 
   /* staging of B before the first final assembly: key = local row * N + global column */
@@ -62,21 +62,21 @@ struct Mat_MPIBinBCSR {
   /* off-process entries waiting for assembly */
   std::vector<PetscInt>    stash_row, stash_col;
   std::vector<PetscScalar> stash_val;
-  PetscBool                donotstash = PETSC_FALSE;
+  PetscBool                donotstash  = PETSC_FALSE;
   PetscBool                roworiented = PETSC_TRUE; /* layout of the values given to MatSetValues */
 
   /* options replayed on A and B when they are (re)created */
   std::vector<std::pair<MatOption, PetscBool>> part_options;
-  PetscBool                                    ignore_new_offdiag = PETSC_FALSE; /* MAT_NEW_NONZERO_LOCATIONS false */
-  PetscInt                                     bin_width = 0;                     /* 0: the inner type's default */
-  PetscBool                                    precision_set = PETSC_FALSE;
-  PetscInt                                     streams       = 0; /* MatBinBCSRSetStreams; 0: the parts' default */
-  PetscInt                                     tune          = -1; /* MatBinBCSRSetTune for the parts; -1: theirs */
-  PetscInt                                     tune_cache    = -1; /* MatBinBCSRSetTuneCache for the parts; -1: theirs */
-  MatBinBCSRKernel                             kernel        = MAT_BINBCSR_KERNEL_AUTO; /* MatBinBCSRSetKernel */
-  MatBinBCSRPrecision                          precision = MAT_BINBCSR_PRECISION_DOUBLE;
-  PetscBool                                    sym = PETSC_FALSE; /* symmetric storage of the diagonal part (B stays full) */
-  PetscBool                                    coo_mirror = PETSC_FALSE; /* MatBinBCSRSetCOOMirror */
+  PetscBool           ignore_new_offdiag = PETSC_FALSE; /* MAT_NEW_NONZERO_LOCATIONS false */
+  PetscInt            bin_width          = 0;           /* 0: the inner type's default */
+  PetscBool           precision_set      = PETSC_FALSE;
+  PetscInt            streams            = 0;  /* MatBinBCSRSetStreams; 0: the parts' default */
+  PetscInt            tune               = -1; /* MatBinBCSRSetTune for the parts; -1: theirs */
+  PetscInt            tune_cache         = -1; /* MatBinBCSRSetTuneCache for the parts; -1: theirs */
+  MatBinBCSRKernel    kernel             = MAT_BINBCSR_KERNEL_AUTO; /* MatBinBCSRSetKernel */
+  MatBinBCSRPrecision precision          = MAT_BINBCSR_PRECISION_DOUBLE;
+  PetscBool           sym        = PETSC_FALSE; /* symmetric storage of the diagonal part (B stays full) */
+  PetscBool           coo_mirror = PETSC_FALSE; /* MatBinBCSRSetCOOMirror */
 
   /* MatGetRow buffers */
   std::vector<PetscInt>    row_cols;
@@ -84,22 +84,25 @@ struct Mat_MPIBinBCSR {
   PetscBool                getrow_active = PETSC_FALSE;
 
   /* local rows that have off-diagonal entries (found once the pattern is fixed; MatMultDotLocal) */
-  PetscBool             offdiag_rows_known = PETSC_FALSE;
-  std::vector<PetscInt> offdiag_rows;
+  PetscBool                offdiag_rows_known = PETSC_FALSE;
+  std::vector<PetscInt>    offdiag_rows;
   std::vector<PetscScalar> offdiag_saved;
 
-  MPIBinBCSRCoo *coo = nullptr;
+  MPIBinBCSRCoo *coo                = nullptr;
   PetscBool      coo_just_assembled = PETSC_FALSE; /* MatSetValuesCOO's own assembly call has nothing to do */
 };
 
 static inline Mat_MPIBinBCSR *MPIBinBCSR(Mat mat) { return static_cast<Mat_MPIBinBCSR *>(mat->data); }
-static inline PetscInt         MPIBinBCSRGhosts(Mat mat) { return static_cast<PetscInt>(MPIBinBCSR(mat)->garray.size()); }
+static inline PetscInt        MPIBinBCSRGhosts(Mat mat)
+{
+  return static_cast<PetscInt>(MPIBinBCSR(mat)->garray.size());
+}
 
 /* A sequential vector on this rank's part of a parallel one (shares its array). */
 struct LocalView {
   Vec                vec = nullptr, seq = nullptr;
-  PetscScalar       *a   = nullptr;
-  const PetscScalar *ra  = nullptr;
+  PetscScalar       *a  = nullptr;
+  const PetscScalar *ra = nullptr;
   /* read_only: the vector may be read-locked (e.g. x of MatZeroRowsColumns); seq is then only read */
   PetscErrorCode open(Vec v, bool read_only = false)
   {
@@ -109,7 +112,8 @@ struct LocalView {
     PetscCall(VecGetLocalSize(v, &n));
     if (read_only) PetscCall(VecGetArrayRead(v, &ra));
     else PetscCall(VecGetArray(v, &a));
-    PetscCall(VecCreateSeqWithArray(PETSC_COMM_SELF, 1, n, read_only ? const_cast<PetscScalar *>(ra) : a, &seq));
+    PetscCall(
+      VecCreateSeqWithArray(PETSC_COMM_SELF, 1, n, read_only ? const_cast<PetscScalar *>(ra) : a, &seq));
     if (read_only) PetscCall(VecLockReadPush(seq));
     PetscFunctionReturn(0);
   }
@@ -140,13 +144,16 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRSetUpLayouts(Mat);
 PETSC_INTERN PetscErrorCode MatMPIBinBCSRResetParts(Mat);
 PETSC_INTERN PetscErrorCode MatMPIBinBCSRSetUpScatter(Mat);
 PETSC_INTERN PetscErrorCode MatMPIBinBCSRGhostIndex(Mat, PetscInt gcol, PetscInt *lcol);
-PETSC_INTERN PetscErrorCode MatMPIBinBCSRBuildSendSF(MPI_Comm, PetscInt nsend, const PetscMPIInt dest[], PetscSF *, PetscInt *nrecv);
+PETSC_INTERN PetscErrorCode MatMPIBinBCSRBuildSendSF(MPI_Comm, PetscInt nsend, const PetscMPIInt dest[],
+                                                     PetscSF *, PetscInt *nrecv);
 
 /* mpibinbcsr_assembly.cpp */
-PETSC_INTERN PetscErrorCode MatSetValues_MPIBinBCSR(Mat, PetscInt, const PetscInt[], PetscInt, const PetscInt[], const PetscScalar[], InsertMode);
+PETSC_INTERN PetscErrorCode MatSetValues_MPIBinBCSR(Mat, PetscInt, const PetscInt[], PetscInt,
+                                                    const PetscInt[], const PetscScalar[], InsertMode);
 PETSC_INTERN PetscErrorCode MatAssemblyBegin_MPIBinBCSR(Mat, MatAssemblyType);
 PETSC_INTERN PetscErrorCode MatAssemblyEnd_MPIBinBCSR(Mat, MatAssemblyType);
-PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_MPIBinBCSR(Mat, PetscCount, const PetscInt[], const PetscInt[]);
+PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_MPIBinBCSR(Mat, PetscCount, const PetscInt[],
+                                                              const PetscInt[]);
 PETSC_INTERN PetscErrorCode MatSetValuesCOO_MPIBinBCSR(Mat, const PetscScalar[], InsertMode);
 PETSC_INTERN PetscErrorCode MatMPIBinBCSRDestroyCoo(Mat);
 
@@ -159,14 +166,17 @@ PETSC_INTERN PetscErrorCode MatMultDotLocal_MPIBinBCSR(Mat, Vec, Vec, PetscScala
 PETSC_INTERN PetscErrorCode MatGetDiagonal_MPIBinBCSR(Mat, Vec);
 PETSC_INTERN PetscErrorCode MatDiagonalSet_MPIBinBCSR(Mat, Vec, InsertMode);
 PETSC_INTERN PetscErrorCode MatInvertBlockDiagonal_MPIBinBCSR(Mat, const PetscScalar **);
-PETSC_INTERN PetscErrorCode MatInvertVariableBlockDiagonal_MPIBinBCSR(Mat, PetscInt, const PetscInt *, PetscScalar *);
-PETSC_INTERN PetscErrorCode MatSOR_MPIBinBCSR(Mat, Vec, PetscReal, MatSORType, PetscReal, PetscInt, PetscInt, Vec);
+PETSC_INTERN PetscErrorCode MatInvertVariableBlockDiagonal_MPIBinBCSR(Mat, PetscInt, const PetscInt *,
+                                                                      PetscScalar *);
+PETSC_INTERN PetscErrorCode MatSOR_MPIBinBCSR(Mat, Vec, PetscReal, MatSORType, PetscReal, PetscInt, PetscInt,
+                                              Vec);
 PETSC_INTERN PetscErrorCode MatMultDiagonalBlock_MPIBinBCSR(Mat, Vec, Vec); /* mpibinbcsr_sor.cpp */
 PETSC_INTERN PetscErrorCode MatScale_MPIBinBCSR(Mat, PetscScalar);
 PETSC_INTERN PetscErrorCode MatShift_MPIBinBCSR(Mat, PetscScalar);
 PETSC_INTERN PetscErrorCode MatZeroEntries_MPIBinBCSR(Mat);
 PETSC_INTERN PetscErrorCode MatZeroRows_MPIBinBCSR(Mat, PetscInt, const PetscInt[], PetscScalar, Vec, Vec);
-PETSC_INTERN PetscErrorCode MatZeroRowsColumns_MPIBinBCSR(Mat, PetscInt, const PetscInt[], PetscScalar, Vec, Vec);
+PETSC_INTERN PetscErrorCode MatZeroRowsColumns_MPIBinBCSR(Mat, PetscInt, const PetscInt[], PetscScalar, Vec,
+                                                          Vec);
 PETSC_INTERN PetscErrorCode MatGetRow_MPIBinBCSR(Mat, PetscInt, PetscInt *, PetscInt **, PetscScalar **);
 PETSC_INTERN PetscErrorCode MatRestoreRow_MPIBinBCSR(Mat, PetscInt, PetscInt *, PetscInt **, PetscScalar **);
 PETSC_INTERN PetscErrorCode MatNorm_MPIBinBCSR(Mat, NormType, PetscReal *);
@@ -181,13 +191,16 @@ PETSC_INTERN PetscErrorCode MatGetRowMinAbs_MPIBinBCSR(Mat, Vec, PetscInt[]);
 PETSC_INTERN PetscErrorCode MatGetColumnReductions_MPIBinBCSR(Mat, PetscInt, PetscReal *);
 PETSC_INTERN PetscErrorCode MatMissingDiagonal_MPIBinBCSR(Mat, PetscBool *, PetscInt *);
 PETSC_INTERN PetscErrorCode MatEqual_MPIBinBCSR(Mat, Mat, PetscBool *);
-PETSC_INTERN PetscErrorCode MatGetValues_MPIBinBCSR(Mat, PetscInt, const PetscInt[], PetscInt, const PetscInt[], PetscScalar[]);
+PETSC_INTERN PetscErrorCode MatGetValues_MPIBinBCSR(Mat, PetscInt, const PetscInt[], PetscInt,
+                                                    const PetscInt[], PetscScalar[]);
 PETSC_INTERN PetscErrorCode MatAXPY_MPIBinBCSR(Mat, PetscScalar, Mat, MatStructure);
 PETSC_INTERN PetscErrorCode MatTranspose_MPIBinBCSR(Mat, MatReuse, Mat *);
 
 /* mpibinbcsr_rowij.cpp: the local rows' structure, global columns (MPIAIJ's MatGetRowIJ) */
-PETSC_INTERN PetscErrorCode MatGetRowIJ_MPIBinBCSR(Mat, PetscInt, PetscBool, PetscBool, PetscInt *, const PetscInt *[], const PetscInt *[], PetscBool *);
-PETSC_INTERN PetscErrorCode MatRestoreRowIJ_MPIBinBCSR(Mat, PetscInt, PetscBool, PetscBool, PetscInt *, const PetscInt *[], const PetscInt *[], PetscBool *);
+PETSC_INTERN PetscErrorCode MatGetRowIJ_MPIBinBCSR(Mat, PetscInt, PetscBool, PetscBool, PetscInt *,
+                                                   const PetscInt *[], const PetscInt *[], PetscBool *);
+PETSC_INTERN PetscErrorCode MatRestoreRowIJ_MPIBinBCSR(Mat, PetscInt, PetscBool, PetscBool, PetscInt *,
+                                                       const PetscInt *[], const PetscInt *[], PetscBool *);
 
 /* mpibinbcsr_convert.cpp: conversion, load, view */
 PETSC_INTERN PetscErrorCode MatConvert_MPIBinBCSR_MPIAIJ(Mat, MatType, MatReuse, Mat *);

@@ -7,10 +7,11 @@
 
 /* Sets the entries of one owned row; cols are global; vals NULL: zeros (PETSc's MatSetValues takes a
    NULL array as zeros; DMDA's preallocation inserts its pattern that way). */
-static PetscErrorCode SetOwnedRow(Mat mat, PetscInt lrow, PetscInt n, const PetscInt cols[], const PetscScalar vals[], PetscInt vstride, InsertMode mode)
+static PetscErrorCode SetOwnedRow(Mat mat, PetscInt lrow, PetscInt n, const PetscInt cols[],
+                                  const PetscScalar vals[], PetscInt vstride, InsertMode mode)
 {
-  Mat_MPIBinBCSR                 *b      = MPIBinBCSR(mat);
-  const PetscInt                  cstart = mat->cmap->rstart, cend = mat->cmap->rend, N = mat->cmap->N;
+  Mat_MPIBinBCSR                       *b      = MPIBinBCSR(mat);
+  const PetscInt                        cstart = mat->cmap->rstart, cend = mat->cmap->rend, N = mat->cmap->N;
   thread_local std::vector<PetscInt>    acol, bcol;
   thread_local std::vector<PetscScalar> aval, bval;
 
@@ -23,7 +24,8 @@ static PetscErrorCode SetOwnedRow(Mat mat, PetscInt lrow, PetscInt n, const Pets
     const PetscInt    c = cols[j];
     const PetscScalar v = vals ? vals[j * vstride] : 0.0;
     if (c < 0) continue;
-    PetscCheck(c < N, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", c, N);
+    PetscCheck(c < N, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+               "Column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", c, N);
     if (c >= cstart && c < cend) {
       acol.push_back(c - cstart);
       aval.push_back(v);
@@ -36,34 +38,46 @@ static PetscErrorCode SetOwnedRow(Mat mat, PetscInt lrow, PetscInt n, const Pets
       PetscCall(MatMPIBinBCSRGhostIndex(mat, c, &lc));
       if (lc < 0) {
         if (b->ignore_new_offdiag) continue;
-        SETERRQ(PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "New nonzero at (%" PetscInt_FMT ",%" PetscInt_FMT ") in the off-diagonal part after the pattern was fixed by the first final assembly", lrow + mat->rmap->rstart, c);
+        SETERRQ(PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+                "New nonzero at (%" PetscInt_FMT ",%" PetscInt_FMT
+                ") in the off-diagonal part after the pattern was fixed by the first final assembly",
+                lrow + mat->rmap->rstart, c);
       }
       bcol.push_back(lc);
       bval.push_back(v);
     }
   }
-  if (!acol.empty()) PetscCall(MatSetValues(b->A, 1, &lrow, static_cast<PetscInt>(acol.size()), acol.data(), aval.data(), mode));
-  if (!bcol.empty()) PetscCall(MatSetValues(b->B, 1, &lrow, static_cast<PetscInt>(bcol.size()), bcol.data(), bval.data(), mode));
+  if (!acol.empty())
+    PetscCall(
+      MatSetValues(b->A, 1, &lrow, static_cast<PetscInt>(acol.size()), acol.data(), aval.data(), mode));
+  if (!bcol.empty())
+    PetscCall(
+      MatSetValues(b->B, 1, &lrow, static_cast<PetscInt>(bcol.size()), bcol.data(), bval.data(), mode));
   PetscFunctionReturn(0);
 }
 
-PETSC_INTERN PetscErrorCode MatSetValues_MPIBinBCSR(Mat mat, PetscInt m, const PetscInt idxm[], PetscInt n, const PetscInt idxn[], const PetscScalar v[], InsertMode mode)
+PETSC_INTERN PetscErrorCode MatSetValues_MPIBinBCSR(Mat mat, PetscInt m, const PetscInt idxm[], PetscInt n,
+                                                    const PetscInt idxn[], const PetscScalar v[],
+                                                    InsertMode mode)
 {
   Mat_MPIBinBCSR *b      = MPIBinBCSR(mat);
   const PetscInt  rstart = mat->rmap->rstart, rend = mat->rmap->rend;
 
   PetscFunctionBegin;
-  PetscCheck(b->A, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Call MatSetUp() or a preallocation routine before MatSetValues() on a MATMPIBINBCSR matrix");
+  PetscCheck(b->A, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "Call MatSetUp() or a preallocation routine before MatSetValues() on a MATMPIBINBCSR matrix");
   for (PetscInt i = 0; i < m; i++) {
     const PetscInt row = idxm[i];
     if (row < 0) continue;
-    PetscCheck(row < mat->rmap->N, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", row, mat->rmap->N);
+    PetscCheck(row < mat->rmap->N, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+               "Row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", row, mat->rmap->N);
     const PetscScalar *vrow    = !v ? nullptr : b->roworiented ? v + i * n : v + i;
     const PetscInt     vstride = b->roworiented ? 1 : m;
     if (row >= rstart && row < rend) {
       PetscCall(SetOwnedRow(mat, row - rstart, n, idxn, vrow, vstride, mode));
     } else if (!b->donotstash) {
-      PetscCheck(!mat->nooffprocentries, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Setting off-process row %" PetscInt_FMT " although MAT_NO_OFF_PROC_ENTRIES was set", row);
+      PetscCheck(!mat->nooffprocentries, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
+                 "Setting off-process row %" PetscInt_FMT " although MAT_NO_OFF_PROC_ENTRIES was set", row);
       for (PetscInt j = 0; j < n; j++) {
         if (idxn[j] < 0) continue;
         b->stash_row.push_back(row);
@@ -87,10 +101,11 @@ static PetscErrorCode ExchangeStash(Mat mat)
   flags[0] = static_cast<int>(mat->insertmode);
   flags[1] = b->stash_row.empty() ? 0 : 1;
   PetscCallMPI(MPI_Allreduce(flags, global, 2, MPI_INT, MPI_BOR, comm));
-  PetscCheck(global[0] != (ADD_VALUES | INSERT_VALUES), comm, PETSC_ERR_ARG_WRONGSTATE, "Some ranks inserted values while others added");
+  PetscCheck(global[0] != (ADD_VALUES | INSERT_VALUES), comm, PETSC_ERR_ARG_WRONGSTATE,
+             "Some ranks inserted values while others added");
   if (!global[1]) PetscFunctionReturn(0);
-  const InsertMode mode  = static_cast<InsertMode>(global[0]);
-  const PetscInt   nsend = static_cast<PetscInt>(b->stash_row.size());
+  const InsertMode         mode  = static_cast<InsertMode>(global[0]);
+  const PetscInt           nsend = static_cast<PetscInt>(b->stash_row.size());
   std::vector<PetscMPIInt> dest(nsend);
   for (PetscInt q = 0; q < nsend; q++) PetscCall(PetscLayoutFindOwner(mat->rmap, b->stash_row[q], &dest[q]));
   PetscSF  sf;
@@ -108,7 +123,8 @@ static PetscErrorCode ExchangeStash(Mat mat)
   b->stash_row.clear();
   b->stash_col.clear();
   b->stash_val.clear();
-  for (PetscInt r = 0; r < nrecv; r++) PetscCall(SetOwnedRow(mat, rrow[r] - mat->rmap->rstart, 1, &rcol[r], &rval[r], 1, mode));
+  for (PetscInt r = 0; r < nrecv; r++)
+    PetscCall(SetOwnedRow(mat, rrow[r] - mat->rmap->rstart, 1, &rcol[r], &rval[r], 1, mode));
   PetscFunctionReturn(0);
 }
 
@@ -146,7 +162,8 @@ static PetscErrorCode CompressOffDiagonal(Mat mat)
       cols.push_back(lc);
       vals.push_back(entries[k].second);
     }
-    PetscCall(MatSetValues(b->B, 1, &row, static_cast<PetscInt>(cols.size()), cols.data(), vals.data(), INSERT_VALUES));
+    PetscCall(MatSetValues(b->B, 1, &row, static_cast<PetscInt>(cols.size()), cols.data(), vals.data(),
+                           INSERT_VALUES));
   }
   PetscCall(MatAssemblyBegin(b->B, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(b->B, MAT_FINAL_ASSEMBLY));
@@ -172,7 +189,8 @@ PETSC_INTERN PetscErrorCode MatAssemblyEnd_MPIBinBCSR(Mat mat, MatAssemblyType t
     b->coo_just_assembled = PETSC_FALSE;
     PetscFunctionReturn(0);
   }
-  PetscCheck(b->A, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONGSTATE, "Call MatSetUp() or a preallocation routine before assembling a MATMPIBINBCSR matrix");
+  PetscCheck(b->A, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONGSTATE,
+             "Call MatSetUp() or a preallocation routine before assembling a MATMPIBINBCSR matrix");
   PetscCall(ExchangeStash(mat));
   PetscCall(MatAssemblyBegin(b->A, type));
   PetscCall(MatAssemblyEnd(b->A, type));
@@ -200,16 +218,19 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRDestroyCoo(Mat mat)
   PetscFunctionReturn(0);
 }
 
-PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_MPIBinBCSR(Mat mat, PetscCount ncoo, const PetscInt coo_i[], const PetscInt coo_j[])
+PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_MPIBinBCSR(Mat mat, PetscCount ncoo,
+                                                              const PetscInt coo_i[], const PetscInt coo_j[])
 {
   Mat_MPIBinBCSR *b    = MPIBinBCSR(mat);
   MPI_Comm        comm = PetscObjectComm((PetscObject)mat);
 
   PetscFunctionBegin;
   PetscCall(MatMPIBinBCSRSetUpLayouts(mat));
-  PetscCheck(mat->rmap->bs == mat->cmap->bs, comm, PETSC_ERR_ARG_INCOMP, "MATMPIBINBCSR needs equal row and column block sizes");
+  PetscCheck(mat->rmap->bs == mat->cmap->bs, comm, PETSC_ERR_ARG_INCOMP,
+             "MATMPIBINBCSR needs equal row and column block sizes");
   PetscCall(MatMPIBinBCSRResetParts(mat));
-  const PetscInt rstart = mat->rmap->rstart, rend = mat->rmap->rend, cstart = mat->cmap->rstart, cend = mat->cmap->rend;
+  const PetscInt rstart = mat->rmap->rstart, rend = mat->rmap->rend, cstart = mat->cmap->rstart,
+                 cend = mat->cmap->rend;
   const PetscInt M = mat->rmap->N, N = mat->cmap->N, bs = mat->cmap->bs, m = mat->rmap->n;
   auto          *coo = new MPIBinBCSRCoo();
   b->coo             = coo;
@@ -219,7 +240,8 @@ PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_MPIBinBCSR(Mat mat, PetscCoun
      it is routed like any other (its row may be another rank's). */
   std::vector<PetscCount> mirror_of;
   if (b->coo_mirror) {
-    PetscCheck(M == N && mat->rmap->n == mat->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "The COO mirror needs a square matrix with equal row and column layouts");
+    PetscCheck(M == N && mat->rmap->n == mat->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+               "The COO mirror needs a square matrix with equal row and column layouts");
     for (PetscCount k = 0; k < ncoo; k++)
       if (coo_i[k] >= 0 && coo_j[k] >= 0 && coo_i[k] / bs != coo_j[k] / bs) mirror_of.push_back(k);
   }
@@ -235,7 +257,10 @@ PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_MPIBinBCSR(Mat mat, PetscCoun
     const PetscInt   i = row_of(e), j = col_of(e);
     const PetscCount k = src_of(e);
     if (i < 0 || j < 0) continue; /* PETSc's convention: negative indices are ignored */
-    PetscCheck(i < M && j < N, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "COO entry %" PetscCount_FMT " (%" PetscInt_FMT ",%" PetscInt_FMT ") out of range for a %" PetscInt_FMT " x %" PetscInt_FMT " matrix", k, i, j, M, N);
+    PetscCheck(i < M && j < N, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+               "COO entry %" PetscCount_FMT " (%" PetscInt_FMT ",%" PetscInt_FMT
+               ") out of range for a %" PetscInt_FMT " x %" PetscInt_FMT " matrix",
+               k, i, j, M, N);
     if (i >= rstart && i < rend) {
       own.push_back(e);
     } else {
@@ -247,7 +272,8 @@ PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_MPIBinBCSR(Mat mat, PetscCoun
       send_j.push_back(j);
     }
   }
-  PetscCall(MatMPIBinBCSRBuildSendSF(comm, static_cast<PetscInt>(dest.size()), dest.data(), &coo->sf, &coo->nrecv));
+  PetscCall(
+    MatMPIBinBCSRBuildSendSF(comm, static_cast<PetscInt>(dest.size()), dest.data(), &coo->sf, &coo->nrecv));
   std::vector<PetscInt> recv_i(coo->nrecv), recv_j(coo->nrecv);
   PetscCall(PetscSFReduceBegin(coo->sf, MPIU_INT, send_i.data(), recv_i.data(), MPI_REPLACE));
   PetscCall(PetscSFReduceBegin(coo->sf, MPIU_INT, send_j.data(), recv_j.data(), MPI_REPLACE));
@@ -310,7 +336,8 @@ PETSC_INTERN PetscErrorCode MatSetValuesCOO_MPIBinBCSR(Mat mat, const PetscScala
   MPIBinBCSRCoo  *coo = b->coo;
 
   PetscFunctionBegin;
-  PetscCheck(coo, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONGSTATE, "Call MatSetPreallocationCOO() first");
+  PetscCheck(coo, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONGSTATE,
+             "Call MatSetPreallocationCOO() first");
   /* no values on this rank: its entries are zeros (as for the seq type); the exchange stays collective */
   std::vector<PetscScalar> zeros;
   if (!v) {

@@ -42,9 +42,11 @@ static PetscErrorCode ConvertByParts(Mat mat, Mat *M)
     PetscCall(MatAssemblyBegin(Ao, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(Ao, MAT_FINAL_ASSEMBLY));
   }
-  PetscCheck(Ao->cmap->n == static_cast<PetscInt>(cols.size()), PETSC_COMM_SELF, PETSC_ERR_PLIB, "Off-diagonal part has %" PetscInt_FMT " columns, garray %zu", Ao->cmap->n, cols.size());
+  PetscCheck(Ao->cmap->n == static_cast<PetscInt>(cols.size()), PETSC_COMM_SELF, PETSC_ERR_PLIB,
+             "Off-diagonal part has %" PetscInt_FMT " columns, garray %zu", Ao->cmap->n, cols.size());
   PetscCall(MatCreateMPIAIJWithSeqAIJ(PetscObjectComm((PetscObject)mat), Ad, Ao, cols.data(), M));
-  PetscCall(MatSetOption(*M, MAT_NEW_NONZERO_LOCATION_ERR, PETSC_FALSE)); /* as any other conversion's result */
+  PetscCall(
+    MatSetOption(*M, MAT_NEW_NONZERO_LOCATION_ERR, PETSC_FALSE)); /* as any other conversion's result */
   PetscCall(MatPropagateSymmetryOptions(mat, *M));
   PetscFunctionReturn(0);
 }
@@ -60,12 +62,19 @@ static PetscErrorCode RefillByParts(Mat mat, Mat M, PetscBool *done)
 
   PetscFunctionBegin;
   PetscCall(PetscObjectTypeCompare((PetscObject)M, MATMPIAIJ, &ok));
-  if (ok) ok = (b->compressed && mat->assembled && M->rmap->n == mat->rmap->n && M->cmap->n == mat->cmap->n && M->rmap->N == mat->rmap->N && M->cmap->N == mat->cmap->N) ? PETSC_TRUE : PETSC_FALSE;
+  if (ok)
+    ok = (b->compressed && mat->assembled && M->rmap->n == mat->rmap->n && M->cmap->n == mat->cmap->n &&
+          M->rmap->N == mat->rmap->N && M->cmap->N == mat->cmap->N)
+           ? PETSC_TRUE
+           : PETSC_FALSE;
   if (ok) {
     const PetscInt *colmap;
     PetscCall(MatMPIAIJGetSeqAIJ(M, &Ad, &Ao, &colmap));
     const std::vector<PetscInt> cols = PointGarray(mat);
-    ok = (Ao->cmap->n == static_cast<PetscInt>(cols.size()) && std::equal(cols.begin(), cols.end(), colmap) && (b->B || cols.empty())) ? PETSC_TRUE : PETSC_FALSE;
+    ok = (Ao->cmap->n == static_cast<PetscInt>(cols.size()) && std::equal(cols.begin(), cols.end(), colmap) &&
+          (b->B || cols.empty()))
+           ? PETSC_TRUE
+           : PETSC_FALSE;
   }
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &ok, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)mat)));
   *done = ok;
@@ -76,7 +85,8 @@ static PetscErrorCode RefillByParts(Mat mat, Mat M, PetscBool *done)
   PetscFunctionReturn(0);
 }
 
-PETSC_INTERN PetscErrorCode MatConvert_MPIBinBCSR_MPIAIJ(Mat mat, MatType newtype, MatReuse reuse, Mat *newmat)
+PETSC_INTERN PetscErrorCode MatConvert_MPIBinBCSR_MPIAIJ(Mat mat, MatType newtype, MatReuse reuse,
+                                                         Mat *newmat)
 {
   Mat M;
 
@@ -127,7 +137,9 @@ PETSC_INTERN PetscErrorCode MatLoad_MPIBinBCSR(Mat mat, PetscViewer viewer)
 
   PetscFunctionBegin;
   PetscCall(MatBinBCSRReadBinaryRows_Private(mat, viewer, rowptr, cols, vals));
-  PetscCall(MatCreateMPIAIJWithArrays(PetscObjectComm((PetscObject)mat), mat->rmap->n, mat->cmap->n, mat->rmap->N, mat->cmap->N, rowptr.data(), cols.data(), vals.data(), &T));
+  PetscCall(MatCreateMPIAIJWithArrays(PetscObjectComm((PetscObject)mat), mat->rmap->n, mat->cmap->n,
+                                      mat->rmap->N, mat->cmap->N, rowptr.data(), cols.data(), vals.data(),
+                                      &T));
   PetscCall(MatBinBCSRPreallocateAndFill_Private(T, mat));
   PetscCall(MatDestroy(&T));
   PetscFunctionReturn(0);
@@ -147,12 +159,20 @@ PETSC_INTERN PetscErrorCode MatView_MPIBinBCSR(Mat mat, PetscViewer viewer)
     PetscViewer sv;
     PetscCallMPI(MPI_Comm_rank(PetscObjectComm((PetscObject)mat), &rank));
     PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)mat), &size));
-    PetscCall(PetscViewerASCIIPrintf(viewer, "MATMPIBINBCSR on %d ranks: diagonal and off-diagonal parts of type %s, block size %" PetscInt_FMT "\n", size, b->inner_type, mat->rmap->bs));
-    if (b->coo_mirror) PetscCall(PetscViewerASCIIPrintf(viewer, "COO mirror on: entries of off-diagonal blocks also fill the transposed place (routed to its owner)\n"));
+    PetscCall(PetscViewerASCIIPrintf(
+      viewer,
+      "MATMPIBINBCSR on %d ranks: diagonal and off-diagonal parts of type %s, block size %" PetscInt_FMT "\n",
+      size, b->inner_type, mat->rmap->bs));
+    if (b->coo_mirror)
+      PetscCall(PetscViewerASCIIPrintf(
+        viewer,
+        "COO mirror on: entries of off-diagonal blocks also fill the transposed place (routed to its owner)\n"));
     if (!b->A) PetscFunctionReturn(0);
     PetscCall(PetscViewerASCIIPushSynchronized(viewer));
     PetscCall(PetscViewerGetSubViewer(viewer, PETSC_COMM_SELF, &sv));
-    PetscCall(PetscViewerASCIIPrintf(sv, "[%d] rows %" PetscInt_FMT " to %" PetscInt_FMT ", %" PetscInt_FMT " ghost block columns\n", rank, mat->rmap->rstart, mat->rmap->rend, static_cast<PetscInt>(b->garray.size())));
+    PetscCall(PetscViewerASCIIPrintf(
+      sv, "[%d] rows %" PetscInt_FMT " to %" PetscInt_FMT ", %" PetscInt_FMT " ghost block columns\n", rank,
+      mat->rmap->rstart, mat->rmap->rend, static_cast<PetscInt>(b->garray.size())));
     PetscCall(PetscViewerASCIIPushTab(sv));
     PetscCall(PetscViewerASCIIPrintf(sv, "[%d] diagonal part:\n", rank));
     PetscCall(MatView(b->A, sv));
@@ -206,10 +226,10 @@ PETSC_INTERN PetscErrorCode MatDuplicate_MPIBinBCSR(Mat mat, MatDuplicateOption 
   PetscCall(PetscLayoutSetUp(C->rmap));
   PetscCall(PetscLayoutSetUp(C->cmap));
   PetscCall(MatMPIBinBCSRCopyConfig(mat, C));
-  Mat_MPIBinBCSR *c     = MPIBinBCSR(C);
-  c->garray             = b->garray;
-  c->compressed         = b->compressed;
-  c->b_staging          = b->b_staging;
+  Mat_MPIBinBCSR *c = MPIBinBCSR(C);
+  c->garray         = b->garray;
+  c->compressed     = b->compressed;
+  c->b_staging      = b->b_staging;
   if (op != MAT_COPY_VALUES)
     for (auto &e : c->b_staging) e.second = 0;
   if (b->A) PetscCall(MatDuplicate(b->A, op, &c->A));
@@ -231,7 +251,8 @@ PETSC_INTERN PetscErrorCode MatCopy_MPIBinBCSR(Mat A, Mat B, MatStructure str)
   PetscCall(PetscObjectTypeCompare((PetscObject)B, MATMPIBINBCSR, &same));
   if (same) {
     Mat_MPIBinBCSR *a = MPIBinBCSR(A), *b = MPIBinBCSR(B);
-    same = (a->compressed && b->compressed && a->garray == b->garray && a->B && b->B) ? PETSC_TRUE : PETSC_FALSE;
+    same =
+      (a->compressed && b->compressed && a->garray == b->garray && a->B && b->B) ? PETSC_TRUE : PETSC_FALSE;
     PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &same, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)A)));
     if (same) {
       PetscCall(MatCopy(a->A, b->A, str));

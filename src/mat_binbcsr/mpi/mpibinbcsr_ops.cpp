@@ -65,9 +65,9 @@ PETSC_INTERN PetscErrorCode MatMultTransposeAdd_MPIBinBCSR(Mat mat, Vec x, Vec y
    summed over those rows alone (from their values before and after). */
 PETSC_INTERN PetscErrorCode MatMultDotLocal_MPIBinBCSR(Mat mat, Vec x, Vec y, PetscScalar *xdoty)
 {
-  Mat_MPIBinBCSR *b                                    = MPIBinBCSR(mat);
+  Mat_MPIBinBCSR *b                                     = MPIBinBCSR(mat);
   PetscErrorCode (*fused)(Mat, Vec, Vec, PetscScalar *) = nullptr;
-  PetscScalar     d_diag                               = 0, d_off = 0;
+  PetscScalar d_diag = 0, d_off = 0;
 
   PetscFunctionBegin;
   PetscCall(PetscObjectQueryFunction((PetscObject)b->A, "MatMultDotLocal_C", &fused));
@@ -106,7 +106,8 @@ PETSC_INTERN PetscErrorCode MatMultDotLocal_MPIBinBCSR(Mat mat, Vec x, Vec y, Pe
     PetscUseTypeMethod(b->B, multadd, b->lvec, y, y);
     PetscCall(VecGetArrayRead(y, &ya));
     PetscCall(VecGetArrayRead(x, &xa));
-    for (std::size_t k = 0; k < nr; k++) d_off += xa[b->offdiag_rows[k]] * (ya[b->offdiag_rows[k]] - b->offdiag_saved[k]);
+    for (std::size_t k = 0; k < nr; k++)
+      d_off += xa[b->offdiag_rows[k]] * (ya[b->offdiag_rows[k]] - b->offdiag_saved[k]);
     PetscCall(VecRestoreArrayRead(x, &xa));
     PetscCall(VecRestoreArrayRead(y, &ya));
     PetscCall(PetscLogFlops(3.0 * nr));
@@ -120,11 +121,11 @@ PETSC_INTERN PetscErrorCode MatGetDiagonal_MPIBinBCSR(Mat mat, Vec d)
   Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
 
   PetscFunctionBegin;
-  PetscCheck(mat->rmap->rstart == mat->cmap->rstart && mat->rmap->n == mat->cmap->n, PETSC_COMM_SELF, PETSC_ERR_SUP, "Only for matrices whose row and column layouts agree");
+  PetscCheck(mat->rmap->rstart == mat->cmap->rstart && mat->rmap->n == mat->cmap->n, PETSC_COMM_SELF,
+             PETSC_ERR_SUP, "Only for matrices whose row and column layouts agree");
   PetscUseTypeMethod(b->A, getdiagonal, d);
   PetscFunctionReturn(0);
 }
-
 
 PETSC_INTERN PetscErrorCode MatDiagonalSet_MPIBinBCSR(Mat mat, Vec d, InsertMode mode)
 {
@@ -157,12 +158,15 @@ PETSC_INTERN PetscErrorCode MatInvertBlockDiagonal_MPIBinBCSR(Mat mat, const Pet
 /* The variable blocks lie in the rows of this rank (MatSetVariableBlockSizes checks their sum), so in the
    diagonal part, as for MPIAIJ. Unlike MPIAIJ, the matrix's MatSetErrorIfFailure reaches the part and a
    zero pivot the part met is reported on the matrix, where PCVPBJACOBI looks for it. */
-PETSC_INTERN PetscErrorCode MatInvertVariableBlockDiagonal_MPIBinBCSR(Mat mat, PetscInt nblocks, const PetscInt *bsizes, PetscScalar *diag)
+PETSC_INTERN PetscErrorCode MatInvertVariableBlockDiagonal_MPIBinBCSR(Mat mat, PetscInt nblocks,
+                                                                      const PetscInt *bsizes,
+                                                                      PetscScalar    *diag)
 {
   Mat A = MPIBinBCSR(mat)->A;
 
   PetscFunctionBegin;
-  PetscCheck(mat->rmap->rstart == mat->cmap->rstart && mat->rmap->n == mat->cmap->n, PETSC_COMM_SELF, PETSC_ERR_SUP, "Only for matrices whose row and column layouts agree");
+  PetscCheck(mat->rmap->rstart == mat->cmap->rstart && mat->rmap->n == mat->cmap->n, PETSC_COMM_SELF,
+             PETSC_ERR_SUP, "Only for matrices whose row and column layouts agree");
   A->erroriffailure = mat->erroriffailure;
   PetscCall(MatFactorClearError(A));
   PetscCall(MatInvertVariableBlockDiagonal(A, nblocks, bsizes, diag));
@@ -187,7 +191,8 @@ PETSC_INTERN PetscErrorCode MatScale_MPIBinBCSR(Mat mat, PetscScalar a)
 PETSC_INTERN PetscErrorCode MatShift_MPIBinBCSR(Mat mat, PetscScalar a)
 {
   PetscFunctionBegin;
-  PetscCheck(mat->rmap->rstart == mat->cmap->rstart && mat->rmap->n == mat->cmap->n, PETSC_COMM_SELF, PETSC_ERR_SUP, "Only for matrices whose row and column layouts agree");
+  PetscCheck(mat->rmap->rstart == mat->cmap->rstart && mat->rmap->n == mat->cmap->n, PETSC_COMM_SELF,
+             PETSC_ERR_SUP, "Only for matrices whose row and column layouts agree");
   PetscCall(MatShift(MPIBinBCSR(mat)->A, a));
   PetscFunctionReturn(0);
 }
@@ -215,10 +220,12 @@ static PetscErrorCode OwnedRows(Mat mat, PetscInt n, const PetscInt rows[], std:
   lrows.clear();
   for (PetscInt k = 0; k < n; k++) {
     const PetscInt r = rows[k];
-    PetscCheck(r >= 0 && r < mat->rmap->N, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", r, mat->rmap->N);
+    PetscCheck(r >= 0 && r < mat->rmap->N, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+               "Row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", r, mat->rmap->N);
     if (r >= rstart && r < rend) lrows.push_back(r - rstart);
     else {
-      PetscCheck(!mat->nooffproczerorows, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Row %" PetscInt_FMT " is not owned although MAT_NO_OFF_PROC_ZERO_ROWS was set", r);
+      PetscCheck(!mat->nooffproczerorows, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
+                 "Row %" PetscInt_FMT " is not owned although MAT_NO_OFF_PROC_ZERO_ROWS was set", r);
       PetscMPIInt owner;
       PetscCall(PetscLayoutFindOwner(mat->rmap, r, &owner));
       dest.push_back(owner);
@@ -240,7 +247,8 @@ static PetscErrorCode OwnedRows(Mat mat, PetscInt n, const PetscInt rows[], std:
   PetscFunctionReturn(0);
 }
 
-PETSC_INTERN PetscErrorCode MatZeroRows_MPIBinBCSR(Mat mat, PetscInt n, const PetscInt rows[], PetscScalar diag, Vec x, Vec rhs)
+PETSC_INTERN PetscErrorCode MatZeroRows_MPIBinBCSR(Mat mat, PetscInt n, const PetscInt rows[],
+                                                   PetscScalar diag, Vec x, Vec rhs)
 {
   Mat_MPIBinBCSR       *b = MPIBinBCSR(mat);
   std::vector<PetscInt> lrows;
@@ -262,7 +270,8 @@ PETSC_INTERN PetscErrorCode MatZeroRows_MPIBinBCSR(Mat mat, PetscInt n, const Pe
   PetscFunctionReturn(0);
 }
 
-PETSC_INTERN PetscErrorCode MatZeroRowsColumns_MPIBinBCSR(Mat mat, PetscInt n, const PetscInt rows[], PetscScalar diag, Vec x, Vec rhs)
+PETSC_INTERN PetscErrorCode MatZeroRowsColumns_MPIBinBCSR(Mat mat, PetscInt n, const PetscInt rows[],
+                                                          PetscScalar diag, Vec x, Vec rhs)
 {
   Mat_MPIBinBCSR       *b  = MPIBinBCSR(mat);
   const PetscInt        ng = Ghosts(b) * mat->cmap->bs;
@@ -270,7 +279,8 @@ PETSC_INTERN PetscErrorCode MatZeroRowsColumns_MPIBinBCSR(Mat mat, PetscInt n, c
   Vec                   mask, ghost_mask;
 
   PetscFunctionBegin;
-  PetscCheck(mat->rmap->rstart == mat->cmap->rstart && mat->rmap->n == mat->cmap->n, PETSC_COMM_SELF, PETSC_ERR_SUP, "Only for matrices whose row and column layouts agree");
+  PetscCheck(mat->rmap->rstart == mat->cmap->rstart && mat->rmap->n == mat->cmap->n, PETSC_COMM_SELF,
+             PETSC_ERR_SUP, "Only for matrices whose row and column layouts agree");
   PetscCall(OwnedRows(mat, n, rows, lrows));
   const PetscInt nl = static_cast<PetscInt>(lrows.size());
 
@@ -314,8 +324,8 @@ PETSC_INTERN PetscErrorCode MatZeroRowsColumns_MPIBinBCSR(Mat mat, PetscInt n, c
 
   if (ng) {
     /* zero the masked columns of B in place (the pattern is kept), then the rows */
-    const PetscScalar       *gm;
-    std::vector<PetscInt>    zr, zc; /* all entries first: MatSetValues unassembles B */
+    const PetscScalar    *gm;
+    std::vector<PetscInt> zr, zc; /* all entries first: MatSetValues unassembles B */
     PetscCall(VecGetArrayRead(ghost_mask, &gm));
     for (PetscInt r = 0; r < mat->rmap->n; r++) {
       PetscInt        nz;
@@ -329,7 +339,8 @@ PETSC_INTERN PetscErrorCode MatZeroRowsColumns_MPIBinBCSR(Mat mat, PetscInt n, c
       PetscCall(MatRestoreRow(b->B, r, &nz, &cols, nullptr));
     }
     const PetscScalar zero = 0.0;
-    for (std::size_t k = 0; k < zr.size(); k++) PetscCall(MatSetValues(b->B, 1, &zr[k], 1, &zc[k], &zero, INSERT_VALUES));
+    for (std::size_t k = 0; k < zr.size(); k++)
+      PetscCall(MatSetValues(b->B, 1, &zr[k], 1, &zc[k], &zero, INSERT_VALUES));
     PetscCall(VecRestoreArrayRead(ghost_mask, &gm));
     PetscCall(MatAssemblyBegin(b->B, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(b->B, MAT_FINAL_ASSEMBLY));
@@ -340,15 +351,19 @@ PETSC_INTERN PetscErrorCode MatZeroRowsColumns_MPIBinBCSR(Mat mat, PetscInt n, c
   PetscFunctionReturn(0);
 }
 
-PETSC_INTERN PetscErrorCode MatGetRow_MPIBinBCSR(Mat mat, PetscInt row, PetscInt *nz, PetscInt **idx, PetscScalar **v)
+PETSC_INTERN PetscErrorCode MatGetRow_MPIBinBCSR(Mat mat, PetscInt row, PetscInt *nz, PetscInt **idx,
+                                                 PetscScalar **v)
 {
   Mat_MPIBinBCSR *b      = MPIBinBCSR(mat);
   const PetscInt  rstart = mat->rmap->rstart, cstart = mat->cmap->rstart, bs = mat->cmap->bs;
 
   PetscFunctionBegin;
-  PetscCheck(!b->getrow_active, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatRestoreRow() not called for the previous row");
-  PetscCheck(row >= rstart && row < mat->rmap->rend, PETSC_COMM_SELF, PETSC_ERR_SUP, "Only local rows (asked for %" PetscInt_FMT ", own [%" PetscInt_FMT ", %" PetscInt_FMT "))", row, rstart, mat->rmap->rend);
-  b->getrow_active = PETSC_TRUE;
+  PetscCheck(!b->getrow_active, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MatRestoreRow() not called for the previous row");
+  PetscCheck(row >= rstart && row < mat->rmap->rend, PETSC_COMM_SELF, PETSC_ERR_SUP,
+             "Only local rows (asked for %" PetscInt_FMT ", own [%" PetscInt_FMT ", %" PetscInt_FMT "))", row,
+             rstart, mat->rmap->rend);
+  b->getrow_active        = PETSC_TRUE;
   const PetscInt     lrow = row - rstart;
   PetscInt           na, nb = 0;
   const PetscInt    *ca, *cb;
@@ -375,7 +390,8 @@ PETSC_INTERN PetscErrorCode MatGetRow_MPIBinBCSR(Mat mat, PetscInt row, PetscInt
   PetscFunctionReturn(0);
 }
 
-PETSC_INTERN PetscErrorCode MatRestoreRow_MPIBinBCSR(Mat mat, PetscInt row, PetscInt *nz, PetscInt **idx, PetscScalar **v)
+PETSC_INTERN PetscErrorCode MatRestoreRow_MPIBinBCSR(Mat mat, PetscInt row, PetscInt *nz, PetscInt **idx,
+                                                     PetscScalar **v)
 {
   PetscFunctionBegin;
   (void)row;
@@ -476,7 +492,8 @@ PETSC_INTERN PetscErrorCode MatGetInfo_MPIBinBCSR(Mat mat, MatInfoType flag, Mat
   if (flag == MAT_LOCAL) {
     for (int k = 0; k < 5; k++) global[k] = local[k];
   } else {
-    PetscCall(MPIU_Allreduce(local, global, 5, MPIU_PETSCLOGDOUBLE, flag == MAT_GLOBAL_MAX ? MPI_MAX : MPI_SUM, PetscObjectComm((PetscObject)mat)));
+    PetscCall(MPIU_Allreduce(local, global, 5, MPIU_PETSCLOGDOUBLE,
+                             flag == MAT_GLOBAL_MAX ? MPI_MAX : MPI_SUM, PetscObjectComm((PetscObject)mat)));
   }
   info->block_size        = mat->rmap->bs;
   info->nz_used           = global[0];

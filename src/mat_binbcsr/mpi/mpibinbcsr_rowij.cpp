@@ -9,14 +9,17 @@
 
 static const char rowij_key[] = "MatGetRowIJ_MPIBinBCSR";
 
-PetscErrorCode MatGetRowIJ_MPIBinBCSR(Mat A, PetscInt shift, PetscBool symmetric, PetscBool inodecompressed, PetscInt *m, const PetscInt *ia[], const PetscInt *ja[], PetscBool *done)
+PetscErrorCode MatGetRowIJ_MPIBinBCSR(Mat A, PetscInt shift, PetscBool symmetric, PetscBool inodecompressed,
+                                      PetscInt *m, const PetscInt *ia[], const PetscInt *ja[],
+                                      PetscBool *done)
 {
   const PetscInt        rstart = A->rmap->rstart, n = A->rmap->n;
   std::vector<PetscInt> ii(n + 1, 0), jj;
   Mat                   L;
 
   PetscFunctionBegin;
-  PetscCheck(A->assembled, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatGetRowIJ needs an assembled matrix");
+  PetscCheck(A->assembled, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MatGetRowIJ needs an assembled matrix");
   for (PetscInt r = 0; r < n; r++) {
     PetscInt        nz;
     const PetscInt *cols;
@@ -35,7 +38,9 @@ PetscErrorCode MatGetRowIJ_MPIBinBCSR(Mat A, PetscInt shift, PetscBool symmetric
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode MatRestoreRowIJ_MPIBinBCSR(Mat A, PetscInt shift, PetscBool symmetric, PetscBool inodecompressed, PetscInt *m, const PetscInt *ia[], const PetscInt *ja[], PetscBool *done)
+PetscErrorCode MatRestoreRowIJ_MPIBinBCSR(Mat A, PetscInt shift, PetscBool symmetric,
+                                          PetscBool inodecompressed, PetscInt *m, const PetscInt *ia[],
+                                          const PetscInt *ja[], PetscBool *done)
 {
   Mat L;
 

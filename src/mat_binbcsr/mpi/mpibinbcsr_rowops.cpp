@@ -8,22 +8,25 @@
 #include <algorithm>
 #include <vector>
 
-namespace
-{
-
+namespace {
 
 /* Global point column of local column c of the off-diagonal part. */
-inline PetscInt GhostColumn(const Mat_MPIBinBCSR *b, PetscInt bs, PetscInt c) { return b->garray[c / bs] * bs + c % bs; }
+inline PetscInt GhostColumn(const Mat_MPIBinBCSR *b, PetscInt bs, PetscInt c)
+{
+  return b->garray[c / bs] * bs + c % bs;
+}
 
 /* MatGetRowMax/Min/MinAbs as MPIAIJ computes them (PETSc's own tests compare the printed columns): the
    diagonal part's own answer over the owned columns, the off-diagonal part's over the others (its
    implicit zeros at the first global column outside the owned ones that it does not store), the better
    of the two, the smaller column on a tie. The off-diagonal rows run the sequential kernels over point
    entries (bw = bs = 1). */
-PetscErrorCode RowExtremesByParts(Mat mat, Vec v, PetscInt idx[], int kind, PetscErrorCode (*part_op)(Mat, Vec, PetscInt[]))
+PetscErrorCode RowExtremesByParts(Mat mat, Vec v, PetscInt idx[], int kind,
+                                  PetscErrorCode (*part_op)(Mat, Vec, PetscInt[]))
 {
-  Mat_MPIBinBCSR       *b = MPIBinBCSR(mat);
-  const PetscInt        m = mat->rmap->n, n = mat->cmap->n, N = mat->cmap->N, cstart = mat->cmap->rstart, bs = mat->cmap->bs;
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+  const PetscInt  m = mat->rmap->n, n = mat->cmap->n, N = mat->cmap->N, cstart = mat->cmap->rstart,
+                 bs = mat->cmap->bs;
   std::vector<PetscInt> ia(m);
   PetscScalar          *x;
   LocalView             xv;
@@ -34,7 +37,9 @@ PetscErrorCode RowExtremesByParts(Mat mat, Vec v, PetscInt idx[], int kind, Pets
   if (!n) {                       /* no owned columns: MPIAIJ's answer */
     PetscCall(VecGetArrayWrite(v, &x));
     for (PetscInt r = 0; r < m; r++) {
-      x[r] = kind == binbcsr::extreme_max ? PETSC_MIN_REAL : kind == binbcsr::extreme_min ? PETSC_MAX_REAL : 0.0;
+      x[r] = kind == binbcsr::extreme_max   ? PETSC_MIN_REAL
+             : kind == binbcsr::extreme_min ? PETSC_MAX_REAL
+                                            : 0.0;
       if (idx) idx[r] = -1;
     }
     PetscCall(VecRestoreArrayWrite(v, &x));
@@ -48,8 +53,10 @@ PetscErrorCode RowExtremesByParts(Mat mat, Vec v, PetscInt idx[], int kind, Pets
       for (PetscInt r = 0; r < m; r++) idx[r] = ia[r] < 0 ? ia[r] : ia[r] + cstart;
     PetscFunctionReturn(0);
   }
-  const PetscBool ghosts = MPIBinBCSRGhosts(mat) ? PETSC_TRUE : PETSC_FALSE;
-  auto            position = [&](PetscInt j) { return j < cstart ? j : j + n; }; /* global column of the j-th not owned one */
+  const PetscBool ghosts   = MPIBinBCSRGhosts(mat) ? PETSC_TRUE : PETSC_FALSE;
+  auto            position = [&](PetscInt j) {
+    return j < cstart ? j : j + n;
+  }; /* global column of the j-th not owned one */
   std::vector<PetscInt> gcols;
   PetscCall(VecGetArray(v, &x));
   for (PetscInt r = 0; r < m; r++) {
@@ -63,7 +70,8 @@ PetscErrorCode RowExtremesByParts(Mat mat, Vec v, PetscInt idx[], int kind, Pets
     for (PetscInt k = 0; k < nz && gap < 0; k++)
       if (gcols[k] != position(k)) gap = position(k);
     binbcsr::row_extreme_start(kind, nz == N - n, gap < 0 ? position(nz) : gap, &best, &at);
-    for (PetscInt k = 0; k < nz; k++) binbcsr::slot_row_extremes(vals + k, 1, 1, false, gcols[k], kind, &best, &at);
+    for (PetscInt k = 0; k < nz; k++)
+      binbcsr::slot_row_extremes(vals + k, 1, 1, false, gcols[k], kind, &best, &at);
     if (ghosts) PetscCall(MatRestoreRow(b->B, r, &nz, &cols, &vals));
     /* the better of the two parts; the smaller column on a tie */
     const PetscInt da = ia[r] + cstart;
@@ -128,7 +136,9 @@ PETSC_INTERN PetscErrorCode MatDiagonalScale_MPIBinBCSR(Mat mat, Vec ll, Vec rr)
     PetscBool same = (ll && rr) ? PETSC_TRUE : PETSC_FALSE, all;
     if (same) PetscCall(VecEqual(ll, rr, &same));
     PetscCall(MPIU_Allreduce(&same, &all, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)mat)));
-    PetscCheck(all, PetscObjectComm((PetscObject)mat), PETSC_ERR_SUP, "MatDiagonalScale with symmetric storage (-mat_binbcsr_symmetric_storage) needs the same left and right scaling: D A D stays symmetric, L A R does not; use full storage for that");
+    PetscCheck(
+      all, PetscObjectComm((PetscObject)mat), PETSC_ERR_SUP,
+      "MatDiagonalScale with symmetric storage (-mat_binbcsr_symmetric_storage) needs the same left and right scaling: D A D stays symmetric, L A R does not; use full storage for that");
   }
   if (rr) PetscCall(VecScatterBegin(b->Mvctx, rr, b->lvec, INSERT_VALUES, SCATTER_FORWARD));
   if (ll) PetscCall(lv.open(ll, true));
@@ -211,9 +221,9 @@ PETSC_INTERN PetscErrorCode MatGetRowMinAbs_MPIBinBCSR(Mat mat, Vec v, PetscInt 
    ranks (as MPIAIJ; every rank gets all N). */
 PETSC_INTERN PetscErrorCode MatGetColumnReductions_MPIBinBCSR(Mat mat, PetscInt type, PetscReal *reductions)
 {
-  Mat_MPIBinBCSR        *b = MPIBinBCSR(mat);
-  const PetscInt         N = mat->cmap->N, n = mat->cmap->n, bs = mat->cmap->bs, ng = MPIBinBCSRGhosts(mat) * bs;
-  PetscInt               part_type = type;
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+  const PetscInt  N = mat->cmap->N, n = mat->cmap->n, bs = mat->cmap->bs, ng = MPIBinBCSRGhosts(mat) * bs;
+  PetscInt        part_type = type;
   std::vector<PetscReal> work(N, 0.0), ra(n), rb(ng);
 
   PetscFunctionBegin;
@@ -227,7 +237,8 @@ PETSC_INTERN PetscErrorCode MatGetColumnReductions_MPIBinBCSR(Mat mat, PetscInt 
   }
   for (PetscInt j = 0; j < n; j++) work[mat->cmap->rstart + j] = ra[j];
   for (PetscInt j = 0; j < ng; j++) work[GhostColumn(b, bs, j)] = rb[j];
-  PetscCall(MPIU_Allreduce(work.data(), reductions, N, MPIU_REAL, type == NORM_INFINITY ? MPIU_MAX : MPIU_SUM, PetscObjectComm((PetscObject)mat)));
+  PetscCall(MPIU_Allreduce(work.data(), reductions, N, MPIU_REAL, type == NORM_INFINITY ? MPIU_MAX : MPIU_SUM,
+                           PetscObjectComm((PetscObject)mat)));
   if (type == NORM_2)
     for (PetscInt j = 0; j < N; j++) reductions[j] = PetscSqrtReal(reductions[j]);
   if (type == REDUCTION_MEAN_REALPART || type == REDUCTION_MEAN_IMAGINARYPART)
@@ -239,7 +250,8 @@ PETSC_INTERN PetscErrorCode MatGetColumnReductions_MPIBinBCSR(Mat mat, PetscInt 
 PETSC_INTERN PetscErrorCode MatMissingDiagonal_MPIBinBCSR(Mat mat, PetscBool *missing, PetscInt *d)
 {
   PetscFunctionBegin;
-  PetscCheck(mat->rmap->rstart == mat->cmap->rstart && mat->rmap->n == mat->cmap->n, PETSC_COMM_SELF, PETSC_ERR_SUP, "Only for matrices whose row and column layouts agree");
+  PetscCheck(mat->rmap->rstart == mat->cmap->rstart && mat->rmap->n == mat->cmap->n, PETSC_COMM_SELF,
+             PETSC_ERR_SUP, "Only for matrices whose row and column layouts agree");
   PetscCall(MatMissingDiagonal(MPIBinBCSR(mat)->A, missing, d));
   if (*missing && d) *d += mat->rmap->rstart;
   PetscFunctionReturn(0);
@@ -252,7 +264,8 @@ PETSC_INTERN PetscErrorCode MatEqual_MPIBinBCSR(Mat A, Mat B, PetscBool *flg)
 
   PetscFunctionBegin;
   /* the off-diagonal parts compare column by column only over the same ghost columns */
-  local = (A->rmap->n == B->rmap->n && A->cmap->n == B->cmap->n && a->garray == b->garray) ? PETSC_TRUE : PETSC_FALSE;
+  local = (A->rmap->n == B->rmap->n && A->cmap->n == B->cmap->n && a->garray == b->garray) ? PETSC_TRUE
+                                                                                           : PETSC_FALSE;
   if (local) PetscCall(MatEqual(a->A, b->A, &local));
   if (local && MPIBinBCSRGhosts(A)) PetscCall(MatEqual(a->B, b->B, &local));
   PetscCall(MPIU_Allreduce(&local, flg, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)A)));
@@ -261,21 +274,28 @@ PETSC_INTERN PetscErrorCode MatEqual_MPIBinBCSR(Mat A, Mat B, PetscBool *flg)
 
 /* As MPIAIJ: rows of this rank only, columns anywhere (0 where the pattern has no entry); negative
    indices are skipped. */
-PETSC_INTERN PetscErrorCode MatGetValues_MPIBinBCSR(Mat mat, PetscInt m, const PetscInt idxm[], PetscInt n, const PetscInt idxn[], PetscScalar v[])
+PETSC_INTERN PetscErrorCode MatGetValues_MPIBinBCSR(Mat mat, PetscInt m, const PetscInt idxm[], PetscInt n,
+                                                    const PetscInt idxn[], PetscScalar v[])
 {
   Mat_MPIBinBCSR *b      = MPIBinBCSR(mat);
-  const PetscInt  rstart = mat->rmap->rstart, rend = mat->rmap->rend, cstart = mat->cmap->rstart, cend = mat->cmap->rend;
+  const PetscInt  rstart = mat->rmap->rstart, rend = mat->rmap->rend, cstart = mat->cmap->rstart,
+                 cend = mat->cmap->rend;
 
   PetscFunctionBegin;
-  PetscCheck(mat->assembled, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatGetValues needs an assembled MATMPIBINBCSR matrix");
+  PetscCheck(mat->assembled, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MatGetValues needs an assembled MATMPIBINBCSR matrix");
   for (PetscInt i = 0; i < m; i++) {
     if (idxm[i] < 0) continue;
-    PetscCheck(idxm[i] < mat->rmap->N, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", idxm[i], mat->rmap->N);
-    PetscCheck(idxm[i] >= rstart && idxm[i] < rend, PETSC_COMM_SELF, PETSC_ERR_SUP, "Only local rows: row %" PetscInt_FMT " is not in [%" PetscInt_FMT ", %" PetscInt_FMT ")", idxm[i], rstart, rend);
+    PetscCheck(idxm[i] < mat->rmap->N, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+               "Row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", idxm[i], mat->rmap->N);
+    PetscCheck(idxm[i] >= rstart && idxm[i] < rend, PETSC_COMM_SELF, PETSC_ERR_SUP,
+               "Only local rows: row %" PetscInt_FMT " is not in [%" PetscInt_FMT ", %" PetscInt_FMT ")",
+               idxm[i], rstart, rend);
     const PetscInt row = idxm[i] - rstart;
     for (PetscInt j = 0; j < n; j++) {
       if (idxn[j] < 0) continue;
-      PetscCheck(idxn[j] < mat->cmap->N, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", idxn[j], mat->cmap->N);
+      PetscCheck(idxn[j] < mat->cmap->N, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+                 "Column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", idxn[j], mat->cmap->N);
       PetscScalar *out = v + i * n + j;
       if (idxn[j] >= cstart && idxn[j] < cend) {
         const PetscInt col = idxn[j] - cstart;
@@ -302,8 +322,10 @@ PETSC_INTERN PetscErrorCode MatAXPY_MPIBinBCSR(Mat Y, PetscScalar a, Mat X, MatS
 
   PetscFunctionBegin;
   PetscCall(PetscObjectTypeCompare((PetscObject)X, MATMPIBINBCSR, &xbin));
-  local_same = (xbin && MPIBinBCSR(X)->garray == y->garray && MPIBinBCSR(X)->sym == y->sym) ? PETSC_TRUE : PETSC_FALSE;
-  PetscCall(MPIU_Allreduce(&local_same, &same_ghosts, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)Y)));
+  local_same =
+    (xbin && MPIBinBCSR(X)->garray == y->garray && MPIBinBCSR(X)->sym == y->sym) ? PETSC_TRUE : PETSC_FALSE;
+  PetscCall(
+    MPIU_Allreduce(&local_same, &same_ghosts, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)Y)));
   if (same_ghosts) {
     Mat_MPIBinBCSR  *x     = MPIBinBCSR(X);
     PetscObjectState nz_a0 = y->A->nonzerostate, nz_b0 = y->B ? y->B->nonzerostate : 0;
@@ -342,13 +364,15 @@ PETSC_INTERN PetscErrorCode MatTranspose_MPIBinBCSR(Mat mat, MatReuse reuse, Mat
   Mat C;
 
   PetscFunctionBegin;
-  PetscCheck(mat->assembled, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatTranspose needs an assembled MATMPIBINBCSR matrix");
+  PetscCheck(mat->assembled, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MatTranspose needs an assembled MATMPIBINBCSR matrix");
   if (MPIBinBCSR(mat)->sym) {
     if (reuse == MAT_INITIAL_MATRIX) PetscCall(MatDuplicate(mat, MAT_COPY_VALUES, B));
     else if (reuse == MAT_REUSE_MATRIX && *B != mat) PetscCall(MatCopy(mat, *B, SAME_NONZERO_PATTERN));
     PetscFunctionReturn(0);
   }
-  PetscCall(MatBinBCSRCreateEmptyLike_Private(mat, mat->cmap->n, mat->rmap->n, mat->cmap->bs, mat->rmap->bs, &C));
+  PetscCall(
+    MatBinBCSRCreateEmptyLike_Private(mat, mat->cmap->n, mat->rmap->n, mat->cmap->bs, mat->rmap->bs, &C));
   for (PetscInt r = mat->rmap->rstart; r < mat->rmap->rend; r++) {
     PetscInt           nz;
     const PetscInt    *cols;

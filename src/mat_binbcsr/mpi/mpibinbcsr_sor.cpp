@@ -8,8 +8,7 @@
    sweeps, so the preconditioned operator is (L_loc + E)^-1 A (U_loc + E)^-1 with the whole A. */
 #include "mpibinbcsr.h"
 
-namespace
-{
+namespace {
 /* x = (L + E)^-1 A (U + E)^-1 b with L, U the diagonal part's triangles:
      y = (U + E)^-1 b                                   local backward sweep from zero
      t = b - (2/omega - 1) D y + B y_ghost              A y = (L + E) y + (U + E) y - (2E - D) y + B y_ghost
@@ -23,7 +22,8 @@ PetscErrorCode SOREisenstat(Mat mat, Vec bb, PetscReal omega, PetscReal fshift, 
   PetscFunctionBegin;
   PetscCall(VecDuplicate(bb, &t));
   PetscCall(VecDuplicate(bb, &z));
-  PetscUseTypeMethod(b->A, sor, bb, omega, (MatSORType)(SOR_ZERO_INITIAL_GUESS | SOR_LOCAL_BACKWARD_SWEEP), fshift, lits, 1, xx);
+  PetscUseTypeMethod(b->A, sor, bb, omega, (MatSORType)(SOR_ZERO_INITIAL_GUESS | SOR_LOCAL_BACKWARD_SWEEP),
+                     fshift, lits, 1, xx);
   PetscCall(VecScatterBegin(b->Mvctx, xx, b->lvec, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(MatHasOperation(b->A, MATOP_MULT_DIAGONAL_BLOCK, &hasop));
   if (hasop) PetscCall(MatMultDiagonalBlock(b->A, xx, t));
@@ -35,7 +35,8 @@ PetscErrorCode SOREisenstat(Mat mat, Vec bb, PetscReal omega, PetscReal fshift, 
   PetscCall(VecAYPX(t, (omega - 2.0) / omega, bb));
   PetscCall(VecScatterEnd(b->Mvctx, xx, b->lvec, INSERT_VALUES, SCATTER_FORWARD));
   if (!b->garray.empty()) PetscUseTypeMethod(b->B, multadd, b->lvec, t, t);
-  PetscUseTypeMethod(b->A, sor, t, omega, (MatSORType)(SOR_ZERO_INITIAL_GUESS | SOR_LOCAL_FORWARD_SWEEP), fshift, lits, 1, z);
+  PetscUseTypeMethod(b->A, sor, t, omega, (MatSORType)(SOR_ZERO_INITIAL_GUESS | SOR_LOCAL_FORWARD_SWEEP),
+                     fshift, lits, 1, z);
   PetscCall(VecAXPY(xx, 1.0, z));
   PetscCall(VecDestroy(&t));
   PetscCall(VecDestroy(&z));
@@ -43,10 +44,11 @@ PetscErrorCode SOREisenstat(Mat mat, Vec bb, PetscReal omega, PetscReal fshift, 
 }
 } // namespace
 
-PETSC_INTERN PetscErrorCode MatSOR_MPIBinBCSR(Mat mat, Vec bb, PetscReal omega, MatSORType flag, PetscReal fshift, PetscInt its, PetscInt lits, Vec xx)
+PETSC_INTERN PetscErrorCode MatSOR_MPIBinBCSR(Mat mat, Vec bb, PetscReal omega, MatSORType flag,
+                                              PetscReal fshift, PetscInt its, PetscInt lits, Vec xx)
 {
-  Mat_MPIBinBCSR  *b     = MPIBinBCSR(mat);
-  const MatSORType local = (MatSORType)(flag & SOR_LOCAL_SYMMETRIC_SWEEP);
+  Mat_MPIBinBCSR  *b      = MPIBinBCSR(mat);
+  const MatSORType local  = (MatSORType)(flag & SOR_LOCAL_SYMMETRIC_SWEEP);
   const PetscBool  ghosts = (PetscBool)!b->garray.empty();
   Vec              bb1    = nullptr;
 
@@ -60,11 +62,17 @@ PETSC_INTERN PetscErrorCode MatSOR_MPIBinBCSR(Mat mat, Vec bb, PetscReal omega, 
     mat->factorerrortype = b->A->factorerrortype;
     PetscFunctionReturn(0);
   }
-  PetscCheck(!(flag & ~(SOR_LOCAL_SYMMETRIC_SWEEP | SOR_ZERO_INITIAL_GUESS)), PetscObjectComm((PetscObject)mat), PETSC_ERR_SUP, "MATMPIBINBCSR's MatSOR does processor-local sweeps (SOR_LOCAL_FORWARD/BACKWARD/SYMMETRIC_SWEEP, e.g. -pc_sor_local_symmetric; PCSOR's default symmetric sweep is local in parallel), SOR_EISENSTAT and SOR_APPLY_UPPER");
-  PetscCheck(local, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONG, "MatSOR: the flag %d asks for no sweep", (int)flag);
-  PetscCheck(its > 0 && lits > 0, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONG, "MatSOR: its (%" PetscInt_FMT ") and lits (%" PetscInt_FMT ") must be positive", its, lits);
+  PetscCheck(
+    !(flag & ~(SOR_LOCAL_SYMMETRIC_SWEEP | SOR_ZERO_INITIAL_GUESS)), PetscObjectComm((PetscObject)mat),
+    PETSC_ERR_SUP,
+    "MATMPIBINBCSR's MatSOR does processor-local sweeps (SOR_LOCAL_FORWARD/BACKWARD/SYMMETRIC_SWEEP, e.g. -pc_sor_local_symmetric; PCSOR's default symmetric sweep is local in parallel), SOR_EISENSTAT and SOR_APPLY_UPPER");
+  PetscCheck(local, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONG,
+             "MatSOR: the flag %d asks for no sweep", (int)flag);
+  PetscCheck(its > 0 && lits > 0, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONG,
+             "MatSOR: its (%" PetscInt_FMT ") and lits (%" PetscInt_FMT ") must be positive", its, lits);
   if (flag & SOR_ZERO_INITIAL_GUESS) { /* x = 0: the ghosts contribute nothing to the first sweep */
-    PetscUseTypeMethod(b->A, sor, bb, omega, (MatSORType)(local | SOR_ZERO_INITIAL_GUESS), fshift, lits, 1, xx);
+    PetscUseTypeMethod(b->A, sor, bb, omega, (MatSORType)(local | SOR_ZERO_INITIAL_GUESS), fshift, lits, 1,
+                       xx);
     its--;
   }
   if (its > 0) PetscCall(VecDuplicate(bb, &bb1));

@@ -58,12 +58,18 @@ static PetscErrorCode MatBinBCSRSetBinWidth_SeqBinBCSR(Mat A, PetscInt bw)
 
   PetscFunctionBegin;
   if (bw == PETSC_DEFAULT || bw == PETSC_DECIDE) {
-    PetscCheck(!a->built || !a->bw_set || a->bw == BinBCSRDefaultBinWidth(a->bs), PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "The bin width must be set before the layout is built (first final assembly or COO preallocation)");
+    PetscCheck(
+      !a->built || !a->bw_set || a->bw == BinBCSRDefaultBinWidth(a->bs), PETSC_COMM_SELF,
+      PETSC_ERR_ARG_WRONGSTATE,
+      "The bin width must be set before the layout is built (first final assembly or COO preallocation)");
     a->bw_set = PETSC_FALSE;
     PetscFunctionReturn(0);
   }
-  PetscCheck(bw >= 1 && bw <= 1024, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Bin width %" PetscInt_FMT " must lie in [1, 1024]", bw);
-  PetscCheck(!a->built || bw == a->bw, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "The bin width must be set before the layout is built (first final assembly or COO preallocation)");
+  PetscCheck(bw >= 1 && bw <= 1024, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+             "Bin width %" PetscInt_FMT " must lie in [1, 1024]", bw);
+  PetscCheck(
+    !a->built || bw == a->bw, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+    "The bin width must be set before the layout is built (first final assembly or COO preallocation)");
   a->bw     = bw;
   a->bw_set = PETSC_TRUE;
   PetscFunctionReturn(0);
@@ -73,17 +79,18 @@ static PetscErrorCode MatBinBCSRGetBinWidth_SeqBinBCSR(Mat A, PetscInt *bw)
 {
   PetscFunctionBegin;
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-  *bw                = (a->built || a->bw_set) ? a->bw : BinBCSRDefaultBinWidth(PetscAbs(A->rmap->bs));
+  *bw               = (a->built || a->bw_set) ? a->bw : BinBCSRDefaultBinWidth(PetscAbs(A->rmap->bs));
   PetscFunctionReturn(0);
 }
 
 static PetscErrorCode MatBinBCSRSetPrecision_SeqBinBCSR(Mat A, MatBinBCSRPrecision p)
 {
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  Mat_SeqBinBCSR *a  = (Mat_SeqBinBCSR *)A->data;
   const size_t    nv = (size_t)a->nslots * a->bs2;
 
   PetscFunctionBegin;
-  PetscCheck(p == MAT_BINBCSR_PRECISION_DOUBLE || p == MAT_BINBCSR_PRECISION_SINGLE, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Unknown precision %d", (int)p);
+  PetscCheck(p == MAT_BINBCSR_PRECISION_DOUBLE || p == MAT_BINBCSR_PRECISION_SINGLE, PETSC_COMM_SELF,
+             PETSC_ERR_ARG_OUTOFRANGE, "Unknown precision %d", (int)p);
   if (p == a->precision) PetscFunctionReturn(0);
   if (a->built) {
     if (p == MAT_BINBCSR_PRECISION_SINGLE) {
@@ -107,8 +114,13 @@ static PetscErrorCode MatBinBCSRSetSymmetricStorage_SeqBinBCSR(Mat A, PetscBool 
 
   PetscFunctionBegin;
   if (flg == a->sym) PetscFunctionReturn(0);
-  PetscCheck(!a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Symmetric storage must be chosen before the layout is built (first final assembly, COO preallocation, conversion or load)");
-  PetscCheck(!flg || A->rmap->N < 0 || A->cmap->N < 0 || A->rmap->N == A->cmap->N, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Symmetric storage needs a square matrix, this one is %" PetscInt_FMT " x %" PetscInt_FMT, A->rmap->N, A->cmap->N);
+  PetscCheck(
+    !a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+    "Symmetric storage must be chosen before the layout is built (first final assembly, COO preallocation, conversion or load)");
+  PetscCheck(!flg || A->rmap->N < 0 || A->cmap->N < 0 || A->rmap->N == A->cmap->N, PETSC_COMM_SELF,
+             PETSC_ERR_ARG_SIZ,
+             "Symmetric storage needs a square matrix, this one is %" PetscInt_FMT " x %" PetscInt_FMT,
+             A->rmap->N, A->cmap->N);
   a->sym = flg;
   if (a->staging && flg) PetscCall(MatSeqBinBCSRStagingDropLower(A));
   if (flg) {
@@ -120,16 +132,14 @@ static PetscErrorCode MatBinBCSRSetSymmetricStorage_SeqBinBCSR(Mat A, PetscBool 
 
 /* Settings that are a field of Mat_SeqBinBCSR and nothing more (the COO mirror, the streams, and the
    getters of precision and storage): written and read as they are, by one pair of functions. */
-template <class T, T Mat_SeqBinBCSR::*field>
-static PetscErrorCode MatSeqBinBCSRSetField(Mat A, T v)
+template <class T, T Mat_SeqBinBCSR::*field> static PetscErrorCode MatSeqBinBCSRSetField(Mat A, T v)
 {
   PetscFunctionBegin;
   ((Mat_SeqBinBCSR *)A->data)->*field = v;
   PetscFunctionReturn(0);
 }
 
-template <class T, T Mat_SeqBinBCSR::*field>
-static PetscErrorCode MatSeqBinBCSRGetField(Mat A, T *v)
+template <class T, T Mat_SeqBinBCSR::*field> static PetscErrorCode MatSeqBinBCSRGetField(Mat A, T *v)
 {
   PetscFunctionBegin;
   *v = ((Mat_SeqBinBCSR *)A->data)->*field;
@@ -198,13 +208,13 @@ static const struct _MatOps &MatOps_SeqBinBCSR(void)
     o.missingdiagonal     = MatMissingDiagonal_SeqBinBCSR;
     o.equal               = MatEqual_SeqBinBCSR;
     /* new matrices, view, load */
-    o.transpose         = MatTranspose_SeqBinBCSR;
-    o.duplicate         = MatDuplicate_SeqBinBCSR;
-    o.copy              = MatCopy_SeqBinBCSR;
-    o.convertfrom       = MatConvertFrom_SeqBinBCSR;
-    o.destroy           = MatDestroy_SeqBinBCSR;
-    o.view              = MatView_SeqBinBCSR;
-    o.load              = MatLoad_SeqBinBCSR;
+    o.transpose   = MatTranspose_SeqBinBCSR;
+    o.duplicate   = MatDuplicate_SeqBinBCSR;
+    o.copy        = MatCopy_SeqBinBCSR;
+    o.convertfrom = MatConvertFrom_SeqBinBCSR;
+    o.destroy     = MatDestroy_SeqBinBCSR;
+    o.view        = MatView_SeqBinBCSR;
+    o.load        = MatLoad_SeqBinBCSR;
     /* through the AIJ shadow (common/; MatCreateSubMatrix uses createsubmatrices on one rank) */
     o.creatempimatconcatenateseqmat = MatCreateMPIMatConcatenateSeqMat_BinBCSR;
     return o;
@@ -231,7 +241,8 @@ static PetscErrorCode MatBinBCSRSetTune_SeqBinBCSR(Mat A, MatBinBCSRTune t)
 static PetscErrorCode MatBinBCSRGetTune_SeqBinBCSR(Mat A, MatBinBCSRTune *t)
 {
   PetscFunctionBegin;
-  *t = ((Mat_SeqBinBCSR *)A->data)->tune == (PetscInt)MAT_BINBCSR_TUNE_OFF ? MAT_BINBCSR_TUNE_OFF : MAT_BINBCSR_TUNE_AUTO;
+  *t = ((Mat_SeqBinBCSR *)A->data)->tune == (PetscInt)MAT_BINBCSR_TUNE_OFF ? MAT_BINBCSR_TUNE_OFF
+                                                                           : MAT_BINBCSR_TUNE_AUTO;
   PetscFunctionReturn(0);
 }
 
@@ -254,11 +265,15 @@ static const BinBCSRComposed composed[] = {
   BINBCSR_COMPOSED("MatBinBCSRSetBinWidth_C", MatBinBCSRSetBinWidth_SeqBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRGetBinWidth_C", MatBinBCSRGetBinWidth_SeqBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRSetPrecision_C", MatBinBCSRSetPrecision_SeqBinBCSR),
-  BINBCSR_COMPOSED("MatBinBCSRGetPrecision_C", (&MatSeqBinBCSRGetField<MatBinBCSRPrecision, &Mat_SeqBinBCSR::precision>)),
+  BINBCSR_COMPOSED("MatBinBCSRGetPrecision_C",
+                   (&MatSeqBinBCSRGetField<MatBinBCSRPrecision, &Mat_SeqBinBCSR::precision>)),
   BINBCSR_COMPOSED("MatBinBCSRSetSymmetricStorage_C", MatBinBCSRSetSymmetricStorage_SeqBinBCSR),
-  BINBCSR_COMPOSED("MatBinBCSRGetSymmetricStorage_C", (&MatSeqBinBCSRGetField<PetscBool, &Mat_SeqBinBCSR::sym>)),
-  BINBCSR_COMPOSED("MatBinBCSRSetCOOMirror_C", (&MatSeqBinBCSRSetField<PetscBool, &Mat_SeqBinBCSR::coo_mirror>)),
-  BINBCSR_COMPOSED("MatBinBCSRGetCOOMirror_C", (&MatSeqBinBCSRGetField<PetscBool, &Mat_SeqBinBCSR::coo_mirror>)),
+  BINBCSR_COMPOSED("MatBinBCSRGetSymmetricStorage_C",
+                   (&MatSeqBinBCSRGetField<PetscBool, &Mat_SeqBinBCSR::sym>)),
+  BINBCSR_COMPOSED("MatBinBCSRSetCOOMirror_C",
+                   (&MatSeqBinBCSRSetField<PetscBool, &Mat_SeqBinBCSR::coo_mirror>)),
+  BINBCSR_COMPOSED("MatBinBCSRGetCOOMirror_C",
+                   (&MatSeqBinBCSRGetField<PetscBool, &Mat_SeqBinBCSR::coo_mirror>)),
   BINBCSR_COMPOSED("MatBinBCSRSetStreams_C", MatBinBCSRSetStreams_SeqBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRGetStreams_C", (&MatSeqBinBCSRGetField<PetscInt, &Mat_SeqBinBCSR::streams>)),
   BINBCSR_COMPOSED("MatBinBCSRSetTune_C", MatBinBCSRSetTune_SeqBinBCSR),
@@ -275,7 +290,8 @@ static const BinBCSRComposed composed[] = {
 #if defined(PETSC_HAVE_HYPRE)
   BINBCSR_COMPOSED("MatConvert_seqbinbcsr_hypre_C", MatConvert_BinBCSR_HYPRE),
 #endif
-  BINBCSR_COMPOSED("MatProductSetFromOptions_anytype_C", MatProductSetFromOptions_BinBCSR), /* products with other types */
+  BINBCSR_COMPOSED("MatProductSetFromOptions_anytype_C",
+                   MatProductSetFromOptions_BinBCSR), /* products with other types */
   BINBCSR_COMPOSED("MatAXPYGetPreallocation_C", MatAXPYGetPreallocation_BinBCSR),
 };
 
@@ -298,7 +314,8 @@ PetscErrorCode MatCreate_SeqBinBCSR(Mat A)
 
   PetscFunctionBegin;
   PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)A), &size));
-  PetscCheck(size == 1, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "MATSEQBINBCSR is for one process; use MATBINBCSR or MATMPIBINBCSR");
+  PetscCheck(size == 1, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
+             "MATSEQBINBCSR is for one process; use MATBINBCSR or MATMPIBINBCSR");
   PetscCall(PetscNew(&a));
   A->data        = (void *)a;
   a->bw          = BinBCSRDefaultBinWidth(1);

@@ -56,11 +56,11 @@ struct BinBCSRStaging; /* the pattern and values while the matrix is being fille
 
 typedef struct {
   /* configuration */
-  PetscInt            bw;        /* bin width: (block) rows per bin */
-  PetscBool           bw_set;    /* set by the user; otherwise the layout build takes the default of
+  PetscInt            bw;          /* bin width: (block) rows per bin */
+  PetscBool           bw_set;      /* set by the user; otherwise the layout build takes the default of
                                     its block size (BinBCSRDefaultBinWidth) */
-  MatBinBCSRPrecision precision; /* value storage; products accumulate in double */
-  PetscInt            nonew;     /* 0: new nonzeros allowed (only before the layout exists);
+  MatBinBCSRPrecision precision;   /* value storage; products accumulate in double */
+  PetscInt            nonew;       /* 0: new nonzeros allowed (only before the layout exists);
                                     1: new locations silently ignored (MAT_NEW_NONZERO_LOCATIONS false);
                                    -1: error (MAT_NEW_NONZERO_LOCATION_ERR); -2: error beyond the
                                     preallocation (MAT_NEW_NONZERO_ALLOCATION_ERR). Once the layout
@@ -68,35 +68,35 @@ typedef struct {
   PetscBool           roworiented; /* MAT_ROW_ORIENTED for MatSetValues(Blocked) */
   PetscInt            streams;     /* MatBinBCSRSetStreams: runs of bins the product sweeps side by side */
   PetscBool           streams_set; /* set by the user before the layout build: the tuner keeps it */
-  PetscInt            tune;        /* MatBinBCSRTune; -1: not set (the option, else auto, at the layout build) */
-  PetscInt            tune_cache;  /* MatBinBCSRSetTuneCache: 1 on, 0 off, -1 not set (the option, else on) */
+  PetscInt            tune; /* MatBinBCSRTune; -1: not set (the option, else auto, at the layout build) */
+  PetscInt            tune_cache; /* MatBinBCSRSetTuneCache: 1 on, 0 off, -1 not set (the option, else on) */
   char                tune_info[768]; /* what the tuner tried and chose at the last layout build (MatView) */
-  MatBinBCSRKernel    kernel;      /* MatBinBCSRSetKernel: the body set asked for (AUTO: the best the CPU has) */
-  PetscBool           kernel_tuned; /* kernel is the tuner's choice, not the user's (a rebuild may change it) */
-  PetscBool           sym;         /* symmetric storage: only blocks with block column >= block row
+  MatBinBCSRKernel    kernel; /* MatBinBCSRSetKernel: the body set asked for (AUTO: the best the CPU has) */
+  PetscBool kernel_tuned;     /* kernel is the tuner's choice, not the user's (a rebuild may change it) */
+  PetscBool sym;              /* symmetric storage: only blocks with block column >= block row
                                       are stored; entries below the block diagonal are ignored. The
                                       slots of a bin are ordered by an edge colouring (below). */
 
   /* the bin layout: valid once built (first final assembly, MatSetPreallocationCOO, MatConvert) */
   PetscBool  built;
-  PetscInt   bs, bs2;      /* block size and its square */
-  PetscInt   mbs, nbs;     /* block rows, block columns */
-  PetscInt   nbins;        /* ceil(mbs / bw) */
-  PetscInt  *bin_start;    /* [nbins + 1]: first slot of each bin (a multiple of bw) */
-  PetscInt  *row_nz;       /* [mbs]: stored blocks of each row, padding excluded */
-  PetscInt  *diag_slot;    /* [mbs]: slot of the diagonal block, -1 if the row has none */
-  PetscInt  *col;          /* [nslots]: block column of each slot (32-bit: PETSc here has 32-bit PetscInt) */
-  PetscInt   nslots;       /* bin_start[nbins] */
-  PetscInt   nz;           /* stored blocks (sum of row_nz) */
-  PetscInt   max_row_nz;   /* longest row, in blocks */
-  PetscInt  *row_off;      /* symmetric storage only: [mbs + 1] offsets into real_slot, else NULL */
-  PetscInt  *real_slot;    /* symmetric storage only: [nz] the slots of each row's real blocks in
+  PetscInt   bs, bs2;    /* block size and its square */
+  PetscInt   mbs, nbs;   /* block rows, block columns */
+  PetscInt   nbins;      /* ceil(mbs / bw) */
+  PetscInt  *bin_start;  /* [nbins + 1]: first slot of each bin (a multiple of bw) */
+  PetscInt  *row_nz;     /* [mbs]: stored blocks of each row, padding excluded */
+  PetscInt  *diag_slot;  /* [mbs]: slot of the diagonal block, -1 if the row has none */
+  PetscInt  *col;        /* [nslots]: block column of each slot (32-bit: PETSc here has 32-bit PetscInt) */
+  PetscInt   nslots;     /* bin_start[nbins] */
+  PetscInt   nz;         /* stored blocks (sum of row_nz) */
+  PetscInt   max_row_nz; /* longest row, in blocks */
+  PetscInt  *row_off;    /* symmetric storage only: [mbs + 1] offsets into real_slot, else NULL */
+  PetscInt  *real_slot;  /* symmetric storage only: [nz] the slots of each row's real blocks in
                               ascending column order (the colouring scatters them over the bin) */
-  PetscInt  *lower_off;    /* symmetric storage, built on demand (MatGetRow): [mbs + 1] offsets */
-  PetscInt  *lower_slot;   /* [2 * (off-diagonal blocks)]: for block row r, (slot, c) of each stored
+  PetscInt  *lower_off;  /* symmetric storage, built on demand (MatGetRow): [mbs + 1] offsets */
+  PetscInt  *lower_slot; /* [2 * (off-diagonal blocks)]: for block row r, (slot, c) of each stored
                               block (c, r), c < r, in ascending c: row r's lower part, transposed */
-  MatScalar *val;          /* [nslots * bs2] when precision is double, else NULL */
-  float     *valf;         /* [nslots * bs2] when precision is single, else NULL */
+  MatScalar *val;        /* [nslots * bs2] when precision is double, else NULL */
+  float     *valf;       /* [nslots * bs2] when precision is single, else NULL */
 
   struct BinBCSRStaging *staging; /* non-NULL between MatSetUp/preallocation and the layout build */
 
@@ -105,12 +105,14 @@ typedef struct {
      the block (the order of a CSR row, so consecutive values gather from the same elements).
      Value q is the sum of the COO entries coo_perm[coo_jmap[q] .. coo_jmap[q+1]-1]; coo_jmap has
      nz*bs2 + 1 entries. 32-bit indices (checked at preallocation) halve the bytes of the refill. */
-  PetscBool  coo_mirror;   /* MatBinBCSRSetCOOMirror: entries of off-diagonal blocks also fill their transposed place */
+  PetscBool
+    coo_mirror; /* MatBinBCSRSetCOOMirror: entries of off-diagonal blocks also fill their transposed place */
   PetscCount coo_n;
   PetscInt  *coo_jmap;
   PetscInt  *coo_perm;
-  PetscInt  *coo_perm_src; /* coo_perm composed with a caller's source map (MatSeqBinBCSRComposeCOO), or NULL */
-  PetscBool  coo_composed;
+  PetscInt
+    *coo_perm_src; /* coo_perm composed with a caller's source map (MatSeqBinBCSRComposeCOO), or NULL */
+  PetscBool coo_composed;
   /* When every stored block is a sum of whole COO blocks of the list (bs2 consecutive entries, row-major,
      or transposed as the COO mirror makes them), the refill sums blocks: slot s sums the source blocks
      coo_slot_src[coo_slot_ptr[s] .. coo_slot_ptr[s+1]-1], each the source index of its entry (0, 0)
@@ -121,13 +123,13 @@ typedef struct {
   PetscInt       *coo_slot_src;
   const PetscInt *coo_slot_perm; /* the value map it was built from (coo_perm or coo_perm_src) */
   PetscCount      coo_slot_n;
-  PetscInt   coo_slot_state;
+  PetscInt        coo_slot_state;
 
   /* scratch */
-  PetscBool    getrowactive;
-  PetscInt    *rowbuf_cols; /* [max_row_nz * bs] for MatGetRow */
-  PetscScalar *rowbuf_vals;
-  MatScalar   *idiag;       /* [mbs * bs2] MatInvertBlockDiagonal result (column-major blocks, as BAIJ) */
+  PetscBool        getrowactive;
+  PetscInt        *rowbuf_cols; /* [max_row_nz * bs] for MatGetRow */
+  PetscScalar     *rowbuf_vals;
+  MatScalar       *idiag;     /* [mbs * bs2] MatInvertBlockDiagonal result (column-major blocks, as BAIJ) */
   MatScalar       *sor_idiag; /* [mbs * bs2] (D + sor_shift I)^-1 for MatSOR, valid for sor_state */
   PetscObjectState sor_state; /* state of the matrix when sor_idiag was computed (0: never) */
   PetscReal        sor_shift;
@@ -142,7 +144,10 @@ binbcsr::Body MatSeqBinBCSRSelectBody(const Mat_SeqBinBCSR *a);
 
 /* Lane of slot s, and the index into val/valf of entry e of slot s. */
 static inline PetscInt BinBCSRLane(PetscInt s, PetscInt bw) { return s % bw; }
-static inline PetscInt BinBCSRValueIndex(PetscInt s, PetscInt e, PetscInt bw, PetscInt bs2) { return (PetscInt)binbcsr::value_index(s, (int)e, (int)bw, (int)bs2); }
+static inline PetscInt BinBCSRValueIndex(PetscInt s, PetscInt e, PetscInt bw, PetscInt bs2)
+{
+  return (PetscInt)binbcsr::value_index(s, (int)e, (int)bw, (int)bs2);
+}
 /* Slot of the k-th real block (ascending column) of block row r, k < row_nz[r]. With full storage
    it is entry k of the lane; with symmetric storage the colouring decides. */
 static inline PetscInt BinBCSRSlot(const Mat_SeqBinBCSR *a, PetscInt r, PetscInt k)
@@ -151,8 +156,11 @@ static inline PetscInt BinBCSRSlot(const Mat_SeqBinBCSR *a, PetscInt r, PetscInt
   return (PetscInt)binbcsr::row_slot<PetscInt>(a->bin_start, a->bw, r, k);
 }
 /* Value at value index v, whatever the storage precision. */
-static inline PetscScalar BinBCSRGetValue(const Mat_SeqBinBCSR *a, PetscInt v) { return a->val ? a->val[v] : (PetscScalar)a->valf[v]; }
-static inline void        BinBCSRSetValue(Mat_SeqBinBCSR *a, PetscInt v, PetscScalar x)
+static inline PetscScalar BinBCSRGetValue(const Mat_SeqBinBCSR *a, PetscInt v)
+{
+  return a->val ? a->val[v] : (PetscScalar)a->valf[v];
+}
+static inline void BinBCSRSetValue(Mat_SeqBinBCSR *a, PetscInt v, PetscScalar x)
 {
   if (a->val) a->val[v] = x;
   else a->valf[v] = (float)x;
@@ -163,12 +171,18 @@ static inline void        BinBCSRSetValue(Mat_SeqBinBCSR *a, PetscInt v, PetscSc
    slot groups L; slot_col gets L * bw columns (slot k of lane l at k * bw + l, padding: the lane's own
    row, mbs - 1 for phantom lanes); entry_k gets, lane by lane, the slot group of each upper block in
    column order. colid: [nbs] scratch, all -1 on entry and on exit. */
-PetscInt MatSeqBinBCSRColourBin(PetscInt bw, PetscInt r0, PetscInt mbs, const PetscInt bi[], const PetscInt bj[], std::vector<PetscInt> &slot_col, std::vector<PetscInt> &entry_k, std::vector<PetscInt> &colid);
+PetscInt MatSeqBinBCSRColourBin(PetscInt bw, PetscInt r0, PetscInt mbs, const PetscInt bi[],
+                                const PetscInt bj[], std::vector<PetscInt> &slot_col,
+                                std::vector<PetscInt> &entry_k, std::vector<PetscInt> &colid);
 
 /* Symmetric storage: builds lower_off/lower_slot if missing (pattern is frozen, so once). */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRBuildLowerIndex(Mat_SeqBinBCSR *);
 /* Refuses an operation that symmetric storage does not provide. */
-#define BinBCSRCheckNotSym(a, opname) PetscCheck(!(a)->sym, PETSC_COMM_SELF, PETSC_ERR_SUP, "%s is not available for MATSEQBINBCSR with symmetric storage (upper triangle only; -mat_binbcsr_symmetric_storage)", opname)
+#define BinBCSRCheckNotSym(a, opname)                                                                                     \
+  PetscCheck(                                                                                                             \
+    !(a)->sym, PETSC_COMM_SELF, PETSC_ERR_SUP,                                                                            \
+    "%s is not available for MATSEQBINBCSR with symmetric storage (upper triangle only; -mat_binbcsr_symmetric_storage)", \
+    opname)
 
 /* Both built with the same bins, slots and columns (block size, bin width, storage): their value arrays
    line up slot by slot (the precisions may differ). */
@@ -198,9 +212,12 @@ PETSC_INTERN PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat, PetscViewer);
 PETSC_INTERN PetscErrorCode MatSetUp_SeqBinBCSR(Mat);
 PETSC_INTERN PetscErrorCode MatSeqAIJSetPreallocation_SeqBinBCSR(Mat, PetscInt, const PetscInt[]);
 PETSC_INTERN PetscErrorCode MatSeqBAIJSetPreallocation_SeqBinBCSR(Mat, PetscInt, PetscInt, const PetscInt[]);
-PETSC_INTERN PetscErrorCode MatSetValues_SeqBinBCSR(Mat, PetscInt, const PetscInt[], PetscInt, const PetscInt[], const PetscScalar[], InsertMode);
-PETSC_INTERN PetscErrorCode MatSetValuesBlocked_SeqBinBCSR(Mat, PetscInt, const PetscInt[], PetscInt, const PetscInt[], const PetscScalar[], InsertMode);
-PETSC_INTERN PetscErrorCode MatGetValues_SeqBinBCSR(Mat, PetscInt, const PetscInt[], PetscInt, const PetscInt[], PetscScalar[]);
+PETSC_INTERN PetscErrorCode MatSetValues_SeqBinBCSR(Mat, PetscInt, const PetscInt[], PetscInt,
+                                                    const PetscInt[], const PetscScalar[], InsertMode);
+PETSC_INTERN PetscErrorCode MatSetValuesBlocked_SeqBinBCSR(Mat, PetscInt, const PetscInt[], PetscInt,
+                                                           const PetscInt[], const PetscScalar[], InsertMode);
+PETSC_INTERN PetscErrorCode MatGetValues_SeqBinBCSR(Mat, PetscInt, const PetscInt[], PetscInt,
+                                                    const PetscInt[], PetscScalar[]);
 PETSC_INTERN PetscErrorCode MatAssemblyEnd_SeqBinBCSR(Mat, MatAssemblyType);
 /* The layout, the staging and the COO map freed (MatDestroy) */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRFreeStorage(Mat_SeqBinBCSR *);
@@ -213,11 +230,15 @@ PETSC_INTERN PetscErrorCode MatMultTransposeAdd_SeqBinBCSR(Mat, Vec, Vec, Vec);
 PETSC_INTERN PetscErrorCode MatMultDotLocal_SeqBinBCSR(Mat, Vec, Vec, PetscScalar *);
 PETSC_INTERN PetscErrorCode MatGetDiagonal_SeqBinBCSR(Mat, Vec);
 PETSC_INTERN PetscErrorCode MatInvertBlockDiagonal_SeqBinBCSR(Mat, const PetscScalar **);
-PETSC_INTERN PetscErrorCode MatInvertVariableBlockDiagonal_SeqBinBCSR(Mat, PetscInt, const PetscInt *, PetscScalar *);
-PETSC_INTERN PetscErrorCode MatSeqBinBCSRInvertDiagonalBlocks(Mat, PetscReal shift, MatScalar *out, PetscInt *zero_row);
-PETSC_INTERN PetscErrorCode MatSOR_SeqBinBCSR(Mat, Vec, PetscReal, MatSORType, PetscReal, PetscInt, PetscInt, Vec);
+PETSC_INTERN PetscErrorCode MatInvertVariableBlockDiagonal_SeqBinBCSR(Mat, PetscInt, const PetscInt *,
+                                                                      PetscScalar *);
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRInvertDiagonalBlocks(Mat, PetscReal shift, MatScalar *out,
+                                                              PetscInt *zero_row);
+PETSC_INTERN PetscErrorCode MatSOR_SeqBinBCSR(Mat, Vec, PetscReal, MatSORType, PetscReal, PetscInt, PetscInt,
+                                              Vec);
 PETSC_INTERN PetscErrorCode MatMultDiagonalBlock_SeqBinBCSR(Mat, Vec, Vec);
-PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat, PetscCount, const PetscInt[], const PetscInt[]);
+PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat, PetscCount, const PetscInt[],
+                                                              const PetscInt[]);
 PETSC_INTERN PetscErrorCode MatSetValuesCOO_SeqBinBCSR(Mat, const PetscScalar[], InsertMode);
 PETSC_INTERN PetscErrorCode MatGetRow_SeqBinBCSR(Mat, PetscInt, PetscInt *, PetscInt **, PetscScalar **);
 PETSC_INTERN PetscErrorCode MatRestoreRow_SeqBinBCSR(Mat, PetscInt, PetscInt *, PetscInt **, PetscScalar **);
@@ -231,8 +252,10 @@ PETSC_INTERN PetscErrorCode MatView_SeqBinBCSR(Mat, PetscViewer);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRAIJValueMap(Mat B, Mat T, std::vector<PetscInt> &map);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRAIJGather(Mat B, const std::vector<PetscInt> &map, Mat T);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRAIJScatter(Mat T, const std::vector<PetscInt> &map, Mat B);
-PETSC_INTERN PetscErrorCode MatGetRowIJ_SeqBinBCSR(Mat, PetscInt, PetscBool, PetscBool, PetscInt *, const PetscInt *[], const PetscInt *[], PetscBool *);
-PETSC_INTERN PetscErrorCode MatRestoreRowIJ_SeqBinBCSR(Mat, PetscInt, PetscBool, PetscBool, PetscInt *, const PetscInt *[], const PetscInt *[], PetscBool *);
+PETSC_INTERN PetscErrorCode MatGetRowIJ_SeqBinBCSR(Mat, PetscInt, PetscBool, PetscBool, PetscInt *,
+                                                   const PetscInt *[], const PetscInt *[], PetscBool *);
+PETSC_INTERN PetscErrorCode MatRestoreRowIJ_SeqBinBCSR(Mat, PetscInt, PetscBool, PetscBool, PetscInt *,
+                                                       const PetscInt *[], const PetscInt *[], PetscBool *);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRDestroyCOO(Mat_SeqBinBCSR *);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRDuplicateStaging(Mat, Mat, PetscBool copyvalues);
 

@@ -9,16 +9,18 @@
    -1 where B has no such entry. */
 PetscErrorCode MatSeqBinBCSRAIJValueMap(Mat B, Mat T, std::vector<PetscInt> &map)
 {
-  Mat_SeqBinBCSR *b = (Mat_SeqBinBCSR *)B->data;
+  Mat_SeqBinBCSR *b  = (Mat_SeqBinBCSR *)B->data;
   const PetscInt  bs = b->bs, bs2 = b->bs2, bw = b->bw;
   const PetscInt *ia, *ja;
   PetscInt        n;
   PetscBool       done;
 
   PetscFunctionBegin;
-  PetscCheck(b->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Value map of an unassembled MATSEQBINBCSR matrix");
+  PetscCheck(b->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "Value map of an unassembled MATSEQBINBCSR matrix");
   PetscCall(MatGetRowIJ(T, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
-  PetscCheck(done && n == B->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Value map: %" PetscInt_FMT " rows against %" PetscInt_FMT, n, B->rmap->n);
+  PetscCheck(done && n == B->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+             "Value map: %" PetscInt_FMT " rows against %" PetscInt_FMT, n, B->rmap->n);
   map.resize(ia[n]);
   for (PetscInt r = 0; r < n; r++) {
     const PetscInt br = r / bs, i = r % bs;

@@ -47,8 +47,8 @@ PetscErrorCode MatSeqBinBCSRDestroyCOO(Mat_SeqBinBCSR *a)
   PetscCall(PetscFree(a->coo_slot_ptr));
   PetscCall(PetscFree(a->coo_slot_src));
   a->coo_slot_state = 0;
-  a->coo_composed = PETSC_FALSE;
-  a->coo_n        = 0;
+  a->coo_composed   = PETSC_FALSE;
+  a->coo_n          = 0;
   PetscFunctionReturn(0);
 }
 
@@ -71,8 +71,13 @@ static PetscErrorCode MatSeqBinBCSRSetSizes(Mat A)
   PetscCall(PetscLayoutSetUp(A->rmap));
   PetscCall(PetscLayoutSetUp(A->cmap));
   PetscCall(MatGetBlockSizes(A, &rbs, &cbs));
-  PetscCheck(rbs == cbs, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP, "MATSEQBINBCSR needs equal row and column block sizes, got %" PetscInt_FMT " and %" PetscInt_FMT, rbs, cbs);
-  PetscCheck(A->rmap->n % rbs == 0 && A->cmap->n % rbs == 0, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP, "Matrix sizes %" PetscInt_FMT " x %" PetscInt_FMT " are not multiples of the block size %" PetscInt_FMT, A->rmap->n, A->cmap->n, rbs);
+  PetscCheck(rbs == cbs, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP,
+             "MATSEQBINBCSR needs equal row and column block sizes, got %" PetscInt_FMT " and %" PetscInt_FMT,
+             rbs, cbs);
+  PetscCheck(A->rmap->n % rbs == 0 && A->cmap->n % rbs == 0, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP,
+             "Matrix sizes %" PetscInt_FMT " x %" PetscInt_FMT
+             " are not multiples of the block size %" PetscInt_FMT,
+             A->rmap->n, A->cmap->n, rbs);
   a->bs  = rbs;
   a->bs2 = rbs * rbs;
   a->mbs = A->rmap->n / rbs;
@@ -109,13 +114,14 @@ static PetscErrorCode MatSeqBinBCSRResetStaging(Mat A, const PetscInt *block_nnz
     a->staging->prealloc.resize(a->mbs);
     for (PetscInt r = 0; r < a->mbs; r++) {
       const PetscInt n = PetscMin(block_nnz ? block_nnz[r] : block_nz, a->nbs);
-      PetscCheck(n >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Negative preallocation %" PetscInt_FMT " for block row %" PetscInt_FMT, n, r);
+      PetscCheck(n >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+                 "Negative preallocation %" PetscInt_FMT " for block row %" PetscInt_FMT, n, r);
       a->staging->prealloc[r] = n;
       a->staging->cols[r].reserve(n);
       a->staging->vals[r].reserve(n * a->bs2);
     }
   }
-  A->preallocated = PETSC_TRUE;
+  A->preallocated  = PETSC_TRUE;
   A->was_assembled = PETSC_FALSE;
   A->assembled     = PETSC_FALSE;
   PetscFunctionReturn(0);
@@ -138,8 +144,11 @@ PetscErrorCode MatSeqAIJSetPreallocation_SeqBinBCSR(Mat A, PetscInt nz, const Pe
   PetscFunctionBegin;
   PetscCall(PetscLayoutSetUp(A->rmap));
   PetscCall(PetscLayoutSetUp(A->cmap));
-  if (A->rmap->bs != A->cmap->bs) { /* a layout the bins cannot hold (PCGAMG's prolongators, made in the operator's type) */
-    PetscCall(PetscInfo(A, "Row and column block sizes %" PetscInt_FMT " and %" PetscInt_FMT " differ: the matrix becomes %s\n", A->rmap->bs, A->cmap->bs, MATSEQAIJ));
+  if (A->rmap->bs !=
+      A->cmap->bs) { /* a layout the bins cannot hold (PCGAMG's prolongators, made in the operator's type) */
+    PetscCall(PetscInfo(
+      A, "Row and column block sizes %" PetscInt_FMT " and %" PetscInt_FMT " differ: the matrix becomes %s\n",
+      A->rmap->bs, A->cmap->bs, MATSEQAIJ));
     PetscCall(MatSetType(A, MATSEQAIJ));
     PetscCall(MatSeqAIJSetPreallocation(A, nz, nnz));
     PetscFunctionReturn(0);
@@ -165,7 +174,10 @@ PetscErrorCode MatSeqBAIJSetPreallocation_SeqBinBCSR(Mat A, PetscInt bs, PetscIn
   PetscCall(MatSetBlockSize(A, PetscAbs(bs)));
   PetscCall(PetscLayoutSetUp(A->rmap));
   PetscCall(PetscLayoutSetUp(A->cmap));
-  PetscCheck(A->rmap->bs == PetscAbs(bs), PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP, "Block size %" PetscInt_FMT " given to the preallocation differs from the matrix block size %" PetscInt_FMT, bs, A->rmap->bs);
+  PetscCheck(A->rmap->bs == PetscAbs(bs), PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP,
+             "Block size %" PetscInt_FMT
+             " given to the preallocation differs from the matrix block size %" PetscInt_FMT,
+             bs, A->rmap->bs);
   PetscCall(MatSeqBinBCSRResetStaging(A, nnz, nz == PETSC_DEFAULT || nz == PETSC_DECIDE ? 0 : nz));
   PetscFunctionReturn(0);
 }
@@ -209,10 +221,10 @@ PetscErrorCode MatSeqBinBCSRDuplicateStaging(Mat A, Mat B, PetscBool copyvalues)
 /* Staging -> bins, with the staged values. */
 static PetscErrorCode MatSeqBinBCSRBuildFromStaging(Mat A)
 {
-  Mat_SeqBinBCSR  *a = (Mat_SeqBinBCSR *)A->data;
-  BinBCSRStaging  *st = a->staging;
-  PetscInt        *bi, *bj;
-  const PetscInt   mbs = a->mbs, bs2 = a->bs2;
+  Mat_SeqBinBCSR *a  = (Mat_SeqBinBCSR *)A->data;
+  BinBCSRStaging *st = a->staging;
+  PetscInt       *bi, *bj;
+  const PetscInt  mbs = a->mbs, bs2 = a->bs2;
 
   PetscFunctionBegin;
   PetscCall(PetscMalloc1(mbs + 1, &bi));
@@ -226,7 +238,8 @@ static PetscErrorCode MatSeqBinBCSRBuildFromStaging(Mat A)
     const std::vector<MatScalar> &v = st->vals[r];
     for (PetscInt k = 0; k < bi[r + 1] - bi[r]; k++) {
       const PetscInt s = BinBCSRSlot(a, r, k);
-      for (PetscInt e = 0; e < bs2; e++) BinBCSRSetValue(a, BinBCSRValueIndex(s, e, a->bw, bs2), v[k * bs2 + e]);
+      for (PetscInt e = 0; e < bs2; e++)
+        BinBCSRSetValue(a, BinBCSRValueIndex(s, e, a->bw, bs2), v[k * bs2 + e]);
     }
   }
   delete st;
@@ -247,7 +260,8 @@ PetscErrorCode MatAssemblyEnd_SeqBinBCSR(Mat A, MatAssemblyType type)
 }
 
 /* One value into the staged pattern; `ok` is false when the location is new and ignored. */
-static PetscErrorCode StagingAdd(Mat A, Mat_SeqBinBCSR *a, PetscInt br, PetscInt bc, PetscInt e, PetscScalar v, InsertMode mode, PetscInt prow, PetscInt pcol)
+static PetscErrorCode StagingAdd(Mat A, Mat_SeqBinBCSR *a, PetscInt br, PetscInt bc, PetscInt e,
+                                 PetscScalar v, InsertMode mode, PetscInt prow, PetscInt pcol)
 {
   BinBCSRStaging        *st   = a->staging;
   std::vector<PetscInt> &cols = st->cols[br];
@@ -257,8 +271,15 @@ static PetscErrorCode StagingAdd(Mat A, Mat_SeqBinBCSR *a, PetscInt br, PetscInt
   PetscFunctionBegin;
   if (it == cols.end() || *it != bc) {
     if (a->nonew == 1) PetscFunctionReturn(0);
-    PetscCheck(a->nonew != -1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Inserting a new nonzero at (%" PetscInt_FMT ", %" PetscInt_FMT ") in the matrix (MAT_NEW_NONZERO_LOCATION_ERR is set)", prow, pcol);
-    PetscCheck(!(a->nonew == -2 && !st->prealloc.empty() && (PetscInt)cols.size() >= st->prealloc[br]), PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "New nonzero at (%" PetscInt_FMT ", %" PetscInt_FMT ") exceeds the preallocation (MAT_NEW_NONZERO_ALLOCATION_ERR is set)", prow, pcol);
+    PetscCheck(a->nonew != -1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+               "Inserting a new nonzero at (%" PetscInt_FMT ", %" PetscInt_FMT
+               ") in the matrix (MAT_NEW_NONZERO_LOCATION_ERR is set)",
+               prow, pcol);
+    PetscCheck(!(a->nonew == -2 && !st->prealloc.empty() && (PetscInt)cols.size() >= st->prealloc[br]),
+               PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+               "New nonzero at (%" PetscInt_FMT ", %" PetscInt_FMT
+               ") exceeds the preallocation (MAT_NEW_NONZERO_ALLOCATION_ERR is set)",
+               prow, pcol);
     cols.insert(it, bc);
     st->vals[br].insert(st->vals[br].begin() + k * a->bs2, (size_t)a->bs2, 0.0);
   }
@@ -270,7 +291,8 @@ static PetscErrorCode StagingAdd(Mat A, Mat_SeqBinBCSR *a, PetscInt br, PetscInt
 
 /* One value into the frozen layout. `cache` keeps the last block found: element matrices hit the
    same block bs times in a row. */
-static inline PetscErrorCode LayoutAdd(Mat_SeqBinBCSR *a, PetscInt br, PetscInt bc, PetscInt e, PetscScalar v, InsertMode mode, PetscInt prow, PetscInt pcol, PetscInt cache[3])
+static inline PetscErrorCode LayoutAdd(Mat_SeqBinBCSR *a, PetscInt br, PetscInt bc, PetscInt e, PetscScalar v,
+                                       InsertMode mode, PetscInt prow, PetscInt pcol, PetscInt cache[3])
 {
   PetscInt s;
 
@@ -283,7 +305,11 @@ static inline PetscErrorCode LayoutAdd(Mat_SeqBinBCSR *a, PetscInt br, PetscInt 
     cache[2] = s;
   }
   if (s < 0) {
-    PetscCheck(a->nonew == 1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "New nonzero at (%" PetscInt_FMT ", %" PetscInt_FMT "): the pattern of a MATSEQBINBCSR matrix is frozen at its first final assembly (use MatSetOption(A, MAT_NEW_NONZERO_LOCATIONS, PETSC_FALSE) to ignore new locations)", prow, pcol);
+    PetscCheck(
+      a->nonew == 1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+      "New nonzero at (%" PetscInt_FMT ", %" PetscInt_FMT
+      "): the pattern of a MATSEQBINBCSR matrix is frozen at its first final assembly (use MatSetOption(A, MAT_NEW_NONZERO_LOCATIONS, PETSC_FALSE) to ignore new locations)",
+      prow, pcol);
     PetscFunctionReturn(0);
   }
   {
@@ -294,24 +320,29 @@ static inline PetscErrorCode LayoutAdd(Mat_SeqBinBCSR *a, PetscInt br, PetscInt 
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode MatSetValues_SeqBinBCSR(Mat A, PetscInt m, const PetscInt im[], PetscInt n, const PetscInt in[], const PetscScalar v[], InsertMode mode)
+PetscErrorCode MatSetValues_SeqBinBCSR(Mat A, PetscInt m, const PetscInt im[], PetscInt n,
+                                       const PetscInt in[], const PetscScalar v[], InsertMode mode)
 {
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  Mat_SeqBinBCSR *a        = (Mat_SeqBinBCSR *)A->data;
   PetscInt        cache[3] = {-1, -1, -1};
 
   PetscFunctionBegin;
   if (!a->built && !a->staging) PetscCall(MatSetUp_SeqBinBCSR(A));
-  PetscCheck(PetscAbs(A->rmap->bs) == a->bs, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP, "Block size changed from %" PetscInt_FMT " to %" PetscInt_FMT " after preallocation", a->bs, A->rmap->bs);
+  PetscCheck(PetscAbs(A->rmap->bs) == a->bs, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP,
+             "Block size changed from %" PetscInt_FMT " to %" PetscInt_FMT " after preallocation", a->bs,
+             A->rmap->bs);
   for (PetscInt i = 0; i < m; i++) {
     const PetscInt r = im[i];
     if (r < 0) continue;
-    PetscCheck(r < A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", r, A->rmap->n);
+    PetscCheck(r < A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+               "Row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", r, A->rmap->n);
     const PetscInt br = r / a->bs, ri = r % a->bs;
     for (PetscInt j = 0; j < n; j++) {
       const PetscInt c = in[j];
       if (c < 0) continue;
-      PetscCheck(c < A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", c, A->cmap->n);
-      const PetscScalar x = v ? (a->roworiented ? v[i * n + j] : v[j * m + i]) : 0.0;
+      PetscCheck(c < A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+                 "Column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", c, A->cmap->n);
+      const PetscScalar x  = v ? (a->roworiented ? v[i * n + j] : v[j * m + i]) : 0.0;
       const PetscInt    bc = c / a->bs, e = ri * a->bs + c % a->bs;
       if (a->sym && bc < br) continue; /* symmetric storage: the lower triangle is implied */
       if (a->built) PetscCall(LayoutAdd(a, br, bc, e, x, mode, r, c, cache));
@@ -321,29 +352,36 @@ PetscErrorCode MatSetValues_SeqBinBCSR(Mat A, PetscInt m, const PetscInt im[], P
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode MatSetValuesBlocked_SeqBinBCSR(Mat A, PetscInt m, const PetscInt im[], PetscInt n, const PetscInt in[], const PetscScalar v[], InsertMode mode)
+PetscErrorCode MatSetValuesBlocked_SeqBinBCSR(Mat A, PetscInt m, const PetscInt im[], PetscInt n,
+                                              const PetscInt in[], const PetscScalar v[], InsertMode mode)
 {
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  Mat_SeqBinBCSR *a        = (Mat_SeqBinBCSR *)A->data;
   PetscInt        cache[3] = {-1, -1, -1}, bs;
 
   PetscFunctionBegin;
   if (!a->built && !a->staging) PetscCall(MatSetUp_SeqBinBCSR(A));
-  PetscCheck(PetscAbs(A->rmap->bs) == a->bs, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP, "Block size changed from %" PetscInt_FMT " to %" PetscInt_FMT " after preallocation", a->bs, A->rmap->bs);
+  PetscCheck(PetscAbs(A->rmap->bs) == a->bs, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP,
+             "Block size changed from %" PetscInt_FMT " to %" PetscInt_FMT " after preallocation", a->bs,
+             A->rmap->bs);
   bs = a->bs;
   for (PetscInt i = 0; i < m; i++) {
     const PetscInt br = im[i];
     if (br < 0) continue;
-    PetscCheck(br < a->mbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Block row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", br, a->mbs);
+    PetscCheck(br < a->mbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+               "Block row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", br, a->mbs);
     for (PetscInt j = 0; j < n; j++) {
       const PetscInt bc = in[j];
       if (bc < 0) continue;
-      PetscCheck(bc < a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Block column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", bc, a->nbs);
+      PetscCheck(bc < a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+                 "Block column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", bc, a->nbs);
       if (a->sym && bc < br) continue; /* symmetric storage: the lower triangle is implied */
       for (PetscInt ii = 0; ii < bs; ii++) {
         for (PetscInt jj = 0; jj < bs; jj++) {
           const PetscInt    prow = i * bs + ii, pcol = j * bs + jj;
-          const PetscScalar x    = v ? (a->roworiented ? v[prow * (n * bs) + pcol] : v[pcol * (m * bs) + prow]) : 0.0;
-          if (a->built) PetscCall(LayoutAdd(a, br, bc, ii * bs + jj, x, mode, br * bs + ii, bc * bs + jj, cache));
+          const PetscScalar x =
+            v ? (a->roworiented ? v[prow * (n * bs) + pcol] : v[pcol * (m * bs) + prow]) : 0.0;
+          if (a->built)
+            PetscCall(LayoutAdd(a, br, bc, ii * bs + jj, x, mode, br * bs + ii, bc * bs + jj, cache));
           else PetscCall(StagingAdd(A, a, br, bc, ii * bs + jj, x, mode, br * bs + ii, bc * bs + jj));
         }
       }
@@ -352,27 +390,35 @@ PetscErrorCode MatSetValuesBlocked_SeqBinBCSR(Mat A, PetscInt m, const PetscInt 
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode MatGetValues_SeqBinBCSR(Mat A, PetscInt m, const PetscInt im[], PetscInt n, const PetscInt in[], PetscScalar v[])
+PetscErrorCode MatGetValues_SeqBinBCSR(Mat A, PetscInt m, const PetscInt im[], PetscInt n,
+                                       const PetscInt in[], PetscScalar v[])
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
 
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatGetValues needs an assembled MATSEQBINBCSR matrix");
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MatGetValues needs an assembled MATSEQBINBCSR matrix");
   for (PetscInt i = 0; i < m; i++) {
     const PetscInt r = im[i];
     if (r < 0) continue;
-    PetscCheck(r < A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", r, A->rmap->n);
+    PetscCheck(r < A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+               "Row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", r, A->rmap->n);
     for (PetscInt j = 0; j < n; j++) {
       const PetscInt c = in[j];
       if (c < 0) continue;
-      PetscCheck(c < A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", c, A->cmap->n);
+      PetscCheck(c < A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+                 "Column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", c, A->cmap->n);
       if (a->sym && c / a->bs < r / a->bs) { /* the transposed entry of the stored upper block */
         const PetscInt s = MatSeqBinBCSRFindSlot(a, c / a->bs, r / a->bs);
-        v[i * n + j]     = s < 0 ? 0.0 : BinBCSRGetValue(a, BinBCSRValueIndex(s, (c % a->bs) * a->bs + r % a->bs, a->bw, a->bs2));
+        v[i * n + j] =
+          s < 0 ? 0.0
+                : BinBCSRGetValue(a, BinBCSRValueIndex(s, (c % a->bs) * a->bs + r % a->bs, a->bw, a->bs2));
         continue;
       }
       const PetscInt s = MatSeqBinBCSRFindSlot(a, r / a->bs, c / a->bs);
-      v[i * n + j]     = s < 0 ? 0.0 : BinBCSRGetValue(a, BinBCSRValueIndex(s, (r % a->bs) * a->bs + c % a->bs, a->bw, a->bs2));
+      v[i * n + j] =
+        s < 0 ? 0.0
+              : BinBCSRGetValue(a, BinBCSRValueIndex(s, (r % a->bs) * a->bs + c % a->bs, a->bw, a->bs2));
     }
   }
   PetscFunctionReturn(0);

@@ -20,17 +20,24 @@ PetscInt MatSeqBinBCSRFindSlot(const Mat_SeqBinBCSR *a, PetscInt brow, PetscInt 
 /* The symmetric-storage part of MatSeqBinBCSRBuildLayout: bins ordered by the colouring. */
 static PetscErrorCode MatSeqBinBCSRBuildLayoutSym(Mat A, const PetscInt bi[], const PetscInt bj[])
 {
-  Mat_SeqBinBCSR       *a = (Mat_SeqBinBCSR *)A->data;
+  Mat_SeqBinBCSR       *a  = (Mat_SeqBinBCSR *)A->data;
   const PetscInt        bw = a->bw, mbs = a->mbs, nbins = a->nbins;
   std::vector<PetscInt> slot_col, entry_k, colid(a->nbs, -1), allcol;
 
   PetscFunctionBegin;
-  PetscCheck(A->rmap->n == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Symmetric storage needs a square matrix, this one is %" PetscInt_FMT " x %" PetscInt_FMT, A->rmap->n, A->cmap->n);
+  PetscCheck(A->rmap->n == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+             "Symmetric storage needs a square matrix, this one is %" PetscInt_FMT " x %" PetscInt_FMT,
+             A->rmap->n, A->cmap->n);
   for (PetscInt r = 0; r < mbs; r++) {
-    PetscCheck(bi[r + 1] - bi[r] >= 0 && bi[r + 1] - bi[r] <= a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_CORRUPT, "Block row %" PetscInt_FMT " has %" PetscInt_FMT " blocks", r, bi[r + 1] - bi[r]);
+    PetscCheck(bi[r + 1] - bi[r] >= 0 && bi[r + 1] - bi[r] <= a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_CORRUPT,
+               "Block row %" PetscInt_FMT " has %" PetscInt_FMT " blocks", r, bi[r + 1] - bi[r]);
     for (PetscInt p = bi[r]; p < bi[r + 1]; p++) {
-      PetscCheck(bj[p] >= 0 && bj[p] < a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Block column %" PetscInt_FMT " of block row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", bj[p], r, a->nbs);
-      PetscCheck(p == bi[r] || bj[p] > bj[p - 1], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Block columns of block row %" PetscInt_FMT " are not sorted and unique", r);
+      PetscCheck(bj[p] >= 0 && bj[p] < a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+                 "Block column %" PetscInt_FMT " of block row %" PetscInt_FMT
+                 " out of range [0, %" PetscInt_FMT ")",
+                 bj[p], r, a->nbs);
+      PetscCheck(p == bi[r] || bj[p] > bj[p - 1], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
+                 "Block columns of block row %" PetscInt_FMT " are not sorted and unique", r);
     }
   }
   PetscCall(PetscMalloc1(mbs + 1, &a->row_off));
@@ -48,14 +55,15 @@ static PetscErrorCode MatSeqBinBCSRBuildLayoutSym(Mat A, const PetscInt bi[], co
     const PetscInt r0 = b * bw;
     entry_k.clear();
     const PetscInt len = MatSeqBinBCSRColourBin(bw, r0, mbs, bi, bj, slot_col, entry_k, colid);
-    PetscCheck((PetscInt64)a->bin_start[b] + (PetscInt64)len * bw <= PETSC_MAX_INT / PetscMax(a->bs2, 1), PETSC_COMM_SELF, PETSC_ERR_SUP, "Matrix too large for 32-bit slot indices");
+    PetscCheck((PetscInt64)a->bin_start[b] + (PetscInt64)len * bw <= PETSC_MAX_INT / PetscMax(a->bs2, 1),
+               PETSC_COMM_SELF, PETSC_ERR_SUP, "Matrix too large for 32-bit slot indices");
     a->bin_start[b + 1] = a->bin_start[b] + len * bw;
     allcol.insert(allcol.end(), slot_col.begin(), slot_col.end());
     size_t e = 0;
     for (PetscInt r = r0; r < PetscMin(mbs, r0 + bw); r++) {
       a->diag_slot[r] = -1;
       for (PetscInt k = 0; k < a->row_nz[r]; k++, e++) {
-        const PetscInt s                 = a->bin_start[b] + entry_k[e] * bw + (r - r0);
+        const PetscInt s                = a->bin_start[b] + entry_k[e] * bw + (r - r0);
         a->real_slot[a->row_off[r] + k] = s;
         if (allcol[s] == r) a->diag_slot[r] = s;
       }
@@ -64,9 +72,12 @@ static PetscErrorCode MatSeqBinBCSRBuildLayoutSym(Mat A, const PetscInt bi[], co
   a->nslots = a->bin_start[nbins];
   PetscCall(PetscMalloc1(a->nslots, &a->col));
   std::copy(allcol.begin(), allcol.end(), a->col);
-  if (a->precision == MAT_BINBCSR_PRECISION_DOUBLE) PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->val));
+  if (a->precision == MAT_BINBCSR_PRECISION_DOUBLE)
+    PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->val));
   else PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->valf));
-  PetscCall(PetscMalloc2((size_t)PetscMax(a->nbs, 1) * a->bs, &a->rowbuf_cols, (size_t)PetscMax(a->nbs, 1) * a->bs, &a->rowbuf_vals)); /* a full row, both triangles */
+  PetscCall(PetscMalloc2((size_t)PetscMax(a->nbs, 1) * a->bs, &a->rowbuf_cols,
+                         (size_t)PetscMax(a->nbs, 1) * a->bs,
+                         &a->rowbuf_vals)); /* a full row, both triangles */
   a->built        = PETSC_TRUE;
   A->preallocated = PETSC_TRUE;
   A->nonzerostate++;
@@ -115,16 +126,16 @@ PetscErrorCode MatSeqBinBCSRBuildLayout(Mat A, const PetscInt bi[], const PetscI
   if (!a->streams_set) a->streams = BINBCSR_DEFAULT_STREAMS;
   PetscCall(MatSeqBinBCSRTune(A, bi, bj)); /* outside the build's log event: it has its own */
   PetscCall(PetscLogEventBegin(MAT_BinBCSR_BuildLayout, A, 0, 0, 0));
-  bw = a->bw;
-  mbs = a->mbs;
-  nbins = (mbs + bw - 1) / bw;
+  bw       = a->bw;
+  mbs      = a->mbs;
+  nbins    = (mbs + bw - 1) / bw;
   a->nbins = nbins;
   PetscCall(PetscMalloc1(nbins + 1, &a->bin_start));
   PetscCall(PetscMalloc1(mbs, &a->row_nz));
   PetscCall(PetscMalloc1(mbs, &a->diag_slot));
   a->bin_start[0] = 0;
-  a->nz = 0;
-  a->max_row_nz = 0;
+  a->nz           = 0;
+  a->max_row_nz   = 0;
   if (a->sym) {
     PetscCall(MatSeqBinBCSRBuildLayoutSym(A, bi, bj));
     PetscCall(PetscLogEventEnd(MAT_BinBCSR_BuildLayout, A, 0, 0, 0));
@@ -132,26 +143,34 @@ PetscErrorCode MatSeqBinBCSRBuildLayout(Mat A, const PetscInt bi[], const PetscI
   }
   for (PetscInt r = 0; r < mbs; r++) {
     const PetscInt n = bi[r + 1] - bi[r];
-    PetscCheck(n >= 0 && n <= a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_CORRUPT, "Block row %" PetscInt_FMT " has %" PetscInt_FMT " blocks", r, n);
+    PetscCheck(n >= 0 && n <= a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_CORRUPT,
+               "Block row %" PetscInt_FMT " has %" PetscInt_FMT " blocks", r, n);
     for (PetscInt p = bi[r]; p < bi[r + 1]; p++) {
-      PetscCheck(bj[p] >= 0 && bj[p] < a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Block column %" PetscInt_FMT " of block row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", bj[p], r, a->nbs);
-      PetscCheck(p == bi[r] || bj[p] > bj[p - 1], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Block columns of block row %" PetscInt_FMT " are not sorted and unique", r);
+      PetscCheck(bj[p] >= 0 && bj[p] < a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+                 "Block column %" PetscInt_FMT " of block row %" PetscInt_FMT
+                 " out of range [0, %" PetscInt_FMT ")",
+                 bj[p], r, a->nbs);
+      PetscCheck(p == bi[r] || bj[p] > bj[p - 1], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
+                 "Block columns of block row %" PetscInt_FMT " are not sorted and unique", r);
     }
-    a->row_nz[r]  = n;
-    a->nz        += n;
+    a->row_nz[r] = n;
+    a->nz += n;
     a->max_row_nz = PetscMax(a->max_row_nz, n);
   }
   {
     const long nslots = binbcsr::bin_starts<PetscInt>(bi, mbs, bw, a->bin_start);
-    PetscCheck(nslots <= PETSC_MAX_INT / PetscMax(a->bs2, 1), PETSC_COMM_SELF, PETSC_ERR_SUP, "Matrix too large for 32-bit slot indices");
+    PetscCheck(nslots <= PETSC_MAX_INT / PetscMax(a->bs2, 1), PETSC_COMM_SELF, PETSC_ERR_SUP,
+               "Matrix too large for 32-bit slot indices");
     a->nslots = (PetscInt)nslots;
   }
   PetscCall(PetscMalloc1(a->nslots, &a->col));
-  if (a->precision == MAT_BINBCSR_PRECISION_DOUBLE) PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->val));
+  if (a->precision == MAT_BINBCSR_PRECISION_DOUBLE)
+    PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->val));
   else PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->valf));
   binbcsr::bin_columns<PetscInt>(bi, bj, mbs, bw, a->bin_start, a->col, a->diag_slot);
-  PetscCall(PetscMalloc2((size_t)a->max_row_nz * a->bs, &a->rowbuf_cols, (size_t)a->max_row_nz * a->bs, &a->rowbuf_vals));
-  a->built = PETSC_TRUE;
+  PetscCall(PetscMalloc2((size_t)a->max_row_nz * a->bs, &a->rowbuf_cols, (size_t)a->max_row_nz * a->bs,
+                         &a->rowbuf_vals));
+  a->built        = PETSC_TRUE;
   A->preallocated = PETSC_TRUE; /* a layout is an allocation, however it was built (convert, load, ...) */
   A->nonzerostate++;
   PetscCall(PetscLogEventEnd(MAT_BinBCSR_BuildLayout, A, 0, 0, 0));

@@ -18,7 +18,9 @@
 #include "binbcsr.h"
 #include <algorithm>
 
-PetscInt MatSeqBinBCSRColourBin(PetscInt bw, PetscInt r0, PetscInt mbs, const PetscInt bi[], const PetscInt bj[], std::vector<PetscInt> &slot_col, std::vector<PetscInt> &entry_k, std::vector<PetscInt> &colid)
+PetscInt MatSeqBinBCSRColourBin(PetscInt bw, PetscInt r0, PetscInt mbs, const PetscInt bi[],
+                                const PetscInt bj[], std::vector<PetscInt> &slot_col,
+                                std::vector<PetscInt> &entry_k, std::vector<PetscInt> &colid)
 {
   const PetscInt        nl = PetscMin(bw, mbs - r0);
   std::vector<PetscInt> first(nl), cols_used, mult, lane_at, col_at;
@@ -50,8 +52,8 @@ PetscInt MatSeqBinBCSRColourBin(PetscInt bw, PetscInt r0, PetscInt mbs, const Pe
 
   /* Koenig colouring of the off-diagonal blocks with D colours */
   const PetscInt ncols = (PetscInt)cols_used.size();
-  lane_at.assign((size_t)nl * D, -1);    /* [lane][colour] -> local column */
-  col_at.assign((size_t)ncols * D, -1);  /* [column][colour] -> lane */
+  lane_at.assign((size_t)nl * D, -1);   /* [lane][colour] -> local column */
+  col_at.assign((size_t)ncols * D, -1); /* [column][colour] -> lane */
   std::vector<PetscInt> path_lane, path_col, path_colour;
   for (PetscInt u = 0; u < nl; u++) {
     const PetscInt r = r0 + u;
@@ -84,9 +86,9 @@ PetscInt MatSeqBinBCSRColourBin(PetscInt bw, PetscInt r0, PetscInt mbs, const Pe
           col_at[path_col[e] * D + path_colour[e]]   = -1;
         }
         for (size_t e = 0; e < path_lane.size(); e++) {
-          const PetscInt nc                 = path_colour[e] == a ? b : a;
-          lane_at[path_lane[e] * D + nc]    = path_col[e];
-          col_at[path_col[e] * D + nc]      = path_lane[e];
+          const PetscInt nc              = path_colour[e] == a ? b : a;
+          lane_at[path_lane[e] * D + nc] = path_col[e];
+          col_at[path_col[e] * D + nc]   = path_lane[e];
         }
       }
       lane_at[u * D + a] = v;
@@ -97,9 +99,9 @@ PetscInt MatSeqBinBCSRColourBin(PetscInt bw, PetscInt r0, PetscInt mbs, const Pe
   /* slots: coloured blocks at their colour, then the diagonal block and padding in the free slots */
   slot_col.assign((size_t)L * bw, 0);
   for (PetscInt l = 0; l < bw; l++) {
-    const PetscInt r   = r0 + l;
-    const PetscInt own = r < mbs ? r : mbs - 1;
-    PetscInt       diag_k = -1;
+    const PetscInt    r      = r0 + l;
+    const PetscInt    own    = r < mbs ? r : mbs - 1;
+    PetscInt          diag_k = -1;
     std::vector<char> used(L, 0);
     if (l < nl)
       for (PetscInt k = 0; k < D; k++)

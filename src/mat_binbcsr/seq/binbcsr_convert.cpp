@@ -11,9 +11,12 @@ PetscErrorCode MatGetRow_SeqBinBCSR(Mat A, PetscInt row, PetscInt *nz, PetscInt 
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
 
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatGetRow needs an assembled MATSEQBINBCSR matrix");
-  PetscCheck(row >= 0 && row < A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", row, A->rmap->n);
-  PetscCheck(!a->getrowactive, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatRestoreRow the previous row first");
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MatGetRow needs an assembled MATSEQBINBCSR matrix");
+  PetscCheck(row >= 0 && row < A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+             "Row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", row, A->rmap->n);
+  PetscCheck(!a->getrowactive, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MatRestoreRow the previous row first");
   const PetscInt bs = a->bs, br = row / bs, ri = row % bs;
   PetscInt       n = 0;
   if (a->sym) { /* the full row: the transposed blocks (c, br), c < br, then the stored ones */
@@ -69,23 +72,23 @@ static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues
   const size_t    nv = (size_t)a->nslots * a->bs2;
 
   PetscFunctionBegin;
-  b->bw          = a->bw;
-  b->bw_set      = a->bw_set;
-  b->precision   = a->precision;
-  b->nonew       = a->nonew;
-  b->roworiented = a->roworiented;
-  b->streams     = a->streams;
-  b->streams_set = a->streams_set;
-  b->kernel      = a->kernel;
+  b->bw           = a->bw;
+  b->bw_set       = a->bw_set;
+  b->precision    = a->precision;
+  b->nonew        = a->nonew;
+  b->roworiented  = a->roworiented;
+  b->streams      = a->streams;
+  b->streams_set  = a->streams_set;
+  b->kernel       = a->kernel;
   b->kernel_tuned = a->kernel_tuned;
-  b->tune        = a->tune;
-  b->tune_cache  = a->tune_cache;
+  b->tune         = a->tune;
+  b->tune_cache   = a->tune_cache;
   PetscCall(PetscStrncpy(b->tune_info, a->tune_info, sizeof(b->tune_info)));
-  b->sym         = a->sym;
-  b->bs          = a->bs;
-  b->bs2         = a->bs2;
-  b->mbs         = a->mbs;
-  b->nbs         = a->nbs;
+  b->sym = a->sym;
+  b->bs  = a->bs;
+  b->bs2 = a->bs2;
+  b->mbs = a->mbs;
+  b->nbs = a->nbs;
   if (a->built) {
     b->nbins      = a->nbins;
     b->nslots     = a->nslots;
@@ -150,16 +153,19 @@ PetscErrorCode MatDuplicate_SeqBinBCSR(Mat A, MatDuplicateOption op, Mat *M)
 /* Same pattern: copy values (converting precision); otherwise row by row through MatSetValues. */
 PetscErrorCode MatCopy_SeqBinBCSR(Mat A, Mat B, MatStructure str)
 {
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  Mat_SeqBinBCSR *a    = (Mat_SeqBinBCSR *)A->data;
   PetscBool       same = PETSC_FALSE, isbin;
 
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatCopy needs an assembled MATSEQBINBCSR matrix");
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MatCopy needs an assembled MATSEQBINBCSR matrix");
   PetscCall(PetscObjectTypeCompare((PetscObject)B, MATSEQBINBCSR, &isbin));
   if (isbin) {
     Mat_SeqBinBCSR *b = (Mat_SeqBinBCSR *)B->data;
-    PetscCheck(b->bs == a->bs || !b->built, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP, "Block sizes differ: %" PetscInt_FMT " and %" PetscInt_FMT, a->bs, b->bs);
-    if (b->built && b->bw == a->bw && b->mbs == a->mbs && b->nbs == a->nbs && b->nslots == a->nslots && b->sym == a->sym) {
+    PetscCheck(b->bs == a->bs || !b->built, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP,
+               "Block sizes differ: %" PetscInt_FMT " and %" PetscInt_FMT, a->bs, b->bs);
+    if (b->built && b->bw == a->bw && b->mbs == a->mbs && b->nbs == a->nbs && b->nslots == a->nslots &&
+        b->sym == a->sym) {
       same = (PetscBool)(str == SAME_NONZERO_PATTERN);
       if (!same) {
         PetscCall(PetscArraycmp(a->bin_start, b->bin_start, a->nbins + 1, &same));
@@ -206,7 +212,8 @@ PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat A, MatType type, MatReuse reuse, Ma
        its own conversion to seqaij */
     Mat T, C = reuse == MAT_REUSE_MATRIX ? *newmat : nullptr;
     PetscCall(MatConvert(A, MATSEQAIJ, MAT_INITIAL_MATRIX, &T));
-    PetscCall(MatConvertFrom_SeqBinBCSR(T, type, reuse == MAT_REUSE_MATRIX ? MAT_REUSE_MATRIX : MAT_INITIAL_MATRIX, &C));
+    PetscCall(MatConvertFrom_SeqBinBCSR(
+      T, type, reuse == MAT_REUSE_MATRIX ? MAT_REUSE_MATRIX : MAT_INITIAL_MATRIX, &C));
     PetscCall(MatDestroy(&T));
     if (reuse == MAT_INPLACE_MATRIX) PetscCall(MatHeaderReplace(A, &C));
     else *newmat = C;
@@ -216,7 +223,9 @@ PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat A, MatType type, MatReuse reuse, Ma
   mbs = m / bs;
   if (reuse == MAT_REUSE_MATRIX) {
     B = *newmat;
-    PetscCheck(B->rmap->bs == bs || bs == 1, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP, "Block size of the reused matrix %" PetscInt_FMT " differs from %" PetscInt_FMT, B->rmap->bs, bs);
+    PetscCheck(B->rmap->bs == bs || bs == 1, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP,
+               "Block size of the reused matrix %" PetscInt_FMT " differs from %" PetscInt_FMT, B->rmap->bs,
+               bs);
   } else {
     PetscCall(MatCreate(PetscObjectComm((PetscObject)A), &B));
     PetscCall(MatSetSizes(B, A->rmap->n, A->cmap->n, A->rmap->N, A->cmap->N));
@@ -224,7 +233,7 @@ PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat A, MatType type, MatReuse reuse, Ma
     PetscCall(MatSetType(B, type));
     PetscCall(MatBinBCSRSetFromOptions(B)); /* the -mat_binbcsr_* options apply to converted matrices too */
   }
-  bs = PetscAbs(B->rmap->bs);
+  bs  = PetscAbs(B->rmap->bs);
   mbs = m / bs;
   /* block pattern: the union of the block columns of each block row's point rows */
   PetscCall(PetscMalloc1(mbs + 1, &bi));
@@ -257,11 +266,16 @@ PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat A, MatType type, MatReuse reuse, Ma
       for (PetscInt p = 0; p < n; p++) { /* both sorted: walk the block row */
         const PetscInt bc = cols[p] / bs;
         if (b->sym) { /* upper triangle only, slots where the colouring put them */
-          if (bc >= br) BinBCSRSetValue(b, BinBCSRValueIndex(MatSeqBinBCSRFindSlot(b, br, bc), (r % bs) * bs + cols[p] % bs, b->bw, b->bs2), vals[p]);
+          if (bc >= br)
+            BinBCSRSetValue(b,
+                            BinBCSRValueIndex(MatSeqBinBCSRFindSlot(b, br, bc), (r % bs) * bs + cols[p] % bs,
+                                              b->bw, b->bs2),
+                            vals[p]);
           continue;
         }
         while (bj[bi[br] + k] != bc) k++;
-        BinBCSRSetValue(b, BinBCSRValueIndex(BinBCSRSlot(b, br, k), (r % bs) * bs + cols[p] % bs, b->bw, b->bs2), vals[p]);
+        BinBCSRSetValue(
+          b, BinBCSRValueIndex(BinBCSRSlot(b, br, k), (r % bs) * bs + cols[p] % bs, b->bw, b->bs2), vals[p]);
       }
       PetscCall(MatRestoreRow(A, r, &n, &cols, &vals));
     }
@@ -276,7 +290,8 @@ PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat A, MatType type, MatReuse reuse, Ma
 }
 
 /* MATSEQBINBCSR -> seqaij (bs 1 rows) or seqbaij (bs x bs blocks). */
-static PetscErrorCode MatConvert_SeqBinBCSR_XAIJ(Mat A, MatType newtype, MatReuse reuse, Mat *newmat, PetscBool blocked)
+static PetscErrorCode MatConvert_SeqBinBCSR_XAIJ(Mat A, MatType newtype, MatReuse reuse, Mat *newmat,
+                                                 PetscBool blocked)
 {
   Mat_SeqBinBCSR *a  = (Mat_SeqBinBCSR *)A->data;
   const PetscInt  bs = a->bs, bs2 = a->bs2;
@@ -285,7 +300,8 @@ static PetscErrorCode MatConvert_SeqBinBCSR_XAIJ(Mat A, MatType newtype, MatReus
   PetscScalar    *vals;
 
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatConvert needs an assembled MATSEQBINBCSR matrix");
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MatConvert needs an assembled MATSEQBINBCSR matrix");
   if (a->sym) { /* both triangles, through the full rows */
     if (reuse == MAT_REUSE_MATRIX) {
       B = *newmat;
@@ -294,7 +310,8 @@ static PetscErrorCode MatConvert_SeqBinBCSR_XAIJ(Mat A, MatType newtype, MatReus
       PetscCall(MatBinBCSRCreateLike_Private(A, newtype, &B));
       PetscCall(MatSeqBinBCSRBuildLowerIndex(a));
       PetscCall(PetscMalloc1(A->rmap->n, &nnz));
-      for (PetscInt r = 0; r < A->rmap->n; r++) nnz[r] = (a->row_nz[r / bs] + a->lower_off[r / bs + 1] - a->lower_off[r / bs]) * (blocked ? 1 : bs);
+      for (PetscInt r = 0; r < A->rmap->n; r++)
+        nnz[r] = (a->row_nz[r / bs] + a->lower_off[r / bs + 1] - a->lower_off[r / bs]) * (blocked ? 1 : bs);
       if (blocked) {
         PetscInt *bnnz;
         PetscCall(PetscMalloc1(a->mbs, &bnnz));
@@ -331,7 +348,8 @@ static PetscErrorCode MatConvert_SeqBinBCSR_XAIJ(Mat A, MatType newtype, MatReus
     for (PetscInt k = 0; k < n; k++) {
       const PetscInt s = BinBCSRSlot(a, br, k);
       for (PetscInt i = 0; i < bs; i++)
-        for (PetscInt j = 0; j < bs; j++) vals[i * n * bs + k * bs + j] = BinBCSRGetValue(a, BinBCSRValueIndex(s, i * bs + j, a->bw, bs2));
+        for (PetscInt j = 0; j < bs; j++)
+          vals[i * n * bs + k * bs + j] = BinBCSRGetValue(a, BinBCSRValueIndex(s, i * bs + j, a->bw, bs2));
     }
     if (blocked) PetscCall(MatSetValuesBlocked(B, 1, &br, n, cols, vals, INSERT_VALUES));
     else {
@@ -390,31 +408,65 @@ PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
   PetscCall(PetscViewerGetFormat(viewer, &format));
   if (format == PETSC_VIEWER_ASCII_FACTOR_INFO) PetscFunctionReturn(0);
   if (format == PETSC_VIEWER_ASCII_INFO || format == PETSC_VIEWER_ASCII_INFO_DETAIL) {
-    const size_t vbytes = (size_t)a->nslots * a->bs2 * (a->precision == MAT_BINBCSR_PRECISION_DOUBLE ? sizeof(MatScalar) : sizeof(float));
+    const size_t vbytes = (size_t)a->nslots * a->bs2 *
+                          (a->precision == MAT_BINBCSR_PRECISION_DOUBLE ? sizeof(MatScalar) : sizeof(float));
     const size_t ibytes = (size_t)a->nslots * sizeof(PetscInt) + (size_t)(a->nbins + 1) * sizeof(PetscInt);
-    PetscCall(PetscViewerASCIIPrintf(viewer, "%s, block size %" PetscInt_FMT ", bin width %" PetscInt_FMT ", values in %s precision (double accumulation)\n", a->bs == 1 ? "BIN-CSR" : "BIN-BCSR", a->bs, a->bw, MatBinBCSRPrecisions[a->precision]));
+    PetscCall(PetscViewerASCIIPrintf(viewer,
+                                     "%s, block size %" PetscInt_FMT ", bin width %" PetscInt_FMT
+                                     ", values in %s precision (double accumulation)\n",
+                                     a->bs == 1 ? "BIN-CSR" : "BIN-BCSR", a->bs, a->bw,
+                                     MatBinBCSRPrecisions[a->precision]));
     if (!a->built) {
-      PetscCall(PetscViewerASCIIPrintf(viewer, "bin layout not built yet (built at the first final assembly)\n"));
+      PetscCall(
+        PetscViewerASCIIPrintf(viewer, "bin layout not built yet (built at the first final assembly)\n"));
       PetscFunctionReturn(0);
     }
-    PetscCall(PetscViewerASCIIPrintf(viewer, "bins %" PetscInt_FMT ", stored blocks %" PetscInt_FMT ", slots %" PetscInt_FMT " (padding overhead %.2f%%), longest row %" PetscInt_FMT " blocks\n", a->nbins, a->nz, a->nslots, a->nz ? 100.0 * (double)(a->nslots - a->nz) / (double)a->nz : 0.0, a->max_row_nz));
-    PetscCall(PetscViewerASCIIPrintf(viewer, "bytes: values %zu, indices %zu (column per slot and bin offsets)\n", vbytes, ibytes));
-    if ((a->bs == 1 || a->bs == 3) && (a->bw == 4 || a->bw == 8 || a->bw == 16 || a->bw == 32)) { /* the shapes of the vectorised sweeps */
+    PetscCall(PetscViewerASCIIPrintf(
+      viewer,
+      "bins %" PetscInt_FMT ", stored blocks %" PetscInt_FMT ", slots %" PetscInt_FMT
+      " (padding overhead %.2f%%), longest row %" PetscInt_FMT " blocks\n",
+      a->nbins, a->nz, a->nslots, a->nz ? 100.0 * (double)(a->nslots - a->nz) / (double)a->nz : 0.0,
+      a->max_row_nz));
+    PetscCall(PetscViewerASCIIPrintf(
+      viewer, "bytes: values %zu, indices %zu (column per slot and bin offsets)\n", vbytes, ibytes));
+    if ((a->bs == 1 || a->bs == 3) &&
+        (a->bw == 4 || a->bw == 8 || a->bw == 16 || a->bw == 32)) { /* the shapes of the vectorised sweeps */
       const PetscInt groups = a->nslots / a->bw, unit = MatSeqBinBCSRCountUnitStrideGroups(a);
-      PetscCall(PetscViewerASCIIPrintf(viewer, "slot groups over consecutive block columns (x%s read without gathers): %" PetscInt_FMT " of %" PetscInt_FMT " (%.1f%%)\n", a->sym ? " and y" : "", unit, groups, groups ? 100.0 * (double)unit / (double)groups : 0.0));
-      PetscCall(PetscViewerASCIIPrintf(viewer, "product: %" PetscInt_FMT " run(s) of bins swept side by side (-mat_binbcsr_streams)\n", a->streams));
+      PetscCall(PetscViewerASCIIPrintf(
+        viewer,
+        "slot groups over consecutive block columns (x%s read without gathers): %" PetscInt_FMT
+        " of %" PetscInt_FMT " (%.1f%%)\n",
+        a->sym ? " and y" : "", unit, groups, groups ? 100.0 * (double)unit / (double)groups : 0.0));
+      PetscCall(PetscViewerASCIIPrintf(
+        viewer, "product: %" PetscInt_FMT " run(s) of bins swept side by side (-mat_binbcsr_streams)\n",
+        a->streams));
     }
-    PetscCall(PetscViewerASCIIPrintf(viewer, "product body: %s (-mat_binbcsr_kernel %s)\n", binbcsr::body_set_name(MatSeqBinBCSRSelectBody(a).set), MatBinBCSRKernels[a->kernel]));
-    if (a->tune_info[0]) PetscCall(PetscViewerASCIIPrintf(viewer, "tuning (-mat_binbcsr_tune): %s\n", a->tune_info));
+    PetscCall(PetscViewerASCIIPrintf(viewer, "product body: %s (-mat_binbcsr_kernel %s)\n",
+                                     binbcsr::body_set_name(MatSeqBinBCSRSelectBody(a).set),
+                                     MatBinBCSRKernels[a->kernel]));
+    if (a->tune_info[0])
+      PetscCall(PetscViewerASCIIPrintf(viewer, "tuning (-mat_binbcsr_tune): %s\n", a->tune_info));
     if (a->coo_jmap || a->coo_mirror) {
-      const char *refill = a->coo_slot_state == 1 ? "by whole blocks" : a->coo_slot_state == -1 ? "value by value (the list is not made of whole blocks)" : "path chosen at the first refill";
-      if (a->coo_jmap) PetscCall(PetscViewerASCIIPrintf(viewer, "COO: %" PetscCount_FMT " entries, refill %s%s\n", a->coo_n, refill, a->coo_mirror ? "; mirror on (entries of off-diagonal blocks also fill the transposed place)" : ""));
+      const char *refill = a->coo_slot_state == 1    ? "by whole blocks"
+                           : a->coo_slot_state == -1 ? "value by value (the list is not made of whole blocks)"
+                                                     : "path chosen at the first refill";
+      if (a->coo_jmap)
+        PetscCall(PetscViewerASCIIPrintf(
+          viewer, "COO: %" PetscCount_FMT " entries, refill %s%s\n", a->coo_n, refill,
+          a->coo_mirror ? "; mirror on (entries of off-diagonal blocks also fill the transposed place)"
+                        : ""));
       else PetscCall(PetscViewerASCIIPrintf(viewer, "COO mirror on (for MatSetPreallocationCOO)\n"));
     }
-    if (a->sym) PetscCall(PetscViewerASCIIPrintf(viewer, "symmetric storage: upper triangle, %" PetscInt_FMT " stored blocks (the lower %" PetscInt_FMT " implied), %" PetscInt_FMT " padding slots; slots ordered by edge colouring\n", a->nz, a->nz - CountDiagonalBlocks(a), a->nslots - a->nz));
+    if (a->sym)
+      PetscCall(PetscViewerASCIIPrintf(viewer,
+                                       "symmetric storage: upper triangle, %" PetscInt_FMT
+                                       " stored blocks (the lower %" PetscInt_FMT " implied), %" PetscInt_FMT
+                                       " padding slots; slots ordered by edge colouring\n",
+                                       a->nz, a->nz - CountDiagonalBlocks(a), a->nslots - a->nz));
     PetscFunctionReturn(0);
   }
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatView of the entries needs an assembled matrix");
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MatView of the entries needs an assembled matrix");
   PetscCall(PetscViewerASCIIUseTabs(viewer, PETSC_FALSE));
   for (PetscInt r = 0; r < A->rmap->n; r++) {
     const PetscInt bs = a->bs, br = r / bs, ri = r % bs;
@@ -424,14 +476,18 @@ PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
       const PetscInt    *cols;
       const PetscScalar *vals;
       PetscCall(MatGetRow_SeqBinBCSR(A, r, &n, (PetscInt **)&cols, (PetscScalar **)&vals));
-      for (PetscInt k = 0; k < n; k++) PetscCall(PetscViewerASCIIPrintf(viewer, " (%" PetscInt_FMT ", %g) ", cols[k], (double)vals[k]));
+      for (PetscInt k = 0; k < n; k++)
+        PetscCall(PetscViewerASCIIPrintf(viewer, " (%" PetscInt_FMT ", %g) ", cols[k], (double)vals[k]));
       PetscCall(MatRestoreRow_SeqBinBCSR(A, r, &n, (PetscInt **)&cols, (PetscScalar **)&vals));
       PetscCall(PetscViewerASCIIPrintf(viewer, "\n"));
       continue;
     }
     for (PetscInt k = 0; k < a->row_nz[br]; k++) {
       const PetscInt s = BinBCSRSlot(a, br, k);
-      for (PetscInt j = 0; j < bs; j++) PetscCall(PetscViewerASCIIPrintf(viewer, " (%" PetscInt_FMT ", %g) ", a->col[s] * bs + j, (double)BinBCSRGetValue(a, BinBCSRValueIndex(s, ri * bs + j, a->bw, a->bs2))));
+      for (PetscInt j = 0; j < bs; j++)
+        PetscCall(PetscViewerASCIIPrintf(
+          viewer, " (%" PetscInt_FMT ", %g) ", a->col[s] * bs + j,
+          (double)BinBCSRGetValue(a, BinBCSRValueIndex(s, ri * bs + j, a->bw, a->bs2))));
     }
     PetscCall(PetscViewerASCIIPrintf(viewer, "\n"));
   }

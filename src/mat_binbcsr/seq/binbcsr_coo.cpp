@@ -14,8 +14,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace
-{
+namespace {
 PetscErrorCode BuildSlotMap(Mat A, const PetscInt *perm, long n);
 }
 
@@ -26,11 +25,14 @@ static PetscErrorCode PreallocateCOO(Mat A, PetscCount n, const PetscInt ci[], c
   uint64_t       *key; /* (block column << 32) | coo index, sorted per block row */
 
   PetscFunctionBegin;
-  PetscCheck(n <= PETSC_MAX_INT, PETSC_COMM_SELF, PETSC_ERR_SUP, "%" PetscCount_FMT " COO entries overflow the 32-bit indices of MATSEQBINBCSR", n);
+  PetscCheck(n <= PETSC_MAX_INT, PETSC_COMM_SELF, PETSC_ERR_SUP,
+             "%" PetscCount_FMT " COO entries overflow the 32-bit indices of MATSEQBINBCSR", n);
   PetscCall(PetscLayoutSetUp(A->rmap));
   PetscCall(PetscLayoutSetUp(A->cmap));
   PetscCall(MatGetBlockSizes(A, &rbs, &cbs));
-  PetscCheck(rbs == cbs, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP, "MATSEQBINBCSR needs equal row and column block sizes, got %" PetscInt_FMT " and %" PetscInt_FMT, rbs, cbs);
+  PetscCheck(rbs == cbs, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP,
+             "MATSEQBINBCSR needs equal row and column block sizes, got %" PetscInt_FMT " and %" PetscInt_FMT,
+             rbs, cbs);
   bs  = rbs;
   mbs = A->rmap->n / bs;
 
@@ -38,8 +40,12 @@ static PetscErrorCode PreallocateCOO(Mat A, PetscCount n, const PetscInt ci[], c
   for (PetscCount k = 0; k < n; k++) {
     const PetscInt i = ci[k], j = cj[k];
     if (i < 0 || j < 0) continue;
-    PetscCheck(i < A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "COO entry %" PetscCount_FMT ": row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", k, i, A->rmap->n);
-    PetscCheck(j < A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "COO entry %" PetscCount_FMT ": column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", k, j, A->cmap->n);
+    PetscCheck(i < A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+               "COO entry %" PetscCount_FMT ": row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", k,
+               i, A->rmap->n);
+    PetscCheck(j < A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+               "COO entry %" PetscCount_FMT ": column %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")",
+               k, j, A->cmap->n);
   }
   /* block rows of the valid entries */
   PetscCall(PetscCalloc1(mbs + 1, &rowptr));
@@ -119,7 +125,8 @@ static PetscErrorCode PreallocateCOO(Mat A, PetscCount n, const PetscInt ci[], c
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat A, PetscCount n, const PetscInt ci[], const PetscInt cj[])
+PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat A, PetscCount n, const PetscInt ci[],
+                                                 const PetscInt cj[])
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
   PetscInt        rbs, cbs;
@@ -133,7 +140,10 @@ PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat A, PetscCount n, const Pets
   PetscCall(PetscLayoutSetUp(A->rmap));
   PetscCall(PetscLayoutSetUp(A->cmap));
   PetscCall(MatGetBlockSizes(A, &rbs, &cbs));
-  PetscCheck(A->rmap->n == A->cmap->n && rbs == cbs, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "The COO mirror needs a square matrix with equal block sizes, this one is %" PetscInt_FMT " x %" PetscInt_FMT, A->rmap->n, A->cmap->n);
+  PetscCheck(A->rmap->n == A->cmap->n && rbs == cbs, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+             "The COO mirror needs a square matrix with equal block sizes, this one is %" PetscInt_FMT
+             " x %" PetscInt_FMT,
+             A->rmap->n, A->cmap->n);
   /* entries n + t: the transposes of the off-diagonal-block entries mirror_of[t] (the original
      entries come first, so a bad index is reported by its own position) */
   std::vector<PetscInt> ei(ci, ci + n), ej(cj, cj + n), mirror_of;
@@ -152,13 +162,13 @@ PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat A, PetscCount n, const Pets
   PetscFunctionReturn(0);
 }
 
-namespace
-{
+namespace {
 /* Refill in row order q (CSR order: gathers from the same elements follow each other); the writes
    stay inside one bin's tiles at a time. perm indices below n read v, the others recv (see
    binbcsr::coo_gather). */
 template <int BS, bool ADD, typename V>
-void coo_refill(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const PetscScalar *v, long n, const PetscScalar *recv)
+void coo_refill(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const PetscScalar *v, long n,
+                const PetscScalar *recv)
 {
   const PetscInt  bs = BS ? BS : a->bs, bs2 = bs * bs, bw = a->bw;
   const PetscInt *jmap = a->coo_jmap;
@@ -167,7 +177,8 @@ void coo_refill(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const Pet
     const PetscInt nr = a->row_nz[r];
     for (PetscInt i = 0; i < bs; i++)
       for (PetscInt k = 0; k < nr; k++) {
-        V *blk = val + BinBCSRValueIndex(BinBCSRSlot(a, r, k), i * bs, bw, bs2); /* entry (i, j): blk[j * bw] */
+        V *blk =
+          val + BinBCSRValueIndex(BinBCSRSlot(a, r, k), i * bs, bw, bs2); /* entry (i, j): blk[j * bw] */
         for (PetscInt j = 0; j < bs; j++, q++) {
           V           &dst = blk[(size_t)j * bw];
           const double s   = binbcsr::coo_gather<PetscInt>(v, n, recv, jmap, perm, q);
@@ -181,12 +192,14 @@ void coo_refill(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const Pet
    stored block is not a sum of whole COO blocks, each in a single source (*why: which test failed,
    for -info). Each value lists its entries in COO order, and the entries of a COO block are
    consecutive in that order, so source block t of a stored block is entry t of each of its values. */
-bool build_slot_map(const Mat_SeqBinBCSR *a, const PetscInt *perm, long n, PetscInt *slot_ptr, std::vector<PetscInt> &slot_src, const char **why)
+bool build_slot_map(const Mat_SeqBinBCSR *a, const PetscInt *perm, long n, PetscInt *slot_ptr,
+                    std::vector<PetscInt> &slot_src, const char **why)
 {
-  const PetscInt  bs = a->bs, bs2 = a->bs2;
-  const PetscInt *jmap = a->coo_jmap;
-  std::vector<PetscInt> count(a->nslots, 0), first(a->nslots, 0); /* per slot: sources, and where its (0, 0) value lists them */
-  PetscInt              qbase = 0;
+  const PetscInt        bs = a->bs, bs2 = a->bs2;
+  const PetscInt       *jmap = a->coo_jmap;
+  std::vector<PetscInt> count(a->nslots, 0),
+    first(a->nslots, 0); /* per slot: sources, and where its (0, 0) value lists them */
+  PetscInt qbase = 0;
   for (PetscInt r = 0; r < a->mbs; r++) {
     const PetscInt nr = a->row_nz[r];
     for (PetscInt k = 0; k < nr; k++) {
@@ -223,7 +236,7 @@ bool build_slot_map(const Mat_SeqBinBCSR *a, const PetscInt *perm, long n, Petsc
     for (PetscInt t = 0; t < count[s]; t++) {
       const long base = perm[jmap[first[s]] + t];
       /* plain or transposed: the (0, 1) value tells (for bs 1 both are the same) */
-      const bool transposed = bs > 1 && perm[jmap[first[s] + 1] + t] != base + 1;
+      const bool transposed     = bs > 1 && perm[jmap[first[s] + 1] + t] != base + 1;
       slot_src[slot_ptr[s] + t] = transposed ? (PetscInt)(-1 - base) : (PetscInt)base;
     }
   return true;
@@ -231,7 +244,8 @@ bool build_slot_map(const Mat_SeqBinBCSR *a, const PetscInt *perm, long n, Petsc
 
 /* The refill by blocks: slot by slot in storage order, so the values are written in sequence. */
 template <int BS, bool ADD, typename V>
-void coo_refill_blocks(const Mat_SeqBinBCSR *a, V *val, const PetscInt *slot_ptr, const PetscInt *slot_src, const PetscScalar *v, long n, const PetscScalar *recv)
+void coo_refill_blocks(const Mat_SeqBinBCSR *a, V *val, const PetscInt *slot_ptr, const PetscInt *slot_src,
+                       const PetscScalar *v, long n, const PetscScalar *recv)
 {
   constexpr int  MAXB2 = BS ? BS * BS : 1;
   const PetscInt bs = BS ? BS : a->bs, bs2 = bs * bs, bw = a->bw;
@@ -263,7 +277,8 @@ void coo_refill_blocks(const Mat_SeqBinBCSR *a, V *val, const PetscInt *slot_ptr
             for (int i = 0; i < BS; i++)
               for (int j = 0; j < BS; j++) sum[i * BS + j] += x[j * BS + i];
         }
-        for (int e = 0; e < MAXB2; e++) dst[(size_t)e * bw] = (V)(ADD ? (double)dst[(size_t)e * bw] + sum[e] : sum[e]);
+        for (int e = 0; e < MAXB2; e++)
+          dst[(size_t)e * bw] = (V)(ADD ? (double)dst[(size_t)e * bw] + sum[e] : sum[e]);
       } else { /* any block size: value by value */
         for (PetscInt i = 0; i < bs; i++)
           for (PetscInt j = 0; j < bs; j++) {
@@ -283,21 +298,29 @@ void coo_refill_blocks(const Mat_SeqBinBCSR *a, V *val, const PetscInt *slot_ptr
 }
 
 template <int BS, typename V>
-void coo_refill_mode(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const PetscScalar *v, long n, const PetscScalar *recv, InsertMode imode)
+void coo_refill_mode(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const PetscScalar *v, long n,
+                     const PetscScalar *recv, InsertMode imode)
 {
   if (imode == ADD_VALUES) coo_refill<BS, true, V>(a, val, perm, v, n, recv);
   else coo_refill<BS, false, V>(a, val, perm, v, n, recv);
 }
 
 template <typename V>
-void coo_refill_any(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const PetscScalar *v, long n, const PetscScalar *recv, InsertMode imode)
+void coo_refill_any(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const PetscScalar *v, long n,
+                    const PetscScalar *recv, InsertMode imode)
 {
   if (a->coo_slot_state == 1) {
-    const bool add = imode == ADD_VALUES;
+    const bool      add = imode == ADD_VALUES;
     const PetscInt *ptr = a->coo_slot_ptr, *src = a->coo_slot_src;
-    if (a->bs == 3) add ? coo_refill_blocks<3, true, V>(a, val, ptr, src, v, n, recv) : coo_refill_blocks<3, false, V>(a, val, ptr, src, v, n, recv);
-    else if (a->bs == 1) add ? coo_refill_blocks<1, true, V>(a, val, ptr, src, v, n, recv) : coo_refill_blocks<1, false, V>(a, val, ptr, src, v, n, recv);
-    else add ? coo_refill_blocks<0, true, V>(a, val, ptr, src, v, n, recv) : coo_refill_blocks<0, false, V>(a, val, ptr, src, v, n, recv);
+    if (a->bs == 3)
+      add ? coo_refill_blocks<3, true, V>(a, val, ptr, src, v, n, recv)
+          : coo_refill_blocks<3, false, V>(a, val, ptr, src, v, n, recv);
+    else if (a->bs == 1)
+      add ? coo_refill_blocks<1, true, V>(a, val, ptr, src, v, n, recv)
+          : coo_refill_blocks<1, false, V>(a, val, ptr, src, v, n, recv);
+    else
+      add ? coo_refill_blocks<0, true, V>(a, val, ptr, src, v, n, recv)
+          : coo_refill_blocks<0, false, V>(a, val, ptr, src, v, n, recv);
     return;
   }
   if (a->bs == 3) coo_refill_mode<3, V>(a, val, perm, v, n, recv, imode);
@@ -324,21 +347,26 @@ PetscErrorCode BuildSlotMap(Mat A, const PetscInt *perm, long n)
     PetscCall(PetscMalloc1(PetscMax(src.size(), (size_t)1), &a->coo_slot_src));
     std::copy(src.begin(), src.end(), a->coo_slot_src);
   } else PetscCall(PetscFree(a->coo_slot_ptr));
-  PetscCall(PetscInfo(A, "COO refill %s%s\n", a->coo_slot_state > 0 ? "by whole blocks" : "by values: ", a->coo_slot_state > 0 ? "" : why));
+  PetscCall(PetscInfo(A, "COO refill %s%s\n", a->coo_slot_state > 0 ? "by whole blocks" : "by values: ",
+                      a->coo_slot_state > 0 ? "" : why));
   PetscFunctionReturn(0);
 }
 
 /* The refill both entry points share; v == NULL means zeros. */
-PetscErrorCode SetValuesCOO(Mat A, const PetscInt *perm, const PetscScalar v[], long n, const PetscScalar recv[], InsertMode imode)
+PetscErrorCode SetValuesCOO(Mat A, const PetscInt *perm, const PetscScalar v[], long n,
+                            const PetscScalar recv[], InsertMode imode)
 {
   Mat_SeqBinBCSR *a  = (Mat_SeqBinBCSR *)A->data;
   const PetscInt  nv = a->nslots * a->bs2; /* padding included: it stays zero */
 
   PetscFunctionBegin;
-  PetscCheck(imode == INSERT_VALUES || imode == ADD_VALUES, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "MatSetValuesCOO supports INSERT_VALUES and ADD_VALUES only");
+  PetscCheck(imode == INSERT_VALUES || imode == ADD_VALUES, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+             "MatSetValuesCOO supports INSERT_VALUES and ADD_VALUES only");
   PetscCall(PetscLogEventBegin(MAT_BinBCSR_SetValuesCOO, A, 0, 0, 0));
   /* the map is built at preallocation; again if this refill reads another map or split (a copy, a part refilled on its own) */
-  if (v && (a->coo_slot_state == 0 || (a->coo_slot_state == 1 && (a->coo_slot_n != n || a->coo_slot_perm != perm)))) PetscCall(BuildSlotMap(A, perm, n));
+  if (v && (a->coo_slot_state == 0 ||
+            (a->coo_slot_state == 1 && (a->coo_slot_n != n || a->coo_slot_perm != perm))))
+    PetscCall(BuildSlotMap(A, perm, n));
   if (!v) { /* no values: zeros */
     if (imode == INSERT_VALUES) {
       if (a->val) PetscCall(PetscArrayzero(a->val, nv));
@@ -356,7 +384,8 @@ PetscErrorCode MatSetValuesCOO_SeqBinBCSR(Mat A, const PetscScalar v[], InsertMo
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
 
   PetscFunctionBegin;
-  PetscCheck(a->built && a->coo_jmap, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatSetValuesCOO needs MatSetPreallocationCOO first");
+  PetscCheck(a->built && a->coo_jmap, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MatSetValuesCOO needs MatSetPreallocationCOO first");
   PetscCall(SetValuesCOO(A, a->coo_perm, v, (long)a->coo_n, nullptr, imode));
   PetscFunctionReturn(0);
 }
@@ -366,8 +395,10 @@ PetscErrorCode MatSeqBinBCSRComposeCOO(Mat A, const PetscCount from[], PetscCoun
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
 
   PetscFunctionBegin;
-  PetscCheck(a->built && a->coo_jmap, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatSeqBinBCSRComposeCOO needs MatSetPreallocationCOO first");
-  PetscCheck(nsrc <= PETSC_MAX_INT, PETSC_COMM_SELF, PETSC_ERR_SUP, "%" PetscCount_FMT " COO sources overflow the 32-bit indices of MATSEQBINBCSR", nsrc);
+  PetscCheck(a->built && a->coo_jmap, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MatSeqBinBCSRComposeCOO needs MatSetPreallocationCOO first");
+  PetscCheck(nsrc <= PETSC_MAX_INT, PETSC_COMM_SELF, PETSC_ERR_SUP,
+             "%" PetscCount_FMT " COO sources overflow the 32-bit indices of MATSEQBINBCSR", nsrc);
   const PetscInt nperm = a->coo_jmap[a->nz * a->bs2];
   PetscCall(PetscFree(a->coo_perm_src));
   PetscCall(PetscMalloc1(nperm, &a->coo_perm_src));
@@ -377,12 +408,14 @@ PetscErrorCode MatSeqBinBCSRComposeCOO(Mat A, const PetscCount from[], PetscCoun
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode MatSetValuesCOOTwoSources_SeqBinBCSR(Mat A, const PetscScalar v[], PetscCount n, const PetscScalar recv[], InsertMode imode)
+PetscErrorCode MatSetValuesCOOTwoSources_SeqBinBCSR(Mat A, const PetscScalar v[], PetscCount n,
+                                                    const PetscScalar recv[], InsertMode imode)
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
 
   PetscFunctionBegin;
-  PetscCheck(a->built && a->coo_composed, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatSetValuesCOOTwoSources_SeqBinBCSR needs MatSeqBinBCSRComposeCOO first");
+  PetscCheck(a->built && a->coo_composed, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MatSetValuesCOOTwoSources_SeqBinBCSR needs MatSeqBinBCSRComposeCOO first");
   PetscCall(SetValuesCOO(A, a->coo_perm_src, v, (long)n, recv, imode));
   /* as MatSetValuesCOO() does after the type's refill */
   PetscCall(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY));

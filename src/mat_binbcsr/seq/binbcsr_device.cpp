@@ -13,8 +13,7 @@
 
 #include <vector>
 
-namespace
-{
+namespace {
 using namespace binbcsr::device;
 
 struct DeviceCopy {
@@ -22,15 +21,15 @@ struct DeviceCopy {
   std::unique_ptr<Executor> exec;
   std::unique_ptr<Matrix>   M;
   std::unique_ptr<Vector>   x, y;
-  PetscObjectState          state = -1;    /* of the values on the device */
-  PetscObjectState          nzstate = -1;  /* of the layout M was made for */
+  PetscObjectState          state     = -1; /* of the values on the device */
+  PetscObjectState          nzstate   = -1; /* of the layout M was made for */
   MatBinBCSRPrecision       precision = MAT_BINBCSR_PRECISION_DOUBLE;
-  const PetscInt           *gather_of = nullptr; /* the coo_jmap the device refill map was made from */
+  const PetscInt           *gather_of = nullptr;     /* the coo_jmap the device refill map was made from */
   PetscBool                 coo_fresh = PETSC_FALSE; /* a COO refill made the device values */
-  std::vector<std::unique_ptr<Vector>>                cached;
+  std::vector<std::unique_ptr<Vector>>                    cached;
   std::vector<std::pair<PetscObjectId, PetscObjectState>> cached_of;
-  PetscErrorCode (*assemblyend)(Mat, MatAssemblyType) = nullptr;
-  PetscErrorCode (*mult)(Mat, Vec, Vec)               = nullptr;
+  PetscErrorCode (*assemblyend)(Mat, MatAssemblyType)         = nullptr;
+  PetscErrorCode (*mult)(Mat, Vec, Vec)                       = nullptr;
   PetscErrorCode (*coo)(Mat, const PetscScalar[], InsertMode) = nullptr;
 };
 
@@ -59,9 +58,11 @@ PetscErrorCode Refresh(Mat A, DeviceCopy *dc)
   PetscObjectState st;
 
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR device copy: the matrix has no layout yet (assemble it first)");
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MATSEQBINBCSR device copy: the matrix has no layout yet (assemble it first)");
   PetscCall(PetscObjectStateGet((PetscObject)A, &st));
-  if (dc->M && dc->nzstate == A->nonzerostate && dc->precision == a->precision && dc->state == st) PetscFunctionReturn(0);
+  if (dc->M && dc->nzstate == A->nonzerostate && dc->precision == a->precision && dc->state == st)
+    PetscFunctionReturn(0);
   PetscCall(PetscLogEventBegin(MAT_BinBCSR_DeviceUpload, A, 0, 0, 0));
   if (!dc->M || dc->nzstate != A->nonzerostate || dc->precision != a->precision) {
     std::vector<int> bin_start(a->bin_start, a->bin_start + a->nbins + 1), col(a->col, a->col + a->nslots);
@@ -72,7 +73,9 @@ PetscErrorCode Refresh(Mat A, DeviceCopy *dc)
     L.symmetric = a->sym ? true : false;
     L.bin_start = bin_start.data();
     L.col       = col.data();
-    BinBCSRDeviceTry(dc->M = dc->exec->matrix(L, a->precision == MAT_BINBCSR_PRECISION_SINGLE ? Precision::single_values : Precision::double_values));
+    BinBCSRDeviceTry(dc->M = dc->exec->matrix(L, a->precision == MAT_BINBCSR_PRECISION_SINGLE
+                                                   ? Precision::single_values
+                                                   : Precision::double_values));
     BinBCSRDeviceTry(dc->x = dc->exec->vector(L.n()));
     BinBCSRDeviceTry(dc->y = dc->exec->vector(L.n()));
     dc->nzstate   = A->nonzerostate;
@@ -111,10 +114,10 @@ PetscErrorCode MatAssemblyEnd_Device(Mat A, MatAssemblyType t)
    is the value index of its slot and entry. */
 PetscErrorCode MakeGatherMap(Mat A, DeviceCopy *dc)
 {
-  Mat_SeqBinBCSR *a  = (Mat_SeqBinBCSR *)A->data;
-  const PetscInt  bs = a->bs, bs2 = a->bs2, bw = a->bw;
-  const long      nv = (long)a->nslots * bs2;
-  std::vector<int> jmap(nv + 1, 0), perm;
+  Mat_SeqBinBCSR   *a  = (Mat_SeqBinBCSR *)A->data;
+  const PetscInt    bs = a->bs, bs2 = a->bs2, bw = a->bw;
+  const long        nv = (long)a->nslots * bs2;
+  std::vector<int>  jmap(nv + 1, 0), perm;
   std::vector<long> vof((size_t)a->nz * bs2);
 
   PetscFunctionBegin;
@@ -123,13 +126,14 @@ PetscErrorCode MakeGatherMap(Mat A, DeviceCopy *dc)
     for (PetscInt i = 0; i < bs; i++)
       for (PetscInt k = 0; k < a->row_nz[r]; k++)
         for (PetscInt j = 0; j < bs; j++, q++) {
-          vof[q] = BinBCSRValueIndex(BinBCSRSlot(a, r, k), i * bs + j, bw, bs2);
+          vof[q]           = BinBCSRValueIndex(BinBCSRSlot(a, r, k), i * bs + j, bw, bs2);
           jmap[vof[q] + 1] = a->coo_jmap[q + 1] - a->coo_jmap[q];
         }
   for (long v = 0; v < nv; v++) jmap[v + 1] += jmap[v];
   perm.resize(jmap[nv]);
   for (PetscInt t = 0; t < q; t++)
-    for (PetscInt e = a->coo_jmap[t]; e < a->coo_jmap[t + 1]; e++) perm[jmap[vof[t]] + (e - a->coo_jmap[t])] = (int)a->coo_perm[e];
+    for (PetscInt e = a->coo_jmap[t]; e < a->coo_jmap[t + 1]; e++)
+      perm[jmap[vof[t]] + (e - a->coo_jmap[t])] = (int)a->coo_perm[e];
   GatherMap G;
   G.ncoo = (long)a->coo_n;
   G.jmap = jmap.data();
@@ -148,7 +152,9 @@ PetscErrorCode MatSetValuesCOO_Device(Mat A, const PetscScalar v[], InsertMode i
   PetscFunctionBegin;
   PetscCall(GetCopy(A, &dc));
   PetscCall(PetscObjectStateGet((PetscObject)A, &st));
-  const PetscBool in_step = (PetscBool)(dc->M && dc->state == st && dc->nzstate == A->nonzerostate && dc->precision == a->precision); /* device values = host values before the refill */
+  const PetscBool in_step =
+    (PetscBool)(dc->M && dc->state == st && dc->nzstate == A->nonzerostate &&
+                dc->precision == a->precision); /* device values = host values before the refill */
   PetscCall((*dc->coo)(A, v, imode));
   if (!v || (imode == ADD_VALUES && !in_step)) PetscFunctionReturn(0); /* the next use uploads */
   if (!dc->M || dc->nzstate != A->nonzerostate || dc->precision != a->precision) PetscCall(Refresh(A, dc));
@@ -199,10 +205,11 @@ PetscErrorCode MatSeqBinBCSRSetDevice(Mat A, MatBinBCSRDevice kind)
   std::string               why;
   std::unique_ptr<Executor> E;
   BinBCSRDeviceTry(E = make_executor(kind == MAT_BINBCSR_DEVICE_CUDA ? "cuda" : "reference", &why));
-  PetscCheck(E, PETSC_COMM_SELF, PETSC_ERR_SUP, "-mat_binbcsr_device %s: %s", MatBinBCSRDevices[kind], why.c_str());
-  auto *n = new DeviceCopy;
-  n->kind = kind;
-  n->exec = std::move(E);
+  PetscCheck(E, PETSC_COMM_SELF, PETSC_ERR_SUP, "-mat_binbcsr_device %s: %s", MatBinBCSRDevices[kind],
+             why.c_str());
+  auto *n        = new DeviceCopy;
+  n->kind        = kind;
+  n->exec        = std::move(E);
   n->assemblyend = A->ops->assemblyend;
   n->mult        = A->ops->mult;
   PetscCall(PetscObjectQueryFunction((PetscObject)A, "MatSetValuesCOO_C", &n->coo));
@@ -214,7 +221,8 @@ PetscErrorCode MatSeqBinBCSRSetDevice(Mat A, MatBinBCSRDevice kind)
   PetscCall(PetscContainerDestroy(&c));
   A->ops->assemblyend = MatAssemblyEnd_Device;
   A->ops->mult        = MatMult_Device;
-  if (n->coo) PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatSetValuesCOO_C", MatSetValuesCOO_Device));
+  if (n->coo)
+    PetscCall(PetscObjectComposeFunction((PetscObject)A, "MatSetValuesCOO_C", MatSetValuesCOO_Device));
   if (((Mat_SeqBinBCSR *)A->data)->built && A->assembled) PetscCall(Refresh(A, n));
   PetscCall(PetscInfo(A, "device copy on the %s executor\n", n->exec->name()));
   PetscFunctionReturn(0);
@@ -301,13 +309,17 @@ PetscErrorCode MatBinBCSRSetDevice(Mat A, MatBinBCSRDevice d)
 
   PetscFunctionBegin;
   PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
-  PetscCheck(d >= MAT_BINBCSR_DEVICE_NONE && d <= MAT_BINBCSR_DEVICE_CUDA, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_OUTOFRANGE, "unknown MatBinBCSRDevice %d", (int)d);
+  PetscCheck(d >= MAT_BINBCSR_DEVICE_NONE && d <= MAT_BINBCSR_DEVICE_CUDA, PetscObjectComm((PetscObject)A),
+             PETSC_ERR_ARG_OUTOFRANGE, "unknown MatBinBCSRDevice %d", (int)d);
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATSEQBINBCSR, &isseq));
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIBINBCSR, &ismpi));
   if (ismpi) {
     PetscMPIInt size;
     PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)A), &size));
-    PetscCheck(d == MAT_BINBCSR_DEVICE_NONE, PetscObjectComm((PetscObject)A), PETSC_ERR_SUP, "-mat_binbcsr_device %s: MATMPIBINBCSR (%d processes) has no device copy; devices work on one process (MATSEQBINBCSR), see docs/gpu.md", MatBinBCSRDevices[d], (int)size);
+    PetscCheck(
+      d == MAT_BINBCSR_DEVICE_NONE, PetscObjectComm((PetscObject)A), PETSC_ERR_SUP,
+      "-mat_binbcsr_device %s: MATMPIBINBCSR (%d processes) has no device copy; devices work on one process (MATSEQBINBCSR), see docs/gpu.md",
+      MatBinBCSRDevices[d], (int)size);
   }
   if (isseq) PetscCall(MatSeqBinBCSRSetDevice(A, d));
   PetscFunctionReturn(0);

@@ -11,13 +11,17 @@ PetscErrorCode MatGetDiagonal_SeqBinBCSR(Mat A, Vec v)
   PetscInt        n;
 
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MATSEQBINBCSR matrix has no layout: assemble it first");
   PetscCall(VecGetLocalSize(v, &n));
-  PetscCheck(n == A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Nonconforming matrix and vector: %" PetscInt_FMT " rows, vector of %" PetscInt_FMT, A->rmap->n, n);
+  PetscCheck(n == A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+             "Nonconforming matrix and vector: %" PetscInt_FMT " rows, vector of %" PetscInt_FMT, A->rmap->n,
+             n);
   PetscCall(VecGetArrayWrite(v, &d));
   for (PetscInt r = 0; r < a->mbs; r++) {
     const PetscInt s = a->diag_slot[r];
-    for (PetscInt i = 0; i < a->bs; i++) d[r * a->bs + i] = s < 0 ? 0.0 : BinBCSRGetValue(a, BinBCSRValueIndex(s, i * a->bs + i, a->bw, a->bs2));
+    for (PetscInt i = 0; i < a->bs; i++)
+      d[r * a->bs + i] = s < 0 ? 0.0 : BinBCSRGetValue(a, BinBCSRValueIndex(s, i * a->bs + i, a->bw, a->bs2));
   }
   PetscCall(VecRestoreArrayWrite(v, &d));
   PetscFunctionReturn(0);
@@ -92,7 +96,8 @@ PetscErrorCode MatSeqBinBCSRInvertDiagonalBlocks(Mat A, PetscReal shift, MatScal
   MatScalar      *aug;
 
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MATSEQBINBCSR matrix has no layout: assemble it first");
   if (zero_row) *zero_row = -1;
   PetscCall(PetscMalloc1(2 * bs2, &aug));
   for (PetscInt r = 0; r < a->mbs; r++) {
@@ -100,12 +105,15 @@ PetscErrorCode MatSeqBinBCSRInvertDiagonalBlocks(Mat A, PetscReal shift, MatScal
     const PetscInt s = a->diag_slot[r];
     /* the block, transposed into BAIJ's column-major order */
     for (PetscInt i = 0; i < bs; i++)
-      for (PetscInt j = 0; j < bs; j++) d[j * bs + i] = (s < 0 ? 0.0 : BinBCSRGetValue(a, BinBCSRValueIndex(s, i * bs + j, a->bw, bs2))) + (i == j ? shift : 0.0);
+      for (PetscInt j = 0; j < bs; j++)
+        d[j * bs + i] = (s < 0 ? 0.0 : BinBCSRGetValue(a, BinBCSRValueIndex(s, i * bs + j, a->bw, bs2))) +
+                        (i == j ? shift : 0.0);
     PetscBool zp;
     PetscCall(InvertBlock(bs, d, aug, &zp));
     if (zp) {
       if (!allowzeropivot) PetscCall(PetscFree(aug));
-      PetscCheck(allowzeropivot, PETSC_COMM_SELF, PETSC_ERR_MAT_LU_ZRPVT, "Zero pivot in the diagonal block of block row %" PetscInt_FMT, r);
+      PetscCheck(allowzeropivot, PETSC_COMM_SELF, PETSC_ERR_MAT_LU_ZRPVT,
+                 "Zero pivot in the diagonal block of block row %" PetscInt_FMT, r);
       if (!zeropivot) *zero_row = r;
       zeropivot                      = PETSC_TRUE;
       A->factorerror_zeropivot_row   = r * bs;
@@ -123,7 +131,8 @@ PetscErrorCode MatInvertBlockDiagonal_SeqBinBCSR(Mat A, const PetscScalar **valu
   PetscInt        zero_row;
 
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MATSEQBINBCSR matrix has no layout: assemble it first");
   if (!a->idiag) PetscCall(PetscMalloc1((size_t)a->mbs * a->bs2, &a->idiag));
   PetscCall(MatSeqBinBCSRInvertDiagonalBlocks(A, 0.0, a->idiag, &zero_row));
   if (values) *values = a->idiag;
@@ -136,22 +145,29 @@ PetscErrorCode MatInvertBlockDiagonal_SeqBinBCSR(Mat A, const PetscScalar **valu
    storage: the mirrored lower entries too); the inversion is MatInvertBlockDiagonal's. Zero pivots as
    there: an error under MatSetErrorIfFailure, else recorded in A->factorerrortype (PCVPBJACOBI turns it
    into its failed reason; aij's scalar blocks divide by zero silently). */
-PetscErrorCode MatInvertVariableBlockDiagonal_SeqBinBCSR(Mat A, PetscInt nblocks, const PetscInt *bsizes, PetscScalar *diag)
+PetscErrorCode MatInvertVariableBlockDiagonal_SeqBinBCSR(Mat A, PetscInt nblocks, const PetscInt *bsizes,
+                                                         PetscScalar *diag)
 {
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  Mat_SeqBinBCSR *a     = (Mat_SeqBinBCSR *)A->data;
   PetscInt        total = 0, nmax = 0, row = 0;
   PetscBool       zeropivot = PETSC_FALSE;
 
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
-  PetscCheck(nblocks >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Negative number of blocks %" PetscInt_FMT, nblocks);
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MATSEQBINBCSR matrix has no layout: assemble it first");
+  PetscCheck(nblocks >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+             "Negative number of blocks %" PetscInt_FMT, nblocks);
   for (PetscInt i = 0; i < nblocks; i++) {
-    PetscCheck(bsizes[i] >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Block %" PetscInt_FMT " has negative size %" PetscInt_FMT, i, bsizes[i]);
+    PetscCheck(bsizes[i] >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+               "Block %" PetscInt_FMT " has negative size %" PetscInt_FMT, i, bsizes[i]);
     total += bsizes[i];
     nmax = PetscMax(nmax, bsizes[i]);
   }
-  PetscCheck(total == A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "The block sizes add up to %" PetscInt_FMT ", the matrix has %" PetscInt_FMT " rows", total, A->rmap->n);
-  PetscCheck(A->rmap->n == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Diagonal blocks of a %" PetscInt_FMT " x %" PetscInt_FMT " matrix", A->rmap->n, A->cmap->n);
+  PetscCheck(total == A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+             "The block sizes add up to %" PetscInt_FMT ", the matrix has %" PetscInt_FMT " rows", total,
+             A->rmap->n);
+  PetscCheck(A->rmap->n == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+             "Diagonal blocks of a %" PetscInt_FMT " x %" PetscInt_FMT " matrix", A->rmap->n, A->cmap->n);
   std::vector<PetscInt>  idx(nmax);
   std::vector<MatScalar> rowmajor((size_t)nmax * nmax), aug(2 * (size_t)nmax * nmax);
   for (PetscInt b = 0; b < nblocks; row += bsizes[b], diag += bsizes[b] * bsizes[b], b++) {
@@ -164,7 +180,10 @@ PetscErrorCode MatInvertVariableBlockDiagonal_SeqBinBCSR(Mat A, PetscInt nblocks
       for (PetscInt j = 0; j < n; j++) diag[j * n + i] = rowmajor[i * n + j];
     PetscCall(InvertBlock(n, diag, aug.data(), &zp));
     if (!zp) continue;
-    PetscCheck(!A->erroriffailure, PETSC_COMM_SELF, PETSC_ERR_MAT_LU_ZRPVT, "Zero pivot in the diagonal block %" PetscInt_FMT " (rows %" PetscInt_FMT "..%" PetscInt_FMT ")", b, row, row + n - 1);
+    PetscCheck(!A->erroriffailure, PETSC_COMM_SELF, PETSC_ERR_MAT_LU_ZRPVT,
+               "Zero pivot in the diagonal block %" PetscInt_FMT " (rows %" PetscInt_FMT "..%" PetscInt_FMT
+               ")",
+               b, row, row + n - 1);
     if (!zeropivot) {
       A->factorerror_zeropivot_row   = row;
       A->factorerror_zeropivot_value = 0.0;

@@ -18,21 +18,20 @@
 #include <algorithm>
 #include <vector>
 
-namespace
-{
+namespace {
 struct FactorShadow {
-  Mat              S = nullptr;     /* seqsbaij (ICC, Cholesky) or seqbaij (ILU, LU) */
-  PetscObjectState nzstate = 0;     /* the binbcsr matrix's nonzero state when S was built */
-  PetscInt         bs = 0, bw = 0;  /* of the binbcsr matrix */
-  std::vector<PetscInt>  src;       /* per block of S: value index of the binbcsr slot's entry 0 */
-  std::vector<char>      transpose; /* per block of S: read the stored block (c, r) transposed */
+  Mat                   S       = nullptr; /* seqsbaij (ICC, Cholesky) or seqbaij (ILU, LU) */
+  PetscObjectState      nzstate = 0;       /* the binbcsr matrix's nonzero state when S was built */
+  PetscInt              bs = 0, bw = 0;    /* of the binbcsr matrix */
+  std::vector<PetscInt> src;               /* per block of S: value index of the binbcsr slot's entry 0 */
+  std::vector<char>     transpose;         /* per block of S: read the stored block (c, r) transposed */
   /* PETSc's ops of the factor, called with S in place of the binbcsr matrix */
-  PetscErrorCode (*iccsymbolic)(Mat, Mat, IS, const MatFactorInfo *)            = nullptr;
-  PetscErrorCode (*choleskysymbolic)(Mat, Mat, IS, const MatFactorInfo *)       = nullptr;
-  PetscErrorCode (*ilusymbolic)(Mat, Mat, IS, IS, const MatFactorInfo *)        = nullptr;
-  PetscErrorCode (*lusymbolic)(Mat, Mat, IS, IS, const MatFactorInfo *)         = nullptr;
-  PetscErrorCode (*choleskynumeric)(Mat, Mat, const MatFactorInfo *)            = nullptr;
-  PetscErrorCode (*lunumeric)(Mat, Mat, const MatFactorInfo *)                  = nullptr;
+  PetscErrorCode (*iccsymbolic)(Mat, Mat, IS, const MatFactorInfo *)      = nullptr;
+  PetscErrorCode (*choleskysymbolic)(Mat, Mat, IS, const MatFactorInfo *) = nullptr;
+  PetscErrorCode (*ilusymbolic)(Mat, Mat, IS, IS, const MatFactorInfo *)  = nullptr;
+  PetscErrorCode (*lusymbolic)(Mat, Mat, IS, IS, const MatFactorInfo *)   = nullptr;
+  PetscErrorCode (*choleskynumeric)(Mat, Mat, const MatFactorInfo *)      = nullptr;
+  PetscErrorCode (*lunumeric)(Mat, Mat, const MatFactorInfo *)            = nullptr;
   /* ICC and Cholesky in an ordering: S holds the permuted matrix (seqsbaij factors in its natural
      order only), and the factor's solves are wrapped to permute in and out */
   std::vector<PetscInt> perm; /* new block row -> A's block row; empty: natural */
@@ -42,7 +41,7 @@ struct FactorShadow {
   PetscErrorCode (*backwardsolve)(Mat, Vec, Vec) = nullptr;
 
   /* the routing (binbcsr_factor_routing.h) */
-  static const char *key() { return "MatSeqBinBCSR_FactorShadow"; }
+  static const char    *key() { return "MatSeqBinBCSR_FactorShadow"; }
   static PetscErrorCode Destroy(void *ctx)
   {
     FactorShadow *f = (FactorShadow *)ctx;
@@ -62,10 +61,11 @@ struct FactorShadow {
    perm[i]; natural when empty): upper = blocks with new column >= new row (for seqsbaij), else all
    blocks (with symmetric storage the lower ones are the stored upper ones transposed). Fills f->src and
    f->transpose in the order of S's blocks (CSR, ascending columns). */
-PetscErrorCode BuildShadowPattern(Mat A, PetscBool upper, FactorShadow *f, std::vector<PetscInt> &bi, std::vector<PetscInt> &bj)
+PetscErrorCode BuildShadowPattern(Mat A, PetscBool upper, FactorShadow *f, std::vector<PetscInt> &bi,
+                                  std::vector<PetscInt> &bj)
 {
-  Mat_SeqBinBCSR *a        = (Mat_SeqBinBCSR *)A->data;
-  const PetscInt  bw       = a->bw, bs2 = a->bs2;
+  Mat_SeqBinBCSR *a  = (Mat_SeqBinBCSR *)A->data;
+  const PetscInt  bw = a->bw, bs2 = a->bs2;
   const bool      permuted = !f->perm.empty();
   struct Block {
     PetscInt col, src;
@@ -87,19 +87,21 @@ PetscErrorCode BuildShadowPattern(Mat A, PetscBool upper, FactorShadow *f, std::
   f->src.clear();
   f->transpose.clear();
   for (PetscInt i = 0; i < a->mbs; i++) {
-    const PetscInt r = permuted ? f->perm[i] : i;
+    const PetscInt r   = permuted ? f->perm[i] : i;
     auto           add = [&](PetscInt c, PetscInt s, char transpose) {
       const PetscInt j = permuted ? iperm[c] : c;
       if (!upper || j >= i) row.push_back({j, base(s), transpose});
     };
     row.clear();
     if (a->sym && a->lower_off)
-      for (PetscInt p = a->lower_off[r]; p < a->lower_off[r + 1]; p++) add(a->lower_slot[2 * p + 1], a->lower_slot[2 * p], 1);
+      for (PetscInt p = a->lower_off[r]; p < a->lower_off[r + 1]; p++)
+        add(a->lower_slot[2 * p + 1], a->lower_slot[2 * p], 1);
     for (PetscInt k = 0; k < a->row_nz[r]; k++) {
       const PetscInt s = BinBCSRSlot(a, r, k);
       add(a->col[s], s, 0);
     }
-    if (permuted) std::sort(row.begin(), row.end(), [](const Block &x, const Block &y) { return x.col < y.col; });
+    if (permuted)
+      std::sort(row.begin(), row.end(), [](const Block &x, const Block &y) { return x.col < y.col; });
     for (const Block &b : row) {
       bj.push_back(b.col);
       f->src.push_back(b.src);
@@ -112,8 +114,7 @@ PetscErrorCode BuildShadowPattern(Mat A, PetscBool upper, FactorShadow *f, std::
 
 /* S's values from A's: one pass over S's blocks (column-major bs x bs, as BAIJ and SBAIJ store them).
    BS > 0: the block size known at compile time (the loops unroll); 0: f->bs. */
-template <typename T, int BS>
-void GatherValues(const T *val, const FactorShadow *f, PetscScalar *dst)
+template <typename T, int BS> void GatherValues(const T *val, const FactorShadow *f, PetscScalar *dst)
 {
   const PetscInt bs = BS ? BS : f->bs, bw = f->bw, bs2 = bs * bs, nb = (PetscInt)f->src.size();
   for (PetscInt k = 0; k < nb; k++) {
@@ -136,8 +137,10 @@ PetscErrorCode RefillShadow(Mat A, FactorShadow *f)
   PetscScalar    *dst;
 
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Factorisation needs an assembled MATSEQBINBCSR matrix");
-  PetscCheck(A->nonzerostate == f->nzstate, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "The MATSEQBINBCSR pattern changed after the symbolic factorisation; redo it (MatGetFactor)");
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "Factorisation needs an assembled MATSEQBINBCSR matrix");
+  PetscCheck(A->nonzerostate == f->nzstate, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "The MATSEQBINBCSR pattern changed after the symbolic factorisation; redo it (MatGetFactor)");
   PetscCall(PetscObjectTypeCompare((PetscObject)f->S, MATSEQSBAIJ, &upper));
   if (upper) PetscCall(MatSeqSBAIJGetArray(f->S, &dst));
   else PetscCall(MatSeqBAIJGetArray(f->S, &dst));
@@ -220,7 +223,11 @@ PetscErrorCode ShadowOrdering(Mat A, FactorShadow *f, IS row, IS col, IS *rperm,
   }
   if (row) PetscCall(ISGetLocalSize(row, &nr));
   if (col) PetscCall(ISGetLocalSize(col, &nc));
-  PetscCheck(nr == mbs && (sbaij || nc == mbs), PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Factorisations of MATSEQBINBCSR take block orderings of its %" PetscInt_FMT " block rows (as MatGetOrdering gives), not index sets of %" PetscInt_FMT " and %" PetscInt_FMT " entries", mbs, nr, nc);
+  PetscCheck(nr == mbs && (sbaij || nc == mbs), PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+             "Factorisations of MATSEQBINBCSR take block orderings of its %" PetscInt_FMT
+             " block rows (as MatGetOrdering gives), not index sets of %" PetscInt_FMT " and %" PetscInt_FMT
+             " entries",
+             mbs, nr, nc);
   if (!sbaij) {
     PetscCall(PetscObjectReference((PetscObject)row));
     PetscCall(PetscObjectReference((PetscObject)col));
@@ -237,7 +244,11 @@ PetscErrorCode ShadowOrdering(Mat A, FactorShadow *f, IS row, IS col, IS *rperm,
     for (PetscInt i = 0; i < mbs; i++) perm[i] = idx[i];
     PetscCall(ISRestoreIndices(row, &idx));
     for (PetscInt i = 0; i < mbs; i++) {
-      PetscCheck(perm[i] >= 0 && perm[i] < mbs && !seen[perm[i]], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "The ordering for the factorisation of MATSEQBINBCSR is not a permutation of its %" PetscInt_FMT " block rows (entry %" PetscInt_FMT " is %" PetscInt_FMT ")", mbs, i, perm[i]);
+      PetscCheck(
+        perm[i] >= 0 && perm[i] < mbs && !seen[perm[i]], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
+        "The ordering for the factorisation of MATSEQBINBCSR is not a permutation of its %" PetscInt_FMT
+        " block rows (entry %" PetscInt_FMT " is %" PetscInt_FMT ")",
+        mbs, i, perm[i]);
       seen[perm[i]] = 1;
     }
     if (perm != f->perm) {
@@ -282,7 +293,8 @@ PetscErrorCode WorkVectors(FactorShadow *f)
 /* One of the factor's solves between the two numberings: the right-hand side moved into S's (in), the
    result moved back into A's (out). The split solves of PCApplySymmetricLeft/Right keep the
    intermediate vector in S's numbering: forward moves in only, backward out only. */
-PetscErrorCode PermutedApply(Mat F, Vec b, Vec x, PetscErrorCode (*FactorShadow::*op)(Mat, Vec, Vec), bool in, bool out)
+PetscErrorCode PermutedApply(Mat F, Vec b, Vec x, PetscErrorCode (*FactorShadow::*op)(Mat, Vec, Vec), bool in,
+                             bool out)
 {
   FactorShadow *f;
 
@@ -315,7 +327,8 @@ PetscErrorCode FactorShadow::Routed(Mat F)
 {
   PetscFunctionBegin;
   if (perm.empty()) PetscFunctionReturn(0);
-  auto route = [](PetscErrorCode (*&op)(Mat, Vec, Vec), PetscErrorCode (*&saved)(Mat, Vec, Vec), PetscErrorCode (*wrapper)(Mat, Vec, Vec)) {
+  auto route = [](PetscErrorCode (*&op)(Mat, Vec, Vec), PetscErrorCode (*&saved)(Mat, Vec, Vec),
+                  PetscErrorCode (*wrapper)(Mat, Vec, Vec)) {
     if (op && op != wrapper) {
       saved = op;
       op    = wrapper;
@@ -333,8 +346,7 @@ PetscErrorCode FactorShadow::Routed(Mat F)
 
 /* The four symbolic factorisations: refill the shadow, translate the ordering to it, run PETSc's
    routine on it (the routing keeps the numeric kernel that routine chose on the shadow). */
-template <class Symbolic>
-PetscErrorCode ShadowSymbolic(Mat F, Mat A, IS row, IS col, Symbolic &&symbolic)
+template <class Symbolic> PetscErrorCode ShadowSymbolic(Mat F, Mat A, IS row, IS col, Symbolic &&symbolic)
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
   FactorShadow   *f;
@@ -344,7 +356,8 @@ PetscErrorCode ShadowSymbolic(Mat F, Mat A, IS row, IS col, Symbolic &&symbolic)
   PetscCall(binbcsr_factor::Get(F, &f));
   if (f->nzstate != A->nonzerostate) {
     PetscBool sbaij;
-    PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Symbolic factorisation needs an assembled MATSEQBINBCSR matrix");
+    PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+               "Symbolic factorisation needs an assembled MATSEQBINBCSR matrix");
     PetscCall(PetscObjectTypeCompare((PetscObject)f->S, MATSEQSBAIJ, &sbaij));
     f->perm.clear();
     PetscCall(BuildShadow(A, sbaij, f));
@@ -365,47 +378,59 @@ PetscErrorCode ShadowSymbolic(Mat F, Mat A, IS row, IS col, Symbolic &&symbolic)
 PetscErrorCode ICCSymbolic(Mat F, Mat A, IS perm, const MatFactorInfo *info)
 {
   PetscFunctionBegin;
-  PetscCall(ShadowSymbolic(F, A, perm, nullptr, [&](FactorShadow *f, IS r, IS) { return (*f->iccsymbolic)(F, f->S, r, info); }));
+  PetscCall(ShadowSymbolic(F, A, perm, nullptr,
+                           [&](FactorShadow *f, IS r, IS) { return (*f->iccsymbolic)(F, f->S, r, info); }));
   PetscFunctionReturn(0);
 }
 
 PetscErrorCode CholeskySymbolic(Mat F, Mat A, IS perm, const MatFactorInfo *info)
 {
   PetscFunctionBegin;
-  PetscCall(ShadowSymbolic(F, A, perm, nullptr, [&](FactorShadow *f, IS r, IS) { return (*f->choleskysymbolic)(F, f->S, r, info); }));
+  PetscCall(ShadowSymbolic(F, A, perm, nullptr, [&](FactorShadow *f, IS r, IS) {
+    return (*f->choleskysymbolic)(F, f->S, r, info);
+  }));
   PetscFunctionReturn(0);
 }
 
 PetscErrorCode ILUSymbolic(Mat F, Mat A, IS row, IS col, const MatFactorInfo *info)
 {
   PetscFunctionBegin;
-  PetscCall(ShadowSymbolic(F, A, row, col, [&](FactorShadow *f, IS r, IS c) { return (*f->ilusymbolic)(F, f->S, r, c, info); }));
+  PetscCall(ShadowSymbolic(
+    F, A, row, col, [&](FactorShadow *f, IS r, IS c) { return (*f->ilusymbolic)(F, f->S, r, c, info); }));
   PetscFunctionReturn(0);
 }
 
 PetscErrorCode LUSymbolic(Mat F, Mat A, IS row, IS col, const MatFactorInfo *info)
 {
   PetscFunctionBegin;
-  PetscCall(ShadowSymbolic(F, A, row, col, [&](FactorShadow *f, IS r, IS c) { return (*f->lusymbolic)(F, f->S, r, c, info); }));
+  PetscCall(ShadowSymbolic(
+    F, A, row, col, [&](FactorShadow *f, IS r, IS c) { return (*f->lusymbolic)(F, f->S, r, c, info); }));
   PetscFunctionReturn(0);
 }
 } // namespace
 
 PetscErrorCode MatGetFactor_SeqBinBCSR_Petsc(Mat A, MatFactorType ftype, Mat *F)
 {
-  const PetscBool upper = (ftype == MAT_FACTOR_ICC || ftype == MAT_FACTOR_CHOLESKY) ? PETSC_TRUE : PETSC_FALSE;
-  FactorShadow   *f;
+  const PetscBool upper =
+    (ftype == MAT_FACTOR_ICC || ftype == MAT_FACTOR_CHOLESKY) ? PETSC_TRUE : PETSC_FALSE;
+  FactorShadow *f;
 
   PetscFunctionBegin;
-  PetscCheck(ftype == MAT_FACTOR_ICC || ftype == MAT_FACTOR_CHOLESKY || ftype == MAT_FACTOR_ILU || ftype == MAT_FACTOR_LU, PETSC_COMM_SELF, PETSC_ERR_SUP, "MATSEQBINBCSR provides ICC, Cholesky, ILU and LU (MATSOLVERPETSC), not %s", MatFactorTypes[ftype]);
-  PetscCheck(A->rmap->n == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Factorisation of a non-square MATSEQBINBCSR matrix (%" PetscInt_FMT " x %" PetscInt_FMT ")", A->rmap->n, A->cmap->n);
+  PetscCheck(ftype == MAT_FACTOR_ICC || ftype == MAT_FACTOR_CHOLESKY || ftype == MAT_FACTOR_ILU ||
+               ftype == MAT_FACTOR_LU,
+             PETSC_COMM_SELF, PETSC_ERR_SUP,
+             "MATSEQBINBCSR provides ICC, Cholesky, ILU and LU (MATSOLVERPETSC), not %s",
+             MatFactorTypes[ftype]);
+  PetscCheck(A->rmap->n == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
+             "Factorisation of a non-square MATSEQBINBCSR matrix (%" PetscInt_FMT " x %" PetscInt_FMT ")",
+             A->rmap->n, A->cmap->n);
   f = new FactorShadow;
   PetscCall(BuildShadow(A, upper, f));
 
   PetscCall(MatGetFactor(f->S, MATSOLVERPETSC, ftype, F));
   PetscCall(binbcsr_factor::Attach(*F, f));
 
-  Mat B = *F;
+  Mat B               = *F;
   f->iccsymbolic      = B->ops->iccfactorsymbolic;
   f->choleskysymbolic = B->ops->choleskyfactorsymbolic;
   f->ilusymbolic      = B->ops->ilufactorsymbolic;
@@ -417,7 +442,8 @@ PetscErrorCode MatGetFactor_SeqBinBCSR_Petsc(Mat A, MatFactorType ftype, Mat *F)
   if (upper) { /* LU and ILU keep BAIJ's preferences (nested dissection for LU, natural for ILU); ICC and
                   Cholesky take AIJ's (natural for ICC, nested dissection for Cholesky) */
     PetscCall(PetscFree(B->preferredordering[ftype]));
-    PetscCall(PetscStrallocpy(ftype == MAT_FACTOR_CHOLESKY ? MATORDERINGND : MATORDERINGNATURAL, (char **)&B->preferredordering[ftype]));
+    PetscCall(PetscStrallocpy(ftype == MAT_FACTOR_CHOLESKY ? MATORDERINGND : MATORDERINGNATURAL,
+                              (char **)&B->preferredordering[ftype]));
   }
   PetscFunctionReturn(0);
 }

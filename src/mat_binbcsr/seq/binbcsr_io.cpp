@@ -12,8 +12,7 @@
 #include <algorithm>
 #include <vector>
 
-namespace
-{
+namespace {
 
 PetscErrorCode ViewBinary(Mat A, PetscViewer viewer)
 {
@@ -24,7 +23,8 @@ PetscErrorCode ViewBinary(Mat A, PetscViewer viewer)
   FILE           *info;
 
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatView to a binary file needs an assembled matrix");
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MatView to a binary file needs an assembled matrix");
   if (a->sym) { /* both triangles, as seqaij writes them */
     Mat B;
     PetscCall(MatConvert(A, MATSEQAIJ, MAT_INITIAL_MATRIX, &B));
@@ -93,7 +93,8 @@ PetscErrorCode MatLoad_SeqBinBCSR(Mat A, PetscViewer viewer)
 
   PetscFunctionBegin;
   PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERBINARY, &isbinary));
-  PetscCheck(isbinary, PetscObjectComm((PetscObject)viewer), PETSC_ERR_SUP, "MATSEQBINBCSR loads from binary viewers only, not %s", ((PetscObject)viewer)->type_name);
+  PetscCheck(isbinary, PetscObjectComm((PetscObject)viewer), PETSC_ERR_SUP,
+             "MATSEQBINBCSR loads from binary viewers only, not %s", ((PetscObject)viewer)->type_name);
   /* everything read is checked before the matrix is touched; repeated entries come back summed */
   PetscCall(MatBinBCSRReadBinaryRows_Private(A, viewer, rowptr, cols, vals));
   m   = A->rmap->n;
@@ -118,7 +119,8 @@ PetscErrorCode MatLoad_SeqBinBCSR(Mat A, PetscViewer viewer)
       for (PetscInt k = rowptr[i]; k < rowptr[i + 1]; k++) {
         if (a->sym && cols[k] / bs < i / bs) continue; /* symmetric storage: the lower triangle is implied */
         const PetscInt s = MatSeqBinBCSRFindSlot(a, i / bs, cols[k] / bs);
-        BinBCSRSetValue(a, BinBCSRValueIndex(s, (i % bs) * bs + cols[k] % bs, a->bw, a->bs2), vals[k]); /* one entry per (row, column) */
+        BinBCSRSetValue(a, BinBCSRValueIndex(s, (i % bs) * bs + cols[k] % bs, a->bw, a->bs2),
+                        vals[k]); /* one entry per (row, column) */
       }
   }
   PetscCall(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY));

@@ -27,7 +27,8 @@ static binbcsr::BinMatrix BinMatrixOf(const Mat_SeqBinBCSR *a)
 
 binbcsr::Body MatSeqBinBCSRSelectBody(const Mat_SeqBinBCSR *a)
 {
-  const binbcsr::Shape s = {(int)a->bs, (int)a->bw, (int)a->streams, a->precision == MAT_BINBCSR_PRECISION_SINGLE, a->sym ? true : false};
+  const binbcsr::Shape s = {(int)a->bs, (int)a->bw, (int)a->streams,
+                            a->precision == MAT_BINBCSR_PRECISION_SINGLE, a->sym ? true : false};
   return binbcsr::select_body(s, (binbcsr::BodySet)a->kernel);
 }
 
@@ -42,13 +43,14 @@ static PetscInt CountDiagonal(const Mat_SeqBinBCSR *a)
 static PetscErrorCode MatMultKernel_SeqBinBCSR(Mat A, Vec xx, Vec zz, Vec yy, PetscScalar *dot)
 {
   Mat_SeqBinBCSR    *a = (Mat_SeqBinBCSR *)A->data;
-  const PetscScalar *x, *z = nullptr;
+  const PetscScalar *x, *z   = nullptr;
   PetscScalar       *y, *acc = nullptr, acc_small[8];
   binbcsr::Body      body;
   binbcsr::BinMatrix m;
 
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MATSEQBINBCSR matrix has no layout: assemble it first");
   body = MatSeqBinBCSRSelectBody(a);
   m    = BinMatrixOf(a);
   if (a->bs > 8) PetscCall(PetscMalloc1(a->bs, &acc)); /* the lane-by-lane bodies' accumulators */
@@ -62,7 +64,8 @@ static PetscErrorCode MatMultKernel_SeqBinBCSR(Mat A, Vec xx, Vec zz, Vec yy, Pe
     PetscCall(VecRestoreArray(yy, &y));
     PetscCall(VecRestoreArrayRead(xx, &x));
     if (acc != acc_small) PetscCall(PetscFree(acc));
-    PetscCall(PetscLogFlops(2.0 * (2 * a->nz - CountDiagonal(a)) * a->bs2 - (zz ? 0.0 : (double)A->rmap->n) + (dot ? 2.0 * A->rmap->n : 0.0)));
+    PetscCall(PetscLogFlops(2.0 * (2 * a->nz - CountDiagonal(a)) * a->bs2 - (zz ? 0.0 : (double)A->rmap->n) +
+                            (dot ? 2.0 * A->rmap->n : 0.0)));
     PetscFunctionReturn(0);
   }
   if (zz == yy) {
@@ -80,7 +83,8 @@ static PetscErrorCode MatMultKernel_SeqBinBCSR(Mat A, Vec xx, Vec zz, Vec yy, Pe
     PetscCall(VecRestoreArrayWrite(yy, &y));
   }
   if (acc != acc_small) PetscCall(PetscFree(acc));
-  PetscCall(PetscLogFlops(2.0 * a->nz * a->bs2 - (zz ? 0.0 : (double)A->rmap->n) + (dot ? 2.0 * A->rmap->n : 0.0)));
+  PetscCall(
+    PetscLogFlops(2.0 * a->nz * a->bs2 - (zz ? 0.0 : (double)A->rmap->n) + (dot ? 2.0 * A->rmap->n : 0.0)));
   PetscFunctionReturn(0);
 }
 
@@ -107,8 +111,10 @@ PetscErrorCode MatMultDotLocal_SeqBinBCSR(Mat A, Vec x, Vec y, PetscScalar *xdot
   PetscCheck(x != y, PETSC_COMM_SELF, PETSC_ERR_ARG_IDN, "x and y must be different vectors");
   PetscCall(VecGetLocalSize(x, &nx));
   PetscCall(VecGetLocalSize(y, &ny));
-  PetscCheck(nx == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Mat A,Vec x: local dim %" PetscInt_FMT " %" PetscInt_FMT, A->cmap->n, nx);
-  PetscCheck(ny == A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Mat A,Vec y: local dim %" PetscInt_FMT " %" PetscInt_FMT, A->rmap->n, ny);
+  PetscCheck(nx == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+             "Mat A,Vec x: local dim %" PetscInt_FMT " %" PetscInt_FMT, A->cmap->n, nx);
+  PetscCheck(ny == A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+             "Mat A,Vec y: local dim %" PetscInt_FMT " %" PetscInt_FMT, A->rmap->n, ny);
   PetscCheck(A->rmap->n == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "x.y needs a square matrix");
   PetscCall(PetscLogEventBegin(MAT_BinBCSR_MultDot, A, x, y, 0));
   PetscCall(MatMultKernel_SeqBinBCSR(A, x, nullptr, y, xdoty));
@@ -124,7 +130,8 @@ static PetscErrorCode MatMultTransposeKernel_SeqBinBCSR(Mat A, Vec xx, Vec zz, V
   PetscScalar       *y;
 
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MATSEQBINBCSR matrix has no layout: assemble it first");
   if (A->symmetric == PETSC_BOOL3_TRUE || a->sym) { /* A^T = A: the vectorised product */
     PetscCall(MatMultKernel_SeqBinBCSR(A, xx, zz, yy, nullptr));
     PetscFunctionReturn(0);
@@ -153,4 +160,3 @@ PetscErrorCode MatMultTransposeAdd_SeqBinBCSR(Mat A, Vec x, Vec z, Vec y)
   PetscCall(MatMultTransposeKernel_SeqBinBCSR(A, x, z, y));
   PetscFunctionReturn(0);
 }
-

@@ -13,12 +13,10 @@
 #include <algorithm>
 #include <vector>
 
-namespace
-{
+namespace {
 
 /* f(bin_val, bin_col, row, lane, nz) for every real block row, bin_val typed as the storage. */
-template <typename V, typename F>
-void ForEachLane(const Mat_SeqBinBCSR *a, V *val, F &&f)
+template <typename V, typename F> void ForEachLane(const Mat_SeqBinBCSR *a, V *val, F &&f)
 {
   for (PetscInt b = 0; b < a->nbins; b++) {
     V              *bin_val = val + (size_t)a->bin_start[b] * a->bs2;
@@ -28,8 +26,7 @@ void ForEachLane(const Mat_SeqBinBCSR *a, V *val, F &&f)
   }
 }
 
-template <typename F>
-void ForEachLane(const Mat_SeqBinBCSR *a, F &&f)
+template <typename F> void ForEachLane(const Mat_SeqBinBCSR *a, F &&f)
 {
   if (a->val) ForEachLane(a, a->val, f);
   else ForEachLane(a, a->valf, f);
@@ -37,8 +34,7 @@ void ForEachLane(const Mat_SeqBinBCSR *a, F &&f)
 
 /* f(value index, row block r, column block c, i, j) for every stored value of a real slot (padding
    excluded), whatever the storage; used where symmetric storage scatters real slots over the bin. */
-template <typename F>
-void ForEachRealValue(const Mat_SeqBinBCSR *a, F &&f)
+template <typename F> void ForEachRealValue(const Mat_SeqBinBCSR *a, F &&f)
 {
   const PetscInt bs = a->bs;
   for (PetscInt r = 0; r < a->mbs; r++)
@@ -53,7 +49,8 @@ PetscErrorCode CheckBuilt(Mat A, const char *op)
 {
   const Mat_SeqBinBCSR *a = (const Mat_SeqBinBCSR *)A->data;
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "%s needs an assembled MATSEQBINBCSR matrix", op);
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "%s needs an assembled MATSEQBINBCSR matrix", op);
   PetscFunctionReturn(0);
 }
 
@@ -62,7 +59,9 @@ PetscErrorCode CheckBuilt(Mat A, const char *op)
 PetscErrorCode CheckFinite(Mat A, PetscScalar v, const char *what)
 {
   PetscFunctionBegin;
-  if (A->erroriffailure) PetscCheck(!PetscIsInfOrNanScalar(v), PETSC_COMM_SELF, PETSC_ERR_FP, "%s is %g (MatSetErrorIfFailure is set)", what, (double)PetscRealPart(v));
+  if (A->erroriffailure)
+    PetscCheck(!PetscIsInfOrNanScalar(v), PETSC_COMM_SELF, PETSC_ERR_FP,
+               "%s is %g (MatSetErrorIfFailure is set)", what, (double)PetscRealPart(v));
   PetscFunctionReturn(0);
 }
 
@@ -72,7 +71,11 @@ PetscErrorCode DiagonalIndex(Mat A, PetscInt i, const char *op, PetscInt *v)
   const Mat_SeqBinBCSR *a  = (const Mat_SeqBinBCSR *)A->data;
   const PetscInt        br = i / a->bs, ii = i % a->bs;
   PetscFunctionBegin;
-  PetscCheck(a->diag_slot[br] >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "%s: row %" PetscInt_FMT " has no diagonal entry and the MATSEQBINBCSR pattern is fixed once built; store the diagonal blocks (zeros are fine)", op, i);
+  PetscCheck(
+    a->diag_slot[br] >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+    "%s: row %" PetscInt_FMT
+    " has no diagonal entry and the MATSEQBINBCSR pattern is fixed once built; store the diagonal blocks (zeros are fine)",
+    op, i);
   *v = BinBCSRValueIndex(a->diag_slot[br], ii * a->bs + ii, a->bw, a->bs2);
   PetscFunctionReturn(0);
 }
@@ -86,20 +89,27 @@ PetscErrorCode CheckAllDiagonals(Mat A, const char *op)
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode CheckRows(Mat A, PetscInt N, const PetscInt rows[], PetscScalar diag, Vec x, Vec b, PetscBool columns_too, const char *op)
+PetscErrorCode CheckRows(Mat A, PetscInt N, const PetscInt rows[], PetscScalar diag, Vec x, Vec b,
+                         PetscBool columns_too, const char *op)
 {
   PetscInt v;
   PetscFunctionBegin;
   PetscCall(CheckBuilt(A, op));
   PetscCall(CheckFinite(A, diag, "the diagonal value"));
-  for (PetscInt i = 0; i < N; i++) PetscCheck(rows[i] >= 0 && rows[i] < A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "%s: row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", op, rows[i], A->rmap->n);
-  if (columns_too) PetscCheck(A->rmap->n == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "%s needs a square matrix", op);
+  for (PetscInt i = 0; i < N; i++)
+    PetscCheck(rows[i] >= 0 && rows[i] < A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+               "%s: row %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", op, rows[i], A->rmap->n);
+  if (columns_too)
+    PetscCheck(A->rmap->n == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "%s needs a square matrix", op);
   if (x && b) {
     PetscInt nx, nb;
     PetscCall(VecGetLocalSize(x, &nx));
     PetscCall(VecGetLocalSize(b, &nb));
-    PetscCheck(nx == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "%s: x has %" PetscInt_FMT " entries, the matrix %" PetscInt_FMT " columns", op, nx, A->cmap->n);
-    PetscCheck(nb == A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "%s: b has %" PetscInt_FMT " entries, the matrix %" PetscInt_FMT " rows", op, nb, A->rmap->n);
+    PetscCheck(nx == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+               "%s: x has %" PetscInt_FMT " entries, the matrix %" PetscInt_FMT " columns", op, nx,
+               A->cmap->n);
+    PetscCheck(nb == A->rmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+               "%s: b has %" PetscInt_FMT " entries, the matrix %" PetscInt_FMT " rows", op, nb, A->rmap->n);
   }
   if (diag != 0.0)
     for (PetscInt i = 0; i < N; i++)
@@ -118,7 +128,8 @@ PetscErrorCode PatternContains(Mat Y, Mat X, PetscBool *contains)
     const PetscInt *cols;
     PetscCall(MatGetRow(X, i, &n, &cols, nullptr));
     for (PetscInt k = 0; k < n; k++)
-      if (!(y->sym && cols[k] / y->bs < i / y->bs) && MatSeqBinBCSRFindSlot(y, i / y->bs, cols[k] / y->bs) < 0) {
+      if (!(y->sym && cols[k] / y->bs < i / y->bs) &&
+          MatSeqBinBCSRFindSlot(y, i / y->bs, cols[k] / y->bs) < 0) {
         *contains = PETSC_FALSE;
         break;
       }
@@ -130,7 +141,7 @@ PetscErrorCode PatternContains(Mat Y, Mat X, PetscBool *contains)
 /* Y += a X through X's rows; X's entries must have slots in Y (PatternContains). */
 PetscErrorCode AddRows(Mat Y, PetscScalar a, Mat X)
 {
-  Mat_SeqBinBCSR *y = (Mat_SeqBinBCSR *)Y->data;
+  Mat_SeqBinBCSR *y  = (Mat_SeqBinBCSR *)Y->data;
   const PetscInt  bs = y->bs;
   PetscFunctionBegin;
   for (PetscInt i = 0; i < Y->rmap->n; i++) {
@@ -154,7 +165,7 @@ PetscErrorCode AddRows(Mat Y, PetscScalar a, Mat X)
    (same bin width and precision), Y's values copied, a X added, and the new matrix takes Y's place. */
 PetscErrorCode AXPYUnion(Mat Y, PetscScalar a, Mat X)
 {
-  Mat_SeqBinBCSR       *y = (Mat_SeqBinBCSR *)Y->data;
+  Mat_SeqBinBCSR       *y  = (Mat_SeqBinBCSR *)Y->data;
   const PetscInt        bs = y->bs, mbs = y->mbs;
   std::vector<PetscInt> bi(mbs + 1, 0), bj, row;
   Mat                   B;
@@ -191,7 +202,9 @@ PetscErrorCode AXPYUnion(Mat Y, PetscScalar a, Mat X)
     for (PetscInt r = 0; r < mbs; r++)
       for (PetscInt k = 0; k < y->row_nz[r]; k++) {
         const PetscInt sy = BinBCSRSlot(y, r, k), sb = MatSeqBinBCSRFindSlot(b, r, y->col[sy]);
-        for (PetscInt e = 0; e < y->bs2; e++) BinBCSRSetValue(b, BinBCSRValueIndex(sb, e, b->bw, b->bs2), BinBCSRGetValue(y, BinBCSRValueIndex(sy, e, y->bw, y->bs2)));
+        for (PetscInt e = 0; e < y->bs2; e++)
+          BinBCSRSetValue(b, BinBCSRValueIndex(sb, e, b->bw, b->bs2),
+                          BinBCSRGetValue(y, BinBCSRValueIndex(sy, e, y->bw, y->bs2)));
       }
   }
   PetscCall(AddRows(B, a, X));
@@ -207,10 +220,16 @@ PetscErrorCode AXPYUnion(Mat Y, PetscScalar a, Mat X)
 PetscBool MatSeqBinBCSRSameLayout(const Mat_SeqBinBCSR *y, const Mat_SeqBinBCSR *x)
 {
   if (!y->built || !x->built) return PETSC_FALSE;
-  if (y->bs != x->bs || y->bw != x->bw || y->mbs != x->mbs || y->nbs != x->nbs || y->nslots != x->nslots || y->sym != x->sym) return PETSC_FALSE;
+  if (y->bs != x->bs || y->bw != x->bw || y->mbs != x->mbs || y->nbs != x->nbs || y->nslots != x->nslots ||
+      y->sym != x->sym)
+    return PETSC_FALSE;
   if (y->bin_start == x->bin_start && y->col == x->col) return PETSC_TRUE;
   if (y->sym && !std::equal(y->real_slot, y->real_slot + y->nz, x->real_slot)) return PETSC_FALSE;
-  return std::equal(y->bin_start, y->bin_start + y->nbins + 1, x->bin_start) && std::equal(y->row_nz, y->row_nz + y->mbs, x->row_nz) && std::equal(y->col, y->col + y->nslots, x->col) ? PETSC_TRUE : PETSC_FALSE;
+  return std::equal(y->bin_start, y->bin_start + y->nbins + 1, x->bin_start) &&
+             std::equal(y->row_nz, y->row_nz + y->mbs, x->row_nz) &&
+             std::equal(y->col, y->col + y->nslots, x->col)
+           ? PETSC_TRUE
+           : PETSC_FALSE;
 }
 
 PetscErrorCode MatZeroEntries_SeqBinBCSR(Mat A)
@@ -238,8 +257,14 @@ PetscErrorCode MatScale_SeqBinBCSR(Mat A, PetscScalar alpha)
   if (PetscIsInfOrNanScalar(alpha)) {
     /* real slots only: 0 * Inf would put NaN into the padding */
     const int bw = (int)a->bw, bs2 = (int)a->bs2;
-    if (a->sym) ForEachRealValue(a, [&](PetscInt v, PetscInt, PetscInt, PetscInt, PetscInt) { BinBCSRSetValue(a, v, alpha * BinBCSRGetValue(a, v)); });
-    else ForEachLane(a, [&](auto *bin_val, const PetscInt *, PetscInt, int lane, int nz) { binbcsr::lane_scale(bin_val, nz, bw, bs2, lane, alpha); });
+    if (a->sym)
+      ForEachRealValue(a, [&](PetscInt v, PetscInt, PetscInt, PetscInt, PetscInt) {
+        BinBCSRSetValue(a, v, alpha * BinBCSRGetValue(a, v));
+      });
+    else
+      ForEachLane(a, [&](auto *bin_val, const PetscInt *, PetscInt, int lane, int nz) {
+        binbcsr::lane_scale(bin_val, nz, bw, bs2, lane, alpha);
+      });
   } else if (a->val) binbcsr::values_scale((long)a->nslots * a->bs2, a->val, alpha);
   else binbcsr::values_scale((long)a->nslots * a->bs2, a->valf, alpha);
   PetscCall(PetscLogFlops((PetscLogDouble)a->nz * a->bs2));
@@ -280,14 +305,16 @@ PetscErrorCode MatDiagonalSet_SeqBinBCSR(Mat A, Vec D, InsertMode mode)
     PetscCall(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY));
     PetscFunctionReturn(0);
   }
-  PetscCheck(A->rmap->n == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "MatDiagonalSet needs a square matrix");
+  PetscCheck(A->rmap->n == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+             "MatDiagonalSet needs a square matrix");
   PetscCall(CheckAllDiagonals(A, "MatDiagonalSet"));
   PetscCall(VecGetArrayRead(D, &d));
   if (A->erroriffailure) {
     for (PetscInt i = 0; i < A->rmap->n; i++) {
       if (PetscIsInfOrNanScalar(d[i])) {
         PetscCall(VecRestoreArrayRead(D, &d));
-        SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FP, "Diagonal entry %" PetscInt_FMT " is not finite (MatSetErrorIfFailure is set)", i);
+        SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FP,
+                "Diagonal entry %" PetscInt_FMT " is not finite (MatSetErrorIfFailure is set)", i);
       }
     }
   }
@@ -312,7 +339,7 @@ PetscErrorCode MatAXPY_SeqBinBCSR(Mat Y, PetscScalar alpha, Mat X, MatStructure 
     /* the fast path: slot by slot, whatever each side's precision */
     const Mat_SeqBinBCSR *x  = (const Mat_SeqBinBCSR *)X->data;
     const int             bw = (int)y->bw, bs2 = (int)y->bs2;
-    const long            n  = (long)y->nslots * y->bs2;
+    const long            n = (long)y->nslots * y->bs2;
     if (!PetscIsInfOrNanScalar(alpha)) {
       /* padding: 0 + alpha 0 = 0, so one contiguous pass over all values */
       if (y->val && x->val) binbcsr::values_axpy(n, y->val, x->val, alpha);
@@ -323,7 +350,9 @@ PetscErrorCode MatAXPY_SeqBinBCSR(Mat Y, PetscScalar alpha, Mat X, MatStructure 
       PetscFunctionReturn(0);
     }
     if (y->sym) { /* real slots only (the colouring scatters them over the bin) */
-      ForEachRealValue(y, [&](PetscInt v, PetscInt, PetscInt, PetscInt, PetscInt) { BinBCSRSetValue(y, v, BinBCSRGetValue(y, v) + alpha * BinBCSRGetValue(x, v)); });
+      ForEachRealValue(y, [&](PetscInt v, PetscInt, PetscInt, PetscInt, PetscInt) {
+        BinBCSRSetValue(y, v, BinBCSRGetValue(y, v) + alpha * BinBCSRGetValue(x, v));
+      });
       PetscCall(PetscLogFlops(2.0 * y->nz * y->bs2));
       PetscFunctionReturn(0);
     }
@@ -350,14 +379,17 @@ PetscErrorCode MatAXPY_SeqBinBCSR(Mat Y, PetscScalar alpha, Mat X, MatStructure 
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode MatZeroRows_SeqBinBCSR(Mat A, PetscInt N, const PetscInt rows[], PetscScalar diag, Vec x, Vec b)
+PetscErrorCode MatZeroRows_SeqBinBCSR(Mat A, PetscInt N, const PetscInt rows[], PetscScalar diag, Vec x,
+                                      Vec b)
 {
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  Mat_SeqBinBCSR *a  = (Mat_SeqBinBCSR *)A->data;
   const int       bw = (int)a->bw, bs = (int)a->bs;
   PetscInt        v;
 
   PetscFunctionBegin;
-  BinBCSRCheckNotSym(a, "MatZeroRows (zeroing rows but not columns would make the matrix non-symmetric; use MatZeroRowsColumns)");
+  BinBCSRCheckNotSym(
+    a,
+    "MatZeroRows (zeroing rows but not columns would make the matrix non-symmetric; use MatZeroRowsColumns)");
   PetscCall(CheckRows(A, N, rows, diag, x, b, PETSC_FALSE, "MatZeroRows"));
   if (x && b) {
     const PetscScalar *xx;
@@ -372,7 +404,8 @@ PetscErrorCode MatZeroRows_SeqBinBCSR(Mat A, PetscInt N, const PetscInt rows[], 
   for (PetscInt i = 0; i < N; i++) {
     const PetscInt r = rows[i] / bs, bin = r / bw;
     const size_t   off = (size_t)a->bin_start[bin] * a->bs2;
-    if (a->val) binbcsr::lane_zero_row(a->val + off, (int)a->row_nz[r], bw, bs, (int)(r % bw), (int)(rows[i] % bs));
+    if (a->val)
+      binbcsr::lane_zero_row(a->val + off, (int)a->row_nz[r], bw, bs, (int)(r % bw), (int)(rows[i] % bs));
     else binbcsr::lane_zero_row(a->valf + off, (int)a->row_nz[r], bw, bs, (int)(r % bw), (int)(rows[i] % bs));
   }
   if (diag != 0.0)
@@ -384,9 +417,10 @@ PetscErrorCode MatZeroRows_SeqBinBCSR(Mat A, PetscInt N, const PetscInt rows[], 
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode MatZeroRowsColumns_SeqBinBCSR(Mat A, PetscInt N, const PetscInt rows[], PetscScalar diag, Vec x, Vec b)
+PetscErrorCode MatZeroRowsColumns_SeqBinBCSR(Mat A, PetscInt N, const PetscInt rows[], PetscScalar diag,
+                                             Vec x, Vec b)
 {
-  Mat_SeqBinBCSR    *a = (Mat_SeqBinBCSR *)A->data;
+  Mat_SeqBinBCSR    *a  = (Mat_SeqBinBCSR *)A->data;
   const int          bw = (int)a->bw, bs = (int)a->bs;
   const PetscScalar *xx = nullptr;
   PetscScalar       *bb = nullptr;
@@ -424,21 +458,25 @@ PetscErrorCode MatZeroRowsColumns_SeqBinBCSR(Mat A, PetscInt N, const PetscInt r
       }
     }
   } else {
-  /* the columns, in the rows that stay (moving the known values to b) */
-  ForEachLane(a, [&](auto *bin_val, const PetscInt *bin_col, PetscInt r, int lane, int nz) { binbcsr::lane_zero_columns(bin_val, bin_col, nz, bw, bs, lane, zeroed, zeroed + r * bs, xx, bb ? bb + r * bs : nullptr); });
-  /* then the rows */
-  for (PetscInt i = 0; i < A->rmap->n; i++) {
-    if (!zeroed[i]) continue;
-    const PetscInt r = i / bs;
-    const size_t   off = (size_t)a->bin_start[r / bw] * a->bs2;
-    if (a->val) binbcsr::lane_zero_row(a->val + off, (int)a->row_nz[r], bw, bs, (int)(r % bw), (int)(i % bs));
-    else binbcsr::lane_zero_row(a->valf + off, (int)a->row_nz[r], bw, bs, (int)(r % bw), (int)(i % bs));
-    if (bb) bb[i] = diag * xx[i];
-    if (diag != 0.0) {
-      PetscCall(DiagonalIndex(A, i, "MatZeroRowsColumns", &v));
-      BinBCSRSetValue(a, v, diag);
+    /* the columns, in the rows that stay (moving the known values to b) */
+    ForEachLane(a, [&](auto *bin_val, const PetscInt *bin_col, PetscInt r, int lane, int nz) {
+      binbcsr::lane_zero_columns(bin_val, bin_col, nz, bw, bs, lane, zeroed, zeroed + r * bs, xx,
+                                 bb ? bb + r * bs : nullptr);
+    });
+    /* then the rows */
+    for (PetscInt i = 0; i < A->rmap->n; i++) {
+      if (!zeroed[i]) continue;
+      const PetscInt r   = i / bs;
+      const size_t   off = (size_t)a->bin_start[r / bw] * a->bs2;
+      if (a->val)
+        binbcsr::lane_zero_row(a->val + off, (int)a->row_nz[r], bw, bs, (int)(r % bw), (int)(i % bs));
+      else binbcsr::lane_zero_row(a->valf + off, (int)a->row_nz[r], bw, bs, (int)(r % bw), (int)(i % bs));
+      if (bb) bb[i] = diag * xx[i];
+      if (diag != 0.0) {
+        PetscCall(DiagonalIndex(A, i, "MatZeroRowsColumns", &v));
+        BinBCSRSetValue(a, v, diag);
+      }
     }
-  }
   }
   if (x && b) {
     PetscCall(VecRestoreArrayRead(x, &xx));
@@ -473,13 +511,17 @@ PetscErrorCode MatNorm_SeqBinBCSR(Mat A, NormType type, PetscReal *nrm)
   if (a->sym) {
     /* Frobenius: off-diagonal blocks count twice; 1 = infinity (symmetric): row sums of the full
        matrix, i.e. the stored rows plus the stored off-diagonal blocks' columns */
-    if (type == NORM_FROBENIUS) { /* twice the contiguous sum over all values (padding is zero), less the diagonal blocks once */
-      const long n   = (long)a->nslots * a->bs2;
-      double     sum = 2.0 * (a->val ? binbcsr::values_sum_squares(n, a->val) : binbcsr::values_sum_squares(n, a->valf));
+    if (
+      type ==
+      NORM_FROBENIUS) { /* twice the contiguous sum over all values (padding is zero), less the diagonal blocks once */
+      const long n = (long)a->nslots * a->bs2;
+      double     sum =
+        2.0 * (a->val ? binbcsr::values_sum_squares(n, a->val) : binbcsr::values_sum_squares(n, a->valf));
       for (PetscInt r = 0; r < a->mbs; r++) {
         if (a->diag_slot[r] < 0) continue;
         for (PetscInt e = 0; e < a->bs2; e++) {
-          const double x = PetscAbsScalar(BinBCSRGetValue(a, BinBCSRValueIndex(a->diag_slot[r], e, a->bw, a->bs2)));
+          const double x =
+            PetscAbsScalar(BinBCSRGetValue(a, BinBCSRValueIndex(a->diag_slot[r], e, a->bw, a->bs2)));
           sum -= x * x;
         }
       }
@@ -492,7 +534,8 @@ PetscErrorCode MatNorm_SeqBinBCSR(Mat A, NormType type, PetscReal *nrm)
   }
   if (type == NORM_FROBENIUS) {
     const long n = (long)a->nslots * a->bs2;
-    *nrm         = PetscSqrtReal(a->val ? binbcsr::values_sum_squares(n, a->val) : binbcsr::values_sum_squares(n, a->valf));
+    *nrm         = PetscSqrtReal(a->val ? binbcsr::values_sum_squares(n, a->val)
+                                        : binbcsr::values_sum_squares(n, a->valf));
   } else if (type == NORM_1) {
     PetscCall(MaxColumnSum(A, nrm));
   } else if (type == NORM_INFINITY) {
@@ -529,7 +572,10 @@ PetscErrorCode MatGetInfo_SeqBinBCSR(Mat A, MatInfoType flag, MatInfo *info)
     info->nz_used            = (double)a->nz * bs2;
     info->nz_allocated       = (double)a->nslots * bs2;
     info->nz_unneeded        = info->nz_allocated - info->nz_used;
-    info->memory             = info->nz_allocated * value_bytes + (double)(a->nslots + a->nbins + 1 + 2 * a->mbs + (a->sym ? a->nz + a->mbs + 1 : 0)) * sizeof(PetscInt) + (a->coo_jmap ? (double)(a->nslots * bs2 + 1 + a->coo_n) * sizeof(PetscInt) : 0.0);
+    info->memory =
+      info->nz_allocated * value_bytes +
+      (double)(a->nslots + a->nbins + 1 + 2 * a->mbs + (a->sym ? a->nz + a->mbs + 1 : 0)) * sizeof(PetscInt) +
+      (a->coo_jmap ? (double)(a->nslots * bs2 + 1 + a->coo_n) * sizeof(PetscInt) : 0.0);
   }
   PetscFunctionReturn(0);
 }

@@ -13,7 +13,8 @@ PETSC_INTERN PetscErrorCode MatShift_SeqBinBCSR(Mat, PetscScalar);
 PETSC_INTERN PetscErrorCode MatDiagonalSet_SeqBinBCSR(Mat, Vec, InsertMode);
 PETSC_INTERN PetscErrorCode MatAXPY_SeqBinBCSR(Mat, PetscScalar, Mat, MatStructure);
 PETSC_INTERN PetscErrorCode MatZeroRows_SeqBinBCSR(Mat, PetscInt, const PetscInt[], PetscScalar, Vec, Vec);
-PETSC_INTERN PetscErrorCode MatZeroRowsColumns_SeqBinBCSR(Mat, PetscInt, const PetscInt[], PetscScalar, Vec, Vec);
+PETSC_INTERN PetscErrorCode MatZeroRowsColumns_SeqBinBCSR(Mat, PetscInt, const PetscInt[], PetscScalar, Vec,
+                                                          Vec);
 PETSC_INTERN PetscErrorCode MatNorm_SeqBinBCSR(Mat, NormType, PetscReal *);
 PETSC_INTERN PetscErrorCode MatGetInfo_SeqBinBCSR(Mat, MatInfoType, MatInfo *);
 

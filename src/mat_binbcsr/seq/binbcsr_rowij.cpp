@@ -5,7 +5,9 @@
    into arrays of our own and freed by MatRestoreRowIJ. Set-up time only: one conversion per call. */
 #include "binbcsr.h"
 
-PetscErrorCode MatGetRowIJ_SeqBinBCSR(Mat A, PetscInt shift, PetscBool symmetric, PetscBool blockcompressed, PetscInt *n, const PetscInt *ia[], const PetscInt *ja[], PetscBool *done)
+PetscErrorCode MatGetRowIJ_SeqBinBCSR(Mat A, PetscInt shift, PetscBool symmetric, PetscBool blockcompressed,
+                                      PetscInt *n, const PetscInt *ia[], const PetscInt *ja[],
+                                      PetscBool *done)
 {
   const PetscBool blocked = (blockcompressed && A->rmap->bs > 1) ? PETSC_TRUE : PETSC_FALSE;
   Mat             T;
@@ -19,7 +21,8 @@ PetscErrorCode MatGetRowIJ_SeqBinBCSR(Mat A, PetscInt shift, PetscBool symmetric
   if (!ia) PetscFunctionReturn(0);
   PetscCall(MatConvert(A, blocked ? MATSEQBAIJ : MATSEQAIJ, MAT_INITIAL_MATRIX, &T));
   PetscCall(MatGetRowIJ(T, shift, symmetric, blocked, &tn, &tia, &tja, &tdone));
-  PetscCheck(tdone && tn == *n, PETSC_COMM_SELF, PETSC_ERR_PLIB, "MatGetRowIJ of the %s copy failed", blocked ? MATSEQBAIJ : MATSEQAIJ);
+  PetscCheck(tdone && tn == *n, PETSC_COMM_SELF, PETSC_ERR_PLIB, "MatGetRowIJ of the %s copy failed",
+             blocked ? MATSEQBAIJ : MATSEQAIJ);
   const PetscInt nnz = tia[tn] - shift;
   PetscCall(PetscMalloc1(tn + 1, &cia));
   PetscCall(PetscMalloc1(nnz, &cja));
@@ -33,7 +36,9 @@ PetscErrorCode MatGetRowIJ_SeqBinBCSR(Mat A, PetscInt shift, PetscBool symmetric
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode MatRestoreRowIJ_SeqBinBCSR(Mat A, PetscInt shift, PetscBool symmetric, PetscBool blockcompressed, PetscInt *n, const PetscInt *ia[], const PetscInt *ja[], PetscBool *done)
+PetscErrorCode MatRestoreRowIJ_SeqBinBCSR(Mat A, PetscInt shift, PetscBool symmetric,
+                                          PetscBool blockcompressed, PetscInt *n, const PetscInt *ia[],
+                                          const PetscInt *ja[], PetscBool *done)
 {
   PetscFunctionBegin;
   (void)A;

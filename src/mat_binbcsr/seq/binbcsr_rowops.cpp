@@ -15,12 +15,10 @@
 #include <algorithm>
 #include <vector>
 
-namespace
-{
+namespace {
 
 /* f(values) with the storage's value array, typed (double or float) */
-template <typename F>
-void WithValues(const Mat_SeqBinBCSR *a, F &&f)
+template <typename F> void WithValues(const Mat_SeqBinBCSR *a, F &&f)
 {
   if (a->val) f(a->val);
   else f(a->valf);
@@ -28,11 +26,11 @@ void WithValues(const Mat_SeqBinBCSR *a, F &&f)
 
 /* f(slot, block column, transposed) for the blocks of block row r's full row in ascending column
    order. Symmetric storage: the lower index must exist (MatSeqBinBCSRBuildLowerIndex). */
-template <typename F>
-void ForEachRowBlock(const Mat_SeqBinBCSR *a, PetscInt r, F &&f)
+template <typename F> void ForEachRowBlock(const Mat_SeqBinBCSR *a, PetscInt r, F &&f)
 {
   if (a->sym)
-    for (PetscInt p = a->lower_off[r]; p < a->lower_off[r + 1]; p++) f(a->lower_slot[2 * p], a->lower_slot[2 * p + 1], true);
+    for (PetscInt p = a->lower_off[r]; p < a->lower_off[r + 1]; p++)
+      f(a->lower_slot[2 * p], a->lower_slot[2 * p + 1], true);
   for (PetscInt k = 0; k < a->row_nz[r]; k++) {
     const PetscInt s = BinBCSRSlot(a, r, k);
     f(s, a->col[s], false);
@@ -42,10 +40,10 @@ void ForEachRowBlock(const Mat_SeqBinBCSR *a, PetscInt r, F &&f)
 PetscErrorCode CheckBuilt(Mat A, const char *op)
 {
   PetscFunctionBegin;
-  PetscCheck(((Mat_SeqBinBCSR *)A->data)->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "%s needs an assembled MATSEQBINBCSR matrix", op);
+  PetscCheck(((Mat_SeqBinBCSR *)A->data)->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "%s needs an assembled MATSEQBINBCSR matrix", op);
   PetscFunctionReturn(0);
 }
-
 
 /* The same scaling on both sides: the same vector, or equal entries (the MPI type passes two views of
    one vector). */
@@ -70,9 +68,9 @@ PetscErrorCode SameScaling(Vec l, Vec r, PetscBool *same)
 /* v[i] (and idx[i]) = the extreme of the kind over row i, PETSc's AIJ rules (binbcsr::row_extreme_start) */
 PetscErrorCode RowExtremes(Mat A, Vec v, PetscInt idx[], int kind, const char *op)
 {
-  Mat_SeqBinBCSR *a  = (Mat_SeqBinBCSR *)A->data;
-  const PetscInt  bs = a->bs;
-  PetscScalar    *x;
+  Mat_SeqBinBCSR       *a  = (Mat_SeqBinBCSR *)A->data;
+  const PetscInt        bs = a->bs;
+  PetscScalar          *x;
   std::vector<double>   best(bs);
   std::vector<PetscInt> at(bs);
 
@@ -90,8 +88,12 @@ PetscErrorCode RowExtremes(Mat A, Vec v, PetscInt idx[], int kind, const char *o
     for (PetscInt b = 0; b < a->nbins; b++) {
       const PetscInt s0 = a->bin_start[b], len = (a->bin_start[b + 1] - s0) / a->bw;
       WithValues(a, [&](const auto *val) {
-        if (a->sym) binbcsr::bin_row_max_abs<true>(val + (size_t)s0 * a->bs2, a->col + s0, (int)len, (int)a->bw, (int)bs, b * a->bw, a->mbs, x, col);
-        else binbcsr::bin_row_max_abs<false>(val + (size_t)s0 * a->bs2, a->col + s0, (int)len, (int)a->bw, (int)bs, b * a->bw, a->mbs, x, col);
+        if (a->sym)
+          binbcsr::bin_row_max_abs<true>(val + (size_t)s0 * a->bs2, a->col + s0, (int)len, (int)a->bw,
+                                         (int)bs, b * a->bw, a->mbs, x, col);
+        else
+          binbcsr::bin_row_max_abs<false>(val + (size_t)s0 * a->bs2, a->col + s0, (int)len, (int)a->bw,
+                                          (int)bs, b * a->bw, a->mbs, x, col);
       });
     }
     PetscCall(VecRestoreArrayWrite(v, &x));
@@ -105,9 +107,13 @@ PetscErrorCode RowExtremes(Mat A, Vec v, PetscInt idx[], int kind, const char *o
       nb++;
     });
     if (gap < 0) gap = nb;
-    for (PetscInt i = 0; i < bs; i++) binbcsr::row_extreme_start(kind, nb * bs == A->cmap->n, gap * bs, &best[i], &at[i]);
+    for (PetscInt i = 0; i < bs; i++)
+      binbcsr::row_extreme_start(kind, nb * bs == A->cmap->n, gap * bs, &best[i], &at[i]);
     WithValues(a, [&](const auto *val) {
-      ForEachRowBlock(a, r, [&](PetscInt s, PetscInt c, bool transposed) { binbcsr::slot_row_extremes(val + BinBCSRValueIndex(s, 0, a->bw, a->bs2), (int)a->bw, (int)bs, transposed, c * bs, kind, best.data(), at.data()); });
+      ForEachRowBlock(a, r, [&](PetscInt s, PetscInt c, bool transposed) {
+        binbcsr::slot_row_extremes(val + BinBCSRValueIndex(s, 0, a->bw, a->bs2), (int)a->bw, (int)bs,
+                                   transposed, c * bs, kind, best.data(), at.data());
+      });
     });
     for (PetscInt i = 0; i < bs; i++) {
       x[r * bs + i] = best[i];
@@ -120,18 +126,18 @@ PetscErrorCode RowExtremes(Mat A, Vec v, PetscInt idx[], int kind, const char *o
 
 } // namespace
 
-namespace
-{
-template <int KIND, bool MIRROR>
-void ColumnReductionsOf(const Mat_SeqBinBCSR *a, double *red)
+namespace {
+template <int KIND, bool MIRROR> void ColumnReductionsOf(const Mat_SeqBinBCSR *a, double *red)
 {
   for (PetscInt b = 0; b < a->nbins; b++) {
     const PetscInt s0 = a->bin_start[b], len = (a->bin_start[b + 1] - s0) / a->bw;
-    WithValues(a, [&](const auto *val) { binbcsr::bin_col_reductions<KIND, MIRROR>(val + (size_t)s0 * a->bs2, a->col + s0, (int)len, (int)a->bw, (int)a->bs, b * a->bw, a->mbs, red); });
+    WithValues(a, [&](const auto *val) {
+      binbcsr::bin_col_reductions<KIND, MIRROR>(val + (size_t)s0 * a->bs2, a->col + s0, (int)len, (int)a->bw,
+                                                (int)a->bs, b * a->bw, a->mbs, red);
+    });
   }
 }
-template <int KIND>
-void ColumnReductionsOf(const Mat_SeqBinBCSR *a, double *red)
+template <int KIND> void ColumnReductionsOf(const Mat_SeqBinBCSR *a, double *red)
 {
   if (a->sym) ColumnReductionsOf<KIND, true>(a, red);
   else ColumnReductionsOf<KIND, false>(a, red);
@@ -199,7 +205,9 @@ PetscErrorCode MatDiagonalScale_SeqBinBCSR(Mat A, Vec ll, Vec rr)
   if (a->sym) {
     PetscBool same;
     PetscCall(SameScaling(ll, rr, &same));
-    PetscCheck(same, PETSC_COMM_SELF, PETSC_ERR_SUP, "MatDiagonalScale with symmetric storage (-mat_binbcsr_symmetric_storage) needs the same left and right scaling: D A D stays symmetric, L A R does not; use full storage for that");
+    PetscCheck(
+      same, PETSC_COMM_SELF, PETSC_ERR_SUP,
+      "MatDiagonalScale with symmetric storage (-mat_binbcsr_symmetric_storage) needs the same left and right scaling: D A D stays symmetric, L A R does not; use full storage for that");
   }
   if (ll) PetscCall(VecGetArrayRead(ll, &l));
   if (rr) PetscCall(VecGetArrayRead(rr, &r));
@@ -208,13 +216,17 @@ PetscErrorCode MatDiagonalScale_SeqBinBCSR(Mat A, Vec ll, Vec rr)
       for (PetscInt row = 0; row < a->mbs; row++)
         for (PetscInt k = 0; k < a->row_nz[row]; k++) {
           const PetscInt s = BinBCSRSlot(a, row, k);
-          binbcsr::slot_diagonal_scale(val + BinBCSRValueIndex(s, 0, a->bw, a->bs2), (int)a->bw, (int)bs, l ? l + row * bs : nullptr, r ? r + a->col[s] * bs : nullptr);
+          binbcsr::slot_diagonal_scale(val + BinBCSRValueIndex(s, 0, a->bw, a->bs2), (int)a->bw, (int)bs,
+                                       l ? l + row * bs : nullptr, r ? r + a->col[s] * bs : nullptr);
         }
       return;
     }
     for (PetscInt b = 0; b < a->nbins; b++) {
       const PetscInt r0 = b * a->bw, r1 = PetscMin(a->mbs, r0 + a->bw);
-      for (PetscInt row = r0; row < r1; row++) binbcsr::lane_diagonal_scale(val + (size_t)a->bin_start[b] * a->bs2, a->col + a->bin_start[b], (int)a->row_nz[row], (int)a->bw, (int)bs, (int)(row - r0), l ? l + row * bs : nullptr, r);
+      for (PetscInt row = r0; row < r1; row++)
+        binbcsr::lane_diagonal_scale(val + (size_t)a->bin_start[b] * a->bs2, a->col + a->bin_start[b],
+                                     (int)a->row_nz[row], (int)a->bw, (int)bs, (int)(row - r0),
+                                     l ? l + row * bs : nullptr, r);
     }
   });
   if (ll) PetscCall(VecRestoreArrayRead(ll, &l));

@@ -19,21 +19,22 @@
 
 #include <type_traits>
 
-namespace
-{
+namespace {
 
 /* acc = sum over c < r (lower) or c > r (upper) of A_rc x_c for block row r: the row's stored
    blocks and, with symmetric storage, the transposed blocks (c, r), c < r, stored in the rows above
    (the lower index). The diagonal block is left out. */
 template <int BS, typename V>
-void row_half_product(const Mat_SeqBinBCSR *a, const V *val, PetscInt r, bool lower, const double *x, double *acc)
+void row_half_product(const Mat_SeqBinBCSR *a, const V *val, PetscInt r, bool lower, const double *x,
+                      double *acc)
 {
   const int bs = BS ? BS : (int)a->bs, bs2 = bs * bs, bw = (int)a->bw;
   for (int i = 0; i < bs; i++) acc[i] = 0.0;
   if (a->sym && lower) {
     for (PetscInt p = a->lower_off[r]; p < a->lower_off[r + 1]; p++) {
       const PetscInt s = a->lower_slot[2 * p], c = a->lower_slot[2 * p + 1];
-      binbcsr::slot_mult_transpose<BS, V>(val + BinBCSRValueIndex(s, 0, bw, bs2), bw, bs, x + (size_t)c * bs, acc);
+      binbcsr::slot_mult_transpose<BS, V>(val + BinBCSRValueIndex(s, 0, bw, bs2), bw, bs, x + (size_t)c * bs,
+                                          acc);
     }
     return;
   }
@@ -46,7 +47,8 @@ void row_half_product(const Mat_SeqBinBCSR *a, const V *val, PetscInt r, bool lo
   }
   for (PetscInt k = k0; k < k1; k++) {
     const PetscInt s = BinBCSRSlot(a, r, k), c = a->col[s];
-    if (lower ? c < r : c > r) binbcsr::slot_mult<BS, V>(val + BinBCSRValueIndex(s, 0, bw, bs2), bw, bs, x + (size_t)c * bs, acc);
+    if (lower ? c < r : c > r)
+      binbcsr::slot_mult<BS, V>(val + BinBCSRValueIndex(s, 0, bw, bs2), bw, bs, x + (size_t)c * bs, acc);
   }
 }
 
@@ -57,19 +59,20 @@ void row_half_product(const Mat_SeqBinBCSR *a, const V *val, PetscInt r, bool lo
    every sweep after the first cost half a matrix pass; with a zero initial guess the first one needs
    no upper half either, so an SSOR application from zero costs one pass. */
 struct HalfSums {
-  double *lower, *upper;     /* [n] L_r and U_r of the last sweep that computed them */
+  double *lower, *upper;      /* [n] L_r and U_r of the last sweep that computed them */
   bool    lower_ok, upper_ok; /* still valid for the current x */
 };
 
 template <int BS, typename V>
-void sweep(const Mat_SeqBinBCSR *a, const V *val, const MatScalar *idiag, PetscReal omega, const double *b, double *x, bool forward, HalfSums &h, double *work)
+void sweep(const Mat_SeqBinBCSR *a, const V *val, const MatScalar *idiag, PetscReal omega, const double *b,
+           double *x, bool forward, HalfSums &h, double *work)
 {
   const int bs = BS ? BS : (int)a->bs, bs2 = bs * bs;
   double   *lo = work, *up = work + bs, *res = work + 2 * bs;
   for (PetscInt q = 0; q < a->mbs; q++) {
-    const PetscInt r   = forward ? q : a->mbs - 1 - q;
-    double        *xr  = x + (size_t)r * bs;
-    double        *Lr  = h.lower + (size_t)r * bs, *Ur = h.upper + (size_t)r * bs;
+    const PetscInt r  = forward ? q : a->mbs - 1 - q;
+    double        *xr = x + (size_t)r * bs;
+    double        *Lr = h.lower + (size_t)r * bs, *Ur = h.upper + (size_t)r * bs;
     if (forward || !h.lower_ok) row_half_product<BS, V>(a, val, r, true, x, lo);
     else
       for (int i = 0; i < bs; i++) lo[i] = Lr[i];
@@ -94,20 +97,23 @@ void sweep(const Mat_SeqBinBCSR *a, const V *val, const MatScalar *idiag, PetscR
 
 /* y_r += alpha (D_r + shift I) x_r for every block row r (D_r: the stored diagonal block, zero if none). */
 template <int BS, typename V>
-void diagonal_block_axpy(const Mat_SeqBinBCSR *a, const V *val, double alpha, double shift, const double *x, double *y, double *acc)
+void diagonal_block_axpy(const Mat_SeqBinBCSR *a, const V *val, double alpha, double shift, const double *x,
+                         double *y, double *acc)
 {
   const int bs = BS ? BS : (int)a->bs, bs2 = bs * bs, bw = (int)a->bw;
   for (PetscInt r = 0; r < a->mbs; r++) {
     const double *xr = x + (size_t)r * bs;
     for (int i = 0; i < bs; i++) acc[i] = shift * xr[i];
-    if (a->diag_slot[r] >= 0) binbcsr::slot_mult<BS, V>(val + BinBCSRValueIndex(a->diag_slot[r], 0, bw, bs2), bw, bs, xr, acc);
+    if (a->diag_slot[r] >= 0)
+      binbcsr::slot_mult<BS, V>(val + BinBCSRValueIndex(a->diag_slot[r], 0, bw, bs2), bw, bs, xr, acc);
     for (int i = 0; i < bs; i++) y[(size_t)r * bs + i] += alpha * acc[i];
   }
 }
 
 /* x_r = (D_r + shift I) b_r / omega + U_r b: SOR_APPLY_UPPER, (U + E) b. */
 template <int BS, typename V>
-void apply_upper(const Mat_SeqBinBCSR *a, const V *val, PetscReal omega, PetscReal shift, const double *b, double *x, double *work)
+void apply_upper(const Mat_SeqBinBCSR *a, const V *val, PetscReal omega, PetscReal shift, const double *b,
+                 double *x, double *work)
 {
   const int bs = BS ? BS : (int)a->bs;
   for (PetscInt r = 0; r < a->mbs; r++) row_half_product<BS, V>(a, val, r, false, b, x + (size_t)r * bs);
@@ -116,8 +122,7 @@ void apply_upper(const Mat_SeqBinBCSR *a, const V *val, PetscReal omega, PetscRe
 
 /* f(block size constant, values) for the storage and block size of a: the kernels are compiled for
    bs 3 and 1 and a runtime block size (0), in double or single storage. */
-template <typename F>
-void dispatch(const Mat_SeqBinBCSR *a, F &&f)
+template <typename F> void dispatch(const Mat_SeqBinBCSR *a, F &&f)
 {
   if (a->val) {
     if (a->bs == 3) f(std::integral_constant<int, 3>(), (const MatScalar *)a->val);
@@ -130,13 +135,15 @@ void dispatch(const Mat_SeqBinBCSR *a, F &&f)
   }
 }
 
-template <typename P>
-using ValueType = std::remove_const_t<std::remove_pointer_t<P>>;
+template <typename P> using ValueType = std::remove_const_t<std::remove_pointer_t<P>>;
 
 /* One sweep of x (forward or backward) in the storage and block size of a. */
-void sweep_any(const Mat_SeqBinBCSR *a, PetscReal omega, const double *b, double *x, bool forward, HalfSums &h, double *work)
+void sweep_any(const Mat_SeqBinBCSR *a, PetscReal omega, const double *b, double *x, bool forward,
+               HalfSums &h, double *work)
 {
-  dispatch(a, [&](auto BS, const auto *val) { sweep<decltype(BS)::value, ValueType<decltype(val)>>(a, val, a->sor_idiag, omega, b, x, forward, h, work); });
+  dispatch(a, [&](auto BS, const auto *val) {
+    sweep<decltype(BS)::value, ValueType<decltype(val)>>(a, val, a->sor_idiag, omega, b, x, forward, h, work);
+  });
 }
 
 /* x = 0 and the half sums of x = 0: the first sweep in either direction needs neither. */
@@ -148,8 +155,7 @@ void zero_start(PetscInt n, double *x, HalfSums &h)
 
 } // namespace
 
-namespace
-{
+namespace {
 /* sor_idiag = (D + shift I)^-1, recomputed when the matrix or the shift changed. */
 PetscErrorCode SORInvertDiagonal(Mat A, PetscReal fshift)
 {
@@ -163,7 +169,9 @@ PetscErrorCode SORInvertDiagonal(Mat A, PetscReal fshift)
     if (!a->sor_idiag) PetscCall(PetscMalloc1((size_t)a->mbs * a->bs2, &a->sor_idiag));
     a->sor_state = 0;
     PetscCall(MatSeqBinBCSRInvertDiagonalBlocks(A, fshift, a->sor_idiag, &zero_row));
-    PetscCheck(zero_row < 0, PETSC_COMM_SELF, PETSC_ERR_MAT_LU_ZRPVT, "MatSOR: the diagonal block of block row %" PetscInt_FMT " (+ shift %g) is singular", zero_row, (double)fshift);
+    PetscCheck(zero_row < 0, PETSC_COMM_SELF, PETSC_ERR_MAT_LU_ZRPVT,
+               "MatSOR: the diagonal block of block row %" PetscInt_FMT " (+ shift %g) is singular", zero_row,
+               (double)fshift);
     a->sor_state = state;
     a->sor_shift = fshift;
   }
@@ -187,12 +195,16 @@ PetscErrorCode SOREisenstat(Mat A, PetscReal omega, PetscReal fshift, const doub
   zero_start(n, x, h);
   sweep_any(a, omega, b, x, false, h, work);
   PetscCall(PetscArraycpy(t, b, n));
-  dispatch(a, [&](auto BS, const auto *val) { diagonal_block_axpy<decltype(BS)::value, ValueType<decltype(val)>>(a, val, 1.0 - 2.0 / omega, fshift, x, t, work); });
+  dispatch(a, [&](auto BS, const auto *val) {
+    diagonal_block_axpy<decltype(BS)::value, ValueType<decltype(val)>>(a, val, 1.0 - 2.0 / omega, fshift, x,
+                                                                       t, work);
+  });
   zero_start(n, z, h);
   sweep_any(a, omega, t, z, true, h, work);
   for (PetscInt i = 0; i < n; i++) x[i] += z[i];
   PetscCall(PetscFree5(work, h.lower, h.upper, t, z));
-  PetscCall(PetscLogFlops((double)(a->sym ? 2 * (a->nz - a->mbs) : a->nz - a->mbs) * a->bs2 + 6.0 * a->mbs * a->bs2));
+  PetscCall(
+    PetscLogFlops((double)(a->sym ? 2 * (a->nz - a->mbs) : a->nz - a->mbs) * a->bs2 + 6.0 * a->mbs * a->bs2));
   PetscFunctionReturn(0);
 }
 } // namespace
@@ -206,13 +218,18 @@ PetscErrorCode MatMultDiagonalBlock_SeqBinBCSR(Mat A, Vec xx, Vec yy)
   double            *work;
 
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
-  PetscCheck(a->mbs == a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "MatMultDiagonalBlock needs a square matrix (%" PetscInt_FMT " x %" PetscInt_FMT " blocks)", a->mbs, a->nbs);
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MATSEQBINBCSR matrix has no layout: assemble it first");
+  PetscCheck(a->mbs == a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+             "MatMultDiagonalBlock needs a square matrix (%" PetscInt_FMT " x %" PetscInt_FMT " blocks)",
+             a->mbs, a->nbs);
   PetscCall(PetscMalloc1(a->bs, &work));
   PetscCall(VecGetArrayRead(xx, &x));
   PetscCall(VecGetArrayWrite(yy, &y));
   PetscCall(PetscArrayzero(y, A->rmap->n));
-  dispatch(a, [&](auto BS, const auto *val) { diagonal_block_axpy<decltype(BS)::value, ValueType<decltype(val)>>(a, val, 1.0, 0.0, x, y, work); });
+  dispatch(a, [&](auto BS, const auto *val) {
+    diagonal_block_axpy<decltype(BS)::value, ValueType<decltype(val)>>(a, val, 1.0, 0.0, x, y, work);
+  });
   PetscCall(VecRestoreArrayWrite(yy, &y));
   PetscCall(VecRestoreArrayRead(xx, &x));
   PetscCall(PetscFree(work));
@@ -220,33 +237,45 @@ PetscErrorCode MatMultDiagonalBlock_SeqBinBCSR(Mat A, Vec xx, Vec yy)
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode MatSOR_SeqBinBCSR(Mat A, Vec bb, PetscReal omega, MatSORType flag, PetscReal fshift, PetscInt its, PetscInt lits, Vec xx)
+PetscErrorCode MatSOR_SeqBinBCSR(Mat A, Vec bb, PetscReal omega, MatSORType flag, PetscReal fshift,
+                                 PetscInt its, PetscInt lits, Vec xx)
 {
   Mat_SeqBinBCSR    *a = (Mat_SeqBinBCSR *)A->data;
   const PetscScalar *b;
   PetscScalar       *x;
   double            *work = nullptr;
-  const PetscBool    forward  = (flag & (SOR_FORWARD_SWEEP | SOR_LOCAL_FORWARD_SWEEP)) ? PETSC_TRUE : PETSC_FALSE;
-  const PetscBool    backward = (flag & (SOR_BACKWARD_SWEEP | SOR_LOCAL_BACKWARD_SWEEP)) ? PETSC_TRUE : PETSC_FALSE;
+  const PetscBool forward = (flag & (SOR_FORWARD_SWEEP | SOR_LOCAL_FORWARD_SWEEP)) ? PETSC_TRUE : PETSC_FALSE;
+  const PetscBool backward =
+    (flag & (SOR_BACKWARD_SWEEP | SOR_LOCAL_BACKWARD_SWEEP)) ? PETSC_TRUE : PETSC_FALSE;
 
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MATSEQBINBCSR matrix has no layout: assemble it first");
-  PetscCheck(a->mbs == a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "MatSOR needs a square matrix (%" PetscInt_FMT " x %" PetscInt_FMT " blocks)", a->mbs, a->nbs);
-  PetscCheck(!(flag & SOR_APPLY_LOWER), PETSC_COMM_SELF, PETSC_ERR_SUP, "MATSEQBINBCSR's MatSOR has no SOR_APPLY_LOWER (nor has PETSc's AIJ; PCEISENSTAT does not use it)");
-  PetscCheck(!PetscIsInfOrNanReal(omega) && !PetscIsInfOrNanReal(fshift) && omega != 0.0, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "MatSOR: omega (%g) must be finite and nonzero, the shift finite", (double)omega);
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MATSEQBINBCSR matrix has no layout: assemble it first");
+  PetscCheck(a->mbs == a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+             "MatSOR needs a square matrix (%" PetscInt_FMT " x %" PetscInt_FMT " blocks)", a->mbs, a->nbs);
+  PetscCheck(
+    !(flag & SOR_APPLY_LOWER), PETSC_COMM_SELF, PETSC_ERR_SUP,
+    "MATSEQBINBCSR's MatSOR has no SOR_APPLY_LOWER (nor has PETSc's AIJ; PCEISENSTAT does not use it)");
+  PetscCheck(!PetscIsInfOrNanReal(omega) && !PetscIsInfOrNanReal(fshift) && omega != 0.0, PETSC_COMM_SELF,
+             PETSC_ERR_ARG_WRONG, "MatSOR: omega (%g) must be finite and nonzero, the shift finite",
+             (double)omega);
   if (a->sym) PetscCall(MatSeqBinBCSRBuildLowerIndex(a));
   if (flag == SOR_APPLY_UPPER) {
     PetscCall(VecGetArrayRead(bb, &b));
     PetscCall(VecGetArrayWrite(xx, &x));
     PetscCall(PetscMalloc1(a->bs, &work));
-    dispatch(a, [&](auto BS, const auto *val) { apply_upper<decltype(BS)::value, ValueType<decltype(val)>>(a, val, omega, fshift, b, x, work); });
+    dispatch(a, [&](auto BS, const auto *val) {
+      apply_upper<decltype(BS)::value, ValueType<decltype(val)>>(a, val, omega, fshift, b, x, work);
+    });
     PetscCall(PetscFree(work));
     PetscCall(VecRestoreArrayWrite(xx, &x));
     PetscCall(VecRestoreArrayRead(bb, &b));
-    PetscCall(PetscLogFlops((double)(a->sym ? a->nz - a->mbs : (a->nz - a->mbs) / 2) * 2 * a->bs2 + 2.0 * a->mbs * a->bs2));
+    PetscCall(PetscLogFlops((double)(a->sym ? a->nz - a->mbs : (a->nz - a->mbs) / 2) * 2 * a->bs2 +
+                            2.0 * a->mbs * a->bs2));
     PetscFunctionReturn(0);
   }
-  PetscCheck(!(flag & SOR_APPLY_UPPER), PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "MatSOR: SOR_APPLY_UPPER cannot be combined with other flags (%d)", (int)flag);
+  PetscCheck(!(flag & SOR_APPLY_UPPER), PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
+             "MatSOR: SOR_APPLY_UPPER cannot be combined with other flags (%d)", (int)flag);
   PetscCall(SORInvertDiagonal(A, fshift));
   if (flag & SOR_EISENSTAT) {
     PetscCall(VecGetArrayRead(bb, &b));
@@ -256,8 +285,10 @@ PetscErrorCode MatSOR_SeqBinBCSR(Mat A, Vec bb, PetscReal omega, MatSORType flag
     PetscCall(VecRestoreArrayRead(bb, &b));
     PetscFunctionReturn(0);
   }
-  PetscCheck(forward || backward, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "MatSOR: the flag %d asks for no sweep", (int)flag);
-  PetscCheck(its > 0 && lits > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "MatSOR: its (%" PetscInt_FMT ") and lits (%" PetscInt_FMT ") must be positive", its, lits);
+  PetscCheck(forward || backward, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
+             "MatSOR: the flag %d asks for no sweep", (int)flag);
+  PetscCheck(its > 0 && lits > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
+             "MatSOR: its (%" PetscInt_FMT ") and lits (%" PetscInt_FMT ") must be positive", its, lits);
   PetscCall(VecGetArrayRead(bb, &b));
   PetscCall(VecGetArray(xx, &x));
   const size_t n = (size_t)a->mbs * a->bs;
@@ -273,7 +304,8 @@ PetscErrorCode MatSOR_SeqBinBCSR(Mat A, Vec bb, PetscReal omega, MatSORType flag
   PetscCall(VecRestoreArrayRead(bb, &b));
   { /* per sweep: about half of the off-diagonal blocks (see HalfSums) and the block solves */
     const double offdiag = (double)(a->sym ? 2 * (a->nz - a->mbs) : a->nz - a->mbs);
-    PetscCall(PetscLogFlops((double)its * lits * ((forward ? 1 : 0) + (backward ? 1 : 0)) * (offdiag * a->bs2 + 2.0 * a->mbs * a->bs2)));
+    PetscCall(PetscLogFlops((double)its * lits * ((forward ? 1 : 0) + (backward ? 1 : 0)) *
+                            (offdiag * a->bs2 + 2.0 * a->mbs * a->bs2)));
   }
   PetscFunctionReturn(0);
 }

@@ -10,13 +10,14 @@
 
 PetscErrorCode MatTranspose_SeqBinBCSR(Mat A, MatReuse reuse, Mat *B)
 {
-  Mat_SeqBinBCSR       *a = (Mat_SeqBinBCSR *)A->data;
+  Mat_SeqBinBCSR       *a  = (Mat_SeqBinBCSR *)A->data;
   const PetscInt        bs = a->bs, bs2 = a->bs2;
   std::vector<PetscInt> bi(a->nbs + 1, 0), bj(a->nz), fill;
   Mat                   C;
 
   PetscFunctionBegin;
-  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "MatTranspose needs an assembled MATSEQBINBCSR matrix");
+  PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MatTranspose needs an assembled MATSEQBINBCSR matrix");
   if (a->sym) { /* symmetric storage: A^T = A */
     if (reuse == MAT_INITIAL_MATRIX) PetscCall(MatDuplicate(A, MAT_COPY_VALUES, B));
     else if (reuse == MAT_REUSE_MATRIX && *B != A) PetscCall(MatCopy(A, *B, SAME_NONZERO_PATTERN));
@@ -46,7 +47,9 @@ PetscErrorCode MatTranspose_SeqBinBCSR(Mat A, MatReuse reuse, Mat *B)
       for (PetscInt k = 0; k < a->row_nz[r]; k++) {
         const PetscInt s = BinBCSRSlot(a, r, k), st = MatSeqBinBCSRFindSlot(c, a->col[s], r);
         for (PetscInt i = 0; i < bs; i++)
-          for (PetscInt j = 0; j < bs; j++) BinBCSRSetValue(c, BinBCSRValueIndex(st, j * bs + i, c->bw, bs2), BinBCSRGetValue(a, BinBCSRValueIndex(s, i * bs + j, a->bw, bs2)));
+          for (PetscInt j = 0; j < bs; j++)
+            BinBCSRSetValue(c, BinBCSRValueIndex(st, j * bs + i, c->bw, bs2),
+                            BinBCSRGetValue(a, BinBCSRValueIndex(s, i * bs + j, a->bw, bs2)));
       }
   }
   PetscCall(MatAssemblyBegin(C, MAT_FINAL_ASSEMBLY));

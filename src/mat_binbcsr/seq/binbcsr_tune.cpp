@@ -24,19 +24,22 @@
 #include <ctime>
 #include <vector>
 
-namespace
-{
+namespace {
 
 constexpr double   budget_seconds  = 0.050;
 constexpr PetscInt budget_products = 30;
-constexpr PetscInt min_tune_kib    = 512; /* smaller matrices live in L2: any layout does (-mat_binbcsr_tune_min_kib) */
+constexpr PetscInt min_tune_kib =
+  512; /* smaller matrices live in L2: any layout does (-mat_binbcsr_tune_min_kib) */
 
 /* The matrix class of a cache key: block size, precision, storage, size bucket (log2 of the value
    bytes), mean row length bucket (log2) and row-length spread (coefficient of variation in quarters),
    plus the parameters set explicitly (their values are part of the question). */
-std::string MatrixClass(const Mat_SeqBinBCSR *a, size_t vbytes, double mean, double cv, PetscBool bw_fixed, PetscBool k_fixed, PetscBool body_fixed)
+std::string MatrixClass(const Mat_SeqBinBCSR *a, size_t vbytes, double mean, double cv, PetscBool bw_fixed,
+                        PetscBool k_fixed, PetscBool body_fixed)
 {
-  std::string c = "bs " + std::to_string(a->bs) + " " + (a->precision == MAT_BINBCSR_PRECISION_SINGLE ? "single" : "double") + (a->sym ? " symmetric" : " whole");
+  std::string c = "bs " + std::to_string(a->bs) + " " +
+                  (a->precision == MAT_BINBCSR_PRECISION_SINGLE ? "single" : "double") +
+                  (a->sym ? " symmetric" : " whole");
   c += " size 2^" + std::to_string((int)std::lround(std::log2((double)std::max<size_t>(vbytes, 1))));
   c += " rowlen 2^" + std::to_string((int)std::lround(std::log2(std::max(mean, 1.0))));
   c += " spread " + std::to_string(std::min(16, (int)(cv * 4.0)));
@@ -113,14 +116,17 @@ struct Timer {
   {
     PetscFunctionBegin;
     ((Mat_SeqBinBCSR *)T->data)->streams = K;
-    const double t0 = Now();
+    const double t0                      = Now();
     PetscCall(MatMult_SeqBinBCSR(T, x, y));
     *sec = Now() - t0;
     products++;
     seconds += *sec;
     PetscFunctionReturn(0);
   }
-  bool Admits(PetscInt n, double per) const { return products + n <= budget_products && seconds + n * per <= budget_seconds; }
+  bool Admits(PetscInt n, double per) const
+  {
+    return products + n <= budget_products && seconds + n * per <= budget_seconds;
+  }
 };
 
 struct Tried {
@@ -141,18 +147,22 @@ static PetscErrorCode TuneSettings(Mat A, PetscBool *tune, PetscBool *cache, siz
 
   PetscFunctionBegin;
   if (a->tune < 0) {
-    PetscCall(PetscOptionsGetEnum(((PetscObject)A)->options, ((PetscObject)A)->prefix, "-mat_binbcsr_tune", MatBinBCSRTunes, &v, &set));
+    PetscCall(PetscOptionsGetEnum(((PetscObject)A)->options, ((PetscObject)A)->prefix, "-mat_binbcsr_tune",
+                                  MatBinBCSRTunes, &v, &set));
     a->tune = set ? (PetscInt)v : (PetscInt)MAT_BINBCSR_TUNE_AUTO;
   }
   if (a->tune_cache < 0) {
     flg = PETSC_TRUE;
-    PetscCall(PetscOptionsGetBool(((PetscObject)A)->options, ((PetscObject)A)->prefix, "-mat_binbcsr_tune_cache", &flg, &set));
+    PetscCall(PetscOptionsGetBool(((PetscObject)A)->options, ((PetscObject)A)->prefix,
+                                  "-mat_binbcsr_tune_cache", &flg, &set));
     a->tune_cache = flg ? 1 : 0;
   }
   {
     PetscInt kib = min_tune_kib; /* the size below which tuning is skipped (tests tune small matrices) */
-    PetscCall(PetscOptionsGetInt(((PetscObject)A)->options, ((PetscObject)A)->prefix, "-mat_binbcsr_tune_min_kib", &kib, &set));
-    PetscCheck(kib >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-mat_binbcsr_tune_min_kib %" PetscInt_FMT " must be >= 0", kib);
+    PetscCall(PetscOptionsGetInt(((PetscObject)A)->options, ((PetscObject)A)->prefix,
+                                 "-mat_binbcsr_tune_min_kib", &kib, &set));
+    PetscCheck(kib >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+               "-mat_binbcsr_tune_min_kib %" PetscInt_FMT " must be >= 0", kib);
     *min_bytes = (size_t)kib << 10;
   }
   *tune  = a->tune == (PetscInt)MAT_BINBCSR_TUNE_AUTO ? PETSC_TRUE : PETSC_FALSE;
@@ -160,7 +170,10 @@ static PetscErrorCode TuneSettings(Mat A, PetscBool *tune, PetscBool *cache, siz
   PetscFunctionReturn(0);
 }
 
-static void SetInfo(Mat_SeqBinBCSR *a, const std::string &s) { PetscStrncpy(a->tune_info, s.c_str(), sizeof(a->tune_info)); }
+static void SetInfo(Mat_SeqBinBCSR *a, const std::string &s)
+{
+  PetscStrncpy(a->tune_info, s.c_str(), sizeof(a->tune_info));
+}
 
 static std::string Fmt(const char *f, double x)
 {
@@ -199,7 +212,8 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
     PetscFunctionReturn(0);
   }
   if (a->bw_set && a->bw != 4 && a->bw != 8 && a->bw != 16 && a->bw != 32) {
-    SetInfo(a, "none: bin width " + std::to_string(a->bw) + " (set) has no vectorised sweep, streams do not apply");
+    SetInfo(a, "none: bin width " + std::to_string(a->bw) +
+                 " (set) has no vectorised sweep, streams do not apply");
     PetscFunctionReturn(0);
   }
   PetscCall(PetscLogEventBegin(MAT_BinBCSR_Tune, A, 0, 0, 0));
@@ -215,18 +229,24 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
     nz += n;
     sq += n * n;
   }
-  const double mean = mbs ? nz / mbs : 0, cv = mean > 0 ? std::sqrt(std::max(0.0, sq / mbs - mean * mean)) / mean : 0;
+  const double mean   = mbs ? nz / mbs : 0,
+               cv     = mean > 0 ? std::sqrt(std::max(0.0, sq / mbs - mean * mean)) / mean : 0;
   const size_t vbytes = (size_t)nz * a->bs2 * vsize;
   if (vbytes < min_bytes) {
-    SetInfo(a, "none: " + std::to_string(vbytes >> 10) + " KiB of values (below " + std::to_string(min_bytes >> 10) + " KiB any layout is as fast; -mat_binbcsr_tune_min_kib)");
+    SetInfo(a, "none: " + std::to_string(vbytes >> 10) + " KiB of values (below " +
+                 std::to_string(min_bytes >> 10) + " KiB any layout is as fast; -mat_binbcsr_tune_min_kib)");
     PetscCall(PetscLogEventEnd(MAT_BinBCSR_Tune, A, 0, 0, 0));
     PetscFunctionReturn(0);
   }
-  const std::string key = BinBCSRTuneMachineKey() + "\t" + MatrixClass(a, vbytes, mean, cv, a->bw_set, a->streams_set, body_free ? PETSC_FALSE : PETSC_TRUE);
+  const std::string key =
+    BinBCSRTuneMachineKey() + "\t" +
+    MatrixClass(a, vbytes, mean, cv, a->bw_set, a->streams_set, body_free ? PETSC_FALSE : PETSC_TRUE);
   if (use_cache) {
     BinBCSRTuneChoice c;
     PetscCall(BinBCSRTuneCacheLookup(key, &c, &found));
-    if (found && (!a->bw_set || c.bw == a->bw) && (!a->streams_set || c.streams == a->streams) && (body_free || c.kernel == (PetscInt)a->kernel) && (c.bw == 4 || c.bw == 8 || c.bw == 16 || (c.bw == 32 && bs == 1))) {
+    if (found && (!a->bw_set || c.bw == a->bw) && (!a->streams_set || c.streams == a->streams) &&
+        (body_free || c.kernel == (PetscInt)a->kernel) &&
+        (c.bw == 4 || c.bw == 8 || c.bw == 16 || (c.bw == 32 && bs == 1))) {
       a->bw      = c.bw;
       a->streams = c.streams;
       if (body_free && c.kernel != (PetscInt)MAT_BINBCSR_KERNEL_AUTO) {
@@ -234,7 +254,9 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
         a->kernel_tuned = PETSC_TRUE;
       }
       PetscCall(PetscTime(&t_end));
-      SetInfo(a, "bin width " + std::to_string(c.bw) + ", streams " + std::to_string(c.streams) + ", kernel " + MatBinBCSRKernels[c.kernel] + " from the cache " + BinBCSRTuneCachePath() + " (" + Fmt("%.3f", 1e3 * (t_end - t_start)) + " ms)");
+      SetInfo(a, "bin width " + std::to_string(c.bw) + ", streams " + std::to_string(c.streams) +
+                   ", kernel " + MatBinBCSRKernels[c.kernel] + " from the cache " + BinBCSRTuneCachePath() +
+                   " (" + Fmt("%.3f", 1e3 * (t_end - t_start)) + " ms)");
       PetscCall(PetscInfo(A, "Tuning: %s\n", a->tune_info));
       PetscCall(PetscLogEventEnd(MAT_BinBCSR_Tune, A, 0, 0, 0));
       PetscFunctionReturn(0);
@@ -243,18 +265,17 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
 
   /* the sample: about twice the last-level cache (so it streams from memory as the matrix does), at
      most what 20 products read in the budget at ~20 GB/s */
-  const long   llc    = binbcsr::last_level_cache_bytes();
-  const size_t target = std::min<size_t>(llc > 0 ? 2 * (size_t)llc : (size_t)64 << 20, (size_t)48 << 20);
+  const long   llc       = binbcsr::last_level_cache_bytes();
+  const size_t target    = std::min<size_t>(llc > 0 ? 2 * (size_t)llc : (size_t)64 << 20, (size_t)48 << 20);
   const double row_bytes = mbs ? (double)(vbytes + (size_t)nz * sizeof(PetscInt)) / mbs : 1;
-  PetscInt     nr        = (PetscInt)std::min<double>((double)mbs, std::max(64.0, target / std::max(row_bytes, 1.0)));
+  PetscInt nr = (PetscInt)std::min<double>((double)mbs, std::max(64.0, target / std::max(row_bytes, 1.0)));
   if (nr < mbs) nr = std::max<PetscInt>(32, nr / 32 * 32);
   const PetscInt r0 = nr < mbs ? (mbs - nr) / 2 / 32 * 32 : 0;
   const Sample   s  = Slab(a, bi, bj, r0, nr);
 
   std::vector<PetscInt> widths, counts;
   if (a->bw_set) widths = {a->bw};
-  else { /* the default first: the stream counts are compared at it */
-    widths = {bw_default};
+  else { /* the default first: the stream counts are compared at it */ widths = {bw_default};
     for (PetscInt bw : {4, 8, 16, 32})
       if (bw != bw_default && (bw < 32 || bs == 1)) widths.push_back(bw);
   }
@@ -302,14 +323,16 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
   };
   /* the other body sets at the best width and streams, where their body differs from the default's */
   auto time_bodies = [&]() -> PetscErrorCode {
-    Mat_SeqBinBCSR      *t = (Mat_SeqBinBCSR *)best_T->data;
-    const binbcsr::Shape sh = {(int)bs, (int)best.bw, (int)best.K, a->precision == MAT_BINBCSR_PRECISION_SINGLE, a->sym ? true : false};
+    Mat_SeqBinBCSR                *t    = (Mat_SeqBinBCSR *)best_T->data;
+    const binbcsr::Shape           sh   = {(int)bs, (int)best.bw, (int)best.K,
+                                           a->precision == MAT_BINBCSR_PRECISION_SINGLE, a->sym ? true : false};
     std::vector<binbcsr::MultBody> seen = {binbcsr::select_body(sh, binbcsr::BodySet::Auto).mult};
     PetscFunctionBegin;
     for (int k = (int)MAT_BINBCSR_KERNEL_PORTABLE; k <= (int)MAT_BINBCSR_KERNEL_AVX512; k++) {
       if (!binbcsr::body_set_available((binbcsr::BodySet)k)) continue;
       const binbcsr::Body b = binbcsr::select_body(sh, (binbcsr::BodySet)k);
-      if (std::find(seen.begin(), seen.end(), b.mult) != seen.end() || b.set != (binbcsr::BodySet)k) continue; /* the same body, or a fallback */
+      if (std::find(seen.begin(), seen.end(), b.mult) != seen.end() || b.set != (binbcsr::BodySet)k)
+        continue; /* the same body, or a fallback */
       seen.push_back(b.mult);
       if (!tm.Admits(2, best.sec)) {
         skipped++;
@@ -360,14 +383,27 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
   double      t_default = -1;
   std::string list;
   for (const Tried &t : tried) {
-    list += (list.empty() ? "" : ", ") + std::to_string(t.bw) + "/" + std::to_string(t.K) + (t.kernel != (body_free ? (PetscInt)MAT_BINBCSR_KERNEL_AUTO : (PetscInt)a->kernel) ? std::string("/") + MatBinBCSRKernels[t.kernel] : std::string("")) + " " + Fmt("%.3g", 1e3 * t.sec);
-    if (t.bw == (a->bw_set ? a->bw : bw_default) && t.K == (a->streams_set ? a->streams : BINBCSR_DEFAULT_STREAMS) && (!body_free || t.kernel == (PetscInt)MAT_BINBCSR_KERNEL_AUTO)) t_default = t.sec;
+    list += (list.empty() ? "" : ", ") + std::to_string(t.bw) + "/" + std::to_string(t.K) +
+            (t.kernel != (body_free ? (PetscInt)MAT_BINBCSR_KERNEL_AUTO : (PetscInt)a->kernel)
+               ? std::string("/") + MatBinBCSRKernels[t.kernel]
+               : std::string("")) +
+            " " + Fmt("%.3g", 1e3 * t.sec);
+    if (t.bw == (a->bw_set ? a->bw : bw_default) &&
+        t.K == (a->streams_set ? a->streams : BINBCSR_DEFAULT_STREAMS) &&
+        (!body_free || t.kernel == (PetscInt)MAT_BINBCSR_KERNEL_AUTO))
+      t_default = t.sec;
   }
-  std::string info = "bin width " + std::to_string(best.bw) + ", streams " + std::to_string(best.K) + ", kernel " + MatBinBCSRKernels[best.kernel] + " measured on block rows " + std::to_string(r0) + ".." + std::to_string(r0 + nr - 1) + " of " + std::to_string(mbs) + " (ms per sample product, width/streams[/kernel]: " + list + (skipped ? "; " + std::to_string(skipped) + " left out by the budget" : "") + ")";
+  std::string info = "bin width " + std::to_string(best.bw) + ", streams " + std::to_string(best.K) +
+                     ", kernel " + MatBinBCSRKernels[best.kernel] + " measured on block rows " +
+                     std::to_string(r0) + ".." + std::to_string(r0 + nr - 1) + " of " + std::to_string(mbs) +
+                     " (ms per sample product, width/streams[/kernel]: " + list +
+                     (skipped ? "; " + std::to_string(skipped) + " left out by the budget" : "") + ")";
   const double cost = t_end - t_start;
-  info += "; cost " + Fmt("%.1f", 1e3 * cost) + " ms (" + Fmt("%.1f", 1e3 * tm.seconds) + " ms CPU in " + std::to_string(tm.products) + " sample products)";
+  info += "; cost " + Fmt("%.1f", 1e3 * cost) + " ms (" + Fmt("%.1f", 1e3 * tm.seconds) + " ms CPU in " +
+          std::to_string(tm.products) + " sample products)";
   if (t_default > 0) {
-    const double gain = (t_default - best.sec) * (double)mbs / (double)nr; /* per product of the whole matrix */
+    const double gain =
+      (t_default - best.sec) * (double)mbs / (double)nr; /* per product of the whole matrix */
     info += "; " + Fmt("%.2f", t_default / best.sec) + "x the default";
     if (gain > 0) info += ", pays back after " + std::to_string((long)std::ceil(cost / gain)) + " products";
   }

@@ -7,8 +7,7 @@
 
 using Catch::Approx;
 
-namespace Catch
-{
+namespace Catch {
 // Catch2 2's string matcher Catch::Contains is Catch::Matchers::ContainsSubstring in Catch2 3.
 inline Matchers::StringContainsMatcher Contains(const std::string &s, CaseSensitive cs = CaseSensitive::Yes)
 {

@@ -63,7 +63,8 @@ TEST_CASE("mcg uses the fused product of binbcsr and says so", "[ksp_mcg][binbcs
   MatDestroy(&A);
 }
 
-TEST_CASE("single storage: rtol 1e-6 converges, rtol 1e-11 stops at the precision floor", "[ksp_mcg][binbcsr]")
+TEST_CASE("single storage: rtol 1e-6 converges, rtol 1e-11 stops at the precision floor",
+          "[ksp_mcg][binbcsr]")
 {
   Mat A = block_laplacian(12, 12);
   Mat B = to_binbcsr(A, MAT_BINBCSR_PRECISION_SINGLE);
@@ -81,7 +82,8 @@ TEST_CASE("single storage: rtol 1e-6 converges, rtol 1e-11 stops at the precisio
   CHECK(rel_residual(A, b, r.x) < 2e-6);
   // rtol 1e-11 with the precision floor off: met on the operator MCG was given (up to the recursive
   // residual's rounding drift) ...
-  r = solve(B, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-11, 1000, 0, "-ksp_mcg_precision_floor 0"});
+  r = solve(B, b,
+            Solve{KSPMCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-11, 1000, 0, "-ksp_mcg_precision_floor 0"});
   CHECK(r.reason == KSP_CONVERGED_RTOL);
   CHECK(rel_residual(B, b, r.x) < 1.05e-11);
   // ... but against the double-precision values the residual stays at float rounding level

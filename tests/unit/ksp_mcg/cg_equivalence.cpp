@@ -8,9 +8,11 @@ using namespace mcg_test;
 
 static void check_same_as_cg(Mat A, Vec b, const char *pc, KSPNormType norm, PetscReal rtol)
 {
-  Solve s_cg{KSPCG, pc, norm, rtol}, s_mcg{KSPMCG, pc, norm, rtol};
+  Solve        s_cg{KSPCG, pc, norm, rtol}, s_mcg{KSPMCG, pc, norm, rtol};
   const Result cg = solve(A, b, s_cg), mcg = solve(A, b, s_mcg);
-  INFO("pc " << pc << " norm " << KSPNormTypes[norm] << ": cg " << cg.its << " its " << KSPConvergedReasons[cg.reason] << ", mcg " << mcg.its << " its " << KSPConvergedReasons[mcg.reason]);
+  INFO("pc " << pc << " norm " << KSPNormTypes[norm] << ": cg " << cg.its << " its "
+             << KSPConvergedReasons[cg.reason] << ", mcg " << mcg.its << " its "
+             << KSPConvergedReasons[mcg.reason]);
   REQUIRE(cg.err == 0);
   REQUIRE(mcg.err == 0);
   CHECK(cg.reason > 0);
@@ -58,9 +60,9 @@ TEST_CASE("mcg iterates equal cg iterates after k iterations", "[ksp_mcg][cg]")
     CHECK(mcg.its == k);
     CHECK(rel_diff(mcg.x, cg.x) < 1e-10);
     // fixed-iteration mode does the same k iterations without any convergence test
-    Solve s_fixed = s_mcg;
-    s_fixed.fixed_its = k;
-    s_fixed.max_it    = 3; // ignored in fixed mode
+    Solve s_fixed      = s_mcg;
+    s_fixed.fixed_its  = k;
+    s_fixed.max_it     = 3; // ignored in fixed mode
     const Result fixed = solve(A, b, s_fixed);
     CHECK(fixed.reason == KSP_CONVERGED_ITS);
     CHECK(fixed.its == k);
@@ -72,8 +74,8 @@ TEST_CASE("mcg iterates equal cg iterates after k iterations", "[ksp_mcg][cg]")
 
 TEST_CASE("mcg honours a nonzero initial guess and norm type none", "[ksp_mcg][cg]")
 {
-  Mat A  = block_laplacian(10, 9);
-  Vec b  = rhs(A), x0 = rhs(A, true, -0.5);
+  Mat   A = block_laplacian(10, 9);
+  Vec   b = rhs(A), x0                                              = rhs(A, true, -0.5);
   Solve s_cg{KSPCG, PCJACOBI, KSP_NORM_PRECONDITIONED, 1e-9}, s_mcg = s_cg;
   s_mcg.type = KSPMCG;
   Result cg = solve(A, b, s_cg, x0), mcg = solve(A, b, s_mcg, x0);
@@ -85,8 +87,8 @@ TEST_CASE("mcg honours a nonzero initial guess and norm type none", "[ksp_mcg][c
 
   s_cg.norm = s_mcg.norm = KSP_NORM_NONE;
   s_cg.max_it = s_mcg.max_it = 12;
-  cg  = solve(A, b, s_cg, x0);
-  mcg = solve(A, b, s_mcg, x0);
+  cg                         = solve(A, b, s_cg, x0);
+  mcg                        = solve(A, b, s_mcg, x0);
   CHECK(mcg.reason == cg.reason);
   CHECK(mcg.its == 12);
   CHECK(rel_diff(mcg.x, cg.x) < 1e-10);

@@ -9,7 +9,7 @@ namespace mcg_test {
 Mat block_laplacian(PetscInt nx, PetscInt ny, const char *mattype, PetscReal neumann_shift)
 {
   const PetscInt    bs = 3, nodes = nx * ny;
-  const PetscScalar K[3][3] = {{4, 1, 0}, {1, 3, 1}, {0, 1, 2}};
+  const PetscScalar K[3][3]     = {{4, 1, 0}, {1, 3, 1}, {0, 1, 2}};
   PetscInt          local_nodes = PETSC_DECIDE, global_nodes = nodes, start;
   Mat               A;
   PetscSplitOwnership(PETSC_COMM_WORLD, &local_nodes, &global_nodes);
@@ -26,15 +26,16 @@ Mat block_laplacian(PetscInt nx, PetscInt ny, const char *mattype, PetscReal neu
   auto scale = [&](PetscInt node) { return 1.0 + 0.5 * std::sin(0.37 * node); };
   for (PetscInt node = start; node < start + local_nodes; node++) {
     const PetscInt i = node % nx, j = node / nx;
-    const PetscInt nb[5][2] = {{i, j}, {i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
+    const PetscInt nb[5][2]   = {{i, j}, {i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
     PetscInt       neighbours = 0;
-    for (int k = 1; k < 5; k++) neighbours += nb[k][0] >= 0 && nb[k][1] >= 0 && nb[k][0] < nx && nb[k][1] < ny;
+    for (int k = 1; k < 5; k++)
+      neighbours += nb[k][0] >= 0 && nb[k][1] >= 0 && nb[k][0] < nx && nb[k][1] < ny;
     const PetscScalar centre = neumann_shift >= 0 ? neighbours + neumann_shift : 4.0 + 1.0;
     for (int k = 0; k < 5; k++) {
       const PetscInt ni = nb[k][0], nj = nb[k][1];
       if (ni < 0 || nj < 0 || ni >= nx || nj >= ny) continue;
-      const PetscInt other = nj * nx + ni;
-      const PetscScalar lap = k == 0 ? centre : -1.0; // shifted Laplacian: SPD
+      const PetscInt    other = nj * nx + ni;
+      const PetscScalar lap   = k == 0 ? centre : -1.0; // shifted Laplacian: SPD
       for (PetscInt a = 0; a < bs; a++)
         for (PetscInt b = 0; b < bs; b++) {
           const PetscScalar v = lap * K[a][b] * scale(node) * scale(other);
@@ -67,7 +68,8 @@ Vec rhs(Mat A, bool ramp, PetscScalar value)
   PetscInt lo, hi;
   MatCreateVecs(A, nullptr, &b);
   VecGetOwnershipRange(b, &lo, &hi);
-  for (PetscInt i = lo; i < hi; i++) VecSetValue(b, i, ramp ? value * (1.0 + std::cos(1.3 * i)) : value, INSERT_VALUES);
+  for (PetscInt i = lo; i < hi; i++)
+    VecSetValue(b, i, ramp ? value * (1.0 + std::cos(1.3 * i)) : value, INSERT_VALUES);
   VecAssemblyBegin(b);
   VecAssemblyEnd(b);
   return b;
@@ -93,12 +95,12 @@ std::vector<PetscScalar> gather(Vec x)
 
 Result solve(Mat A, Vec b, const Solve &s, Vec x0)
 {
-  Result    r;
-  KSP       ksp;
-  PC        pc;
-  Vec       x;
-  PetscInt  nhist;
-  PetscReal hist[4096];
+  Result           r;
+  KSP              ksp;
+  PC               pc;
+  Vec              x;
+  PetscInt         nhist;
+  PetscReal        hist[4096];
   const PetscReal *h;
 
   VecDuplicate(b, &x);
@@ -163,7 +165,9 @@ void check_mcg_same_as_cg(Mat A, Vec b, const char *pc, const char *options)
   CHECK(mcg.reason == cg.reason);
   CHECK(std::abs(mcg.its - cg.its) <= 1);
   CHECK(rel_diff(mcg.x, cg.x) < 1e-7);
-  for (size_t k = 0; k < 15 && k < cg.history.size() && k < mcg.history.size() && cg.history[k] > 1e-9 * cg.history[0]; k++) CHECK(mcg.history[k] == Approx(cg.history[k]).epsilon(1e-8));
+  for (size_t k = 0;
+       k < 15 && k < cg.history.size() && k < mcg.history.size() && cg.history[k] > 1e-9 * cg.history[0]; k++)
+    CHECK(mcg.history[k] == Approx(cg.history[k]).epsilon(1e-8));
   // k iterates equal to round-off
   const Result cg5  = solve(A, b, Solve{KSPCG, pc, KSP_NORM_UNPRECONDITIONED, 1e-30, 5});
   const Result mcg5 = solve(A, b, Solve{KSPMCG, pc, KSP_NORM_UNPRECONDITIONED, 1e-30, 5, 0, options});

@@ -19,20 +19,20 @@ Mat diagonal(const std::vector<PetscScalar> &d);
 Vec rhs(Mat A, bool ramp = true, PetscScalar value = 1.0);
 
 struct Solve {
-  std::string            type, pc;
-  KSPNormType            norm      = KSP_NORM_DEFAULT;
-  PetscReal              rtol      = 1e-10;
-  PetscInt               max_it    = 1000;
-  PetscInt               fixed_its = 0;  // mcg only
-  const char            *options   = ""; // extra options, inserted before KSPSetFromOptions
+  std::string type, pc;
+  KSPNormType norm      = KSP_NORM_DEFAULT;
+  PetscReal   rtol      = 1e-10;
+  PetscInt    max_it    = 1000;
+  PetscInt    fixed_its = 0;  // mcg only
+  const char *options   = ""; // extra options, inserted before KSPSetFromOptions
 };
 struct Result {
-  PetscErrorCode         err = 0;
-  KSPConvergedReason     reason = KSP_CONVERGED_ITERATING;
-  PetscInt               its    = -1;
-  PetscReal              rnorm  = -1;
-  std::vector<PetscReal> history;
-  std::vector<PetscScalar> x;      // gathered on every rank
+  PetscErrorCode           err    = 0;
+  KSPConvergedReason       reason = KSP_CONVERGED_ITERATING;
+  PetscInt                 its    = -1;
+  PetscReal                rnorm  = -1;
+  std::vector<PetscReal>   history;
+  std::vector<PetscScalar> x; // gathered on every rank
 };
 // Solves A x = b from x0 (zero when x0 is null) with the given settings.
 Result solve(Mat A, Vec b, const Solve &s, Vec x0 = nullptr);

@@ -29,20 +29,23 @@ void check_same_as_cg(Mat B, Vec b, const char *floor)
   check_mcg_same_as_cg(B, b, PCPBJACOBI, floor);
   const Result      cg5     = solve(B, b, Solve{KSPCG, PCPBJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-30, 5});
   const std::string generic = std::string(floor) + " -ksp_mcg_fused_pc 0";
-  const Result      g5      = solve(B, b, Solve{KSPMCG, PCPBJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-30, 5, 0, generic.c_str()});
+  const Result      g5 =
+    solve(B, b, Solve{KSPMCG, PCPBJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-30, 5, 0, generic.c_str()});
   CHECK(rel_diff(g5.x, cg5.x) < 1e-12);
 }
 
 } // namespace
 
-TEST_CASE("fused pbjacobi: same iterates as cg + pbjacobi on aij and every binbcsr storage", "[ksp_mcg][pbjacobi]")
+TEST_CASE("fused pbjacobi: same iterates as cg + pbjacobi on aij and every binbcsr storage",
+          "[ksp_mcg][pbjacobi]")
 {
   Mat A = block_laplacian(9, 11);
   Vec b = rhs(A);
   SECTION("aij") { check_same_as_cg(A, b, ""); }
   for (bool symmetric : {false, true})
     for (MatBinBCSRPrecision precision : {MAT_BINBCSR_PRECISION_DOUBLE, MAT_BINBCSR_PRECISION_SINGLE}) {
-      INFO("binbcsr " << (symmetric ? "symmetric" : "whole") << " storage, " << MatBinBCSRPrecisions[precision]);
+      INFO("binbcsr " << (symmetric ? "symmetric" : "whole") << " storage, "
+                      << MatBinBCSRPrecisions[precision]);
       Mat B = binbcsr_copy(A, precision, symmetric);
       if (!B) {
         WARN("binbcsr not available on this communicator: skipped");
@@ -111,7 +114,8 @@ TEST_CASE("fused pbjacobi follows a refill of the values", "[ksp_mcg][pbjacobi]"
   MatDestroy(&A);
 }
 
-TEST_CASE("fused pbjacobi on a singular 3x3 diagonal block: an error naming the block row", "[ksp_mcg][pbjacobi]")
+TEST_CASE("fused pbjacobi on a singular 3x3 diagonal block: an error naming the block row",
+          "[ksp_mcg][pbjacobi]")
 {
   Mat      A = block_laplacian(4, 4);
   PetscInt N;

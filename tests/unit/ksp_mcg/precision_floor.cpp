@@ -16,7 +16,6 @@ PetscReal norm(Vec b)
   return n;
 }
 
-
 PetscErrorCode ShellMult(Mat S, Vec x, Vec y)
 {
   Mat A;
@@ -33,7 +32,8 @@ TEST_CASE("precision floor: double products have none, any operator can be given
   // aij and binbcsr double: no floor, rtol 1e-12 is claimed as before
   Result r = solve(A, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-12});
   CHECK(r.reason == KSP_CONVERGED_RTOL);
-  CHECK(view_after_solve(A, b, "-ksp_rtol 1e-12").find("precision floor: none (operator products in double precision)") != std::string::npos);
+  CHECK(view_after_solve(A, b, "-ksp_rtol 1e-12")
+          .find("precision floor: none (operator products in double precision)") != std::string::npos);
   if (Mat B = to_binbcsr(A, MAT_BINBCSR_PRECISION_DOUBLE)) {
     r = solve(B, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-12});
     CHECK(r.reason == KSP_CONVERGED_RTOL);
@@ -49,10 +49,12 @@ TEST_CASE("precision floor: double products have none, any operator can be given
   r = solve(S, b, Solve{KSPMCG, PCNONE, KSP_NORM_UNPRECONDITIONED, 1e-12});
   CHECK(r.reason == KSP_CONVERGED_RTOL);
   // ... and the one -ksp_mcg_precision_floor declares (here as if its products were single precision)
-  r = solve(S, b, Solve{KSPMCG, PCNONE, KSP_NORM_UNPRECONDITIONED, 1e-12, 1000, 0, "-ksp_mcg_precision_floor 6e-8"});
+  r = solve(
+    S, b, Solve{KSPMCG, PCNONE, KSP_NORM_UNPRECONDITIONED, 1e-12, 1000, 0, "-ksp_mcg_precision_floor 6e-8"});
   CHECK(r.reason == KSP_DIVERGED_BREAKDOWN);
   // fixed-iteration mode claims no tolerance: untouched
-  r = solve(S, b, Solve{KSPMCG, PCNONE, KSP_NORM_UNPRECONDITIONED, 1e-12, 1000, 60, "-ksp_mcg_precision_floor 6e-8"});
+  r = solve(
+    S, b, Solve{KSPMCG, PCNONE, KSP_NORM_UNPRECONDITIONED, 1e-12, 1000, 60, "-ksp_mcg_precision_floor 6e-8"});
   CHECK(r.reason == KSP_CONVERGED_ITS);
   CHECK(r.its == 60);
   // out of range
@@ -70,7 +72,8 @@ TEST_CASE("precision floor: double products have none, any operator can be given
   VecDestroy(&b);
 }
 
-TEST_CASE("precision floor: single storage, every norm type, error if not converged, view", "[ksp_mcg][floor]")
+TEST_CASE("precision floor: single storage, every norm type, error if not converged, view",
+          "[ksp_mcg][floor]")
 {
   Mat A = block_laplacian(12, 12);
   Mat B = to_binbcsr(A, MAT_BINBCSR_PRECISION_SINGLE);
@@ -94,7 +97,8 @@ TEST_CASE("precision floor: single storage, every norm type, error if not conver
     CHECK(r.reason == KSP_DIVERGED_BREAKDOWN);
     CHECK(r.its < 100);
   }
-  const Result e = solve(B, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-12, 1000, 0, "-ksp_error_if_not_converged"});
+  const Result e = solve(
+    B, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-12, 1000, 0, "-ksp_error_if_not_converged"});
   CHECK(e.err == PETSC_ERR_NOT_CONVERGED);
   std::string text = view_after_solve(B, b, "-ksp_rtol 1e-12");
   CHECK(text.find("precision floor: operator products rounded at u = 5.96") != std::string::npos);
@@ -116,8 +120,8 @@ TEST_CASE("precision floor: single storage, every norm type, error if not conver
 // one against the double values (and not wildly above it).
 TEST_CASE("extremes: single storage on an ill-conditioned system reports its floor honestly", "[.][extremes]")
 {
-  Mat A = block_laplacian(8, 8, MATAIJ, 7e-7);
-  Vec b = rhs(A), x;
+  Mat       A = block_laplacian(8, 8, MATAIJ, 7e-7);
+  Vec       b = rhs(A), x;
   PetscReal bnorm, emax, emin;
   VecNorm(b, NORM_2, &bnorm);
   {
@@ -150,7 +154,7 @@ TEST_CASE("extremes: single storage on an ill-conditioned system reports its flo
     CHECK(r.reason == KSP_CONVERGED_RTOL);
     CHECK(rel_residual(A, b, r.x) < 1.1e-8);
     // single storage, KSPCG: claims rtol 1e-10, true residual against the double values far above it
-    const Result cg = solve(B, b, Solve{KSPCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-10, 5000});
+    const Result    cg      = solve(B, b, Solve{KSPCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-10, 5000});
     const PetscReal cg_true = rel_residual(A, b, cg.x);
     CHECK(cg.reason == KSP_CONVERGED_RTOL);
     CHECK(cg.rnorm / bnorm < 1e-10);
@@ -159,7 +163,7 @@ TEST_CASE("extremes: single storage on an ill-conditioned system reports its flo
     // good as CG's (CG's extra iterations refine only the rounded system)
     for (KSPNormType nt : {KSP_NORM_UNPRECONDITIONED, KSP_NORM_PRECONDITIONED}) {
       INFO("norm " << KSPNormTypes[nt]);
-      r = solve(B, b, Solve{KSPMCG, PCJACOBI, nt, 1e-10, 5000});
+      r                        = solve(B, b, Solve{KSPMCG, PCJACOBI, nt, 1e-10, 5000});
       const PetscReal mcg_true = rel_residual(A, b, r.x);
       CHECK(r.err == 0);
       CHECK(r.reason == KSP_DIVERGED_BREAKDOWN);
@@ -183,8 +187,8 @@ TEST_CASE("precision floor: a residual that reaches zero below the floor, tolera
   // A scaled identity with Jacobi: the first iteration solves the system exactly, so the recursive
   // residual drops to zero, below the floor u ||A|| ||x||, while rtol 1e-6 lies far above that floor:
   // the claim is honest (b - A x is at most the floor) and must stand, not end as a breakdown.
-  Mat A = diagonal(std::vector<PetscScalar>(60, 2.0));
-  Vec b = rhs(A);
+  Mat      A = diagonal(std::vector<PetscScalar>(60, 2.0));
+  Vec      b = rhs(A);
   PetscInt m, n, M, N;
   Mat      S;
   MatGetLocalSize(A, &m, &n);

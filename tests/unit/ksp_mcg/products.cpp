@@ -52,14 +52,14 @@ TEST_CASE("matrix products per solve", "[ksp_mcg][passes]")
   Mat S   = counted(&c);
   Vec b   = rhs(c.inner);
 
-  c.mults = 0;
+  c.mults  = 0;
   Result r = solve(S, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_DEFAULT, 1e-10, 1000, 30});
   CHECK(r.reason == KSP_CONVERGED_ITS);
   CHECK(r.its == 30);
   CHECK(c.mults == 30);
 
   c.mults = 0;
-  r = solve(S, b, Solve{KSPCG, PCJACOBI, KSP_NORM_DEFAULT, 1e-30, 30});
+  r       = solve(S, b, Solve{KSPCG, PCJACOBI, KSP_NORM_DEFAULT, 1e-30, 30});
   CHECK(c.mults == 30);
 
   // to a tolerance far above the rounding drift: one product per iteration plus the first one; on
@@ -68,7 +68,7 @@ TEST_CASE("matrix products per solve", "[ksp_mcg][passes]")
   PetscMPIInt size;
   MPI_Comm_size(PETSC_COMM_WORLD, &size);
   c.mults = 0;
-  r = solve(S, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_DEFAULT, 1e-6});
+  r       = solve(S, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_DEFAULT, 1e-6});
   CHECK(r.reason == KSP_CONVERGED_RTOL);
   CHECK(c.mults == r.its + (size > 1 ? 1 : 0));
   const PetscInt mcg_its = r.its;

@@ -29,7 +29,7 @@ TEST_CASE("singular operator", "[ksp_mcg][reasons]")
 {
   Mat A = diagonal({1, 2, 0, 3});
   // inconsistent right-hand side (component in the null space): no solution, must not converge
-  Vec b = rhs(A, false, 1.0);
+  Vec    b = rhs(A, false, 1.0);
   Result r = solve(A, b, Solve{KSPMCG, PCNONE});
   CHECK(r.err == 0);
   CHECK(r.reason < 0);
@@ -48,8 +48,8 @@ TEST_CASE("singular operator", "[ksp_mcg][reasons]")
 
 TEST_CASE("zero right-hand side", "[ksp_mcg][reasons]")
 {
-  Mat A = block_laplacian(4, 3);
-  Vec b = rhs(A, false, 0.0);
+  Mat          A  = block_laplacian(4, 3);
+  Vec          b  = rhs(A, false, 0.0);
   const Result cg = solve(A, b, Solve{KSPCG, PCJACOBI});
   Result       r  = solve(A, b, Solve{KSPMCG, PCJACOBI});
   CHECK(r.reason > 0);
@@ -98,7 +98,7 @@ TEST_CASE("max_it 0 and 1", "[ksp_mcg][reasons]")
   CHECK(r0.reason == KSP_DIVERGED_ITS);
   CHECK(r0.its == 0);
   for (PetscScalar v : r0.x) CHECK(v == 0.0);
-  Result r1 = solve(A, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_DEFAULT, 1e-10, 1});
+  Result       r1 = solve(A, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_DEFAULT, 1e-10, 1});
   const Result c1 = solve(A, b, Solve{KSPCG, PCJACOBI, KSP_NORM_DEFAULT, 1e-10, 1});
   CHECK(r1.reason == KSP_DIVERGED_ITS);
   CHECK(r1.its == 1);
@@ -110,15 +110,17 @@ TEST_CASE("max_it 0 and 1", "[ksp_mcg][reasons]")
 TEST_CASE("zero diagonal entries are treated as PCJACOBI treats them", "[ksp_mcg][jacobi]")
 {
   // symmetric, zero diagonal entry in row 1; fused Jacobi and PCApply(PCJACOBI) must agree
-  Mat A = diagonal({4, 0, 2, 5});
-  Vec b = rhs(A);
-  const Result fused   = solve(A, b, Solve{KSPMCG, PCJACOBI});
-  const Result generic = solve(A, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_DEFAULT, 1e-10, 1000, 0, "-ksp_mcg_fused_pc 0"});
+  Mat          A     = diagonal({4, 0, 2, 5});
+  Vec          b     = rhs(A);
+  const Result fused = solve(A, b, Solve{KSPMCG, PCJACOBI});
+  const Result generic =
+    solve(A, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_DEFAULT, 1e-10, 1000, 0, "-ksp_mcg_fused_pc 0"});
   CHECK(fused.reason == generic.reason);
   CHECK(fused.its == generic.its);
   CHECK(fused.reason < 0); // singular and inconsistent: must not claim convergence
   REQUIRE(fused.history.size() == generic.history.size());
-  for (size_t k = 0; k < fused.history.size(); k++) CHECK(fused.history[k] == Approx(generic.history[k]).epsilon(1e-14));
+  for (size_t k = 0; k < fused.history.size(); k++)
+    CHECK(fused.history[k] == Approx(generic.history[k]).epsilon(1e-14));
   MatDestroy(&A);
   VecDestroy(&b);
 }
@@ -127,8 +129,8 @@ TEST_CASE("an unattainable tolerance is not reported as converged", "[ksp_mcg][r
 {
   // rtol far below what double precision can reach on this system: the recursive residual may go
   // below it, the true residual cannot; MCG must stop with a negative reason, not claim RTOL.
-  Mat A = block_laplacian(20, 20);
-  Vec b = rhs(A);
+  Mat    A = block_laplacian(20, 20);
+  Vec    b = rhs(A);
   Result r = solve(A, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-22, 5000});
   CHECK(r.err == 0);
   CHECK(r.reason < 0);
@@ -164,7 +166,8 @@ TEST_CASE("fixed iterations far past convergence end converged, not in a breakdo
       REQUIRE(r.err == 0);
       CHECK(r.reason > 0);
       CHECK(rel_residual(A, b, r.x) < 1e-12);
-      const Result none = solve(A, b, Solve{KSPMCG, pc, KSP_NORM_NONE, 1e-10, 1000, 0, "-ksp_convergence_test skip"});
+      const Result none =
+        solve(A, b, Solve{KSPMCG, pc, KSP_NORM_NONE, 1e-10, 1000, 0, "-ksp_convergence_test skip"});
       REQUIRE(none.err == 0);
       CHECK(none.reason > 0);
       CHECK(rel_residual(A, b, none.x) < 1e-12);
@@ -174,7 +177,8 @@ TEST_CASE("fixed iterations far past convergence end converged, not in a breakdo
   }
 }
 
-TEST_CASE("a NaN in the matrix or the right-hand side is reported as a NaN residual norm", "[ksp_mcg][reasons]")
+TEST_CASE("a NaN in the matrix or the right-hand side is reported as a NaN residual norm",
+          "[ksp_mcg][reasons]")
 {
   const PetscScalar nan = PETSC_MAX_REAL * 10.0 - PETSC_MAX_REAL * 10.0;
   PetscMPIInt       rank;

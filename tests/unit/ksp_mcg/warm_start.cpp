@@ -37,7 +37,7 @@ void check_warm_started_fixed_iterations(Mat A, Vec b, Vec x0)
   for (PetscInt k : {1, 2, 5, 10, 20, 30}) {
     INFO("k = " << k);
     Solve fixed{KSPMCG, PCJACOBI, KSP_NORM_NONE, 1e-30, 3};
-    fixed.fixed_its = k;
+    fixed.fixed_its  = k;
     const Result mcg = solve(A, b, fixed, x0);
     const Result cg  = solve(A, b, Solve{KSPCG, PCJACOBI, KSP_NORM_NONE, 1e-30, k}, x0);
     REQUIRE(mcg.err == 0);
@@ -55,8 +55,8 @@ void check_warm_started_fixed_iterations(Mat A, Vec b, Vec x0)
 
 TEST_CASE("fixed iterations from a nonzero guess: same as cg, A-norm error never grows", "[ksp_mcg][cg]")
 {
-  Mat A  = block_laplacian(16, 12, MATAIJ, 1e-3); // condition number ~1e3: 30 iterations do not converge
-  Vec b  = rhs(A), x0 = rhs(A, true, -0.7);
+  Mat A = block_laplacian(16, 12, MATAIJ, 1e-3); // condition number ~1e3: 30 iterations do not converge
+  Vec b = rhs(A), x0 = rhs(A, true, -0.7);
   SECTION("aij") { check_warm_started_fixed_iterations(A, b, x0); }
   SECTION("binbcsr, upper-triangle storage (the fused fast path)")
   {

@@ -27,22 +27,25 @@ struct FemProblem {
     for (int k = 0; k + 1 < nz; ++k)
       for (int j = 0; j + 1 < ny; ++j)
         for (int i = 0; i + 1 < nx; ++i)
-          for (int c = 0; c < 8; ++c) elements.push_back(id(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1)));
+          for (int c = 0; c < 8; ++c)
+            elements.push_back(id(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1)));
   }
-  int nodes() const { return nx * ny * nz; }
-  int element_count() const { return static_cast<int>(elements.size() / 8); }
+  int      nodes() const { return nx * ny * nz; }
+  int      element_count() const { return static_cast<int>(elements.size() / 8); }
   PetscInt rows() const { return 3 * nodes(); }
 
   // 24x24 element matrix, row-major, rows ordered (node a, component p).
   std::vector<PetscScalar> element_matrix(int e) const
   {
-    const double s = 0.01 * (e % 7);
-    const double S[3][3] = {{2 + s, 0.1, 0}, {0.1, 2, 0.2 + s}, {0, 0.2 + s, 2.5}};
+    const double             s       = 0.01 * (e % 7);
+    const double             S[3][3] = {{2 + s, 0.1, 0}, {0.1, 2, 0.2 + s}, {0, 0.2 + s, 2.5}};
     std::vector<PetscScalar> K(24 * 24);
     for (int a = 0; a < 8; ++a)
       for (int p = 0; p < 3; ++p)
         for (int b = 0; b < 8; ++b)
-          for (int q = 0; q < 3; ++q) K[(3 * a + p) * 24 + 3 * b + q] = ((a == b ? 8.0 : 0.0) - 1.0) * S[p][q] + (a == b && p == q ? 0.5 : 0.0);
+          for (int q = 0; q < 3; ++q)
+            K[(3 * a + p) * 24 + 3 * b + q] =
+              ((a == b ? 8.0 : 0.0) - 1.0) * S[p][q] + (a == b && p == q ? 0.5 : 0.0);
     return K;
   }
   // Block (node) indices of element e in the matrix numbering.
@@ -96,8 +99,7 @@ inline void rank_coo_entries(const FemProblem &fem, std::vector<PetscInt> &ci, s
 }
 
 // The values of rank_coo_entries' list, element e's matrix scaled by weight(e).
-template <class Weight>
-std::vector<PetscScalar> rank_element_values(const FemProblem &fem, Weight weight)
+template <class Weight> std::vector<PetscScalar> rank_element_values(const FemProblem &fem, Weight weight)
 {
   PetscMPIInt rank, size;
   MPI_Comm_rank(PETSC_COMM_WORLD, &rank);

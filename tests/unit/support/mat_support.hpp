@@ -11,8 +11,7 @@
 #include <random>
 #include <vector>
 
-namespace mat_core
-{
+namespace mat_core {
 
 struct Entry {
   PetscInt    i, j;
@@ -27,11 +26,12 @@ struct Pattern {
 
 // Random block pattern: every block row gets 0..maxblocks random blocks (some rows empty), each
 // block full; the diagonal block is added when `diag`.
-inline Pattern random_pattern(PetscInt mbs, PetscInt nbs, PetscInt bs, PetscInt maxblocks, unsigned seed, bool diag = true)
+inline Pattern random_pattern(PetscInt mbs, PetscInt nbs, PetscInt bs, PetscInt maxblocks, unsigned seed,
+                              bool diag = true)
 {
-  std::mt19937                          rng(seed);
+  std::mt19937                           rng(seed);
   std::uniform_real_distribution<double> val(-1.0, 1.0);
-  Pattern                               p;
+  Pattern                                p;
   p.m  = mbs * bs;
   p.n  = nbs * bs;
   p.bs = bs;
@@ -40,12 +40,14 @@ inline Pattern random_pattern(PetscInt mbs, PetscInt nbs, PetscInt bs, PetscInt 
     const PetscInt        nb = (PetscInt)(rng() % (maxblocks + 1));
     for (PetscInt k = 0; k < nb; k++) cols.push_back((PetscInt)(rng() % nbs));
     if (diag && r < nbs && r % 7 != 3) cols.push_back(r); // some rows lack the diagonal
-    if (r % 5 == 2) cols.clear();                          // empty rows
+    if (r % 5 == 2) cols.clear();                         // empty rows
     std::sort(cols.begin(), cols.end());
     cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
     for (PetscInt c : cols)
       for (PetscInt i = 0; i < bs; i++)
-        for (PetscInt j = 0; j < bs; j++) p.entries.push_back({r * bs + i, c * bs + j, val(rng) + (r == c && i == j ? 4.0 * maxblocks : 0.0)});
+        for (PetscInt j = 0; j < bs; j++)
+          p.entries.push_back(
+            {r * bs + i, c * bs + j, val(rng) + (r == c && i == j ? 4.0 * maxblocks : 0.0)});
   }
   return p;
 }
@@ -54,7 +56,7 @@ inline Pattern random_pattern(PetscInt mbs, PetscInt nbs, PetscInt bs, PetscInt 
 // symmetric, diagonally dominant.
 inline Pattern fem_pattern(PetscInt nx, PetscInt ny, PetscInt nz, PetscInt bs = 3)
 {
-  Pattern p;
+  Pattern        p;
   const PetscInt nn = nx * ny * nz;
   p.m = p.n = nn * bs;
   p.bs      = bs;
@@ -73,7 +75,9 @@ inline Pattern fem_pattern(PetscInt nx, PetscInt ny, PetscInt nz, PetscInt bs = 
                 for (PetscInt j = 0; j < bs; j++) {
                   const PetscInt lo = PetscMin(r, c), hi = PetscMax(r, c);
                   // symmetric: block (c, r) is the transpose of block (r, c)
-                  const double v = (r == c) ? (i == j ? 60.0 : 0.5 / (1 + i + j)) : -1.0 / (1.0 + ((lo * 31 + hi * 17 + (r < c ? i * 3 + j : j * 3 + i)) % 7));
+                  const double v =
+                    (r == c) ? (i == j ? 60.0 : 0.5 / (1 + i + j))
+                             : -1.0 / (1.0 + ((lo * 31 + hi * 17 + (r < c ? i * 3 + j : j * 3 + i)) % 7));
                   p.entries.push_back({r * bs + i, c * bs + j, v});
                 }
             }
@@ -92,18 +96,23 @@ inline Pattern wild_pattern(PetscInt mbs, PetscInt bs, PetscInt longrow)
     for (PetscInt k = 0; k < nb; k++) {
       const PetscInt c = (r == 1) ? (k * 7919) % mbs : r;
       for (PetscInt i = 0; i < bs; i++)
-        for (PetscInt j = 0; j < bs; j++) p.entries.push_back({r * bs + i, c * bs + j, 1.0 + 0.01 * ((r + 3 * k + i + 2 * j) % 13)});
+        for (PetscInt j = 0; j < bs; j++)
+          p.entries.push_back({r * bs + i, c * bs + j, 1.0 + 0.01 * ((r + 3 * k + i + 2 * j) % 13)});
     }
   }
   // (r==1) columns k*7919 % mbs may repeat when mbs divides 7919*k: dedupe
-  std::sort(p.entries.begin(), p.entries.end(), [](const Entry &a, const Entry &b) { return a.i < b.i || (a.i == b.i && a.j < b.j); });
-  p.entries.erase(std::unique(p.entries.begin(), p.entries.end(), [](const Entry &a, const Entry &b) { return a.i == b.i && a.j == b.j; }), p.entries.end());
+  std::sort(p.entries.begin(), p.entries.end(),
+            [](const Entry &a, const Entry &b) { return a.i < b.i || (a.i == b.i && a.j < b.j); });
+  p.entries.erase(std::unique(p.entries.begin(), p.entries.end(),
+                              [](const Entry &a, const Entry &b) { return a.i == b.i && a.j == b.j; }),
+                  p.entries.end());
   return p;
 }
 
 // Creates and assembles `type` from the pattern through MatSetValues (one entry at a time, a
 // shuffled order so staging sees unsorted input). bw/precision are applied to binbcsr matrices.
-inline Mat build(const Pattern &p, MatType type, PetscInt bw = 0, MatBinBCSRPrecision prec = MAT_BINBCSR_PRECISION_DOUBLE)
+inline Mat build(const Pattern &p, MatType type, PetscInt bw = 0,
+                 MatBinBCSRPrecision prec = MAT_BINBCSR_PRECISION_DOUBLE)
 {
   Mat A = nullptr;
   REQUIRE(MatCreate(PETSC_COMM_SELF, &A) == 0);
@@ -117,7 +126,8 @@ inline Mat build(const Pattern &p, MatType type, PetscInt bw = 0, MatBinBCSRPrec
   for (size_t k = 0; k < order.size(); k++) order[k] = (k * 7919) % order.size();
   if (!order.empty() && std::__gcd(order.size(), (size_t)7919) != 1)
     for (size_t k = 0; k < order.size(); k++) order[k] = k;
-  for (size_t k : order) REQUIRE(MatSetValue(A, p.entries[k].i, p.entries[k].j, p.entries[k].v, INSERT_VALUES) == 0);
+  for (size_t k : order)
+    REQUIRE(MatSetValue(A, p.entries[k].i, p.entries[k].j, p.entries[k].v, INSERT_VALUES) == 0);
   REQUIRE(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY) == 0);
   REQUIRE(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY) == 0);
   return A;
@@ -149,7 +159,8 @@ inline std::vector<PetscScalar> values(Vec v)
 
 // Per-row bound of |(A x)_i - ref_i|: the rounding of the stored values (relative `unit`, i.e.
 // FLT_EPSILON/2 for float storage) times sum_j |a_ij x_j|, plus double accumulation error.
-inline std::vector<double> mult_bound(const Pattern &p, const std::vector<PetscScalar> &x, double unit, bool transpose)
+inline std::vector<double> mult_bound(const Pattern &p, const std::vector<PetscScalar> &x, double unit,
+                                      bool transpose)
 {
   std::vector<double> b(transpose ? p.n : p.m, 0.0);
   for (const Entry &e : p.entries) {
@@ -160,13 +171,15 @@ inline std::vector<double> mult_bound(const Pattern &p, const std::vector<PetscS
   return b;
 }
 
-inline void check_close(const std::vector<PetscScalar> &got, const std::vector<PetscScalar> &ref, const std::vector<double> &bound)
+inline void check_close(const std::vector<PetscScalar> &got, const std::vector<PetscScalar> &ref,
+                        const std::vector<double> &bound)
 {
   REQUIRE(got.size() == ref.size());
   size_t bad = 0;
   for (size_t i = 0; i < got.size(); i++)
     if (!(std::fabs(got[i] - ref[i]) <= bound[i])) {
-      if (bad < 5) UNSCOPED_INFO("entry " << i << ": got " << got[i] << " ref " << ref[i] << " bound " << bound[i]);
+      if (bad < 5)
+        UNSCOPED_INFO("entry " << i << ": got " << got[i] << " ref " << ref[i] << " bound " << bound[i]);
       bad++;
     }
   CHECK(bad == 0);

@@ -6,8 +6,7 @@
 #pragma once
 #include "support/mat_support.hpp"
 
-namespace mat_core
-{
+namespace mat_core {
 
 struct Products {
   std::vector<PetscScalar> mult, mult_add, mult_add_in_place, mult_dot;
@@ -56,7 +55,8 @@ inline void check_streams(Mat A, const Pattern &p)
     if (p.m == p.n) {
       check_close(got.mult_dot, one.mult_dot, bound);
       double dbound = 0;
-      for (size_t i = 0; i < xv.size(); i++) dbound += std::fabs(xv[i]) * (bound[i] + 64 * DBL_EPSILON * std::fabs(one.mult_dot[i]));
+      for (size_t i = 0; i < xv.size(); i++)
+        dbound += std::fabs(xv[i]) * (bound[i] + 64 * DBL_EPSILON * std::fabs(one.mult_dot[i]));
       CHECK(std::fabs(got.dot - one.dot) <= dbound);
     }
   }

@@ -17,10 +17,8 @@
 
 #include <immintrin.h>
 
-namespace binbcsr
-{
-namespace avx512
-{
+namespace binbcsr {
+namespace avx512 {
 
 inline __m512d load8(const double *p) { return _mm512_loadu_pd(p); }
 inline __m512d load8(const float *p) { return _mm512_cvtps_pd(_mm256_loadu_ps(p)); }
@@ -29,17 +27,26 @@ inline __m512d load8(const float *p) { return _mm512_cvtps_pd(_mm256_loadu_ps(p)
 inline void split_xyz(const double *xs, __m512d &x0, __m512d &x1, __m512d &x2)
 {
   const __m512d a = _mm512_loadu_pd(xs), b = _mm512_loadu_pd(xs + 8), c = _mm512_loadu_pd(xs + 16);
-  x0 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, _mm512_setr_epi64(0, 3, 6, 9, 12, 15, 0, 0), b), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 10, 13), c);
-  x1 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, _mm512_setr_epi64(1, 4, 7, 10, 13, 0, 0, 0), b), _mm512_setr_epi64(0, 1, 2, 3, 4, 8, 11, 14), c);
-  x2 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, _mm512_setr_epi64(2, 5, 8, 11, 14, 0, 0, 0), b), _mm512_setr_epi64(0, 1, 2, 3, 4, 9, 12, 15), c);
+  x0 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, _mm512_setr_epi64(0, 3, 6, 9, 12, 15, 0, 0), b),
+                              _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 10, 13), c);
+  x1 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, _mm512_setr_epi64(1, 4, 7, 10, 13, 0, 0, 0), b),
+                              _mm512_setr_epi64(0, 1, 2, 3, 4, 8, 11, 14), c);
+  x2 = _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, _mm512_setr_epi64(2, 5, 8, 11, 14, 0, 0, 0), b),
+                              _mm512_setr_epi64(0, 1, 2, 3, 4, 9, 12, 15), c);
 }
 
 /* ys[3l + j] += s_j[l]: one register per component back to 24 interleaved doubles (split_xyz inverted) */
 inline void add_xyz(double *ys, __m512d s0, __m512d s1, __m512d s2)
 {
-  const __m512d lo = _mm512_permutex2var_pd(_mm512_permutex2var_pd(s0, _mm512_setr_epi64(0, 8, 0, 1, 9, 0, 2, 10), s1), _mm512_setr_epi64(0, 1, 8, 3, 4, 9, 6, 7), s2);
-  const __m512d mi = _mm512_permutex2var_pd(_mm512_permutex2var_pd(s0, _mm512_setr_epi64(0, 3, 11, 0, 4, 12, 0, 5), s1), _mm512_setr_epi64(10, 1, 2, 11, 4, 5, 12, 7), s2);
-  const __m512d hi = _mm512_permutex2var_pd(_mm512_permutex2var_pd(s0, _mm512_setr_epi64(13, 0, 6, 14, 0, 7, 15, 0), s1), _mm512_setr_epi64(0, 13, 2, 3, 14, 5, 6, 15), s2);
+  const __m512d lo =
+    _mm512_permutex2var_pd(_mm512_permutex2var_pd(s0, _mm512_setr_epi64(0, 8, 0, 1, 9, 0, 2, 10), s1),
+                           _mm512_setr_epi64(0, 1, 8, 3, 4, 9, 6, 7), s2);
+  const __m512d mi =
+    _mm512_permutex2var_pd(_mm512_permutex2var_pd(s0, _mm512_setr_epi64(0, 3, 11, 0, 4, 12, 0, 5), s1),
+                           _mm512_setr_epi64(10, 1, 2, 11, 4, 5, 12, 7), s2);
+  const __m512d hi =
+    _mm512_permutex2var_pd(_mm512_permutex2var_pd(s0, _mm512_setr_epi64(13, 0, 6, 14, 0, 7, 15, 0), s1),
+                           _mm512_setr_epi64(0, 13, 2, 3, 14, 5, 6, 15), s2);
   _mm512_storeu_pd(ys, _mm512_add_pd(_mm512_loadu_pd(ys), lo));
   _mm512_storeu_pd(ys + 8, _mm512_add_pd(_mm512_loadu_pd(ys + 8), mi));
   _mm512_storeu_pd(ys + 16, _mm512_add_pd(_mm512_loadu_pd(ys + 16), hi));
@@ -69,9 +76,12 @@ inline void group_mult_3x8(const V *t, const I *c, const double *x, __m512d *a, 
     x1                = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), real, off, x + 1, 8);
     x2                = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), real, off, x + 2, 8);
   }
-  a[0] = _mm512_fmadd_pd(load8(t + 16), x2, _mm512_fmadd_pd(load8(t + 8), x1, _mm512_fmadd_pd(load8(t), x0, a[0])));
-  a[1] = _mm512_fmadd_pd(load8(t + 40), x2, _mm512_fmadd_pd(load8(t + 32), x1, _mm512_fmadd_pd(load8(t + 24), x0, a[1])));
-  a[2] = _mm512_fmadd_pd(load8(t + 64), x2, _mm512_fmadd_pd(load8(t + 56), x1, _mm512_fmadd_pd(load8(t + 48), x0, a[2])));
+  a[0] = _mm512_fmadd_pd(load8(t + 16), x2,
+                         _mm512_fmadd_pd(load8(t + 8), x1, _mm512_fmadd_pd(load8(t), x0, a[0])));
+  a[1] = _mm512_fmadd_pd(load8(t + 40), x2,
+                         _mm512_fmadd_pd(load8(t + 32), x1, _mm512_fmadd_pd(load8(t + 24), x0, a[1])));
+  a[2] = _mm512_fmadd_pd(load8(t + 64), x2,
+                         _mm512_fmadd_pd(load8(t + 56), x1, _mm512_fmadd_pd(load8(t + 48), x0, a[2])));
 }
 
 /* The whole-storage product of K bins swept together (3x3 blocks, 8 lanes): acc[q][i] (lane l in
@@ -79,7 +89,8 @@ inline void group_mult_3x8(const V *t, const I *c, const double *x, __m512d *a, 
    in turn; the accumulators stay in registers for the whole sweep. K bins far apart in memory are K
    streams for the hardware prefetcher (bins_sweep in binbcsr_bin_drivers.h says why). */
 template <int K, typename V, typename I>
-inline void bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, const int *len, const int (*nz)[8], const double *x, double (*const *acc)[8])
+inline void bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, const int *len,
+                          const int (*nz)[8], const double *x, double (*const *acc)[8])
 {
   __m512d a[K][3];
   __m256i n[K]; /* the lanes' real blocks: slot group k of lane l is real when k < n[l] */
@@ -87,7 +98,10 @@ inline void bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, cons
     n[q] = _mm256_loadu_si256((const __m256i *)nz[q]);
     for (int i = 0; i < 3; i++) a[q][i] = _mm512_loadu_pd(acc[q][i]);
   }
-  interleave_groups<K>(len, [&](int q, int k) { group_mult_3x8(bin_val[q] + (long)k * 72, bin_col[q] + (long)k * 8, x, a[q], _mm256_cmpgt_epi32_mask(n[q], _mm256_set1_epi32(k))); });
+  interleave_groups<K>(len, [&](int q, int k) {
+    group_mult_3x8(bin_val[q] + (long)k * 72, bin_col[q] + (long)k * 8, x, a[q],
+                   _mm256_cmpgt_epi32_mask(n[q], _mm256_set1_epi32(k)));
+  });
   for (int q = 0; q < K; q++)
     for (int i = 0; i < 3; i++) _mm512_storeu_pd(acc[q][i], a[q][i]);
 }
@@ -99,8 +113,7 @@ inline void bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, cons
    groups load x and update y contiguously; the others gather x and gather-add-scatter y for the lanes
    whose column is not their own row (conflict-free within a group: the colouring). Same semantics as
    the portable sym_bins_mult: on exit y_r += acc for the real lanes of every bin. */
-template <typename V, typename I>
-struct SymBin3x8 {
+template <typename V, typename I> struct SymBin3x8 {
   const V *t;
   const I *c;
   I        r0;
@@ -110,7 +123,8 @@ struct SymBin3x8 {
 };
 
 template <typename V, typename I>
-inline void sym_bin_begin_3x8(SymBin3x8<V, I> &b, const V *bin_val, const I *bin_col, I r0, I mbs, const int *kd, const double *x)
+inline void sym_bin_begin_3x8(SymBin3x8<V, I> &b, const V *bin_val, const I *bin_col, I r0, I mbs,
+                              const int *kd, const double *x)
 {
   const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   b.t                = bin_val;
@@ -119,7 +133,8 @@ inline void sym_bin_begin_3x8(SymBin3x8<V, I> &b, const V *bin_val, const I *bin
   b.k                = 0;
   b.kd               = _mm256_loadu_si256((const __m256i *)kd);
   b.nreal            = mbs - r0 < 8 ? (int)(mbs - r0) : 8;
-  b.own              = _mm256_mask_blend_epi32((__mmask8)((1u << b.nreal) - 1), _mm256_set1_epi32((int)mbs - 1), _mm256_add_epi32(_mm256_set1_epi32((int)r0), iota));
+  b.own = _mm256_mask_blend_epi32((__mmask8)((1u << b.nreal) - 1), _mm256_set1_epi32((int)mbs - 1),
+                                  _mm256_add_epi32(_mm256_set1_epi32((int)r0), iota));
   for (int i = 0; i < 3; i++) b.a[i] = _mm512_setzero_pd();
   if (b.nreal == 8) split_xyz(x + (long)r0 * 3, b.r[0], b.r[1], b.r[2]);
   else {
@@ -143,9 +158,9 @@ inline void sym_bin_group_3x8(SymBin3x8<V, I> &b, const double *x, double *y)
   const __m256i ci = _mm256_loadu_si256((const __m256i *)c);
   __m512d       v[9], xc[3], s[3];
   for (int e = 0; e < 9; e++) v[e] = load8(t + e * 8);
-  const bool     unit    = _mm256_cmpeq_epi32_mask(ci, _mm256_add_epi32(_mm256_set1_epi32((int)c[0]), iota)) == 0xFF;
-  __m256i        off     = _mm256_add_epi32(ci, _mm256_add_epi32(ci, ci)); /* 3 c */
-  const __mmask8 scatter = _mm256_cmpneq_epi32_mask(ci, b.own);            /* not the diagonal block, not padding */
+  const bool unit = _mm256_cmpeq_epi32_mask(ci, _mm256_add_epi32(_mm256_set1_epi32((int)c[0]), iota)) == 0xFF;
+  __m256i    off  = _mm256_add_epi32(ci, _mm256_add_epi32(ci, ci)); /* 3 c */
+  const __mmask8 scatter = _mm256_cmpneq_epi32_mask(ci, b.own);     /* not the diagonal block, not padding */
   /* real blocks: the off-diagonal ones and the diagonal block; padding's x_c reads as zero (zero times a
      NaN or Inf of x_own would be a NaN the row does not have) */
   const __mmask8 real = scatter | _mm256_cmpeq_epi32_mask(b.kd, _mm256_set1_epi32(b.k++));
@@ -154,9 +169,12 @@ inline void sym_bin_group_3x8(SymBin3x8<V, I> &b, const double *x, double *y)
     for (int j = 0; j < 3; j++) xc[j] = _mm512_maskz_mov_pd(real, xc[j]);
   } else
     for (int j = 0; j < 3; j++) xc[j] = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), real, off, x + j, 8);
-  for (int i = 0; i < 3; i++) b.a[i] = _mm512_fmadd_pd(v[3 * i + 2], xc[2], _mm512_fmadd_pd(v[3 * i + 1], xc[1], _mm512_fmadd_pd(v[3 * i], xc[0], b.a[i])));
+  for (int i = 0; i < 3; i++)
+    b.a[i] = _mm512_fmadd_pd(v[3 * i + 2], xc[2],
+                             _mm512_fmadd_pd(v[3 * i + 1], xc[1], _mm512_fmadd_pd(v[3 * i], xc[0], b.a[i])));
   if (!scatter) return;
-  for (int j = 0; j < 3; j++) s[j] = _mm512_fmadd_pd(v[6 + j], b.r[2], _mm512_fmadd_pd(v[3 + j], b.r[1], _mm512_mul_pd(v[j], b.r[0])));
+  for (int j = 0; j < 3; j++)
+    s[j] = _mm512_fmadd_pd(v[6 + j], b.r[2], _mm512_fmadd_pd(v[3 + j], b.r[1], _mm512_mul_pd(v[j], b.r[0])));
   if (unit) add_xyz(y + (long)c[0] * 3, s[0], s[1], s[2]); /* all lanes scatter: c0 != r0 */
   else
     for (int j = 0; j < 3; j++) {
@@ -165,8 +183,7 @@ inline void sym_bin_group_3x8(SymBin3x8<V, I> &b, const double *x, double *y)
     }
 }
 
-template <typename V, typename I>
-inline void sym_bin_end_3x8(const SymBin3x8<V, I> &b, double *y)
+template <typename V, typename I> inline void sym_bin_end_3x8(const SymBin3x8<V, I> &b, double *y)
 {
   if (b.nreal == 8) add_xyz(y + (long)b.r0 * 3, b.a[0], b.a[1], b.a[2]);
   else {
@@ -178,7 +195,8 @@ inline void sym_bin_end_3x8(const SymBin3x8<V, I> &b, double *y)
 }
 
 template <int K, typename V, typename I>
-inline void sym_bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, const int *len, const I *r0, I mbs, const int (*kd)[8], const double *x, double *y)
+inline void sym_bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, const int *len, const I *r0,
+                              I mbs, const int (*kd)[8], const double *x, double *y)
 {
   /* interleave_groups' order written out: through its lambda this body ran slower (upper double at
      48^3, three alternations: 7.0-7.6 ms against 6.5-6.9) */

@@ -18,10 +18,8 @@
 
 #include "../binbcsr_kernels.h"
 
-namespace binbcsr
-{
-namespace cuda
-{
+namespace binbcsr {
+namespace cuda {
 
 constexpr int block_threads = 256;
 
@@ -40,7 +38,8 @@ __device__ __forceinline__ double block_sum(double v)
 
 /* Stores the block's partial sum; the last block to arrive sums all partials in block order into *out
    (and, if hist is non-null, appends it there). ticket: one counter, zero on entry, zero again on exit. */
-__device__ __forceinline__ void finish_sum(double mine, double *partials, unsigned *ticket, double *out, double *hist)
+__device__ __forceinline__ void finish_sum(double mine, double *partials, unsigned *ticket, double *out,
+                                           double *hist)
 {
   __shared__ bool last;
   if (threadIdx.x == 0) {
@@ -61,26 +60,33 @@ __device__ __forceinline__ void finish_sum(double mine, double *partials, unsign
 
 /* y = A x, one thread per lane (block row). */
 template <int BS, typename V>
-__global__ void __launch_bounds__(block_threads) bin_mult(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start, int mbs, int bw, const double *__restrict__ x, double *__restrict__ y)
+__global__ void __launch_bounds__(block_threads)
+  bin_mult(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start, int mbs,
+           int bw, const double *__restrict__ x, double *__restrict__ y)
 {
   const int t = blockIdx.x * blockDim.x + threadIdx.x, b = t / bw, lane = t % bw, r = t;
   if (r >= mbs) return;
   const int s0 = bin_start[b], len = (bin_start[b + 1] - s0) / bw;
   double    acc[BS];
   for (int i = 0; i < BS; i++) acc[i] = 0.0;
-  lane_mult<BS, V, int>(val + (long)s0 * BS * BS, col + s0, len, bw, BS, lane, x, acc); /* len: padding read (no row lengths here) */
+  lane_mult<BS, V, int>(val + (long)s0 * BS * BS, col + s0, len, bw, BS, lane, x,
+                        acc); /* len: padding read (no row lengths here) */
   for (int i = 0; i < BS; i++) y[(long)r * BS + i] = acc[i];
 }
 
 /* y = A x with bs threads per lane, one per point row (lane_row_mult): thread t is point row i of lane
    l of bin b, t = (b * BS + i) * bw + l. */
 template <int BS, typename V>
-__global__ void __launch_bounds__(block_threads) bin_mult_rows(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start, int mbs, int bw, const double *__restrict__ x, double *__restrict__ y)
+__global__ void __launch_bounds__(block_threads)
+  bin_mult_rows(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start,
+                int mbs, int bw, const double *__restrict__ x, double *__restrict__ y)
 {
-  const int t = blockIdx.x * blockDim.x + threadIdx.x, b = t / (BS * bw), i = t / bw % BS, lane = t % bw, r = b * bw + lane;
+  const int t = blockIdx.x * blockDim.x + threadIdx.x, b = t / (BS * bw), i = t / bw % BS, lane = t % bw,
+            r = b * bw + lane;
   if (r >= mbs) return;
   const int s0 = bin_start[b], len = (bin_start[b + 1] - s0) / bw;
-  y[(long)r * BS + i] = lane_row_mult<BS, V, int>(val + (long)s0 * BS * BS, col + s0, len, bw, BS, lane, i, x);
+  y[(long)r * BS + i] =
+    lane_row_mult<BS, V, int>(val + (long)s0 * BS * BS, col + s0, len, bw, BS, lane, i, x);
 }
 
 /* Bin width 8 (the CPU's default): a warp is one point row of one bin, its 32 threads 8 lanes x 4 slot
@@ -88,11 +94,14 @@ __global__ void __launch_bounds__(block_threads) bin_mult_rows(const V *__restri
    walks a quarter of its bin, which is what bins holding a few very long rows need (a warp's time is
    its longest row's). Launch 32 * BS threads per bin: split_threads(). */
 template <int BS, typename V>
-__device__ __forceinline__ double bin_row_split8(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start, int mbs, const double *__restrict__ x, int *row)
+__device__ __forceinline__ double bin_row_split8(const V *__restrict__ val, const int *__restrict__ col,
+                                                 const int *__restrict__ bin_start, int mbs,
+                                                 const double *__restrict__ x, int     *row)
 {
-  const int t = blockIdx.x * blockDim.x + threadIdx.x, warp = t / 32, lane = t % 8, h = t % 32 / 8, b = warp / BS, i = warp % BS;
-  double    s = 0.0;
-  *row = -1;
+  const int t = blockIdx.x * blockDim.x + threadIdx.x, warp = t / 32, lane = t % 8, h = t % 32 / 8,
+            b = warp / BS, i = warp % BS;
+  double s = 0.0;
+  *row     = -1;
   if (b * 8 < mbs) {
     const int s0 = bin_start[b], len = (bin_start[b + 1] - s0) / 8;
     s = lane_row_mult<BS, V, int>(val + (long)s0 * BS * BS, col + s0, len, 8, BS, lane, i, x, h, 4);
@@ -103,7 +112,9 @@ __device__ __forceinline__ double bin_row_split8(const V *__restrict__ val, cons
   return s;
 }
 template <int BS, typename V>
-__global__ void __launch_bounds__(block_threads) bin_mult_split8(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start, int mbs, const double *__restrict__ x, double *__restrict__ y)
+__global__ void __launch_bounds__(block_threads)
+  bin_mult_split8(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start,
+                  int mbs, const double *__restrict__ x, double *__restrict__ y)
 {
   int          row;
   const double s = bin_row_split8<BS, V>(val, col, bin_start, mbs, x, &row);
@@ -117,22 +128,29 @@ inline long rows_threads(int mbs, int bw, int bs) { return (long)((mbs + bw - 1)
 /* q = A p and p.q, finished into *out by the last block (finish_sum; ticket: its counter): the product
    of a merged CG iteration. Launch rows_threads(mbs, bw, BS) threads. */
 template <int BS, typename V>
-__global__ void __launch_bounds__(block_threads) bin_mult_dot(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start, int mbs, int bw, const double *__restrict__ p, double *__restrict__ q, double *partials, unsigned *ticket, double *out)
+__global__ void __launch_bounds__(block_threads)
+  bin_mult_dot(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start,
+               int mbs, int bw, const double *__restrict__ p, double *__restrict__ q, double *partials,
+               unsigned *ticket, double *out)
 {
-  const int t = blockIdx.x * blockDim.x + threadIdx.x, b = t / (BS * bw), i = t / bw % BS, lane = t % bw, r = b * bw + lane;
-  double    d = 0.0;
+  const int t = blockIdx.x * blockDim.x + threadIdx.x, b = t / (BS * bw), i = t / bw % BS, lane = t % bw,
+            r = b * bw + lane;
+  double d    = 0.0;
   if (r < mbs) { /* the thread mapping of bin_mult_rows */
     const int    s0 = bin_start[b], len = (bin_start[b + 1] - s0) / bw;
     const double qi = lane_row_mult<BS, V, int>(val + (long)s0 * BS * BS, col + s0, len, bw, BS, lane, i, p);
     q[(long)r * BS + i] = qi;
-    d = p[(long)r * BS + i] * qi;
+    d                   = p[(long)r * BS + i] * qi;
   }
   finish_sum(block_sum(d), partials, ticket, out, nullptr);
 }
 
 /* bin_mult_dot for bin width 8, the bin_mult_split8 mapping. Launch split_threads(mbs, BS) threads. */
 template <int BS, typename V>
-__global__ void __launch_bounds__(block_threads) bin_mult_dot_split8(const V *__restrict__ val, const int *__restrict__ col, const int *__restrict__ bin_start, int mbs, const double *__restrict__ p, double *__restrict__ q, double *partials, unsigned *ticket, double *out)
+__global__ void __launch_bounds__(block_threads)
+  bin_mult_dot_split8(const V *__restrict__ val, const int *__restrict__ col,
+                      const int *__restrict__ bin_start, int mbs, const double *__restrict__ p,
+                      double *__restrict__ q, double *partials, unsigned *ticket, double *out)
 {
   int          row;
   const double qi = bin_row_split8<BS, V>(val, col, bin_start, mbs, p, &row);
@@ -149,7 +167,8 @@ __global__ void __launch_bounds__(block_threads) bin_mult_dot_split8(const V *__
    the colouring makes the scatters of one slot group conflict-free, not those of different groups.
    Compiled (tests/cuda/kernels_device.cu), not yet run on a GPU. */
 template <int BS, typename V>
-__global__ void sym_bin_mult(const V *val, const int *col, const int *bin_start, const int *diag_slot, int nbins, int mbs, int bw, const double *x, double *y)
+__global__ void sym_bin_mult(const V *val, const int *col, const int *bin_start, const int *diag_slot,
+                             int nbins, int mbs, int bw, const double *x, double *y)
 {
   const int b = blockIdx.x, lane = threadIdx.x, r = b * bw + lane;
   if (b >= nbins || lane >= bw) return;

@@ -5,8 +5,7 @@
 
 using namespace mat_core;
 
-namespace
-{
+namespace {
 
 Mat create(PetscInt m, PetscInt n, PetscInt bs, PetscInt bw = 0)
 {
@@ -59,11 +58,12 @@ TEST_CASE("MatSetValues INSERT and ADD, staged and after the layout is frozen", 
   MatDestroy(&A);
 }
 
-TEST_CASE("staged ADD sums duplicates; negative indices are ignored; NULL values insert zeros", "[mat_core][setvalues]")
+TEST_CASE("staged ADD sums duplicates; negative indices are ignored; NULL values insert zeros",
+          "[mat_core][setvalues]")
 {
-  Mat            A    = create(6, 6, 1, 4);
-  const PetscInt rows[3] = {0, -1, 5}, cols[3] = {-3, 2, 5};
-  const PetscScalar v[9]  = {100, 1, 2, 200, 300, 400, 500, 3, 4};
+  Mat               A       = create(6, 6, 1, 4);
+  const PetscInt    rows[3] = {0, -1, 5}, cols[3] = {-3, 2, 5};
+  const PetscScalar v[9] = {100, 1, 2, 200, 300, 400, 500, 3, 4};
   REQUIRE(MatSetUp(A) == 0);
   REQUIRE(MatSetValues(A, 3, rows, 3, cols, v, ADD_VALUES) == 0);
   REQUIRE(MatSetValues(A, 3, rows, 3, cols, v, ADD_VALUES) == 0);
@@ -86,7 +86,7 @@ TEST_CASE("staged ADD sums duplicates; negative indices are ignored; NULL values
 
 TEST_CASE("MatSetValuesBlocked, row- and column-oriented, against seqbaij", "[mat_core][setvalues]")
 {
-  const PetscInt bs = GENERATE(1, 2, 3);
+  const PetscInt  bs          = GENERATE(1, 2, 3);
   const PetscBool roworiented = GENERATE(PETSC_TRUE, PETSC_FALSE);
   CAPTURE(bs, roworiented);
   const PetscInt mbs = 11;
@@ -99,7 +99,9 @@ TEST_CASE("MatSetValuesBlocked, row- and column-oriented, against seqbaij", "[ma
       const PetscInt           br[2] = {r, (r * 5 + 1) % mbs}, bc[2] = {(r * 3) % mbs, r};
       std::vector<PetscScalar> v(4 * bs * bs);
       for (size_t k = 0; k < v.size(); k++) v[k] = 1.0 + r + 0.25 * k + pass;
-      for (Mat M : {A, B}) REQUIRE(MatSetValuesBlocked(M, 2, br, 2, bc, v.data(), (pass == 0 && r % 2 == 0) ? INSERT_VALUES : ADD_VALUES) == 0);
+      for (Mat M : {A, B})
+        REQUIRE(MatSetValuesBlocked(M, 2, br, 2, bc, v.data(),
+                                    (pass == 0 && r % 2 == 0) ? INSERT_VALUES : ADD_VALUES) == 0);
       for (Mat M : {A, B}) {
         REQUIRE(MatAssemblyBegin(M, MAT_FLUSH_ASSEMBLY) == 0);
         REQUIRE(MatAssemblyEnd(M, MAT_FLUSH_ASSEMBLY) == 0);
@@ -115,7 +117,7 @@ TEST_CASE("MatSetValuesBlocked, row- and column-oriented, against seqbaij", "[ma
 
 TEST_CASE("the preallocation calls of stock programs give a working matrix", "[mat_core][prealloc]")
 {
-  const Pattern p  = fem_pattern(3, 3, 2);
+  const Pattern p   = fem_pattern(3, 3, 2);
   const auto    ref = dense(p);
   SECTION("MatXAIJSetPreallocation")
   {
@@ -203,7 +205,7 @@ TEST_CASE("COO: duplicates summed, negative indices dropped, INSERT and ADD refi
     cj.push_back(r);
   }
   const PetscCount ncoo = (PetscCount)ci.size();
-  Mat              A = create(m, n, bs, bw), ref;
+  Mat              A    = create(m, n, bs, bw), ref;
   REQUIRE(MatBinBCSRSetPrecision(A, prec) == 0);
   REQUIRE(MatCreateSeqAIJ(PETSC_COMM_SELF, m, n, 0, nullptr, &ref) == 0);
   // PETSc may permute the index arrays: give each matrix its own copy
@@ -213,17 +215,19 @@ TEST_CASE("COO: duplicates summed, negative indices dropped, INSERT and ADD refi
     REQUIRE(MatSetPreallocationCOO(ref, ncoo, i2.data(), j2.data()) == 0);
   }
   std::vector<PetscScalar> v(ncoo);
-  const double unit = prec == MAT_BINBCSR_PRECISION_SINGLE ? FLT_EPSILON : 4 * DBL_EPSILON;
+  const double             unit = prec == MAT_BINBCSR_PRECISION_SINGLE ? FLT_EPSILON : 4 * DBL_EPSILON;
   for (int round = 0; round < 3; round++) {
     for (PetscCount k = 0; k < ncoo; k++) v[k] = std::sin(1.0 + k + 10 * round);
     const InsertMode mode = round == 1 ? ADD_VALUES : INSERT_VALUES;
     REQUIRE(MatSetValuesCOO(A, v.data(), mode) == 0);
     REQUIRE(MatSetValuesCOO(ref, v.data(), mode) == 0);
     // bound: sums of |v| rounded once to float (plus the stored old value for ADD)
-    auto got = dense(A), want = dense(ref);
+    auto   got = dense(A), want = dense(ref);
     size_t bad = 0;
     for (size_t k = 0; k < got.size(); k++)
-      if (!(std::fabs(got[k] - want[k]) <= unit * (std::fabs(want[k]) + 16.0 * (mode == ADD_VALUES)) * 1.0 + 1e-13)) bad++;
+      if (!(std::fabs(got[k] - want[k]) <=
+            unit * (std::fabs(want[k]) + 16.0 * (mode == ADD_VALUES)) * 1.0 + 1e-13))
+        bad++;
     CHECK(bad == 0);
   }
   // a matrix filled by COO multiplies like the reference, and a duplicate refills too
@@ -238,8 +242,8 @@ TEST_CASE("COO: duplicates summed, negative indices dropped, INSERT and ADD refi
 
 TEST_CASE("options and the public setters", "[mat_core][options]")
 {
-  Mat A = create(12, 12, 3);
-  PetscInt bw;
+  Mat                 A = create(12, 12, 3);
+  PetscInt            bw;
   MatBinBCSRPrecision p;
   REQUIRE(MatBinBCSRGetBinWidth(A, &bw) == 0);
   CHECK(bw == 8); // the default for blocks (measured, docs/mat_binbcsr.md)
@@ -281,7 +285,7 @@ TEST_CASE("bad input gives PETSc errors", "[mat_core][errors]")
     REQUIRE(MatSetUp(A) == 0);
     CHECK(MatSetValue(A, 6, 0, 1.0, INSERT_VALUES) == PETSC_ERR_ARG_OUTOFRANGE);
     CHECK(MatSetValue(A, 0, 6, 1.0, INSERT_VALUES) == PETSC_ERR_ARG_OUTOFRANGE);
-    const PetscInt br = 2, bc = 0;
+    const PetscInt    br = 2, bc = 0;
     const PetscScalar v[9] = {0};
     CHECK(MatSetValuesBlocked(A, 1, &br, 1, &bc, v, INSERT_VALUES) == PETSC_ERR_ARG_OUTOFRANGE);
     REQUIRE(MatSetValue(A, 0, 0, 1.0, INSERT_VALUES) == 0);
@@ -362,11 +366,11 @@ TEST_CASE("bad input gives PETSc errors", "[mat_core][errors]")
   }
   SECTION("COO misuse")
   {
-    Mat      A = create(6, 6, 3);
+    Mat      A    = create(6, 6, 3);
     PetscInt i[2] = {0, 6}, j[2] = {0, 0};
     CHECK(MatSetPreallocationCOO(A, 2, i, j) == PETSC_ERR_ARG_OUTOFRANGE);
     MatDestroy(&A);
-    A                 = create(6, 6, 3);
+    A                = create(6, 6, 3);
     PetscScalar v[2] = {1, 2};
     REQUIRE(MatSetUp(A) == 0);
     CHECK(MatSetValuesCOO(A, v, INSERT_VALUES) == PETSC_ERR_ARG_WRONGSTATE);
@@ -411,7 +415,11 @@ TEST_CASE("the info view reports the COO refill path and the mirror", "[mat_core
     MatDestroy(&A);
     return info;
   };
-  CHECK(view_after_refill(bi, bj, PETSC_FALSE).find("COO: 180 entries, refill by whole blocks\n") != std::string::npos);
-  CHECK(view_after_refill(si, sj, PETSC_FALSE).find("COO: 30 entries, refill value by value (the list is not made of whole blocks)") != std::string::npos);
-  CHECK(view_after_refill(bi, bj, PETSC_TRUE).find("COO: 180 entries, refill by whole blocks; mirror on") != std::string::npos);
+  CHECK(view_after_refill(bi, bj, PETSC_FALSE).find("COO: 180 entries, refill by whole blocks\n") !=
+        std::string::npos);
+  CHECK(view_after_refill(si, sj, PETSC_FALSE)
+          .find("COO: 30 entries, refill value by value (the list is not made of whole blocks)") !=
+        std::string::npos);
+  CHECK(view_after_refill(bi, bj, PETSC_TRUE).find("COO: 180 entries, refill by whole blocks; mirror on") !=
+        std::string::npos);
 }

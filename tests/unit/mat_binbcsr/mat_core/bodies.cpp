@@ -5,8 +5,7 @@
 
 using namespace mat_core;
 
-namespace
-{
+namespace {
 
 std::vector<MatBinBCSRKernel> available_sets()
 {
@@ -93,7 +92,8 @@ TEST_CASE("kernel: default, option, view, duplicate and bad values", "[mat_core]
   for (MatBinBCSRKernel s : available_sets()) best = s;
   REQUIRE(MatBinBCSRGetKernel(A, &k) == 0);
   CHECK(k == best); /* auto: the best set this CPU has (bs 3, bin width 8 has a body in each) */
-  CHECK(info_view(A).find(std::string("product body: ") + MatBinBCSRKernels[best] + " (-mat_binbcsr_kernel auto)") != std::string::npos);
+  CHECK(info_view(A).find(std::string("product body: ") + MatBinBCSRKernels[best] +
+                          " (-mat_binbcsr_kernel auto)") != std::string::npos);
 
   REQUIRE(PetscOptionsSetValue(nullptr, "-mat_binbcsr_kernel", "portable") == 0);
   REQUIRE(MatBinBCSRSetFromOptions(A) == 0);

@@ -49,14 +49,32 @@ TEST_CASE("a binbcsr matrix set to another type keeps none of its composed funct
 {
   PetscMPIInt size;
   REQUIRE(MPI_Comm_size(PETSC_COMM_WORLD, &size) == 0);
-  std::vector<std::string> names = {"MatBinBCSRSetBinWidth_C", "MatBinBCSRGetBinWidth_C", "MatBinBCSRSetPrecision_C", "MatBinBCSRGetPrecision_C", "MatBinBCSRSetSymmetricStorage_C", "MatBinBCSRGetSymmetricStorage_C", "MatBinBCSRSetCOOMirror_C", "MatBinBCSRGetCOOMirror_C", "MatBinBCSRSetStreams_C", "MatBinBCSRGetStreams_C", "MatSetPreallocationCOO_C", "MatSetValuesCOO_C", "MatMultDotLocal_C", "MatProductSetFromOptions_anytype_C", "MatAXPYGetPreallocation_C"};
+  std::vector<std::string> names = {"MatBinBCSRSetBinWidth_C",
+                                    "MatBinBCSRGetBinWidth_C",
+                                    "MatBinBCSRSetPrecision_C",
+                                    "MatBinBCSRGetPrecision_C",
+                                    "MatBinBCSRSetSymmetricStorage_C",
+                                    "MatBinBCSRGetSymmetricStorage_C",
+                                    "MatBinBCSRSetCOOMirror_C",
+                                    "MatBinBCSRGetCOOMirror_C",
+                                    "MatBinBCSRSetStreams_C",
+                                    "MatBinBCSRGetStreams_C",
+                                    "MatSetPreallocationCOO_C",
+                                    "MatSetValuesCOO_C",
+                                    "MatMultDotLocal_C",
+                                    "MatProductSetFromOptions_anytype_C",
+                                    "MatAXPYGetPreallocation_C"};
   if (size == 1) {
-    for (const char *s : {"MatSeqAIJSetPreallocation_C", "MatSeqBAIJSetPreallocation_C", "MatConvert_seqbinbcsr_seqaij_C", "MatConvert_seqbinbcsr_seqbaij_C"}) names.push_back(s);
+    for (const char *s : {"MatSeqAIJSetPreallocation_C", "MatSeqBAIJSetPreallocation_C",
+                          "MatConvert_seqbinbcsr_seqaij_C", "MatConvert_seqbinbcsr_seqbaij_C"})
+      names.push_back(s);
 #if defined(PETSC_HAVE_HYPRE)
     names.push_back("MatConvert_seqbinbcsr_hypre_C");
 #endif
   } else {
-    for (const char *s : {"MatMPIAIJSetPreallocation_C", "MatMPIBAIJSetPreallocation_C", "MatGetDiagonalBlock_C", "MatConvert_mpibinbcsr_mpiaij_C"}) names.push_back(s);
+    for (const char *s : {"MatMPIAIJSetPreallocation_C", "MatMPIBAIJSetPreallocation_C",
+                          "MatGetDiagonalBlock_C", "MatConvert_mpibinbcsr_mpiaij_C"})
+      names.push_back(s);
 #if defined(PETSC_HAVE_HYPRE)
     names.push_back("MatConvert_mpibinbcsr_hypre_C");
 #endif

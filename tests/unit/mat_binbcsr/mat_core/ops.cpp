@@ -20,8 +20,12 @@ TEST_CASE("diagonal and inverted block diagonal against seqbaij", "[mat_core][di
   for (PetscInt r = 0; r < 21; r++)
     for (PetscInt i = 0; i < bs; i++) p.entries.push_back({r * bs + i, r * bs + i, 0.0});
   // dedupe: keep the first of each position (the diagonal bump lives there)
-  std::sort(p.entries.begin(), p.entries.end(), [](const Entry &a, const Entry &b) { return a.i < b.i || (a.i == b.i && (a.j < b.j || (a.j == b.j && a.v > b.v))); });
-  p.entries.erase(std::unique(p.entries.begin(), p.entries.end(), [](const Entry &a, const Entry &b) { return a.i == b.i && a.j == b.j; }), p.entries.end());
+  std::sort(p.entries.begin(), p.entries.end(), [](const Entry &a, const Entry &b) {
+    return a.i < b.i || (a.i == b.i && (a.j < b.j || (a.j == b.j && a.v > b.v)));
+  });
+  p.entries.erase(std::unique(p.entries.begin(), p.entries.end(),
+                              [](const Entry &a, const Entry &b) { return a.i == b.i && a.j == b.j; }),
+                  p.entries.end());
   for (Entry &e : p.entries)
     if (e.i == e.j && e.v == 0.0) e.v = 3.0 + e.i % 5;
   Mat A = build(p, MATSEQBINBCSR, bw, prec), B = build(p, MATSEQBAIJ);
@@ -107,7 +111,9 @@ TEST_CASE("MatDuplicate and MatCopy", "[mat_core][copy]")
   REQUIRE(MatCopy(A, Z, DIFFERENT_NONZERO_PATTERN) == 0);
   check_dense(dense(Z), ref, 0);
   // into a matrix of the other precision
-  REQUIRE(MatBinBCSRSetPrecision(Z, prec == MAT_BINBCSR_PRECISION_DOUBLE ? MAT_BINBCSR_PRECISION_SINGLE : MAT_BINBCSR_PRECISION_DOUBLE) == 0);
+  REQUIRE(MatBinBCSRSetPrecision(Z, prec == MAT_BINBCSR_PRECISION_DOUBLE
+                                      ? MAT_BINBCSR_PRECISION_SINGLE
+                                      : MAT_BINBCSR_PRECISION_DOUBLE) == 0);
   REQUIRE(MatCopy(A, Z, SAME_NONZERO_PATTERN) == 0);
   check_dense(dense(Z), ref, FLT_EPSILON / 2);
   // into seqaij with a larger pattern, and into a binbcsr with a different (superset) pattern
@@ -130,10 +136,10 @@ TEST_CASE("MatDuplicate and MatCopy", "[mat_core][copy]")
 
 TEST_CASE("MatConvert to and from seqaij and seqbaij", "[mat_core][convert]")
 {
-  const PetscInt bs = GENERATE(1, 3);
-  Pattern        p  = random_pattern(14, 14, bs, 4, 21);
+  const PetscInt bs  = GENERATE(1, 3);
+  Pattern        p   = random_pattern(14, 14, bs, 4, 21);
   const auto     ref = dense(p);
-  Mat            A = build(p, MATSEQBINBCSR, 4);
+  Mat            A   = build(p, MATSEQBINBCSR, 4);
   for (MatType t : {MATSEQAIJ, MATSEQBAIJ, MATAIJ}) {
     Mat       B;
     PetscBool is;
@@ -194,8 +200,8 @@ TEST_CASE("switching precision converts the stored values", "[mat_core][precisio
 
 TEST_CASE("MatView: ASCII info and entries", "[mat_core][view]")
 {
-  Pattern     p = fem_pattern(3, 2, 2);
-  Mat         A = build(p, MATSEQBINBCSR, 4, MAT_BINBCSR_PRECISION_SINGLE);
+  Pattern     p      = fem_pattern(3, 2, 2);
+  Mat         A      = build(p, MATSEQBINBCSR, 4, MAT_BINBCSR_PRECISION_SINGLE);
   char        name[] = "/tmp/mat_core_view_XXXXXX";
   const int   fd     = mkstemp(name);
   PetscViewer v;

@@ -4,8 +4,7 @@
 
 using namespace mat_core;
 
-namespace
-{
+namespace {
 
 void check_products(const Pattern &p, PetscInt bw, MatBinBCSRPrecision prec)
 {
@@ -58,7 +57,8 @@ void check_products(const Pattern &p, PetscInt bw, MatBinBCSRPrecision prec)
       check_close(values(y), values(yref), yb);
       REQUIRE(VecDot(yref, x, &dotref) == 0);
       double dbound = 0;
-      for (size_t i = 0; i < xv.size(); i++) dbound += std::fabs(xv[i]) * yb[i] + 1e-14 * std::fabs(xv[i] * values(yref)[i]);
+      for (size_t i = 0; i < xv.size(); i++)
+        dbound += std::fabs(xv[i]) * yb[i] + 1e-14 * std::fabs(xv[i] * values(yref)[i]);
       CHECK(std::fabs(dot - dotref) <= dbound + 1e-12);
     }
   }
@@ -97,7 +97,8 @@ TEST_CASE("products on a FEM-like 3x3 block stencil", "[mat_core][mult]")
 // Grids numbered along their rows give slot groups whose lanes read consecutive block columns; the
 // products load x there instead of gathering it. nx = 48: every bin inside a grid row; nx = 49: bins
 // straddle grid rows, so unit-stride and gathered groups alternate.
-TEST_CASE("products on structured grids (slot groups over consecutive columns), bs 1 and 3", "[mat_core][mult]")
+TEST_CASE("products on structured grids (slot groups over consecutive columns), bs 1 and 3",
+          "[mat_core][mult]")
 {
   const PetscInt            bs   = GENERATE(1, 3);
   const PetscInt            bw   = GENERATE(4, 8, 16);
@@ -111,14 +112,17 @@ TEST_CASE("products on structured grids (slot groups over consecutive columns), 
   const size_t      at   = info.find("slot groups over consecutive block columns (x read without gathers): ");
   REQUIRE(at != std::string::npos);
   long unit = -1, groups = -1;
-  REQUIRE(std::sscanf(info.c_str() + at, "slot groups over consecutive block columns (x read without gathers): %ld of %ld", &unit, &groups) == 2);
+  REQUIRE(std::sscanf(info.c_str() + at,
+                      "slot groups over consecutive block columns (x read without gathers): %ld of %ld",
+                      &unit, &groups) == 2);
   CHECK(groups > 0);
   if (nx == 48) CHECK(unit >= groups / 4); // boundary bins of the grid are the exceptions
   else CHECK(unit > 0);
   MatDestroy(&A);
 }
 
-TEST_CASE("a matrix flagged symmetric multiplies its transpose through the vectorised product", "[mat_core][mult]")
+TEST_CASE("a matrix flagged symmetric multiplies its transpose through the vectorised product",
+          "[mat_core][mult]")
 {
   const Pattern p = fem_pattern(4, 3, 3);
   Mat           A = build(p, MATSEQBINBCSR), R = build(p, MATSEQAIJ);
@@ -140,7 +144,8 @@ TEST_CASE("a matrix flagged symmetric multiplies its transpose through the vecto
   MatDestroy(&R);
 }
 
-TEST_CASE("products with rows of 1 and 500 blocks in one bin, a single row, an empty matrix", "[mat_core][mult]")
+TEST_CASE("products with rows of 1 and 500 blocks in one bin, a single row, an empty matrix",
+          "[mat_core][mult]")
 {
   const PetscInt bs = GENERATE(1, 3);
   const PetscInt bw = GENERATE(4, 8, 5);

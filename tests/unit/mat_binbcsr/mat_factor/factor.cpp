@@ -10,8 +10,7 @@
 
 using namespace mat_core;
 
-namespace
-{
+namespace {
 
 struct Solution {
   PetscInt                 its    = -1;
@@ -146,8 +145,7 @@ TEST_CASE("ICC, Cholesky, ILU and LU on binbcsr equal PETSc's on seqsbaij/seqbai
     }
 }
 
-namespace
-{
+namespace {
 // A factorisation through PCFactor with an ordering (nullptr: the factor's preferred one) and fill
 // levels (ILU/ICC; 0: PETSc's default); LU and Cholesky are direct solves (preonly), ILU and ICC
 // precondition GMRES. Returns the solution and the factor's stored nonzeros, which show which ordering
@@ -171,7 +169,8 @@ Solution factor_solve(Mat A, PCType pc, const char *ordering, Vec b, double *fac
 }
 } // namespace
 
-TEST_CASE("LU and ILU take PETSc's orderings as seqbaij does; LU defaults to nested dissection", "[mat_factor]")
+TEST_CASE("LU and ILU take PETSc's orderings as seqbaij does; LU defaults to nested dissection",
+          "[mat_factor]")
 {
   for (PetscInt bs : {1, 3})
     for (bool sym : {false, true}) {
@@ -179,14 +178,17 @@ TEST_CASE("LU and ILU take PETSc's orderings as seqbaij does; LU defaults to nes
       Mat           A    = build_bin(p, sym);
       Mat           Aref = build(p, MATSEQBAIJ);
       Vec           b    = make_vec(p.m, 11);
-      for (const char *ordering : {(const char *)nullptr, MATORDERINGNATURAL, MATORDERINGND, MATORDERINGRCM, MATORDERINGQMD, MATORDERING1WD}) {
+      for (const char *ordering : {(const char *)nullptr, MATORDERINGNATURAL, MATORDERINGND, MATORDERINGRCM,
+                                   MATORDERINGQMD, MATORDERING1WD}) {
         CAPTURE(bs, sym, ordering ? ordering : "default");
         double         nz = 0, nzref = 0;
-        const Solution lu = factor_solve(A, PCLU, ordering, b, &nz), luref = factor_solve(Aref, PCLU, ordering, b, &nzref);
+        const Solution lu    = factor_solve(A, PCLU, ordering, b, &nz),
+                       luref = factor_solve(Aref, PCLU, ordering, b, &nzref);
         CHECK(lu.relres < 1e-13);
         CHECK(nz == nzref); // the same ordering gives the same fill
         check_same(lu, luref, 1e-13);
-        const Solution ilu = factor_solve(A, PCILU, ordering, b, &nz), iluref = factor_solve(Aref, PCILU, ordering, b, &nzref);
+        const Solution ilu    = factor_solve(A, PCILU, ordering, b, &nz),
+                       iluref = factor_solve(Aref, PCILU, ordering, b, &nzref);
         CHECK(nz == nzref);
         check_same(ilu, iluref, 1e-10);
       }
@@ -201,8 +203,7 @@ TEST_CASE("LU and ILU take PETSc's orderings as seqbaij does; LU defaults to nes
     }
 }
 
-namespace
-{
+namespace {
 // The pattern renumbered by a block permutation (new block row i is old block row perm[i]), and a
 // vector moved the same way: the reference for a factorisation in that ordering is the one of the
 // renumbered matrix in natural order.
@@ -218,7 +219,8 @@ Pattern permuted(const Pattern &p, const std::vector<PetscInt> &perm)
   return q;
 }
 
-std::vector<PetscScalar> permuted(const std::vector<PetscScalar> &x, const std::vector<PetscInt> &perm, PetscInt bs)
+std::vector<PetscScalar> permuted(const std::vector<PetscScalar> &x, const std::vector<PetscInt> &perm,
+                                  PetscInt bs)
 {
   std::vector<PetscScalar> y(x.size());
   for (size_t i = 0; i < perm.size(); i++)
@@ -243,7 +245,9 @@ std::vector<PetscInt> block_ordering(Mat A, const char *ordering)
 
 } // namespace
 
-TEST_CASE("ICC and Cholesky take PETSc's orderings (the permuted matrix factored); Cholesky defaults to nested dissection", "[mat_factor]")
+TEST_CASE(
+  "ICC and Cholesky take PETSc's orderings (the permuted matrix factored); Cholesky defaults to nested dissection",
+  "[mat_factor]")
 {
   for (PetscInt bs : {1, 3})
     for (bool sym : {false, true}) {
@@ -401,7 +405,9 @@ TEST_CASE("unsupported factorisations are errors, not crashes", "[mat_factor][er
   REQUIRE(MatDestroy(&A) == 0);
 }
 
-TEST_CASE("the factor asked for before the first assembly (PCSetFromOptions) factors the matrix assembled later", "[mat_factor]")
+TEST_CASE(
+  "the factor asked for before the first assembly (PCSetFromOptions) factors the matrix assembled later",
+  "[mat_factor]")
 {
   for (PCType pc : {PCICC, PCILU, PCLU, PCCHOLESKY})
     for (bool sym : {false, true}) {
@@ -438,8 +444,7 @@ TEST_CASE("the factor asked for before the first assembly (PCSetFromOptions) fac
     }
 }
 
-namespace
-{
+namespace {
 // The pattern's matrix on PETSC_COMM_WORLD, rows split by PETSc (whole blocks), each rank setting its own.
 Mat build_world(const Pattern &p, MatType type)
 {
@@ -472,7 +477,8 @@ TEST_CASE("block Jacobi with ICC/ILU blocks on binbcsr equals baij", "[mat_facto
   for (const char *sub : {PCICC, PCILU}) {
     CAPTURE(sub);
     REQUIRE(PetscOptionsSetValue(nullptr, "-sub_pc_type", sub) == 0);
-    KSP k = make_ksp(PETSC_COMM_WORLD, KSPCG, PCBJACOBI, 1e-10), kref = make_ksp(PETSC_COMM_WORLD, KSPCG, PCBJACOBI, 1e-10);
+    KSP k    = make_ksp(PETSC_COMM_WORLD, KSPCG, PCBJACOBI, 1e-10),
+        kref = make_ksp(PETSC_COMM_WORLD, KSPCG, PCBJACOBI, 1e-10);
     REQUIRE(KSPSetFromOptions(k) == 0);
     REQUIRE(KSPSetFromOptions(kref) == 0);
     check_same(solve_with(k, A, b), solve_with(kref, Aref, b), 1e-10);

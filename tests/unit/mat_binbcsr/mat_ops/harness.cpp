@@ -33,7 +33,8 @@ namespace {
 // Expands per-block-row block columns into scalar CSR with full bs x bs blocks. Values: random in
 // [-1, 1] scaled per block row by 10^k (k in -3..3) so tolerances must follow row norms, and a
 // dominant diagonal like a stiffness matrix.
-Pattern expand(const std::string &name, PetscInt bs, const std::vector<std::set<PetscInt>> &block_cols, unsigned seed)
+Pattern expand(const std::string &name, PetscInt bs, const std::vector<std::set<PetscInt>> &block_cols,
+               unsigned seed)
 {
   Pattern p;
   p.name = name;
@@ -127,10 +128,7 @@ std::vector<Pattern> patterns()
   return p;
 }
 
-Pattern revalue(const Pattern &p, unsigned seed)
-{
-  return expand(p.name, p.bs, block_pattern(p), seed);
-}
+Pattern revalue(const Pattern &p, unsigned seed) { return expand(p.name, p.bs, block_pattern(p), seed); }
 
 Pattern other_pattern(const Pattern &p, unsigned seed)
 {
@@ -237,15 +235,26 @@ Mismatch compare(Mat got, Mat want, const std::vector<double> &scale)
     calls_ok = calls_ok && MatGetRow(got, i, &nc, &c, &v) == 0;
     if (!calls_ok) break;
     for (PetscInt k = 0; k < nc; k++) {
-      if (c[k] < 0 || c[k] >= n) { columns_ok = false; break; }
-      if (!touched[c[k]]) { touched[c[k]] = 1; list.push_back(c[k]); g[c[k]] = w[c[k]] = 0; }
+      if (c[k] < 0 || c[k] >= n) {
+        columns_ok = false;
+        break;
+      }
+      if (!touched[c[k]]) {
+        touched[c[k]] = 1;
+        list.push_back(c[k]);
+        g[c[k]] = w[c[k]] = 0;
+      }
       g[c[k]] += v[k];
     }
     calls_ok = calls_ok && MatRestoreRow(got, i, &nc, &c, &v) == 0;
     calls_ok = calls_ok && MatGetRow(want, i, &nc, &c, &v) == 0;
     if (!calls_ok) break;
     for (PetscInt k = 0; k < nc; k++) {
-      if (!touched[c[k]]) { touched[c[k]] = 1; list.push_back(c[k]); g[c[k]] = w[c[k]] = 0; }
+      if (!touched[c[k]]) {
+        touched[c[k]] = 1;
+        list.push_back(c[k]);
+        g[c[k]] = w[c[k]] = 0;
+      }
       w[c[k]] += v[k];
     }
     calls_ok = calls_ok && MatRestoreRow(want, i, &nc, &c, &v) == 0;

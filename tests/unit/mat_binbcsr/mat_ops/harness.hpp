@@ -15,7 +15,7 @@ namespace matops {
 
 // Turned on once MATSEQBINBCSR's core (assembly, MatGetRow, preallocation) is on main.
 #ifndef MAT_OPS_TEST_BINBCSR
-#define MAT_OPS_TEST_BINBCSR 1
+  #define MAT_OPS_TEST_BINBCSR 1
 #endif
 
 // A matrix under test: a type and, for binbcsr, its storage.
@@ -23,11 +23,11 @@ struct Flavour {
   std::string         name;
   const char         *type;
   MatBinBCSRPrecision precision = MAT_BINBCSR_PRECISION_DOUBLE;
-  PetscInt            bin_width = 0;    // 0: the type's default
-  bool                fixed_pattern;    // refuses new nonzeros after the first assembly
-  bool                validates_input;  // checks vector sizes, NaN under MatSetErrorIfFailure, file data
-  double              eps() const { return precision == MAT_BINBCSR_PRECISION_SINGLE ? FLT_EPSILON : DBL_EPSILON; }
-  bool                is_binbcsr() const { return std::string(type) == MATSEQBINBCSR; }
+  PetscInt            bin_width = 0;   // 0: the type's default
+  bool                fixed_pattern;   // refuses new nonzeros after the first assembly
+  bool                validates_input; // checks vector sizes, NaN under MatSetErrorIfFailure, file data
+  double eps() const { return precision == MAT_BINBCSR_PRECISION_SINGLE ? FLT_EPSILON : DBL_EPSILON; }
+  bool   is_binbcsr() const { return std::string(type) == MATSEQBINBCSR; }
 };
 std::vector<Flavour> flavours();
 
@@ -78,10 +78,10 @@ PetscErrorCode random_vec(PetscInt n, unsigned seed, Vec *v);
 
 #define PETSC_OK(expr) REQUIRE((expr) == 0)
 // The result of a comparison: within kRoundings * eps of each row's scale.
-#define CHECK_CLOSE(mm, eps)                                                                            \
-  do {                                                                                                   \
-    const matops::Mismatch mm_ = (mm);                                                                   \
-    INFO("worst entry (" << mm_.row << "," << mm_.col << "): got " << mm_.got << " want " << mm_.want    \
-                         << ", error / (eps * row scale) = " << mm_.ratio / (eps));                      \
-    CHECK(mm_.ratio <= matops::kRoundings * (eps));                                                      \
+#define CHECK_CLOSE(mm, eps)                                                                          \
+  do {                                                                                                \
+    const matops::Mismatch mm_ = (mm);                                                                \
+    INFO("worst entry (" << mm_.row << "," << mm_.col << "): got " << mm_.got << " want " << mm_.want \
+                         << ", error / (eps * row scale) = " << mm_.ratio / (eps));                   \
+    CHECK(mm_.ratio <= matops::kRoundings * (eps));                                                   \
   } while (0)

@@ -65,7 +65,8 @@ PetscErrorCode write_raw(const std::string &name, PetscInt classid, PetscInt M, 
   PetscFunctionBeginUser;
   PetscCall(open(name, FILE_MODE_WRITE, &v));
   PetscCall(PetscViewerBinaryWrite(v, header, 4, PETSC_INT));
-  if (!rowlens.empty()) PetscCall(PetscViewerBinaryWrite(v, rowlens.data(), (PetscInt)rowlens.size(), PETSC_INT));
+  if (!rowlens.empty())
+    PetscCall(PetscViewerBinaryWrite(v, rowlens.data(), (PetscInt)rowlens.size(), PETSC_INT));
   if (!cols.empty()) PetscCall(PetscViewerBinaryWrite(v, cols.data(), (PetscInt)cols.size(), PETSC_INT));
   if (!vals.empty()) PetscCall(PetscViewerBinaryWrite(v, vals.data(), (PetscInt)vals.size(), PETSC_SCALAR));
   PetscCall(PetscViewerDestroy(&v));
@@ -144,9 +145,9 @@ TEST_CASE("MatLoad refuses malformed files", "[mat_ops][io][errors]")
     PETSC_OK(load(&f, 1, name, &A));
     PETSC_OK(MatDestroy(&A));
     struct Bad {
-      const char *what;
-      bool        generic; // refused by every type, not just the validating ones
-      PetscInt    classid, M, N, nz;
+      const char              *what;
+      bool                     generic; // refused by every type, not just the validating ones
+      PetscInt                 classid, M, N, nz;
       std::vector<PetscInt>    lens, cols;
       std::vector<PetscScalar> vals;
       PetscInt                 bs;

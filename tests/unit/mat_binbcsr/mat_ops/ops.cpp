@@ -8,8 +8,7 @@ using namespace matops;
 
 namespace {
 
-template <class Body>
-void for_all(Body body)
+template <class Body> void for_all(Body body)
 {
   for (const Flavour &f : flavours()) {
     for (const Pattern &p : patterns()) {
@@ -27,7 +26,8 @@ std::vector<PetscInt> rows_to_zero(const Pattern &p, bool need_diagonal, unsigne
   std::uniform_int_distribution<int> pct(0, 99);
   std::vector<PetscInt>              rows;
   for (PetscInt i = p.m() - 1; i >= 0; i--) {
-    const bool has_diag = std::binary_search(p.cols.begin() + p.rowptr[i], p.cols.begin() + p.rowptr[i + 1], i);
+    const bool has_diag =
+      std::binary_search(p.cols.begin() + p.rowptr[i], p.cols.begin() + p.rowptr[i + 1], i);
     if ((has_diag || !need_diagonal) && (pct(rng) < 25 || p.m() == 1)) rows.push_back(i);
   }
   return rows;
@@ -140,13 +140,13 @@ TEST_CASE("MatDiagonalSet with INSERT_VALUES and ADD_VALUES", "[mat_ops]")
 TEST_CASE("MatAXPY with the same, a subset and a different pattern", "[mat_ops]")
 {
   for_all([](const Flavour &f, const Pattern &p) {
-    const PetscScalar a = -0.75;
+    const PetscScalar a    = -0.75;
     const Pattern     same = revalue(p, 21), other = other_pattern(p, 22);
     struct Case {
-      const char  *name;
+      const char    *name;
       const Pattern *x;
-      MatStructure str;
-      bool         x_reference_type; // X stored as seqaij instead of the flavour
+      MatStructure   str;
+      bool           x_reference_type; // X stored as seqaij instead of the flavour
     } cases[] = {
       {"same pattern, SAME_NONZERO_PATTERN", &same, SAME_NONZERO_PATTERN, false},
       {"same pattern, UNKNOWN_NONZERO_PATTERN", &same, UNKNOWN_NONZERO_PATTERN, false},
@@ -179,7 +179,8 @@ TEST_CASE("MatAXPY with the same, a subset and a different pattern", "[mat_ops]"
       PETSC_OK(MatMult(RY, x, ry));
       // A sum of n products in another order: the classic bound n * eps * sum |a_ij x_j|.
       std::vector<double> product_scale(scale);
-      for (PetscInt i = 0; i < p.m(); i++) product_scale[i] *= (double)(p.rowptr[i + 1] - p.rowptr[i] + c.x->rowptr[i + 1] - c.x->rowptr[i] + 1);
+      for (PetscInt i = 0; i < p.m(); i++)
+        product_scale[i] *= (double)(p.rowptr[i + 1] - p.rowptr[i] + c.x->rowptr[i + 1] - c.x->rowptr[i] + 1);
       CHECK_CLOSE(compare(y, ry, product_scale), f.eps());
       PETSC_OK(VecDestroy(&x));
       PETSC_OK(VecDestroy(&y));
@@ -201,7 +202,7 @@ TEST_CASE("MatAXPY between binbcsr matrices of different precision", "[mat_ops][
     for (const Flavour &fx : bins) {
       for (const Pattern &p : patterns()) {
         INFO("Y: " << fy.name << ", X: " << fx.name << ", pattern: " << p.name);
-        const PetscScalar a = 1.5;
+        const PetscScalar a  = 1.5;
         const Pattern     xp = revalue(p, 31);
         Mat               Y, X, RY, RX;
         PETSC_OK(build(&fy, p, &Y));

@@ -3,8 +3,7 @@
 #include <algorithm>
 #include <map>
 
-namespace rowops
-{
+namespace rowops {
 
 std::vector<Config> configs()
 {
@@ -15,10 +14,10 @@ std::vector<Config> configs()
         for (PetscInt bw : {0, 5}) {
           Config c;
           c.holes = bw == 0;
-          c.bs   = bs;
-          c.sym  = sym;
-          c.prec = prec;
-          c.bw   = bw;
+          c.bs    = bs;
+          c.sym   = sym;
+          c.prec  = prec;
+          c.bw    = bw;
           v.push_back(c);
         }
   for (bool sym : {false, true}) { // the generic block size path
@@ -46,7 +45,8 @@ static double scale_of(PetscInt I) { return std::pow(10.0, (double)(hash3((unsig
 
 double entry(const Config &c, PetscInt i, PetscInt j)
 {
-  const unsigned a = c.sym ? (unsigned)std::min(i, j) : (unsigned)i, b = c.sym ? (unsigned)std::max(i, j) : (unsigned)j;
+  const unsigned a = c.sym ? (unsigned)std::min(i, j) : (unsigned)i,
+                 b = c.sym ? (unsigned)std::max(i, j) : (unsigned)j;
   const unsigned h = hash3(a, b, 30 + c.value_seed);
   double         u = h % 10 == 0 ? 0.0 : ((double)(h % 20001) - 10000.0) / 10000.0;
   if (c.ties) u = (double)(h % 3) - 1.0;
@@ -56,7 +56,8 @@ double entry(const Config &c, PetscInt i, PetscInt j)
   const PetscInt lo = (c.sym ? std::min(i, j) : i) / c.bs;
   if (lo % 5 == 1) u = -std::fabs(u) - 0.1;
   if (lo % 5 == 3) u = std::fabs(u) + 0.1;
-  const double v = u * (scale_of(std::min(i, j) / c.bs) * scale_of(std::max(i, j) / c.bs)); // bitwise symmetric
+  const double v =
+    u * (scale_of(std::min(i, j) / c.bs) * scale_of(std::max(i, j) / c.bs)); // bitwise symmetric
   return c.prec == MAT_BINBCSR_PRECISION_SINGLE || c.float_values ? (double)(float)v : v;
 }
 
@@ -136,7 +137,8 @@ PetscErrorCode make_vec(Mat A, bool left, unsigned seed, Vec *v)
   PetscCall(VecGetArray(*v, &a));
   for (PetscInt i = rstart; i < rend; i++) {
     const unsigned h = hash3((unsigned)i, seed, 41);
-    a[i - rstart]    = (h % 2 ? -1.0 : 1.0) * (0.5 + 1.5 * (double)(h % 1000) / 1000.0) * std::pow(10.0, (double)(h % 3) - 1.0);
+    a[i - rstart]    = (h % 2 ? -1.0 : 1.0) * (0.5 + 1.5 * (double)(h % 1000) / 1000.0) *
+                    std::pow(10.0, (double)(h % 3) - 1.0);
   }
   PetscCall(VecRestoreArray(*v, &a));
   PetscFunctionReturn(0);

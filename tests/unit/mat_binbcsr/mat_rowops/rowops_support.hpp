@@ -11,8 +11,7 @@
 #include <string>
 #include <vector>
 
-namespace rowops
-{
+namespace rowops {
 
 #define PETSC_OK(expr) REQUIRE((expr) == 0)
 
@@ -23,21 +22,24 @@ namespace rowops
 // zeros decide MatGetRowMax/Min there), times row and column scales 10^-2 .. 10^2; symmetric when sym (symmetric storage needs it).
 // Variants for MatAXPY: drop removes some off-diagonal blocks (a subset), extra adds some.
 struct Config {
-  PetscInt            bs   = 3;
-  bool                sym  = false; // symmetric values and -mat_binbcsr_symmetric_storage
-  MatBinBCSRPrecision prec = MAT_BINBCSR_PRECISION_DOUBLE;
-  PetscInt            bw   = 0; // 0: the default bin width
-  bool                holes = true;
+  PetscInt            bs         = 3;
+  bool                sym        = false; // symmetric values and -mat_binbcsr_symmetric_storage
+  MatBinBCSRPrecision prec       = MAT_BINBCSR_PRECISION_DOUBLE;
+  PetscInt            bw         = 0; // 0: the default bin width
+  bool                holes      = true;
   unsigned            value_seed = 1;
   bool                drop = false, extra = false;
   bool                float_values = false; // float-representable entries whatever the precision
-  bool                ties = false;
-  bool                full_storage = false; // symmetric values (sym) kept in full storage         // entries -1, 0, 1 (times the scales): rows with equal extremes
-  PetscInt            mbs() const { return bs == 1 ? 43 : 23; }
-  double              eps() const { return prec == MAT_BINBCSR_PRECISION_SINGLE ? FLT_EPSILON : DBL_EPSILON; }
-  std::string         name() const
+  bool                ties         = false;
+  bool                full_storage =
+    false; // symmetric values (sym) kept in full storage         // entries -1, 0, 1 (times the scales): rows with equal extremes
+  PetscInt    mbs() const { return bs == 1 ? 43 : 23; }
+  double      eps() const { return prec == MAT_BINBCSR_PRECISION_SINGLE ? FLT_EPSILON : DBL_EPSILON; }
+  std::string name() const
   {
-    return "bs " + std::to_string(bs) + (sym ? " symmetric storage" : " full storage") + (prec == MAT_BINBCSR_PRECISION_SINGLE ? " single" : " double") + (bw ? " bw " + std::to_string(bw) : "") + (holes ? " holes" : "");
+    return "bs " + std::to_string(bs) + (sym ? " symmetric storage" : " full storage") +
+           (prec == MAT_BINBCSR_PRECISION_SINGLE ? " single" : " double") +
+           (bw ? " bw " + std::to_string(bw) : "") + (holes ? " holes" : "");
   }
 };
 

@@ -11,8 +11,7 @@
 
 using namespace rowops;
 
-namespace
-{
+namespace {
 
 constexpr double kRoundings = 4.0;
 
@@ -126,11 +125,15 @@ TEST_CASE("MatDiagonalScale matches aij; symmetric storage takes only D A D", "[
   }
 }
 
-TEST_CASE("MatGetRowMaxAbs, MatGetRowMax, MatGetRowMin, MatGetRowMinAbs match aij, columns included", "[rowops]")
+TEST_CASE("MatGetRowMaxAbs, MatGetRowMax, MatGetRowMin, MatGetRowMinAbs match aij, columns included",
+          "[rowops]")
 {
   typedef PetscErrorCode (*RowOp)(Mat, Vec, PetscInt[]);
-  const std::pair<const char *, RowOp> ops[] = {{"MatGetRowMaxAbs", MatGetRowMaxAbs}, {"MatGetRowMax", MatGetRowMax}, {"MatGetRowMin", MatGetRowMin}, {"MatGetRowMinAbs", MatGetRowMinAbs}};
-  std::vector<Config> cases = configs();
+  const std::pair<const char *, RowOp> ops[] = {{"MatGetRowMaxAbs", MatGetRowMaxAbs},
+                                                {"MatGetRowMax", MatGetRowMax},
+                                                {"MatGetRowMin", MatGetRowMin},
+                                                {"MatGetRowMinAbs", MatGetRowMinAbs}};
+  std::vector<Config>                  cases = configs();
   for (Config c : configs()) { // and matrices whose rows reach their extremes in several columns
     c.ties = true;
     cases.push_back(c);
@@ -170,8 +173,8 @@ TEST_CASE("MatGetColumnNorms and the column sums and means match aij", "[rowops]
   for (const Config &c : configs()) {
     SECTION(c.name())
     {
-      Pair           p(c);
-      const PetscInt N = c.mbs() * c.bs;
+      Pair                   p(c);
+      const PetscInt         N = c.mbs() * c.bs;
       std::vector<PetscReal> col_abs(N), got(N), want(N);
       PETSC_OK(MatGetColumnNorms(p.aij, NORM_1, col_abs.data()));
       for (PetscReal &s : col_abs) s = s > 0 ? s : 1.0;
@@ -286,7 +289,9 @@ TEST_CASE("MatEqual: values and pattern, across bin widths and precisions", "[ro
         PETSC_OK(make(sc, MATBINBCSR, &As));
         PETSC_OK(MatEqual(Ad, As, &eq));
         CHECK(eq);
-        if (c.prec == MAT_BINBCSR_PRECISION_DOUBLE) { /* and a double matrix whose entries are not float-representable is not */
+        if (
+          c.prec ==
+          MAT_BINBCSR_PRECISION_DOUBLE) { /* and a double matrix whose entries are not float-representable is not */
           PETSC_OK(MatEqual(A, As, &eq));
           CHECK(!eq);
         }
@@ -299,7 +304,7 @@ TEST_CASE("MatEqual: values and pattern, across bin widths and precisions", "[ro
       MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
       PETSC_OK(MatGetOwnershipRange(D, &rstart, &rend));
       if (rank == comm_size() - 1) {
-        const PetscInt    i = rend - 1, j = rend - 1; // the last block row is not a hole (22 % 7, 42 % 7 != 5)
+        const PetscInt i = rend - 1, j = rend - 1; // the last block row is not a hole (22 % 7, 42 % 7 != 5)
         const PetscScalar v = 1.5;
         PETSC_OK(MatSetValues(D, 1, &i, 1, &j, &v, ADD_VALUES));
       }
@@ -339,7 +344,7 @@ TEST_CASE("MatGetValues: local rows, columns anywhere, as aij", "[rowops]")
       for (PetscInt i = rstart; i < rend; i++) rows.push_back(i);
       for (PetscInt j = 0; j < N; j++) cols[j] = N - 1 - j; // any order
       cols.push_back(-1);                                   // negative indices are skipped
-      const PetscInt         m = (PetscInt)rows.size(), n = (PetscInt)cols.size();
+      const PetscInt           m = (PetscInt)rows.size(), n = (PetscInt)cols.size();
       std::vector<PetscScalar> vb(m * n, -99.0), va(m * n, -99.0);
       PETSC_OK(MatGetValues(p.bin, m, rows.data(), n, cols.data(), vb.data()));
       PETSC_OK(MatGetValues(p.aij, m, rows.data(), n, cols.data(), va.data()));
@@ -354,7 +359,8 @@ TEST_CASE("MatGetValues: local rows, columns anywhere, as aij", "[rowops]")
   }
 }
 
-TEST_CASE("MatAXPY with the same, a subset and a different pattern keeps the type and its options", "[rowops]")
+TEST_CASE("MatAXPY with the same, a subset and a different pattern keeps the type and its options",
+          "[rowops]")
 {
   for (const Config &c : configs()) {
     for (MatStructure str : {SAME_NONZERO_PATTERN, SUBSET_NONZERO_PATTERN, DIFFERENT_NONZERO_PATTERN}) {
@@ -364,9 +370,10 @@ TEST_CASE("MatAXPY with the same, a subset and a different pattern keeps the typ
         xc.value_seed = 2;
         xc.drop       = str != SAME_NONZERO_PATTERN;
         xc.extra      = str == DIFFERENT_NONZERO_PATTERN;
-        Pair                y(c), x(xc);
-        const PetscScalar   a = 1.25; // positive: the rows of one sign do not cancel (the tolerance follows the result row)
-        PetscObjectState    nz0;
+        Pair              y(c), x(xc);
+        const PetscScalar a =
+          1.25; // positive: the rows of one sign do not cancel (the tolerance follows the result row)
+        PetscObjectState nz0;
         PETSC_OK(MatGetNonzeroState(y.bin, &nz0));
         PETSC_OK(MatAXPY(y.bin, a, x.bin, str));
         PETSC_OK(MatAXPY(y.aij, a, x.aij, str));
@@ -474,8 +481,11 @@ TEST_CASE("MatPermute matches aij and keeps the type and its options", "[rowops]
       PETSC_OK(ISSetPermutation(rb));
       PETSC_OK(ISSetPermutation(rp));
       PETSC_OK(ISSetPermutation(ro));
-      const std::pair<IS, IS> cases_full[] = {{rb, rb}, {rb, ro}, {rp, rb}}, cases_sym[] = {{rb, rb}, {rp, rp}};
-      for (const auto &rc : c.sym ? std::vector<std::pair<IS, IS>>(std::begin(cases_sym), std::end(cases_sym)) : std::vector<std::pair<IS, IS>>(std::begin(cases_full), std::end(cases_full))) {
+      const std::pair<IS, IS> cases_full[] = {{rb, rb}, {rb, ro}, {rp, rb}},
+                              cases_sym[]  = {{rb, rb}, {rp, rp}};
+      for (const auto &rc :
+           c.sym ? std::vector<std::pair<IS, IS>>(std::begin(cases_sym), std::end(cases_sym))
+                 : std::vector<std::pair<IS, IS>>(std::begin(cases_full), std::end(cases_full))) {
         Mat pb, pa;
         PETSC_OK(MatPermute(p.bin, rc.first, rc.second, &pb));
         PETSC_OK(MatPermute(p.aij, rc.first, rc.second, &pa));

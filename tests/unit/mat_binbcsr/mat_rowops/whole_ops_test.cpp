@@ -10,8 +10,7 @@
 
 using namespace rowops;
 
-namespace
-{
+namespace {
 
 // This rank's variable blocks: sizes 1, 2, 4, 3, 5, ... (cutting across the bs x bs blocks), the last
 // one cut to what is left of the local rows.
@@ -134,15 +133,16 @@ TEST_CASE("MatInvertVariableBlockDiagonal and PCVPBJACOBI match aij", "[wholeops
       // so they differ by the roundings of two elimination orders, bounded through the block's
       // condition number: |D_bin - D_aij| <= 8 n cond_inf(B) eps_double |B^-1|_max
       const std::vector<PetscScalar> db = invert_blocks(p.bin, sizes), da = invert_blocks(p.aij, sizes);
-      PetscInt                       rstart, off = 0;
+      PetscInt                       rstart, off                          = 0;
       PETSC_OK(MatGetOwnershipRange(p.aij, &rstart, nullptr));
       for (size_t k = 0, row = rstart; k < sizes.size(); row += sizes[k], off += sizes[k] * sizes[k], k++) {
-        const PetscInt n = sizes[k];
+        const PetscInt n     = sizes[k];
         double         bnorm = 0, inorm = 0, imax = 0, err = 0;
         for (PetscInt i = 0; i < n; i++) {
           double bs = 0, is = 0;
           for (PetscInt j = 0; j < n; j++) {
-            if (block_present(c, ((PetscInt)row + i) / c.bs, ((PetscInt)row + j) / c.bs)) bs += std::fabs(entry(c, (PetscInt)row + i, (PetscInt)row + j));
+            if (block_present(c, ((PetscInt)row + i) / c.bs, ((PetscInt)row + j) / c.bs))
+              bs += std::fabs(entry(c, (PetscInt)row + i, (PetscInt)row + j));
             is += std::fabs(da[off + j * n + i]);
             imax = std::max(imax, std::fabs(da[off + j * n + i]));
             err  = std::max(err, std::fabs(db[off + j * n + i] - da[off + j * n + i]));
@@ -187,12 +187,13 @@ TEST_CASE("MatInvertVariableBlockDiagonal refuses bad block sizes and reports ze
 {
   Config c; // bs 3 with empty rows (holes): blocks holding an empty row are singular; every rank has one
   Pair   p(c);
-  std::vector<PetscInt> sizes = variable_blocks(p.bin);
+  std::vector<PetscInt>    sizes = variable_blocks(p.bin);
   std::vector<PetscScalar> d(25 * sizes.size());
   PetscInt                 n;
   PETSC_OK(MatGetLocalSize(p.bin, &n, nullptr));
   // sizes that do not add up to the local rows, a negative size
-  PETSC_FAILS_WITH(MatInvertVariableBlockDiagonal(p.bin, (PetscInt)sizes.size() - 1, sizes.data(), d.data()), PETSC_ERR_ARG_SIZ);
+  PETSC_FAILS_WITH(MatInvertVariableBlockDiagonal(p.bin, (PetscInt)sizes.size() - 1, sizes.data(), d.data()),
+                   PETSC_ERR_ARG_SIZ);
   const PetscInt neg[] = {-1, n + 1};
   PETSC_FAILS_WITH(MatInvertVariableBlockDiagonal(p.bin, 2, neg, d.data()), PETSC_ERR_ARG_OUTOFRANGE);
   // zero pivot: recorded (PCVPBJACOBI then fails with a reason), or an error under MatSetErrorIfFailure
@@ -208,12 +209,15 @@ TEST_CASE("MatInvertVariableBlockDiagonal refuses bad block sizes and reports ze
   vpbjacobi_solve(p.bin, b, x, &reason);
   CHECK(reason == KSP_DIVERGED_PC_FAILED);
   PETSC_OK(MatSetErrorIfFailure(p.bin, PETSC_TRUE));
-  PETSC_FAILS_WITH(MatInvertVariableBlockDiagonal(p.bin, (PetscInt)sizes.size(), sizes.data(), d.data()), PETSC_ERR_MAT_LU_ZRPVT);
+  PETSC_FAILS_WITH(MatInvertVariableBlockDiagonal(p.bin, (PetscInt)sizes.size(), sizes.data(), d.data()),
+                   PETSC_ERR_MAT_LU_ZRPVT);
   PETSC_OK(VecDestroy(&b));
   PETSC_OK(VecDestroy(&x));
 }
 
-TEST_CASE("MatSetRandom fills the stored pattern; whole storage draws aij's values, symmetric storage stays symmetric", "[wholeops]")
+TEST_CASE(
+  "MatSetRandom fills the stored pattern; whole storage draws aij's values, symmetric storage stays symmetric",
+  "[wholeops]")
 {
   for (const Config &c : configs()) {
     SECTION(c.name())
@@ -283,7 +287,8 @@ TEST_CASE("MatSetRandom fills the stored pattern; whole storage draws aij's valu
   }
 }
 
-TEST_CASE("MatFindNonzeroRows, MatGetColumnVector, MatRealPart/ImaginaryPart/Conjugate match aij", "[wholeops]")
+TEST_CASE("MatFindNonzeroRows, MatGetColumnVector, MatRealPart/ImaginaryPart/Conjugate match aij",
+          "[wholeops]")
 {
   for (const Config &c : configs()) {
     SECTION(c.name())
@@ -366,7 +371,8 @@ TEST_CASE("MatGetRowIJ gives aij's structure of the local rows (global columns)"
         CHECK(bool(db));
         REQUIRE(nb == na);
         CHECK(std::vector<PetscInt>(ib, ib + nb + 1) == std::vector<PetscInt>(ia, ia + na + 1));
-        CHECK(std::vector<PetscInt>(jb, jb + ib[nb] - shift) == std::vector<PetscInt>(ja, ja + ia[na] - shift));
+        CHECK(std::vector<PetscInt>(jb, jb + ib[nb] - shift) ==
+              std::vector<PetscInt>(ja, ja + ia[na] - shift));
         PETSC_OK(MatRestoreRowIJ(p.bin, shift, PETSC_FALSE, PETSC_FALSE, &nb, &ib, &jb, &db));
         PETSC_OK(MatRestoreRowIJ(p.aij, shift, PETSC_FALSE, PETSC_FALSE, &na, &ia, &ja, &da));
       }

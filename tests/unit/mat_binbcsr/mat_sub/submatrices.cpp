@@ -25,11 +25,11 @@ struct Storage {
   const char *name;
   bool        sym, single;
 };
-const Storage storages[] = {{"full", false, false}, {"symmetric storage", true, false}, {"single", false, true}};
+const Storage storages[] = {
+  {"full", false, false}, {"symmetric storage", true, false}, {"single", false, true}};
 
 double weight0(int) { return 1.0; }
 double weight1(int e) { return 1.0 + 3.0 * (e % 4); } // a refill that changes the preconditioner a lot
-
 
 // A binbcsr (or aij) matrix filled through COO with element weights weight0.
 PetscErrorCode coo_matrix(const FemProblem &fem, MatType type, const Storage &st, Mat *A)
@@ -72,7 +72,6 @@ PetscErrorCode refill_pair(const FemProblem &fem, const Storage &st, Mat A, Mat 
   PetscFunctionReturn(0);
 }
 
-
 // Tolerance for comparing a binbcsr submatrix with aij's: exact for double (same values moved), the
 // float rounding of the entries for single.
 double sub_tol(const Storage &st) { return st.single ? 2 * 1.2e-7 : 1e-15; }
@@ -110,10 +109,11 @@ struct ScopedOptions {
   }
 };
 
-
 } // namespace
 
-TEST_CASE("binbcsr submatrices (MatIncreaseOverlap, MatCreateSubMatrices, MatCreateSubMatrix) equal aij's, also after a refill", "[mat_sub]")
+TEST_CASE(
+  "binbcsr submatrices (MatIncreaseOverlap, MatCreateSubMatrices, MatCreateSubMatrix) equal aij's, also after a refill",
+  "[mat_sub]")
 {
   const FemProblem fem(5, 4, 4, true); // shuffled numbering: ghost-heavy rows
   for (const Storage &st : storages) {
@@ -162,7 +162,8 @@ TEST_CASE("binbcsr submatrices (MatIncreaseOverlap, MatCreateSubMatrices, MatCre
       for (PetscInt r = rstart; r < rend; ++r)
         if (r % 3 != 1) f02.push_back(r);
       IS fis;
-      PCHK(ISCreateGeneral(PETSC_COMM_WORLD, static_cast<PetscInt>(f02.size()), f02.data(), PETSC_COPY_VALUES, &fis));
+      PCHK(ISCreateGeneral(PETSC_COMM_WORLD, static_cast<PetscInt>(f02.size()), f02.data(), PETSC_COPY_VALUES,
+                           &fis));
       Mat pa, pr;
       PCHK(MatCreateSubMatrix(A, fis, fis, MAT_INITIAL_MATRIX, &pa));
       PCHK(MatCreateSubMatrix(R, fis, fis, MAT_INITIAL_MATRIX, &pr));
@@ -174,7 +175,7 @@ TEST_CASE("binbcsr submatrices (MatIncreaseOverlap, MatCreateSubMatrices, MatCre
       // refill: the same submatrix objects get the new values, their layout (nonzero state) stays
       PCHK(refill_pair(fem, st, A, R));
       Mat              keep[2] = {sa[0], sa[1]}, keep_p = pa;
-      PetscObjectState nz0     = sa[0]->nonzerostate, nzp = pa->nonzerostate;
+      PetscObjectState nz0 = sa[0]->nonzerostate, nzp = pa->nonzerostate;
       PCHK(MatCreateSubMatrices(A, 2, isa, cols_a, MAT_REUSE_MATRIX, &sa));
       PCHK(MatCreateSubMatrices(R, 2, isr, cols_r, MAT_REUSE_MATRIX, &sr));
       PCHK(MatCreateSubMatrix(A, fis, fis, MAT_REUSE_MATRIX, &pa));
@@ -227,7 +228,7 @@ TEST_CASE("binbcsr submatrices: bad input gives PETSc errors", "[mat_sub]")
 namespace {
 
 struct PCCase {
-  const char                                        *name;
+  const char                                      *name;
   std::vector<std::pair<std::string, std::string>> opts; // without the KSP prefix
   bool copy_values = false; // compare with the aij copy of the binbcsr matrix: round-off-sensitive PCs
 };
@@ -259,11 +260,13 @@ PetscErrorCode make_ksp(Mat A, const char *prefix, const PCCase &c, KSPType type
 const std::vector<PCCase> pc_cases = {
   {"asm overlap 0, sub lu", {{"pc_type", "asm"}, {"pc_asm_overlap", "0"}, {"sub_pc_type", "lu"}}},
   {"asm overlap 1, sub lu", {{"pc_type", "asm"}, {"pc_asm_overlap", "1"}, {"sub_pc_type", "lu"}}},
-  {"asm overlap 1, 2 blocks per rank, sub lu", {{"pc_type", "asm"}, {"pc_asm_overlap", "1"}, {"pc_asm_local_blocks", "2"}, {"sub_pc_type", "lu"}}},
+  {"asm overlap 1, 2 blocks per rank, sub lu",
+   {{"pc_type", "asm"}, {"pc_asm_overlap", "1"}, {"pc_asm_local_blocks", "2"}, {"sub_pc_type", "lu"}}},
   {"gasm, sub lu", {{"pc_type", "gasm"}, {"sub_pc_type", "lu"}}},
   {"redundant", {{"pc_type", "redundant"}}},
   {"redundant, one copy over all ranks", {{"pc_type", "redundant"}, {"pc_redundant_number", "1"}}},
-  {"fieldsplit by component", {{"pc_type", "fieldsplit"}, {"pc_fieldsplit_block_size", "3"}, {"fieldsplit_pc_type", "jacobi"}}},
+  {"fieldsplit by component",
+   {{"pc_type", "fieldsplit"}, {"pc_fieldsplit_block_size", "3"}, {"fieldsplit_pc_type", "jacobi"}}},
 #if defined(PETSC_HAVE_HYPRE)
   // BoomerAMG's coarsening breaks ties of equal |a_ij| by round-off: the aij side gets the same bits
   {"hypre boomeramg", {{"pc_type", "hypre"}}, true},
@@ -274,13 +277,15 @@ const std::vector<PCCase> pc_cases = {
 #if defined(PETSC_HAVE_MUMPS)
   {"lu mumps", {{"pc_type", "lu"}, {"pc_factor_mat_solver_type", "mumps"}}},
 #endif
-// (not SuperLU_DIST: with Debian's PETSc 3.18 two of its factors alive in one process corrupt the heap,
-// aij alone as well; it is checked on its own in tests/mat_sub.cmake)
+  // (not SuperLU_DIST: with Debian's PETSc 3.18 two of its factors alive in one process corrupt the heap,
+  // aij alone as well; it is checked on its own in tests/mat_sub.cmake)
 };
 
 } // namespace
 
-TEST_CASE("PCASM, PCGASM, PCREDUNDANT, PCFIELDSPLIT, PCLU, PCCHOLESKY on binbcsr equal aij's, and see a refill", "[mat_sub][pc]")
+TEST_CASE(
+  "PCASM, PCGASM, PCREDUNDANT, PCFIELDSPLIT, PCLU, PCCHOLESKY on binbcsr equal aij's, and see a refill",
+  "[mat_sub][pc]")
 {
   const FemProblem fem(5, 4, 4, true);
   for (const Storage &st : storages) {

@@ -8,7 +8,8 @@
 
 using namespace mat_sym;
 
-TEST_CASE("symmetric storage: every streams count gives the one-run product up to rounding", "[mat_sym][mult][streams]")
+TEST_CASE("symmetric storage: every streams count gives the one-run product up to rounding",
+          "[mat_sym][mult][streams]")
 {
   const PetscInt            bs   = GENERATE(1, 3);
   const PetscInt            bw   = GENERATE(4, 8, 16, 32);

@@ -5,8 +5,7 @@
 #include "mat_binbcsr/seq/binbcsr.h"
 #include <map>
 
-namespace mat_sym
-{
+namespace mat_sym {
 using namespace mat_core;
 
 // The symmetric matrix whose upper block triangle (and upper triangle of each diagonal block) is p's.
@@ -40,7 +39,10 @@ inline Pattern end_rows_pattern(PetscInt mbs, PetscInt bs)
     cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
     for (PetscInt c : cols)
       for (PetscInt i = 0; i < bs; i++)
-        for (PetscInt j = 0; j < bs; j++) p.entries.push_back({r * bs + i, c * bs + j, r == c ? (i == j ? 10.0 : 0.1 * (i + j)) : -0.3 - 0.01 * ((r + c + i + j) % 5)});
+        for (PetscInt j = 0; j < bs; j++)
+          p.entries.push_back(
+            {r * bs + i, c * bs + j,
+             r == c ? (i == j ? 10.0 : 0.1 * (i + j)) : -0.3 - 0.01 * ((r + c + i + j) % 5)});
   }
   return symmetrize(p);
 }
@@ -56,7 +58,8 @@ inline Mat build_sym(const Pattern &p, PetscInt bw, MatBinBCSRPrecision prec, bo
   REQUIRE(MatBinBCSRSetPrecision(A, prec) == 0);
   REQUIRE(MatBinBCSRSetSymmetricStorage(A, sym ? PETSC_TRUE : PETSC_FALSE) == 0);
   REQUIRE(MatSetUp(A) == 0);
-  for (const Entry &e : p.entries) REQUIRE(MatSetValue(A, e.i, e.j, e.v, INSERT_VALUES) == 0); // both triangles
+  for (const Entry &e : p.entries)
+    REQUIRE(MatSetValue(A, e.i, e.j, e.v, INSERT_VALUES) == 0); // both triangles
   REQUIRE(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY) == 0);
   REQUIRE(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY) == 0);
   return A;
@@ -74,8 +77,9 @@ inline void check_colouring(Mat A)
     for (PetscInt k = 0; k < len; k++) {
       std::vector<PetscInt> seen;
       for (PetscInt l = 0; l < a->bw; l++) {
-        const PetscInt s = a->bin_start[b] + k * a->bw + l, r = b * a->bw + l, own = r < a->mbs ? r : a->mbs - 1;
-        const PetscInt c = a->col[s];
+        const PetscInt s = a->bin_start[b] + k * a->bw + l, r = b * a->bw + l,
+                       own = r < a->mbs ? r : a->mbs - 1;
+        const PetscInt c   = a->col[s];
         if (c < 0 || c >= a->nbs) bad++;
         if (c == own) continue;
         if (c < r) bad++; // below the diagonal

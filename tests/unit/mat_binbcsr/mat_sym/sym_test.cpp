@@ -7,8 +7,7 @@
 
 using namespace mat_sym;
 
-namespace
-{
+namespace {
 
 Pattern sym_case(int which)
 {
@@ -41,7 +40,10 @@ Mat build_ref(const Pattern &p, MatType type)
   return A;
 }
 
-double unit_of(MatBinBCSRPrecision prec) { return prec == MAT_BINBCSR_PRECISION_SINGLE ? FLT_EPSILON / 2 : DBL_EPSILON / 2; }
+double unit_of(MatBinBCSRPrecision prec)
+{
+  return prec == MAT_BINBCSR_PRECISION_SINGLE ? FLT_EPSILON / 2 : DBL_EPSILON / 2;
+}
 
 // |a - b| <= tol * scale for two value lists
 void check_rows_close(const std::vector<PetscScalar> &got, const std::vector<PetscScalar> &ref, double tol)
@@ -74,18 +76,22 @@ TEST_CASE("symmetric storage: products against seqaij", "[mat_sym][mult]")
   check_dense(dense(A), dense(p), unit_of(prec));
   if (which >= 7 && bw != 3) { // the grids take the contiguous path in most slot groups
     const std::string info = info_view(A);
-    const size_t      at   = info.find("slot groups over consecutive block columns (x and y read without gathers): ");
+    const size_t      at =
+      info.find("slot groups over consecutive block columns (x and y read without gathers): ");
     REQUIRE(at != std::string::npos);
     long unit = -1, groups = -1;
-    REQUIRE(std::sscanf(info.c_str() + at, "slot groups over consecutive block columns (x and y read without gathers): %ld of %ld", &unit, &groups) == 2);
+    REQUIRE(
+      std::sscanf(info.c_str() + at,
+                  "slot groups over consecutive block columns (x and y read without gathers): %ld of %ld",
+                  &unit, &groups) == 2);
     CHECK(unit >= groups / 4);
   }
 
   Vec x = make_vec(p.n, 1), z = make_vec(p.m, 2), y, yr;
   REQUIRE(VecDuplicate(z, &y) == 0);
   REQUIRE(VecDuplicate(z, &yr) == 0);
-  const auto xv = values(x), zv = values(z);
-  auto       bound = mult_bound(p, xv, unit_of(prec), false);
+  const auto          xv = values(x), zv = values(z);
+  auto                bound = mult_bound(p, xv, unit_of(prec), false);
   std::vector<double> bound_add(bound);
   for (size_t i = 0; i < bound_add.size(); i++) bound_add[i] += 2 * DBL_EPSILON * std::fabs(zv[i]);
 
@@ -101,7 +107,8 @@ TEST_CASE("symmetric storage: products against seqaij", "[mat_sym][mult]")
   REQUIRE(VecDot(yr, x, &dotref) == 0);
   {
     double dbound = 0;
-    for (size_t i = 0; i < xv.size(); i++) dbound += std::fabs(xv[i]) * (bound[i] + std::fabs(values(yr)[i]) * 4 * DBL_EPSILON * xv.size());
+    for (size_t i = 0; i < xv.size(); i++)
+      dbound += std::fabs(xv[i]) * (bound[i] + std::fabs(values(yr)[i]) * 4 * DBL_EPSILON * xv.size());
     CHECK(std::fabs(dot - dotref) <= dbound + 1e-300);
   }
 
@@ -122,19 +129,22 @@ TEST_CASE("symmetric storage: products against seqaij", "[mat_sym][mult]")
   MatDestroy(&R);
 }
 
-TEST_CASE("symmetric storage: the colouring is conflict-free and adds no padding on the stencil", "[mat_sym][colouring]")
+TEST_CASE("symmetric storage: the colouring is conflict-free and adds no padding on the stencil",
+          "[mat_sym][colouring]")
 {
   const PetscInt bw = GENERATE(4, 8, 16);
   CAPTURE(bw);
-  const Pattern         p  = fem_pattern(9, 8, 7, 3);
-  Mat                   A  = build_sym(p, bw, MAT_BINBCSR_PRECISION_DOUBLE);
-  const Mat_SeqBinBCSR *a  = (const Mat_SeqBinBCSR *)A->data;
+  const Pattern         p = fem_pattern(9, 8, 7, 3);
+  Mat                   A = build_sym(p, bw, MAT_BINBCSR_PRECISION_DOUBLE);
+  const Mat_SeqBinBCSR *a = (const Mat_SeqBinBCSR *)A->data;
   check_colouring(A);
   size_t extra = 0;
   for (PetscInt b = 0; b < a->nbins; b++) {
     PetscInt longest = 0;
-    for (PetscInt r = b * bw; r < PetscMin(a->mbs, (b + 1) * bw); r++) longest = PetscMax(longest, a->row_nz[r]);
-    extra += (size_t)((a->bin_start[b + 1] - a->bin_start[b]) / bw - longest); // slot groups beyond the longest upper row
+    for (PetscInt r = b * bw; r < PetscMin(a->mbs, (b + 1) * bw); r++)
+      longest = PetscMax(longest, a->row_nz[r]);
+    extra += (size_t)((a->bin_start[b + 1] - a->bin_start[b]) / bw -
+                      longest); // slot groups beyond the longest upper row
   }
   CHECK(extra == 0);
   // stored blocks: the upper triangle of the 27-point stencil
@@ -163,8 +173,8 @@ TEST_CASE("symmetric storage: value operations against seqaij", "[mat_sym][ops]"
   const Pattern p        = sym_case(which);
   const bool    all_diag = which == 2 || which == 5; // the random patterns lack some diagonal blocks
   const double  tol      = 8 * unit_of(prec) * 64;
-  Mat           R   = build_ref(p, MATSEQAIJ);
-  Mat           A   = build_sym(p, 3, prec);
+  Mat           R        = build_ref(p, MATSEQAIJ);
+  Mat           A        = build_sym(p, 3, prec);
 
   SECTION("diagonal and block diagonal inverse")
   {

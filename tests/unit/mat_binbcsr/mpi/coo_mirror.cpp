@@ -38,8 +38,8 @@ CooList random_list(PetscInt nblocks, PetscInt bs, int count, unsigned seed)
     PetscInt i, j;
     if (k > 0 && u(gen) < 0.1) {
       const size_t p = std::uniform_int_distribution<size_t>(0, l.i.size() - 1)(gen);
-      i = l.i[p];
-      j = l.j[p];
+      i              = l.i[p];
+      j              = l.j[p];
     } else {
       const PetscInt I = block(gen), J = u(gen) < 0.2 ? I : block(gen);
       i = I * bs + point(gen);
@@ -68,7 +68,8 @@ CooList with_transposes(const CooList &l, PetscInt bs)
   return t;
 }
 
-PetscErrorCode create(MPI_Comm comm, MatType type, PetscInt nblocks, PetscInt bs, bool mirror, bool sym, const char *parts, Mat *A)
+PetscErrorCode create(MPI_Comm comm, MatType type, PetscInt nblocks, PetscInt bs, bool mirror, bool sym,
+                      const char *parts, Mat *A)
 {
   PetscFunctionBeginUser;
   PetscCall(MatCreate(comm, A));
@@ -109,7 +110,8 @@ double relative_difference(Mat A, Mat R)
 
 } // namespace
 
-TEST_CASE("COO mirror: binbcsr equals aij given the list and its transposes (bs 1 and 3, any rank's rows)", "[mpi][coo_mirror]")
+TEST_CASE("COO mirror: binbcsr equals aij given the list and its transposes (bs 1 and 3, any rank's rows)",
+          "[mpi][coo_mirror]")
 {
   for (MPI_Comm comm : {PETSC_COMM_WORLD, PETSC_COMM_SELF})
     for (PetscInt bs : {1, 3})
@@ -120,10 +122,12 @@ TEST_CASE("COO mirror: binbcsr equals aij given the list and its transposes (bs 
           MPI_Comm_rank(comm, &rank);
           MPI_Comm_size(comm, &size);
           if (parts && size == 1) continue; // no parts on one rank
-          INFO("ranks " << size << " bs " << bs << " parts " << (parts ? parts : "seqbinbcsr") << " sym " << sym);
+          INFO("ranks " << size << " bs " << bs << " parts " << (parts ? parts : "seqbinbcsr") << " sym "
+                        << sym);
           const PetscInt nblocks = 17;
           CooList        l       = random_list(nblocks, bs, 300, 1234u + 7u * (unsigned)rank + (unsigned)bs);
-          if (sym) { // symmetric storage ignores the lower triangle: give the upper one, diagonal blocks in full
+          if (
+            sym) { // symmetric storage ignores the lower triangle: give the upper one, diagonal blocks in full
             CooList u;
             for (size_t k = 0; k < l.i.size(); ++k)
               if (l.i[k] < 0 || l.i[k] / bs <= l.j[k] / bs) {
@@ -169,7 +173,8 @@ TEST_CASE("COO mirror: binbcsr equals aij given the list and its transposes (bs 
         }
 }
 
-TEST_CASE("COO mirror: off by default, option, other types unaffected, non-square refused", "[mpi][coo_mirror]")
+TEST_CASE("COO mirror: off by default, option, other types unaffected, non-square refused",
+          "[mpi][coo_mirror]")
 {
   Mat       A;
   PetscBool on = PETSC_TRUE;
@@ -206,16 +211,18 @@ namespace {
 // `repeated` every rank lists all blocks and the first ten twice (values summed from several blocks).
 // `broken` spoils the whole-block structure (one entry moved to another block position), so the
 // refill must fall back to the value-by-value map.
-CooList whole_blocks(PetscInt nblocks, bool mirror, bool broken, bool repeated, unsigned seed, int rank, int size)
+CooList whole_blocks(PetscInt nblocks, bool mirror, bool broken, bool repeated, unsigned seed, int rank,
+                     int size)
 {
-  std::mt19937                            gen(seed);
-  std::uniform_int_distribution<PetscInt> block(0, nblocks - 1);
-  std::uniform_real_distribution<double>  value(-1, 1), u(0, 1);
+  std::mt19937                               gen(seed);
+  std::uniform_int_distribution<PetscInt>    block(0, nblocks - 1);
+  std::uniform_real_distribution<double>     value(-1, 1), u(0, 1);
   std::vector<std::pair<PetscInt, PetscInt>> blocks;
   for (int k = 0; k < 60; ++k) {
     PetscInt I = block(gen), J = u(gen) < 0.2 ? I : block(gen);
     if (mirror && I > J) std::swap(I, J);
-    if (std::find(blocks.begin(), blocks.end(), std::make_pair(I, J)) == blocks.end()) blocks.emplace_back(I, J);
+    if (std::find(blocks.begin(), blocks.end(), std::make_pair(I, J)) == blocks.end())
+      blocks.emplace_back(I, J);
   }
   std::vector<size_t> listed;
   for (size_t k = repeated ? 0 : rank; k < blocks.size(); k += repeated ? 1 : size) listed.push_back(k);
@@ -234,27 +241,30 @@ CooList whole_blocks(PetscInt nblocks, bool mirror, bool broken, bool repeated, 
 
 } // namespace
 
-TEST_CASE("COO refill by whole blocks (plain, mirrored, repeated) equals aij; other lists fall back", "[mpi][coo_mirror]")
+TEST_CASE("COO refill by whole blocks (plain, mirrored, repeated) equals aij; other lists fall back",
+          "[mpi][coo_mirror]")
 {
   for (MPI_Comm comm : {PETSC_COMM_WORLD, PETSC_COMM_SELF})
     for (bool mirror : {false, true})
       for (bool sym : {false, true})
         for (bool single : {false, true})
           for (int variant : {0, 1, 2}) { // whole blocks once, broken, repeated
-            const bool broken = variant == 1, repeated = variant == 2;
+            const bool  broken = variant == 1, repeated = variant == 2;
             PetscMPIInt rank, size;
             MPI_Comm_rank(comm, &rank);
             MPI_Comm_size(comm, &size);
             // symmetric storage keeps the blocks coupling two ranks in full: without the mirror the
             // caller lists both (the mpibinbcsr tests do); here every list is an upper triangle
             if (sym && !mirror && size > 1) continue;
-            INFO("ranks " << size << " mirror " << mirror << " sym " << sym << " single " << single << " broken " << broken << " repeated " << repeated);
+            INFO("ranks " << size << " mirror " << mirror << " sym " << sym << " single " << single
+                          << " broken " << broken << " repeated " << repeated);
             const PetscInt nblocks = 23;
             CooList        l       = whole_blocks(nblocks, mirror || sym, broken, repeated, 99u, rank, size);
             if (sym) // diagonal blocks symmetric, so that the stored upper triangle is the whole matrix
               for (size_t k = 0; k < l.i.size(); ++k)
                 if (l.i[k] / 3 == l.j[k] / 3) {
-                  const size_t t = k - (l.i[k] % 3) * 3 - l.j[k] % 3 + (l.j[k] % 3) * 3 + l.i[k] % 3; // transposed entry
+                  const size_t t =
+                    k - (l.i[k] % 3) * 3 - l.j[k] % 3 + (l.j[k] % 3) * 3 + l.i[k] % 3; // transposed entry
                   if (t < k) l.v[k] = l.v[t];
                 }
             CooList full = mirror ? with_transposes(l, 3) : l;
@@ -269,7 +279,9 @@ TEST_CASE("COO refill by whole blocks (plain, mirrored, repeated) equals aij; ot
             PCHK(create(comm, MATAIJ, nblocks, 3, false, false, nullptr, &R));
             PCHK(MatSetPreallocationCOO(R, (PetscCount)full.i.size(), full.i.data(), full.j.data()));
             const double tol = single ? 1e-7 : 1e-14;
-            for (auto [mode, scale] : {std::pair<InsertMode, double>{INSERT_VALUES, 1.0}, {ADD_VALUES, 2.0}, {INSERT_VALUES, -0.5}}) {
+            for (auto [mode, scale] : {std::pair<InsertMode, double>{INSERT_VALUES, 1.0},
+                                       {ADD_VALUES, 2.0},
+                                       {INSERT_VALUES, -0.5}}) {
               PCHK(fill(A, l, mode, scale));
               PCHK(fill(R, full, mode, scale));
               CHECK(all_ranks(relative_difference(A, R) < tol, comm));

@@ -102,7 +102,8 @@ double product_error(Mat A, const std::vector<double> &expected)
   REQUIRE(MatMult(A, x, y) == 0);
   const PetscScalar *a;
   REQUIRE(VecGetArrayRead(y, &a) == 0);
-  for (PetscInt i = rstart; i < rend; ++i) err = std::max(err, std::abs((double)PetscRealPart(a[i - rstart]) - expected[i]));
+  for (PetscInt i = rstart; i < rend; ++i)
+    err = std::max(err, std::abs((double)PetscRealPart(a[i - rstart]) - expected[i]));
   REQUIRE(VecRestoreArrayRead(y, &a) == 0);
   REQUIRE(VecDestroy(&x) == 0);
   REQUIRE(VecDestroy(&y) == 0);
@@ -121,12 +122,12 @@ std::vector<double> ramp(PetscInt n)
 
 TEST_CASE("MatLoad of a file with repeated entries gives seqaij's product (the sum)", "[mpi][load]")
 {
-  const FileMatrix    f;
-  const std::string   name     = shared_name("dups");
-  const auto          expected = f.product(ramp(f.n));
+  const FileMatrix  f;
+  const std::string name     = shared_name("dups");
+  const auto        expected = f.product(ramp(f.n));
   PCHK(write_file(name, f));
   {
-    Mat S; // the reference itself, where it is serial
+    Mat         S; // the reference itself, where it is serial
     PetscMPIInt size;
     MPI_Comm_size(PETSC_COMM_WORLD, &size);
     if (size == 1) {
@@ -147,17 +148,18 @@ TEST_CASE("MatLoad of a file with repeated entries gives seqaij's product (the s
   std::remove(name.c_str());
 }
 
-TEST_CASE("MatLoad refuses a negative or too large column on every rank and any reader", "[mpi][load][errors]")
+TEST_CASE("MatLoad refuses a negative or too large column on every rank and any reader",
+          "[mpi][load][errors]")
 {
   for (PetscInt bad : {-1, 6}) {
     FileMatrix f;
-    f.cols[13] = bad; // row 5: on the last rank when there are several
+    f.cols[13]             = bad; // row 5: on the last rank when there are several
     const std::string name = shared_name("badcol");
     PCHK(write_file(name, f));
     for (MatType type : {MATBINBCSR, MATMPIBINBCSR})
       for (PetscInt bs : {1, 3}) {
         INFO("type " << type << " bs " << bs << " column " << bad);
-        Mat A = nullptr;
+        Mat                  A    = nullptr;
         const PetscErrorCode ierr = load(type, bs, name, &A);
         CHECK(all_ranks(ierr != 0));
         PCHK(MatDestroy(&A));

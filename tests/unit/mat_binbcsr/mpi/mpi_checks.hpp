@@ -17,12 +17,20 @@ using namespace mpitest;
 
 namespace {
 
-enum class Fill { Blocked, Coo, ScalarOwnRows };
+enum class Fill {
+  Blocked,
+  Coo,
+  ScalarOwnRows
+};
 
-const char *fill_name(Fill f) { return f == Fill::Blocked ? "blocked+stash" : f == Fill::Coo ? "coo" : "scalar own rows"; }
+const char *fill_name(Fill f)
+{
+  return f == Fill::Blocked ? "blocked+stash" : f == Fill::Coo ? "coo" : "scalar own rows";
+}
 
 // parts: type of the diagonal/off-diagonal parts (-mat_mpibinbcsr_inner_type), default seqbinbcsr.
-PetscErrorCode assemble(const FemProblem &fem, MatType type, Fill fill, bool empty_rank0, Mat *A, const char *parts = nullptr)
+PetscErrorCode assemble(const FemProblem &fem, MatType type, Fill fill, bool empty_rank0, Mat *A,
+                        const char *parts = nullptr)
 {
   MPI_Comm    comm = PETSC_COMM_WORLD;
   PetscMPIInt rank, size;
@@ -74,8 +82,7 @@ PetscErrorCode assemble(const FemProblem &fem, MatType type, Fill fill, bool emp
 
 // This rank's COO values in assemble()'s order, element e scaled by weight(e), and a value for the
 // ignored entry assemble() appends.
-template <class Weight>
-std::vector<PetscScalar> rank_coo_values(const FemProblem &fem, Weight weight)
+template <class Weight> std::vector<PetscScalar> rank_coo_values(const FemProblem &fem, Weight weight)
 {
   std::vector<PetscScalar> cv = rank_element_values(fem, weight);
   cv.push_back(0);
@@ -126,7 +133,8 @@ PetscErrorCode create_solver(Mat A, KSPType kt, PCType pt, KSP *ksp)
 
 // Solves A x = b with the given KSP and PC to rtol 1e-10 (x is the initial guess and the result);
 // returns the iterations and, through reason, why it stopped.
-PetscErrorCode solve_to_tolerance(Mat A, Vec b, Vec x, KSPType kt, PCType pt, PetscInt *its, KSPConvergedReason *reason)
+PetscErrorCode solve_to_tolerance(Mat A, Vec b, Vec x, KSPType kt, PCType pt, PetscInt *its,
+                                  KSPConvergedReason *reason)
 {
   KSP ksp;
   PetscFunctionBeginUser;

@@ -9,7 +9,8 @@ TEST_CASE("mpibinbcsr equals the serial matrix for every assembly path and parti
   for (bool shuffle : {false, true})
     for (bool empty_rank0 : {false, true})
       for (Fill fill : {Fill::Blocked, Fill::Coo, Fill::ScalarOwnRows}) {
-        INFO("fill " << fill_name(fill) << ", shuffled numbering " << shuffle << ", rank 0 empty " << empty_rank0);
+        INFO("fill " << fill_name(fill) << ", shuffled numbering " << shuffle << ", rank 0 empty "
+                     << empty_rank0);
         const FemProblem fem(5, 4, 3, shuffle);
         Mat              A, S;
         PCHK(assemble(fem, MATMPIBINBCSR, fill, empty_rank0, &A));
@@ -218,7 +219,8 @@ TEST_CASE("mpibinbcsr: parallel MatLoad of a PETSc binary file, and per-rank inf
     char        buf[512];
     while (std::fgets(buf, sizeof(buf), f)) content += buf;
     std::fclose(f);
-    for (int r = 0; r < size; ++r) CHECK(content.find("[" + std::to_string(r) + "] rows") != std::string::npos);
+    for (int r = 0; r < size; ++r)
+      CHECK(content.find("[" + std::to_string(r) + "] rows") != std::string::npos);
     CHECK(content.find("ghost block columns") != std::string::npos);
     std::remove(txt.c_str());
     std::remove(name);

@@ -2,7 +2,9 @@
 // the same matrix assembled serially and against MPIAIJ/MPIBAIJ. Collective, as mpibinbcsr.cpp.
 #include "mpi_checks.hpp"
 
-TEST_CASE("mpibinbcsr with symmetric storage (upper diagonal part, full off-diagonal part) equals the serial matrix", "[mpi][sym]")
+TEST_CASE(
+  "mpibinbcsr with symmetric storage (upper diagonal part, full off-diagonal part) equals the serial matrix",
+  "[mpi][sym]")
 {
   PCHK(PetscOptionsSetValue(nullptr, "-mat_binbcsr_symmetric_storage", "1"));
   for (bool empty_rank0 : {false, true})
@@ -78,7 +80,8 @@ TEST_CASE("mpibinbcsr with symmetric storage: MatZeroRowsColumns with rows named
   PCHK(MatDestroy(&S));
 }
 
-TEST_CASE("mpibinbcsr: MatSOR local sweeps and PCSOR in CG equal mpibaij's (whole and symmetric storage)", "[mpi][sor]")
+TEST_CASE("mpibinbcsr: MatSOR local sweeps and PCSOR in CG equal mpibaij's (whole and symmetric storage)",
+          "[mpi][sor]")
 {
   const FemProblem fem(6, 5, 4, true);
   for (const char *sym : {"0", "1"}) {
@@ -92,7 +95,8 @@ TEST_CASE("mpibinbcsr: MatSOR local sweeps and PCSOR in CG equal mpibaij's (whol
     PCHK(VecDuplicate(x, &xr));
     PCHK(fill_test_vector(b));
     // block SOR with omega 1 (BAIJ's bs 3 sweeps invert the diagonal blocks the same way)
-    for (int flag : {SOR_LOCAL_SYMMETRIC_SWEEP | SOR_ZERO_INITIAL_GUESS, (int)SOR_LOCAL_FORWARD_SWEEP, (int)SOR_LOCAL_BACKWARD_SWEEP})
+    for (int flag : {SOR_LOCAL_SYMMETRIC_SWEEP | SOR_ZERO_INITIAL_GUESS, (int)SOR_LOCAL_FORWARD_SWEEP,
+                     (int)SOR_LOCAL_BACKWARD_SWEEP})
       for (PetscInt its : {1, 3}) {
         INFO("flag " << flag << " its " << its);
         PCHK(fill_test_vector(x, 1));
@@ -134,7 +138,8 @@ TEST_CASE("mpibinbcsr: MatSOR local sweeps and PCSOR in CG equal mpibaij's (whol
 // A PC set up once must see later COO refills: block Jacobi's sub-PCs and the SOR cache key their
 // set-up on the state of the part they read, which the refill of each part has to move (both the
 // composed refill of BIN-BCSR parts and the plain one of other part types).
-TEST_CASE("mpibinbcsr: a COO refill with values reaches a PC set up before it (bjacobi, sor)", "[mpi][coo_state]")
+TEST_CASE("mpibinbcsr: a COO refill with values reaches a PC set up before it (bjacobi, sor)",
+          "[mpi][coo_state]")
 {
   const FemProblem fem(5, 4, 4, true);
   // the same elements, weighted unevenly so that a stale factor or diagonal is a different operator

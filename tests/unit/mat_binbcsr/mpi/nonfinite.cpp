@@ -13,14 +13,14 @@
 
 #define PCHK(expr) REQUIRE((expr) == 0)
 
-namespace
-{
+namespace {
 
 constexpr PetscInt rows_per_rank = 10, empty_row = 9;
 
 // The global block pattern: diagonal blocks except the empty row, couplings (0, N-3), (1, 6), (1, 7)
 // and their transposes (N = block rows).
-Mat build(MatType type, PetscInt bs, PetscInt bw, MatBinBCSRPrecision prec, PetscBool sym, MatBinBCSRKernel kernel)
+Mat build(MatType type, PetscInt bs, PetscInt bw, MatBinBCSRPrecision prec, PetscBool sym,
+          MatBinBCSRKernel kernel)
 {
   PetscMPIInt size, rank;
   MPI_Comm_size(PETSC_COMM_WORLD, &size);
@@ -67,7 +67,8 @@ void compare(Vec got, Vec ref, PetscInt *bad, PetscInt *nonfinite)
   PCHK(VecGetArrayRead(ref, &r));
   for (PetscInt i = 0; i < n; i++) {
     cnt[1] += cls(r[i]) != 3;
-    if (cls(g[i]) != cls(r[i]) || (cls(r[i]) == 3 && std::fabs(g[i] - r[i]) > 1e-5 * (1.0 + std::fabs(r[i])))) cnt[0]++;
+    if (cls(g[i]) != cls(r[i]) || (cls(r[i]) == 3 && std::fabs(g[i] - r[i]) > 1e-5 * (1.0 + std::fabs(r[i]))))
+      cnt[0]++;
   }
   PCHK(VecRestoreArrayRead(got, &g));
   PCHK(VecRestoreArrayRead(ref, &r));
@@ -84,13 +85,16 @@ TEST_CASE("products propagate NaN and Inf of x exactly as aij", "[mpi][nonfinite
   const PetscInt            bw   = GENERATE(4, 8, 16, 5);
   const MatBinBCSRPrecision prec = GENERATE(MAT_BINBCSR_PRECISION_DOUBLE, MAT_BINBCSR_PRECISION_SINGLE);
   const PetscBool           sym  = GENERATE(PETSC_FALSE, PETSC_TRUE);
-  const double              bad_x = GENERATE(std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity());
-  for (MatBinBCSRKernel kernel : {MAT_BINBCSR_KERNEL_PORTABLE, MAT_BINBCSR_KERNEL_AVX2, MAT_BINBCSR_KERNEL_AVX512}) {
+  const double              bad_x =
+    GENERATE(std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity());
+  for (MatBinBCSRKernel kernel :
+       {MAT_BINBCSR_KERNEL_PORTABLE, MAT_BINBCSR_KERNEL_AVX2, MAT_BINBCSR_KERNEL_AVX512}) {
     PetscBool avail;
     PCHK(MatBinBCSRKernelAvailable(kernel, &avail));
     if (!avail) continue;
     CAPTURE(bs, bw, prec, sym, bad_x, kernel);
-    Mat         A = build(MATBINBCSR, bs, bw, prec, sym, kernel), R = build(MATAIJ, bs, bw, prec, PETSC_FALSE, kernel);
+    Mat A = build(MATBINBCSR, bs, bw, prec, sym, kernel),
+        R = build(MATAIJ, bs, bw, prec, PETSC_FALSE, kernel);
     Vec         x, y, yr, z;
     PetscMPIInt rank;
     MPI_Comm_rank(PETSC_COMM_WORLD, &rank);

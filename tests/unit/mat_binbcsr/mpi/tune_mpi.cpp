@@ -14,8 +14,7 @@ using namespace mpitest;
 
 #define PCHK(expr) REQUIRE((expr) == 0)
 
-namespace
-{
+namespace {
 
 Mat coo_matrix(const FemProblem &fem, MatType type)
 {
@@ -89,7 +88,9 @@ TEST_CASE("mpi: each rank tunes its parts; the matrix and its products stay MPIA
   MPI_Comm_size(PETSC_COMM_WORLD, &size);
   // every rank's diagonal part says what it measured (rank 0's viewer gathers them all)
   size_t n = 0;
-  for (size_t p = txt.find("measured on block rows"); p != std::string::npos; p = txt.find("measured on block rows", p + 1)) n++;
+  for (size_t p = txt.find("measured on block rows"); p != std::string::npos;
+       p        = txt.find("measured on block rows", p + 1))
+    n++;
   PetscMPIInt rank;
   MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
   if (rank == 0) {

@@ -59,7 +59,8 @@ PetscErrorCode eisenstat_ksp(Mat A, const char *prefix, double rtol, KSP *ksp)
 
 } // namespace
 
-TEST_CASE("MatSOR SOR_EISENSTAT, SOR_APPLY_UPPER, MatMultDiagonalBlock of binbcsr satisfy their definitions", "[pc][eisenstat]")
+TEST_CASE("MatSOR SOR_EISENSTAT, SOR_APPLY_UPPER, MatMultDiagonalBlock of binbcsr satisfy their definitions",
+          "[pc][eisenstat]")
 {
   const FemProblem fem(5, 4, 3, true);
   for (PetscInt bs : {1, 3})
@@ -108,7 +109,7 @@ TEST_CASE("MatSOR of binbcsr: flags PCEISENSTAT does not use are refused clearly
   PetscMPIInt size;
   MPI_Comm_size(PETSC_COMM_WORLD, &size);
   if (size > 1) CHECK(MatSOR(A, b, 1.0, SOR_FORWARD_SWEEP, 0.0, 1, 1, x) == PETSC_ERR_SUP); // global sweeps
-  else CHECK(MatSOR(A, b, 0.0, SOR_EISENSTAT, 0.0, 1, 1, x) == PETSC_ERR_ARG_WRONG);       // omega 0
+  else CHECK(MatSOR(A, b, 0.0, SOR_EISENSTAT, 0.0, 1, 1, x) == PETSC_ERR_ARG_WRONG);        // omega 0
   PCHK(VecDestroy(&b));
   PCHK(VecDestroy(&x));
   PCHK(MatDestroy(&A));
@@ -117,7 +118,8 @@ TEST_CASE("MatSOR of binbcsr: flags PCEISENSTAT does not use are refused clearly
 // PETSc 3.18's MPIAIJ cannot run PCEISENSTAT when its diagonal part has no inodes (bs 1): MatSOR_MPIAIJ
 // calls MatMultDiagonalBlock, which seqaij has only with inodes. The aij reference is taken where it
 // works: on one rank always, on more ranks for bs 3 (3-row inodes: the same point-block Eisenstat).
-TEST_CASE("PCEISENSTAT in GMRES: binbcsr takes aij's iterations and gives its solution, also after a refill", "[pc][eisenstat]")
+TEST_CASE("PCEISENSTAT in GMRES: binbcsr takes aij's iterations and gives its solution, also after a refill",
+          "[pc][eisenstat]")
 {
   const FemProblem fem(6, 5, 4, true);
   PetscMPIInt      size;

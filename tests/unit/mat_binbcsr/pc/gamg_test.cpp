@@ -15,7 +15,6 @@ using namespace pctest;
 
 namespace {
 
-
 // The rigid body modes of the FEM grid (node coordinates i, j, k) as A's near null space.
 PetscErrorCode set_rigid_body_modes(const FemProblem &fem, Mat A)
 {
@@ -31,7 +30,7 @@ PetscErrorCode set_rigid_body_modes(const FemProblem &fem, Mat A)
   PetscCall(VecGetOwnershipRange(coords, &lo, &hi));
   PetscCall(VecGetArray(coords, &c));
   for (PetscInt n = lo / 3; n < hi / 3; n++) {
-    const int g = grid_of[n];
+    const int g             = grid_of[n];
     c[3 * (n - lo / 3) + 0] = g % fem.nx;
     c[3 * (n - lo / 3) + 1] = (g / fem.nx) % fem.ny;
     c[3 * (n - lo / 3) + 2] = g / (fem.nx * fem.ny);
@@ -45,9 +44,9 @@ PetscErrorCode set_rigid_body_modes(const FemProblem &fem, Mat A)
 }
 
 struct GamgCase {
-  const char                                        *name;
+  const char                                      *name;
   std::vector<std::pair<std::string, std::string>> opts; // without the KSP prefix
-  bool                                               rigid_body_modes = false;
+  bool                                             rigid_body_modes = false;
 };
 
 PetscErrorCode gamg_ksp(Mat A, const char *prefix, const GamgCase &c, KSPType type, double rtol, KSP *ksp)
@@ -94,7 +93,9 @@ PetscErrorCode aggregate_prolongator(Mat A, Mat *P)
 
 } // namespace
 
-TEST_CASE("Matrix products with binbcsr operands (through the AIJ shadow) equal aij's, also reused after a refill", "[pc][gamg][product]")
+TEST_CASE(
+  "Matrix products with binbcsr operands (through the AIJ shadow) equal aij's, also reused after a refill",
+  "[pc][gamg][product]")
 {
   const FemProblem fem(5, 4, 3, true);
   for (PetscInt bs : {1, 3})
@@ -129,7 +130,8 @@ TEST_CASE("Matrix products with binbcsr operands (through the AIJ shadow) equal 
         PCHK(MatSetRandom(X, nullptr));
         PCHK(MatMatMult(F, X, MAT_INITIAL_MATRIX, PETSC_DEFAULT, &Y));
         PCHK(MatMatMult(R, X, MAT_INITIAL_MATRIX, PETSC_DEFAULT, &YR));
-        CHECK(mat_rel_diff(Y, YR) < (st.single ? 1e-6 : 1e-13)); // F holds weight0 values, R (single: a copy of A) too
+        CHECK(mat_rel_diff(Y, YR) <
+              (st.single ? 1e-6 : 1e-13)); // F holds weight0 values, R (single: a copy of A) too
         PetscObject shadow = nullptr;
         PCHK(PetscObjectQuery((PetscObject)F, "MatBinBCSR_AIJShadow", &shadow));
         CHECK(shadow == nullptr);
@@ -163,7 +165,8 @@ TEST_CASE("Matrix products with binbcsr operands (through the AIJ shadow) equal 
       PCHK(MatAssemblyEnd(R, MAT_FINAL_ASSEMBLY));
       PCHK(MatPtAP(A, P, MAT_REUSE_MATRIX, 2.0, &ptap_a));
       PCHK(MatPtAP(R, P, MAT_REUSE_MATRIX, 2.0, &ptap_r));
-      CHECK(mat_rel_diff(ptap_a, ptap_r) < (st.single ? 1e-6 : tol)); // single: A rounds the new diagonal to float, R does not
+      CHECK(mat_rel_diff(ptap_a, ptap_r) <
+            (st.single ? 1e-6 : tol)); // single: A rounds the new diagonal to float, R does not
       // a new preallocation: if it gave a new nonzero state (a rebuilt shadow), the old symbolic phase
       // cannot serve it and that is a clear error; a preallocation that kept the layout keeps the product
       std::vector<PetscInt> ci, cj;
@@ -183,7 +186,9 @@ TEST_CASE("Matrix products with binbcsr operands (through the AIJ shadow) equal 
     }
 }
 
-TEST_CASE("MatCreateGraph of binbcsr is aij's; a binbcsr matrix with row and column block sizes 3 and 6 becomes aij at its AIJ preallocation", "[pc][gamg]")
+TEST_CASE(
+  "MatCreateGraph of binbcsr is aij's; a binbcsr matrix with row and column block sizes 3 and 6 becomes aij at its AIJ preallocation",
+  "[pc][gamg]")
 {
   const FemProblem fem(4, 3, 3, true);
   Mat              A, R, GA, GR;
@@ -217,11 +222,13 @@ TEST_CASE("MatCreateGraph of binbcsr is aij's; a binbcsr matrix with row and col
   PCHK(MatDestroy(&R));
 }
 
-TEST_CASE("PCGAMG on binbcsr equals aij's: one V-cycle, CG iterations and solution, before and after a refill", "[pc][gamg]")
+TEST_CASE(
+  "PCGAMG on binbcsr equals aij's: one V-cycle, CG iterations and solution, before and after a refill",
+  "[pc][gamg]")
 {
   const FemProblem fem(6, 5, 5, true);
-  const double     rtol = 1e-8, tol = 10 * rtol; // two solutions that each meet rtol, from the same iterations
-  const GamgCase   cases[] = {
+  const double   rtol = 1e-8, tol = 10 * rtol; // two solutions that each meet rtol, from the same iterations
+  const GamgCase cases[] = {
     {"default (interpolation reused after a refill)", {}},
     {"interpolation rebuilt after a refill", {{"pc_gamg_reuse_interpolation", "false"}}},
     {"unsmoothed aggregation (binbcsr tentative prolongator)", {{"pc_gamg_agg_nsmooths", "0"}}},

@@ -21,14 +21,16 @@ struct Storage {
   const char *name;
   bool        sym, single;
 };
-const Storage storages[] = {{"full", false, false}, {"symmetric storage", true, false}, {"single", false, true}};
+const Storage storages[] = {
+  {"full", false, false}, {"symmetric storage", true, false}, {"single", false, true}};
 
 inline double weight0(int) { return 1.0; }
 inline double weight1(int e) { return 1.0 + 3.0 * (e % 4); } // a refill that changes any preconditioner a lot
 
 // bs 3: the FEM problem's 24 x 24 element matrices; bs 1: a scalar 8 x 8 element matrix per element
 // (8 I - 1 1^T) s_e + mass on the nodes. This rank's elements are dealt round-robin, as rank_coo_entries.
-inline void coo_entries(const FemProblem &fem, PetscInt bs, std::vector<PetscInt> &ci, std::vector<PetscInt> &cj)
+inline void coo_entries(const FemProblem &fem, PetscInt bs, std::vector<PetscInt> &ci,
+                        std::vector<PetscInt> &cj)
 {
   if (bs == 3) return rank_coo_entries(fem, ci, cj);
   PetscMPIInt rank, size;
@@ -44,8 +46,7 @@ inline void coo_entries(const FemProblem &fem, PetscInt bs, std::vector<PetscInt
   }
 }
 
-template <class Weight>
-std::vector<PetscScalar> coo_values(const FemProblem &fem, PetscInt bs, Weight weight)
+template <class Weight> std::vector<PetscScalar> coo_values(const FemProblem &fem, PetscInt bs, Weight weight)
 {
   if (bs == 3) return rank_element_values(fem, weight);
   PetscMPIInt rank, size;
@@ -61,7 +62,10 @@ std::vector<PetscScalar> coo_values(const FemProblem &fem, PetscInt bs, Weight w
 }
 
 // Local rows of this rank for block size bs (nodes split evenly).
-inline PetscInt rows_for(const FemProblem &fem, PetscInt bs) { return local_rows(fem, PETSC_COMM_WORLD, false) / 3 * bs; }
+inline PetscInt rows_for(const FemProblem &fem, PetscInt bs)
+{
+  return local_rows(fem, PETSC_COMM_WORLD, false) / 3 * bs;
+}
 
 // A matrix of the given type (binbcsr: with the storage variant) filled through COO with weight0.
 inline PetscErrorCode coo_matrix(const FemProblem &fem, PetscInt bs, MatType type, const Storage &st, Mat *A)
@@ -103,7 +107,6 @@ inline PetscErrorCode refill_pair(const FemProblem &fem, PetscInt bs, const Stor
   else PetscCall(MatSetValuesCOO(R, cv.data(), INSERT_VALUES));
   PetscFunctionReturn(0);
 }
-
 
 inline PetscErrorCode random_vec(Mat A, unsigned seed, Vec *b)
 {

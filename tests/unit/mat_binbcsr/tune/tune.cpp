@@ -78,7 +78,7 @@ PetscInt streams(Mat A)
 // rounding of the sums with symmetric storage (the transposed contributions arrive in another order).
 void check_same(Mat A, Mat R, const Pattern &p)
 {
-  Vec       x = make_vec(p.n, 7), y, yr;
+  Vec              x = make_vec(p.n, 7), y, yr;
   PetscBool        sym;
   MatBinBCSRKernel kernel;
   // R runs A's body set: bodies compiled with other target flags contract multiply-adds differently,

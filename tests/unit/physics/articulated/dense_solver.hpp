@@ -30,8 +30,9 @@ struct DenseBlockSolver {
       r.iterations = 1;
       r.converged  = lu.isInvertible();
       r.breakdown  = !r.converged;
-      Eigen::VectorXd sol = r.converged ? Eigen::VectorXd(lu.solve(Eigen::Map<const Eigen::VectorXd>(rhs.data(), rhs.size())))
-                                        : Eigen::VectorXd::Zero(rhs.size());
+      Eigen::VectorXd sol =
+        r.converged ? Eigen::VectorXd(lu.solve(Eigen::Map<const Eigen::VectorXd>(rhs.data(), rhs.size())))
+                    : Eigen::VectorXd::Zero(rhs.size());
       x.assign(sol.data(), sol.data() + sol.size());
       return r;
     };

@@ -61,7 +61,8 @@ RunStats run(ArticulatedScene &scene, ArticulatedParams params, int steps)
     st.singular |= r.singular_detected;
     st.worst_error = std::max(st.worst_error, r.joint_error);
     st.corrections += r.corrections;
-    for (const RigidBody &b : scene.bodies) st.finite &= b.position.allFinite() && b.velocity.allFinite() && b.angular_velocity.allFinite();
+    for (const RigidBody &b : scene.bodies)
+      st.finite &= b.position.allFinite() && b.velocity.allFinite() && b.angular_velocity.allFinite();
     st.energy_growth = std::max(st.energy_growth, total_energy(scene) - e0);
   }
   return st;
@@ -75,7 +76,9 @@ TEST_CASE("joint matrix values equal J M^-1 J^T built densely", "[articulated]")
   opt.chains = 3, opt.links = 6, opt.tie_every = 2;
   ArticulatedScene scene = make_bridge(opt);
   // Turn and spin the planks so that every block term is exercised.
-  for (size_t i = 0; i < scene.bodies.size(); ++i) scene.bodies[i].orientation = rotated(scene.bodies[i].orientation, Eigen::Vector3d(0.3, -0.7 + 0.1 * i, 0.2), 1.0);
+  for (size_t i = 0; i < scene.bodies.size(); ++i)
+    scene.bodies[i].orientation =
+      rotated(scene.bodies[i].orientation, Eigen::Vector3d(0.3, -0.7 + 0.1 * i, 0.2), 1.0);
   const JointMatrixPattern p = build_joint_matrix_pattern(scene);
   std::vector<double>      values;
   fill_joint_matrix(scene, p, 0.0, values);
@@ -84,7 +87,8 @@ TEST_CASE("joint matrix values equal J M^-1 J^T built densely", "[articulated]")
   Eigen::MatrixXd       B = Eigen::MatrixXd::Zero(A.rows(), A.cols());
   for (size_t k = 0; k < p.block_row.size(); ++k)
     for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) B(3 * p.block_row[k] + i, 3 * p.block_col[k] + j) += values[9 * k + 3 * i + j];
+      for (int j = 0; j < 3; ++j)
+        B(3 * p.block_row[k] + i, 3 * p.block_col[k] + j) += values[9 * k + 3 * i + j];
   CHECK((A - B).norm() < 1e-12 * A.norm());
   // The pattern holds exactly the nonzero blocks, both triangles.
   int nonzero_blocks = 0;
@@ -100,14 +104,14 @@ TEST_CASE("chain: joint error below tolerance after every step, energy does not 
   opt.links = 10, opt.angle = 0.8;
   ArticulatedScene  scene = make_chain(opt);
   ArticulatedParams params;
-  params.dt = 1.0 / 60;
-  ArticulatedSolver s   = make_articulated_solver(scene, params);
-  DenseBlockSolver  ref = dense_solver_for(s.pattern);
-  auto              lin = ref.adapter();
-  const double      e0  = total_energy(scene);
-  const double      scale = 10 * 9.81 * 5.0; // m g (chain length): the energy that swinging moves around
+  params.dt                 = 1.0 / 60;
+  ArticulatedSolver   s     = make_articulated_solver(scene, params);
+  DenseBlockSolver    ref   = dense_solver_for(s.pattern);
+  auto                lin   = ref.adapter();
+  const double        e0    = total_energy(scene);
+  const double        scale = 10 * 9.81 * 5.0; // m g (chain length): the energy that swinging moves around
   std::vector<double> energy;
-  long corrections = 0;
+  long                corrections = 0;
   for (int n = 0; n < 600; ++n) {
     const ArticulatedStepReport r = articulated_step(scene, s, params, lin);
     REQUIRE(r.converged);
@@ -129,7 +133,8 @@ TEST_CASE("four-bar loop: 1000 steps without NaN or drift", "[articulated][loops
 {
   ArticulatedScene scene = make_four_bar();
   CHECK(loop_closing_joints(scene).size() == 1);
-  scene.bodies[0].angular_velocity = Eigen::Vector3d(0, 0, 2.0); // crank turning, links follow through joint impulses
+  scene.bodies[0].angular_velocity =
+    Eigen::Vector3d(0, 0, 2.0); // crank turning, links follow through joint impulses
   ArticulatedParams params;
   params.dt         = 1.0 / 60;
   const RunStats st = run(scene, params, 1000);
@@ -165,7 +170,7 @@ TEST_CASE("bridge scene has the seed's size and its loops are found", "[articula
   CHECK(max_joint_error(scene) < 1e-9);
   BridgeOptions small;
   small.chains = 4, small.links = 12, small.tie_every = 4;
-  ArticulatedScene s = make_bridge(small);
+  ArticulatedScene s  = make_bridge(small);
   const RunStats   st = run(s, ArticulatedParams{}, 120);
   CHECK(st.finite);
   CHECK(st.all_converged);
@@ -217,7 +222,7 @@ TEST_CASE("bad articulated input is rejected with a clear message", "[articulate
   ArticulatedScene negative = scene;
   negative.bodies[1].mass   = -2;
   CHECK_THAT(validate_scene(negative), Catch::Contains("mass must be positive"));
-  ArticulatedScene flat_inertia          = scene;
+  ArticulatedScene flat_inertia             = scene;
   flat_inertia.bodies[0].inertia_body(2, 2) = 0;
   CHECK_THAT(validate_scene(flat_inertia), Catch::Contains("inertia"));
   ArticulatedScene self = scene;
@@ -231,14 +236,17 @@ TEST_CASE("bad articulated input is rejected with a clear message", "[articulate
   CHECK_THROWS_AS(make_chain(ChainOptions{0}), std::invalid_argument);
 }
 
-TEST_CASE("joint matrix refill: stale values are overwritten, a row subset is filled completely", "[articulated]")
+TEST_CASE("joint matrix refill: stale values are overwritten, a row subset is filled completely",
+          "[articulated]")
 {
   BridgeOptions opt;
   opt.chains = 3, opt.links = 6, opt.tie_every = 2;
   ArticulatedScene scene = make_bridge(opt);
-  for (size_t i = 0; i < scene.bodies.size(); ++i) scene.bodies[i].orientation = rotated(scene.bodies[i].orientation, Eigen::Vector3d(0.2, 0.5 - 0.1 * i, -0.3), 1.0);
-  const JointMatrixPattern p = build_joint_matrix_pattern(scene);
-  const size_t             nb = scene.bodies.size(), nj = scene.joints.size();
+  for (size_t i = 0; i < scene.bodies.size(); ++i)
+    scene.bodies[i].orientation =
+      rotated(scene.bodies[i].orientation, Eigen::Vector3d(0.2, 0.5 - 0.1 * i, -0.3), 1.0);
+  const JointMatrixPattern     p  = build_joint_matrix_pattern(scene);
+  const size_t                 nb = scene.bodies.size(), nj = scene.joints.size();
   std::vector<Eigen::Matrix3d> inv_inertia(nb);
   std::vector<Eigen::Vector3d> arm_a(nj), arm_b(nj);
   for (size_t i = 0; i < nb; ++i) {
@@ -247,8 +255,10 @@ TEST_CASE("joint matrix refill: stale values are overwritten, a row subset is fi
   }
   for (size_t j = 0; j < nj; ++j) {
     const BallJoint &jt = scene.joints[j];
-    arm_a[j] = jt.body_a == kWorld ? Eigen::Vector3d::Zero() : Eigen::Vector3d(scene.bodies[jt.body_a].orientation * jt.anchor_a);
-    arm_b[j] = jt.body_b == kWorld ? Eigen::Vector3d::Zero() : Eigen::Vector3d(scene.bodies[jt.body_b].orientation * jt.anchor_b);
+    arm_a[j]            = jt.body_a == kWorld ? Eigen::Vector3d::Zero()
+                                              : Eigen::Vector3d(scene.bodies[jt.body_a].orientation * jt.anchor_a);
+    arm_b[j]            = jt.body_b == kWorld ? Eigen::Vector3d::Zero()
+                                              : Eigen::Vector3d(scene.bodies[jt.body_b].orientation * jt.anchor_b);
   }
   std::vector<double> full;
   fill_joint_matrix(scene, p, 0.0, inv_inertia, arm_a, arm_b, full);
@@ -268,7 +278,9 @@ TEST_CASE("joint matrix refill: stale values are overwritten, a row subset is fi
       for (int e = 0; e < 9; ++e) REQUIRE(part[9 * k + e] == full[9 * k + e]);
 }
 
-TEST_CASE("work split over processes: own joints partition, every body counted once, active = bodies of own joints", "[articulated][mpi]")
+TEST_CASE(
+  "work split over processes: own joints partition, every body counted once, active = bodies of own joints",
+  "[articulated][mpi]")
 {
   BridgeOptions opt;
   opt.chains = 3, opt.links = 6, opt.tie_every = 2;
@@ -296,7 +308,8 @@ TEST_CASE("work split over processes: own joints partition, every body counted o
     CHECK(std::is_sorted(w.active_bodies.begin(), w.active_bodies.end()));
     for (int j = 0; j < nj; ++j) { // impulse joints: exactly those with an active end
       const BallJoint &jt     = scene.joints[j];
-      const bool       active = (jt.body_a != kWorld && w.body_active[jt.body_a]) || (jt.body_b != kWorld && w.body_active[jt.body_b]);
+      const bool       active = (jt.body_a != kWorld && w.body_active[jt.body_a]) ||
+                          (jt.body_b != kWorld && w.body_active[jt.body_b]);
       CHECK(std::count(w.impulse_joints.begin(), w.impulse_joints.end(), j) == (active ? 1 : 0));
     }
     CHECK(w.body_active[nb - 1] == (p == 0));

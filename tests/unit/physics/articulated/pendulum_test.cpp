@@ -29,13 +29,15 @@ double swing_angle(const Eigen::Vector3d &centre, const Eigen::Vector3d &pivot)
 }
 
 // Period from the mean spacing of upward zero crossings of signal(t) (linear interpolation).
-template <class Signal> double measured_period(ArticulatedScene &scene, double dt, int steps, Signal signal, ArticulatedParams params = {})
+template <class Signal>
+double measured_period(ArticulatedScene &scene, double dt, int steps, Signal signal,
+                       ArticulatedParams params = {})
 {
-  params.dt              = dt;
-  ArticulatedSolver s    = make_articulated_solver(scene, params);
-  DenseBlockSolver  ref  = dense_solver_for(s.pattern);
-  auto              lin  = ref.adapter();
-  double            prev = signal(scene);
+  params.dt                = dt;
+  ArticulatedSolver   s    = make_articulated_solver(scene, params);
+  DenseBlockSolver    ref  = dense_solver_for(s.pattern);
+  auto                lin  = ref.adapter();
+  double              prev = signal(scene);
   std::vector<double> crossings;
   for (int n = 0; n < steps; ++n) {
     const ArticulatedStepReport r = articulated_step(scene, s, params, lin);
@@ -63,7 +65,8 @@ TEST_CASE("small-angle point pendulum has period 2 pi sqrt(L/g)", "[articulated]
   j.body_b   = 0;
   j.anchor_b = -bob.position; // pivot in the body's (unrotated) frame
   scene.joints.push_back(j);
-  const double T = measured_period(scene, 1e-3, 7000, [](const ArticulatedScene &s) { return s.bodies[0].position.x(); });
+  const double T =
+    measured_period(scene, 1e-3, 7000, [](const ArticulatedScene &s) { return s.bodies[0].position.x(); });
   const double T0 = 2 * M_PI * std::sqrt(L / g);
   CHECK(std::abs(T / T0 - 1) < 0.005);
   // The finer check: the amplitude correction 1 + th^2/16 (1.6e-4) and the sphere's own inertia
@@ -80,26 +83,31 @@ TEST_CASE("rigid rod pendulum has period 2 pi sqrt(I_O/(m g d))", "[articulated]
   ArticulatedScene scene = make_chain(opt);
   const double     m = opt.mass_first, l = opt.link_length, w = opt.link_width, d = l / 2;
   const double     I_O = m * (l * l + w * w) / 12 + m * d * d;
-  const double     T   = measured_period(scene, 1e-3, 5000, [](const ArticulatedScene &s) { return s.bodies[0].position.x(); });
-  const double     T_expected = 2 * M_PI * std::sqrt(I_O / (m * g * d));
+  const double     T =
+    measured_period(scene, 1e-3, 5000, [](const ArticulatedScene &s) { return s.bodies[0].position.x(); });
+  const double T_expected = 2 * M_PI * std::sqrt(I_O / (m * g * d));
   CHECK(std::abs(T / T_expected - 1) < 0.005);
 }
 
 TEST_CASE("double pendulum normal modes have w^2 = (g/l)(2 -/+ sqrt 2)", "[articulated][validation]")
 {
   const double l = 1.0, eps = 0.02, r = 0.01;
-  for (int mode : {-1, +1}) { // -1: slow in-phase mode, theta2 = +sqrt2 theta1; +1: fast, theta2 = -sqrt2 theta1
+  for (int mode :
+       {-1, +1}) { // -1: slow in-phase mode, theta2 = +sqrt2 theta1; +1: fast, theta2 = -sqrt2 theta1
     const double     theta1 = eps, theta2 = -mode * std::sqrt(2.0) * eps;
     ArticulatedScene scene;
     RigidBody        b1 = small_sphere(1.0, r), b2 = small_sphere(1.0, r);
-    b1.position = Eigen::Vector3d(l * std::sin(theta1), -l * std::cos(theta1), 0);
-    b2.position = b1.position + Eigen::Vector3d(l * std::sin(theta2), -l * std::cos(theta2), 0);
+    b1.position  = Eigen::Vector3d(l * std::sin(theta1), -l * std::cos(theta1), 0);
+    b2.position  = b1.position + Eigen::Vector3d(l * std::sin(theta2), -l * std::cos(theta2), 0);
     scene.bodies = {b1, b2};
     BallJoint top, mid;
     top.body_a = kWorld, top.anchor_a = Eigen::Vector3d::Zero(), top.body_b = 0, top.anchor_b = -b1.position;
-    mid.body_a = 0, mid.anchor_a = Eigen::Vector3d::Zero(), mid.body_b = 1, mid.anchor_b = b1.position - b2.position;
-    scene.joints = {top, mid};
-    const double T = measured_period(scene, 5e-4, 16000, [](const ArticulatedScene &s) { return swing_angle(s.bodies[0].position, Eigen::Vector3d::Zero()); });
+    mid.body_a = 0, mid.anchor_a = Eigen::Vector3d::Zero(), mid.body_b = 1,
+    mid.anchor_b            = b1.position - b2.position;
+    scene.joints            = {top, mid};
+    const double T          = measured_period(scene, 5e-4, 16000, [](const ArticulatedScene &s) {
+      return swing_angle(s.bodies[0].position, Eigen::Vector3d::Zero());
+    });
     const double w_expected = std::sqrt(g / l * (2 + mode * std::sqrt(2.0)));
     CHECK(std::abs(2 * M_PI / T / w_expected - 1) < 0.005);
   }

@@ -14,8 +14,8 @@ namespace {
 
 struct Run {
   double worst_error = 0, max_speed = 0;
-  long   iterations  = 0;
-  bool   converged   = true;
+  long   iterations = 0;
+  bool   converged  = true;
 };
 
 Run run_chain(double angle, bool warm, int steps)
@@ -24,12 +24,12 @@ Run run_chain(double angle, bool warm, int steps)
   opt.links = 20, opt.angle = angle;
   ArticulatedScene  scene = make_chain(opt);
   ArticulatedParams params;
-  params.dt         = 1.0 / 60;
-  params.warm_start = warm;
+  params.dt           = 1.0 / 60;
+  params.warm_start   = warm;
   ArticulatedSolver s = make_articulated_solver(scene, params);
   CgBlockSolver     cg;
   cg.pattern = &s.pattern, cg.rtol = 1e-8;
-  auto lin   = cg.adapter();
+  auto lin = cg.adapter();
   Run  out;
   for (int n = 0; n < steps; ++n) {
     const ArticulatedStepReport r = articulated_step(scene, s, params, lin);
@@ -49,11 +49,11 @@ TEST_CASE("warm-started CG: rigid rod keeps its period 2 pi sqrt(I_O/(m g d))", 
   opt.links = 1, opt.link_length = 1.0, opt.link_width = 0.05, opt.angle = 0.05;
   ArticulatedScene  scene = make_chain(opt);
   ArticulatedParams params;
-  params.dt         = 1e-3;
-  params.warm_start = true;
+  params.dt           = 1e-3;
+  params.warm_start   = true;
   ArticulatedSolver s = make_articulated_solver(scene, params);
   CgBlockSolver     cg;
-  cg.pattern = &s.pattern;
+  cg.pattern               = &s.pattern;
   auto                lin  = cg.adapter();
   double              prev = scene.bodies[0].position.x();
   std::vector<double> crossings;
@@ -64,17 +64,19 @@ TEST_CASE("warm-started CG: rigid rod keeps its period 2 pi sqrt(I_O/(m g d))", 
     prev = cur;
   }
   REQUIRE(crossings.size() >= 2);
-  const double T   = (crossings.back() - crossings.front()) / (crossings.size() - 1);
-  const double m   = opt.mass_first, l = opt.link_length, w = opt.link_width, d = l / 2;
+  const double T = (crossings.back() - crossings.front()) / (crossings.size() - 1);
+  const double m = opt.mass_first, l = opt.link_length, w = opt.link_width, d = l / 2;
   const double I_O = m * (l * l + w * w) / 12 + m * d * d;
   CHECK(std::abs(T / (2 * M_PI * std::sqrt(I_O / (m * 9.81 * d))) - 1) < 0.005);
 }
 
-TEST_CASE("warm start: a chain hanging at rest stays at rest with far fewer CG iterations", "[articulated][warm]")
+TEST_CASE("warm start: a chain hanging at rest stays at rest with far fewer CG iterations",
+          "[articulated][warm]")
 {
   const Run cold = run_chain(0.0, false, 120);
   const Run warm = run_chain(0.0, true, 120);
-  std::printf("20-link chain at rest, CG to 1e-8, 120 steps: %ld iterations cold, %ld warm\n", cold.iterations, warm.iterations);
+  std::printf("20-link chain at rest, CG to 1e-8, 120 steps: %ld iterations cold, %ld warm\n",
+              cold.iterations, warm.iterations);
   CHECK(cold.converged);
   CHECK(warm.converged);
   CHECK(warm.worst_error < 1e-6);

@@ -24,12 +24,14 @@ struct SparseBlockSolver {
     };
     s.solve = [this](const std::vector<double> &rhs, std::vector<double> &x) {
       Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> llt(A);
-      physics::LinearSolveResult                       r;
-      last_spd    = llt.info() == Eigen::Success;
-      r.converged = last_spd;
-      r.breakdown = !last_spd;
+      physics::LinearSolveResult                        r;
+      last_spd     = llt.info() == Eigen::Success;
+      r.converged  = last_spd;
+      r.breakdown  = !last_spd;
       r.iterations = 1;
-      Eigen::VectorXd sol = last_spd ? Eigen::VectorXd(llt.solve(Eigen::Map<const Eigen::VectorXd>(rhs.data(), rhs.size()))) : Eigen::VectorXd::Zero(rhs.size());
+      Eigen::VectorXd sol =
+        last_spd ? Eigen::VectorXd(llt.solve(Eigen::Map<const Eigen::VectorXd>(rhs.data(), rhs.size())))
+                 : Eigen::VectorXd::Zero(rhs.size());
       x.assign(sol.data(), sol.data() + sol.size());
       return r;
     };

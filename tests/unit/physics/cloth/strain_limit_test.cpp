@@ -17,8 +17,8 @@ namespace {
 double worst_stretch(int n, double max_strain, int steps, bool sphere)
 {
   ClothOptions opt;
-  opt.n = n;
-  Cloth cloth = make_cloth(opt);
+  opt.n                = n;
+  Cloth cloth          = make_cloth(opt);
   cloth.sphere.enabled = sphere;
   cloth.sphere.centre  = Eigen::Vector3d(0, -0.5, 0);
   ClothSystem sys      = make_cloth_system(cloth);
@@ -26,7 +26,7 @@ double worst_stretch(int n, double max_strain, int steps, bool sphere)
   auto        lin      = ref.adapter();
   ClothParams params;
   params.strain_limit.max_strain = max_strain;
-  double worst = 0;
+  double worst                   = 0;
   for (int s = 0; s < steps; ++s) {
     const ClothStepReport r = cloth_step(cloth, sys, params, lin);
     REQUIRE(r.converged);
@@ -37,7 +37,8 @@ double worst_stretch(int n, double max_strain, int steps, bool sphere)
 
 } // namespace
 
-TEST_CASE("strain limiting keeps a corner-pinned cloth within a few percent of its rest lengths", "[cloth][strain]")
+TEST_CASE("strain limiting keeps a corner-pinned cloth within a few percent of its rest lengths",
+          "[cloth][strain]")
 {
   // without it the pinned corners carry the cloth's weight on a few springs and stretch far
   const double free = worst_stretch(24, 0, 40, true);
@@ -54,11 +55,11 @@ TEST_CASE("strain limiting keeps a corner-pinned cloth within a few percent of i
 TEST_CASE("strain limiting leaves a cloth within the bound alone", "[cloth][strain]")
 {
   ClothOptions opt;
-  opt.n       = 6;
+  opt.n             = 6;
   Cloth       cloth = make_cloth(opt);
   const auto  x0    = cloth.position;
   StrainLimit limit;
-  limit.max_strain        = 0.05;
+  limit.max_strain          = 0.05;
   const StrainLimitReport r = limit_strain(cloth, limit, 0.01);
   CHECK(r.corrected == 0);
   CHECK(r.sweeps == 1);
@@ -77,8 +78,8 @@ TEST_CASE("strain limiting moves the free end of an overstretched spring and its
   StrainLimit limit;
   limit.max_strain          = 0.1;
   const StrainLimitReport r = limit_strain(c, limit, 0.5);
-  CHECK(c.position[0].norm() == 0.0);            // pinned
-  CHECK(c.position[1].x() == Approx(1.1));       // pulled back to the bound
+  CHECK(c.position[0].norm() == 0.0);             // pinned
+  CHECK(c.position[1].x() == Approx(1.1));        // pulled back to the bound
   CHECK(c.velocity[1].x() == Approx(-0.9 / 0.5)); // the change of position over the step
   CHECK(r.max_ratio == Approx(1.1));
 }

@@ -27,10 +27,19 @@ Eigen::Matrix3d random_rotation(std::mt19937 &rng)
 }
 
 // Kinds of current shape, drawn per element.
-enum Kind { Small, Large, Rigid, Inverted, NearlyFlat, Flat, Collapsed, kKinds };
+enum Kind {
+  Small,
+  Large,
+  Rigid,
+  Inverted,
+  NearlyFlat,
+  Flat,
+  Collapsed,
+  kKinds
+};
 
 struct Elements {
-  TetMesh           mesh; // disjoint elements: element e owns nodes npe e .. npe e + npe - 1
+  TetMesh             mesh; // disjoint elements: element e owns nodes npe e .. npe e + npe - 1
   std::vector<double> x, v;
   std::vector<int>    kind;
 };
@@ -50,14 +59,15 @@ Elements make_elements(int order, int n, unsigned seed)
     const Eigen::Vector3d base(0.5 * u(rng), 0.5 * u(rng), 0.5 * u(rng));
     for (int a = 0; a < 4; ++a) c[a] = base + Eigen::Vector3d(u(rng), u(rng), u(rng));
     if ((c[1] - c[0]).cross(c[2] - c[0]).dot(c[3] - c[0]) < 0) std::swap(c[1], c[2]);
-    if (std::fabs((c[1] - c[0]).cross(c[2] - c[0]).dot(c[3] - c[0])) < 0.05) c[3] += Eigen::Vector3d(0.3, 0.4, 0.5) * 2;
+    if (std::fabs((c[1] - c[0]).cross(c[2] - c[0]).dot(c[3] - c[0])) < 0.05)
+      c[3] += Eigen::Vector3d(0.3, 0.4, 0.5) * 2;
     if ((c[1] - c[0]).cross(c[2] - c[0]).dot(c[3] - c[0]) < 0) std::swap(c[1], c[2]);
     for (int a = 0; a < 4; ++a) {
       for (int d = 0; d < 3; ++d) lin.nodes.push_back(c[a][d]);
       lin.elements.push_back(4 * e + a);
     }
   }
-  s.mesh = order == 2 ? promote_to_quadratic(lin) : lin;
+  s.mesh        = order == 2 ? promote_to_quadratic(lin) : lin;
   const int npe = s.mesh.nodes_per_element();
   s.x.assign(s.mesh.nodes.size(), 0.0);
   s.v.resize(s.x.size());
@@ -74,7 +84,7 @@ Elements make_elements(int order, int n, unsigned seed)
       for (int j = 0; j < 9; ++j) A.data()[j] += 0.4 * u(rng);
     const Eigen::Vector3d t(u(rng), u(rng), u(rng));
     for (int a = 0; a < npe; ++a) {
-      const Eigen::Vector3d X = Eigen::Vector3d::Map(&s.mesh.nodes[3 * nd[a]]);
+      const Eigen::Vector3d X               = Eigen::Vector3d::Map(&s.mesh.nodes[3 * nd[a]]);
       Eigen::Vector3d::Map(&s.x[3 * nd[a]]) = Q * A * X + t;
     }
     // Corner 3 moved onto the plane of the other corners (Flat), just off it (NearlyFlat), through it
@@ -91,7 +101,8 @@ Elements make_elements(int order, int n, unsigned seed)
     if (order == 2) // edge nodes: midpoints of the moved corners, then bent a little (curved current edges)
       for (int k = 0; k < 6; ++k)
         for (int d = 0; d < 3; ++d)
-          s.x[3 * nd[4 + k] + d] = 0.5 * (c[kTetEdges[k][0]][d] + c[kTetEdges[k][1]][d]) + (kind == Collapsed ? 0 : 0.01 * u(rng));
+          s.x[3 * nd[4 + k] + d] =
+            0.5 * (c[kTetEdges[k][0]][d] + c[kTetEdges[k][1]][d]) + (kind == Collapsed ? 0 : 0.01 * u(rng));
   }
   return s;
 }
@@ -119,24 +130,26 @@ TEST_CASE("batched element kernels equal the scalar ones element by element", "[
         settings.poisson      = 0.45;
         settings.corotational = corotational;
         settings.mass         = variant == 1 ? MassLumping::Lumped : MassLumping::Consistent;
-        const FemModel   m = make_fem_model(s.mesh, settings);
+        const FemModel   m    = make_fem_model(s.mesh, settings);
         std::vector<int> elements(n);
         for (int e = 0; e < n; ++e) elements[e] = (e * 37) % n; // a permuted element list
         std::vector<char> fixed(m.node_count(), 0);
         fixed[3] = fixed[m.node_count() - 1] = 1; // some slots dropped
-        const BlockPattern p = make_block_pattern(m, elements, fixed, 0, m.node_count(), false); // one COO block per element block
-        const StepCoefficients c = variant == 0   ? implicit_euler_coefficients(0.01, 0.5, 0.002)
-                                   : variant == 1 ? implicit_euler_coefficients(0.01)
-                                                  : StepCoefficients{1, 0, 0, 0, 1};
-        const bool          blocks = variant != 3;
-        std::vector<double> vs, vb, rs(s.x.size(), 0.0), rb(s.x.size(), 0.0);
+        const BlockPattern p =
+          make_block_pattern(m, elements, fixed, 0, m.node_count(), false); // one COO block per element block
+        const StepCoefficients c      = variant == 0   ? implicit_euler_coefficients(0.01, 0.5, 0.002)
+                                        : variant == 1 ? implicit_euler_coefficients(0.01)
+                                                       : StepCoefficients{1, 0, 0, 0, 1};
+        const bool             blocks = variant != 3;
+        std::vector<double>    vs, vb, rs(s.x.size(), 0.0), rb(s.x.size(), 0.0);
         reset_block_values(p, vs);
         reset_block_values(p, vb);
         std::vector<Eigen::Matrix3d> Rs(n), Rb(n);
-        assemble_elements(m, elements, s.x.data(), s.v.data(), c, blocks ? &p : nullptr, blocks ? vs.data() : nullptr, rs.data(),
-                          Rs.data(), ElementKernel::Scalar);
-        const long long scalar_path = assemble_elements(m, elements, s.x.data(), s.v.data(), c, blocks ? &p : nullptr,
-                                                        blocks ? vb.data() : nullptr, rb.data(), Rb.data(), ElementKernel::Batched);
+        assemble_elements(m, elements, s.x.data(), s.v.data(), c, blocks ? &p : nullptr,
+                          blocks ? vs.data() : nullptr, rs.data(), Rs.data(), ElementKernel::Scalar);
+        const long long scalar_path =
+          assemble_elements(m, elements, s.x.data(), s.v.data(), c, blocks ? &p : nullptr,
+                            blocks ? vb.data() : nullptr, rb.data(), Rb.data(), ElementKernel::Batched);
         // Every inverted, flat or collapsed element takes the scalar SVD path, regular ones do not.
         if (corotational) {
           long long expected_min = 0, expected_max = 0;
@@ -150,12 +163,12 @@ TEST_CASE("batched element kernels equal the scalar ones element by element", "[
         } else {
           CHECK(scalar_path == 0);
         }
-        const int npe = m.npe;
+        const int npe         = m.npe;
         double    worst_block = 0, worst_rhs = 0, worst_R = 0;
-        int       compared    = 0;
+        int       compared = 0;
         for (int i = 0; i < n; ++i) {
-          const int e  = elements[i];
-          worst_R      = std::max(worst_R, (Rs[i] - Rb[i]).norm());
+          const int e   = elements[i];
+          worst_R       = std::max(worst_R, (Rs[i] - Rb[i]).norm());
           const int *nd = &m.mesh.elements[static_cast<size_t>(e) * npe];
           // This element's nodes are its own: compare its forces, scaled by their largest entry, or
           // for a rigidly moved element (forces of round-off) by those of a 0.1% strain.
@@ -194,7 +207,8 @@ TEST_CASE("batched element kernels equal the scalar ones element by element", "[
       }
 }
 
-TEST_CASE("fixed-step polar kernel: the scalar rotation where it accepts, the fallback flag elsewhere", "[fem][polar][batch]")
+TEST_CASE("fixed-step polar kernel: the scalar rotation where it accepts, the fallback flag elsewhere",
+          "[fem][polar][batch]")
 {
   std::mt19937                           rng(23);
   std::normal_distribution<double>       normal(0, 1);
@@ -205,9 +219,10 @@ TEST_CASE("fixed-step polar kernel: the scalar rotation where it accepts, the fa
     // Singular values 1 +- 1% or with ratios up to 4:1 (3:1 stretch), overall scale 1e-3..1e3.
     Eigen::Vector3d sv;
     for (int d = 0; d < 3; ++d) sv[d] = k % 2 ? std::pow(4.0, -0.5 + uniform(rng)) : 1.0 + 0.01 * normal(rng);
-    const Eigen::Matrix3d F = std::pow(10.0, -3 + 6 * uniform(rng)) * random_rotation(rng) * sv.asDiagonal() * random_rotation(rng);
-    double                R[9];
-    const double          ok = kernels::polar_rotation<1>(F.data(), R);
+    const Eigen::Matrix3d F =
+      std::pow(10.0, -3 + 6 * uniform(rng)) * random_rotation(rng) * sv.asDiagonal() * random_rotation(rng);
+    double       R[9];
+    const double ok = kernels::polar_rotation<1>(F.data(), R);
     accepted += ok != 0;
     REQUIRE(ok != 0);
     worst = std::max(worst, (Eigen::Matrix3d::Map(R) - rotation_from_deformation(F)).norm());
@@ -217,12 +232,13 @@ TEST_CASE("fixed-step polar kernel: the scalar rotation where it accepts, the fa
   // Refused (identity returned, no NaN): inverted, flat, collapsed, zero, NaN, Inf.
   const Eigen::Matrix3d Q   = random_rotation(rng);
   Eigen::Matrix3d       nan = Eigen::Matrix3d::Identity(), inf = Eigen::Matrix3d::Identity();
-  nan(1, 2)                 = std::nan("");
-  inf(0, 1)                 = std::numeric_limits<double>::infinity();
+  nan(1, 2) = std::nan("");
+  inf(0, 1) = std::numeric_limits<double>::infinity();
   for (const Eigen::Matrix3d &F :
        {Eigen::Matrix3d(-Q), Eigen::Matrix3d(Q * Eigen::DiagonalMatrix<double, 3>(1.0, 1.0, -0.2)),
         Eigen::Matrix3d(Q * Eigen::DiagonalMatrix<double, 3>(1.0, 2.0, 0.0)),
-        Eigen::Matrix3d(Q * Eigen::DiagonalMatrix<double, 3>(1.0, 0.0, 0.0)), Eigen::Matrix3d(Eigen::Matrix3d::Zero()), nan, inf}) {
+        Eigen::Matrix3d(Q * Eigen::DiagonalMatrix<double, 3>(1.0, 0.0, 0.0)),
+        Eigen::Matrix3d(Eigen::Matrix3d::Zero()), nan, inf}) {
     double R[9];
     CHECK(kernels::polar_rotation<1>(F.data(), R) == 0);
     CHECK((Eigen::Matrix3d::Map(R) - Eigen::Matrix3d::Identity()).norm() == 0);

@@ -20,7 +20,8 @@ namespace {
 
 bool is_rotation(const Eigen::Matrix3d &R, double tol = 1e-10)
 {
-  return R.allFinite() && (R.transpose() * R - Eigen::Matrix3d::Identity()).norm() < tol && std::fabs(R.determinant() - 1) < tol;
+  return R.allFinite() && (R.transpose() * R - Eigen::Matrix3d::Identity()).norm() < tol &&
+         std::fabs(R.determinant() - 1) < tol;
 }
 
 Eigen::Matrix3d some_rotation()
@@ -38,13 +39,14 @@ Eigen::Matrix3d random_rotation(std::mt19937 &rng, std::normal_distribution<doub
 
 TetMesh jittered_box(int order)
 {
-  TetMesh      m = make_box_mesh(1.0, 0.8, 0.6, 3, 3, 3);
-  std::mt19937 rng(7);
+  TetMesh                                m = make_box_mesh(1.0, 0.8, 0.6, 3, 3, 3);
+  std::mt19937                           rng(7);
   std::uniform_real_distribution<double> u(-0.06, 0.06);
   for (int i = 0; i < m.node_count(); ++i) {
-    bool interior = true;
-    const double ext[3] = {1.0, 0.8, 0.6};
-    for (int d = 0; d < 3; ++d) interior = interior && m.nodes[3 * i + d] > 1e-9 && m.nodes[3 * i + d] < ext[d] - 1e-9;
+    bool         interior = true;
+    const double ext[3]   = {1.0, 0.8, 0.6};
+    for (int d = 0; d < 3; ++d)
+      interior = interior && m.nodes[3 * i + d] > 1e-9 && m.nodes[3 * i + d] < ext[d] - 1e-9;
     if (interior)
       for (int d = 0; d < 3; ++d) m.nodes[3 * i + d] += u(rng);
   }
@@ -82,12 +84,13 @@ TEST_CASE("polar decomposition: proper rotation for regular, inverted, flat and 
   CHECK((rotation_from_deformation(1e-9 * Q * S) - Q).norm() < 1e-9);
 }
 
-TEST_CASE("polar decomposition agrees with the SVD polar factor on random F, near inversion too", "[fem][polar]")
+TEST_CASE("polar decomposition agrees with the SVD polar factor on random F, near inversion too",
+          "[fem][polar]")
 {
   std::mt19937                           rng(11);
   std::normal_distribution<double>       normal(0, 1);
   std::uniform_real_distribution<double> uniform(0, 1);
-  double worst = 0;
+  double                                 worst = 0;
   for (int k = 0; k < 2000; ++k) {
     // F = U diag(s) V^T with singular values between 0.05 and 3 (strains of 1e-6 to 200%).
     const double    spread = std::pow(10.0, -6 + 6 * uniform(rng));
@@ -114,12 +117,13 @@ TEST_CASE("polar decomposition agrees with the SVD polar factor on random F, nea
   }
 }
 
-TEST_CASE("batched polar decomposition: the scalar path's rotations, special lanes mixed into batches", "[fem][polar]")
+TEST_CASE("batched polar decomposition: the scalar path's rotations, special lanes mixed into batches",
+          "[fem][polar]")
 {
   std::mt19937                           rng(5);
   std::normal_distribution<double>       normal(0, 1);
   std::uniform_real_distribution<double> uniform(0, 1);
-  std::vector<Eigen::Matrix3d> F, polar; // polar: U V^T where known (zero: no reference)
+  std::vector<Eigen::Matrix3d>           F, polar; // polar: U V^T where known (zero: no reference)
   for (int k = 0; k < 2000; ++k) {
     const double    spread = std::pow(10.0, -6 + 6 * uniform(rng));
     Eigen::Vector3d s;
@@ -135,14 +139,15 @@ TEST_CASE("batched polar decomposition: the scalar path's rotations, special lan
     polar.push_back(U * V.transpose());
   }
   // Strongly inverted, flat, collapsed, zero, non-finite: compared with the scalar path only.
-  const Eigen::Matrix3d Q = some_rotation();
+  const Eigen::Matrix3d Q   = some_rotation();
   Eigen::Matrix3d       nan = Eigen::Matrix3d::Identity(), inf = Eigen::Matrix3d::Identity();
-  nan(1, 2)               = std::nan("");
-  inf(0, 1)               = std::numeric_limits<double>::infinity();
+  nan(1, 2) = std::nan("");
+  inf(0, 1) = std::numeric_limits<double>::infinity();
   for (const Eigen::Matrix3d &special :
        {Eigen::Matrix3d(-Q), Eigen::Matrix3d(Q * Eigen::DiagonalMatrix<double, 3>(1.0, 1.0, -0.2)),
         Eigen::Matrix3d(Q * Eigen::DiagonalMatrix<double, 3>(1.0, 2.0, 0.0)),
-        Eigen::Matrix3d(Q * Eigen::DiagonalMatrix<double, 3>(1.0, 0.0, 0.0)), Eigen::Matrix3d(Eigen::Matrix3d::Zero()), nan, inf}) {
+        Eigen::Matrix3d(Q * Eigen::DiagonalMatrix<double, 3>(1.0, 0.0, 0.0)),
+        Eigen::Matrix3d(Eigen::Matrix3d::Zero()), nan, inf}) {
     F.push_back(special);
     polar.push_back(Eigen::Matrix3d::Zero());
   }
@@ -159,7 +164,8 @@ TEST_CASE("batched polar decomposition: the scalar path's rotations, special lan
     for (size_t i = 0; i < n; ++i) {
       REQUIRE(is_rotation(R[i]));
       worst_scalar = std::max(worst_scalar, (R[i] - rotation_from_deformation(F_mixed[i])).norm());
-      if (polar_mixed[i].squaredNorm() > 0) worst_polar = std::max(worst_polar, (R[i] - polar_mixed[i]).norm());
+      if (polar_mixed[i].squaredNorm() > 0)
+        worst_polar = std::max(worst_polar, (R[i] - polar_mixed[i]).norm());
     }
     CHECK(worst_scalar < 1e-14);
     CHECK(worst_polar < 1e-9); // the inversion sweep's tolerance; regular F below
@@ -189,26 +195,28 @@ TEST_CASE("P2 shape functions integrate to -V/20 (corners) and V/5 (edges); mass
   CHECK(Mh(0, 0) == Approx(1.0 / 36));
 }
 
-TEST_CASE("rigidly rotated mesh at rest: zero corotational force, spurious linear force", "[fem][corotational]")
+TEST_CASE("rigidly rotated mesh at rest: zero corotational force, spurious linear force",
+          "[fem][corotational]")
 {
   for (int order : {1, 2}) {
     INFO("order " << order);
     FemSettings s;
-    s.young          = 1e6;
-    const TetMesh mesh = jittered_box(order);
-    const Eigen::Matrix3d  Q = some_rotation();
-    const Eigen::Vector3d  t(0.4, -1.0, 2.0);
-    std::vector<double>    x(mesh.nodes.size());
-    double                 scale = 0;
-    for (int i = 0; i < mesh.node_count(); ++i) Eigen::Vector3d::Map(&x[3 * i]) = Q * Eigen::Vector3d::Map(&mesh.nodes[3 * i]) + t;
+    s.young                    = 1e6;
+    const TetMesh         mesh = jittered_box(order);
+    const Eigen::Matrix3d Q    = some_rotation();
+    const Eigen::Vector3d t(0.4, -1.0, 2.0);
+    std::vector<double>   x(mesh.nodes.size());
+    double                scale = 0;
+    for (int i = 0; i < mesh.node_count(); ++i)
+      Eigen::Vector3d::Map(&x[3 * i]) = Q * Eigen::Vector3d::Map(&mesh.nodes[3 * i]) + t;
     s.corotational        = true;
     const FemModel corot  = make_fem_model(mesh, s);
     s.corotational        = false;
     const FemModel linear = make_fem_model(mesh, s);
     // Force scale: what a unit-size displacement would produce (E * characteristic area).
-    scale = s.young * 0.1;
-    const auto fc = elastic_forces(corot, x.data());
-    const auto fl = elastic_forces(linear, x.data());
+    scale            = s.young * 0.1;
+    const auto fc    = elastic_forces(corot, x.data());
+    const auto fl    = elastic_forces(linear, x.data());
     double     max_c = 0, max_l = 0;
     for (size_t k = 0; k < fc.size(); ++k) {
       max_c = std::max(max_c, std::fabs(fc[k]));
@@ -226,9 +234,9 @@ TEST_CASE("patch test: a linear displacement field is reproduced exactly by P1 a
     INFO("order " << order);
     const TetMesh mesh = jittered_box(order);
     FemSettings   s;
-    s.corotational = false;
-    s.poisson      = 0.35;
-    const FemModel m = make_fem_model(mesh, s);
+    s.corotational    = false;
+    s.poisson         = 0.35;
+    const FemModel  m = make_fem_model(mesh, s);
     Eigen::Matrix3d G;
     G << 1e-3, 2e-3, -1e-3, 0.5e-3, -2e-3, 1e-3, 3e-3, 1e-3, 0.7e-3;
     const Eigen::Vector3d b(0.01, -0.02, 0.03);
@@ -244,21 +252,23 @@ TEST_CASE("patch test: a linear displacement field is reproduced exactly by P1 a
     }
     // Static Newton step from x: K dx = f(x).
     const physics::StepCoefficients c{1, 0, 0, 0, 1};
-    const auto   sys = fem_test::assemble(m, boundary, c, x, std::vector<double>(x.size(), 0.0), {}, 0);
-    const auto   dx  = fem_test::solve(sys);
-    double       err = 0;
-    int          interior = 0;
+    const auto sys      = fem_test::assemble(m, boundary, c, x, std::vector<double>(x.size(), 0.0), {}, 0);
+    const auto dx       = fem_test::solve(sys);
+    double     err      = 0;
+    int        interior = 0;
     for (int i = 0; i < mesh.node_count(); ++i) {
       if (boundary[i]) continue;
       ++interior;
-      const Eigen::Vector3d u = Eigen::Vector3d::Map(&x[3 * i]) + dx.segment<3>(3 * i) - Eigen::Vector3d::Map(&mesh.nodes[3 * i]);
+      const Eigen::Vector3d u =
+        Eigen::Vector3d::Map(&x[3 * i]) + dx.segment<3>(3 * i) - Eigen::Vector3d::Map(&mesh.nodes[3 * i]);
       err = std::max(err, (u - exact(i)).norm());
     }
     CHECK(interior > 0);
     CHECK(err < 1e-12);
     // And the internal nodal forces of the exact field vanish at interior nodes.
-    for (int i = 0; i < mesh.node_count(); ++i) Eigen::Vector3d::Map(&x[3 * i]) = Eigen::Vector3d::Map(&mesh.nodes[3 * i]) + exact(i);
-    const auto f = elastic_forces(m, x.data());
+    for (int i = 0; i < mesh.node_count(); ++i)
+      Eigen::Vector3d::Map(&x[3 * i]) = Eigen::Vector3d::Map(&mesh.nodes[3 * i]) + exact(i);
+    const auto f    = elastic_forces(m, x.data());
     double     fmax = 0;
     for (int i = 0; i < mesh.node_count(); ++i)
       if (!boundary[i]) fmax = std::max(fmax, Eigen::Vector3d::Map(&f[3 * i]).norm());
@@ -270,43 +280,49 @@ TEST_CASE("P1 fast kernel (rotated gradients) equals the generic K0 kernel", "[f
 {
   const TetMesh mesh = jittered_box(1);
   FemSettings   s;
-  s.poisson       = 0.42;
-  FemModel fast   = make_fem_model(mesh, s);
+  s.poisson        = 0.42;
+  FemModel fast    = make_fem_model(mesh, s);
   FemModel generic = fast;
   generic.gradients.clear(); // falls back to the stored-K0 kernel
-  const auto elements = fem_test::all_elements(fast);
+  const auto        elements = fem_test::all_elements(fast);
   std::vector<char> fixed(mesh.node_count(), 0);
-  fixed[0] = fixed[5] = 1;
-  const BlockPattern p = make_block_pattern(fast, elements, fixed, 0, mesh.node_count(), true);
-  std::vector<double> x(mesh.nodes), v(x.size());
+  fixed[0] = fixed[5]     = 1;
+  const BlockPattern    p = make_block_pattern(fast, elements, fixed, 0, mesh.node_count(), true);
+  std::vector<double>   x(mesh.nodes), v(x.size());
   const Eigen::Matrix3d Q = some_rotation();
   for (int i = 0; i < mesh.node_count(); ++i) {
-    Eigen::Vector3d::Map(&x[3 * i]) = Q * (Eigen::Vector3d::Map(&mesh.nodes[3 * i]) * 1.1 + Eigen::Vector3d(0, 0.05 * mesh.nodes[3 * i], 0));
+    Eigen::Vector3d::Map(&x[3 * i]) =
+      Q * (Eigen::Vector3d::Map(&mesh.nodes[3 * i]) * 1.1 + Eigen::Vector3d(0, 0.05 * mesh.nodes[3 * i], 0));
     v[3 * i] = std::sin(i * 0.3), v[3 * i + 1] = std::cos(i * 0.7), v[3 * i + 2] = 0.1 * i;
   }
   const StepCoefficients c = implicit_euler_coefficients(0.02, 0.3, 0.001);
-  std::vector<double> va, vb, ra(x.size(), 0.0), rb(x.size(), 0.0);
+  std::vector<double>    va, vb, ra(x.size(), 0.0), rb(x.size(), 0.0);
   reset_block_values(p, va);
   reset_block_values(p, vb);
-  assemble_elements(fast, elements, x.data(), v.data(), c, &p, va.data(), ra.data(), nullptr, ElementKernel::Scalar);
-  assemble_elements(generic, elements, x.data(), v.data(), c, &p, vb.data(), rb.data(), nullptr, ElementKernel::Scalar);
+  assemble_elements(fast, elements, x.data(), v.data(), c, &p, va.data(), ra.data(), nullptr,
+                    ElementKernel::Scalar);
+  assemble_elements(generic, elements, x.data(), v.data(), c, &p, vb.data(), rb.data(), nullptr,
+                    ElementKernel::Scalar);
   double dv = 0, sv = 0, dr = 0, sr = 0;
-  for (size_t k = 0; k < va.size(); ++k) dv = std::max(dv, std::fabs(va[k] - vb[k])), sv = std::max(sv, std::fabs(vb[k]));
-  for (size_t k = 0; k < ra.size(); ++k) dr = std::max(dr, std::fabs(ra[k] - rb[k])), sr = std::max(sr, std::fabs(rb[k]));
+  for (size_t k = 0; k < va.size(); ++k)
+    dv = std::max(dv, std::fabs(va[k] - vb[k])), sv = std::max(sv, std::fabs(vb[k]));
+  for (size_t k = 0; k < ra.size(); ++k)
+    dr = std::max(dr, std::fabs(ra[k] - rb[k])), sr = std::max(sr, std::fabs(rb[k]));
   CHECK(dv < 1e-12 * sv);
   CHECK(dr < 1e-12 * sr);
   CHECK(sr > 0);
 }
 
-TEST_CASE("element loop overwrites the block values: one first write per block, no reset needed", "[fem][kernel]")
+TEST_CASE("element loop overwrites the block values: one first write per block, no reset needed",
+          "[fem][kernel]")
 {
   for (int order : {1, 2})
     for (bool merge : {true, false})
       for (bool drop : {false, true}) {
         INFO("order " << order << " merge " << merge << " drop lower " << drop);
-        const TetMesh  mesh     = jittered_box(order);
-        const FemModel m        = make_fem_model(mesh, FemSettings{});
-        const auto     elements = fem_test::all_elements(m);
+        const TetMesh     mesh     = jittered_box(order);
+        const FemModel    m        = make_fem_model(mesh, FemSettings{});
+        const auto        elements = fem_test::all_elements(m);
         std::vector<char> fixed(mesh.node_count(), 0);
         fixed[0] = fixed[5] = 1;
         LowerTriangle lower;
@@ -330,7 +346,8 @@ TEST_CASE("element loop overwrites the block values: one first write per block, 
         // Garbage in the element blocks, then two assemblies without a reset: the same bits.
         std::vector<double> reused(fresh.size(), std::nan(""));
         reset_block_values(p, reused);
-        for (int pass = 0; pass < 2; ++pass) assemble_elements(m, elements, x.data(), v.data(), c, &p, reused.data(), rhs.data());
+        for (int pass = 0; pass < 2; ++pass)
+          assemble_elements(m, elements, x.data(), v.data(), c, &p, reused.data(), rhs.data());
         CHECK(reused == fresh);
         // Against the unmerged assembly (one COO block per element block, nothing shared) summed here.
         if (merge) {
@@ -347,7 +364,8 @@ TEST_CASE("element loop overwrites the block values: one first write per block, 
           double diff = 0, scale = 0;
           for (size_t k = 0; k < p.rows.size(); ++k) {
             const Eigen::Matrix<double, 9, 1> &ref = sum.at({p.rows[k], p.cols[k]});
-            diff  = std::max(diff, (Eigen::Matrix<double, 9, 1>::Map(&fresh[9 * k]) - ref).cwiseAbs().maxCoeff());
+            diff =
+              std::max(diff, (Eigen::Matrix<double, 9, 1>::Map(&fresh[9 * k]) - ref).cwiseAbs().maxCoeff());
             scale = std::max(scale, ref.cwiseAbs().maxCoeff());
           }
           CHECK(diff <= 1e-13 * scale);
@@ -355,41 +373,43 @@ TEST_CASE("element loop overwrites the block values: one first write per block, 
       }
 }
 
-TEST_CASE("upper-triangle patterns: kept blocks equal the full assembly's, lower ones dropped", "[fem][kernel]")
+TEST_CASE("upper-triangle patterns: kept blocks equal the full assembly's, lower ones dropped",
+          "[fem][kernel]")
 {
   for (int order : {1, 2}) {
     INFO("order " << order);
-    const TetMesh mesh = jittered_box(order);
-    const FemModel m   = make_fem_model(mesh, FemSettings{});
-    const auto elements = fem_test::all_elements(m);
+    const TetMesh     mesh     = jittered_box(order);
+    const FemModel    m        = make_fem_model(mesh, FemSettings{});
+    const auto        elements = fem_test::all_elements(m);
     std::vector<char> fixed(mesh.node_count(), 0);
-    fixed[0] = fixed[5] = 1;
+    fixed[0] = fixed[5]     = 1;
     const int          n    = mesh.node_count();
     const BlockPattern full = make_block_pattern(m, elements, fixed, 0, n, true);
     LowerTriangle      drop;
-    drop.drop = true;
+    drop.drop            = true;
     LowerTriangle across = drop;
     across.part_offsets  = {0, n / 3, n}; // two parts: lower blocks between them are kept
-    std::vector<double> x(mesh.nodes), v(x.size());
+    std::vector<double>   x(mesh.nodes), v(x.size());
     const Eigen::Matrix3d Q = some_rotation();
     for (int i = 0; i < n; ++i) {
       Eigen::Vector3d::Map(&x[3 * i]) = Q * (Eigen::Vector3d::Map(&mesh.nodes[3 * i]) * 1.05);
       v[3 * i] = std::sin(i * 0.3), v[3 * i + 1] = std::cos(i * 0.7), v[3 * i + 2] = 0.1 * i;
     }
     const StepCoefficients c = implicit_euler_coefficients(0.02, 0.3, 0.001);
-    std::vector<double> vf, rf(x.size(), 0.0);
+    std::vector<double>    vf, rf(x.size(), 0.0);
     reset_block_values(full, vf);
     assemble_elements(m, elements, x.data(), v.data(), c, &full, vf.data(), rf.data());
     std::map<std::pair<int, int>, int> full_slot;
-    for (size_t k = 0; k < full.rows.size(); ++k) full_slot[{full.rows[k], full.cols[k]}] = static_cast<int>(k);
+    for (size_t k = 0; k < full.rows.size(); ++k)
+      full_slot[{full.rows[k], full.cols[k]}] = static_cast<int>(k);
     for (const LowerTriangle &lower : {drop, across}) {
-      const BlockPattern p = make_block_pattern(m, elements, fixed, 0, n, true, lower);
+      const BlockPattern  p = make_block_pattern(m, elements, fixed, 0, n, true, lower);
       std::vector<double> vp, rp(x.size(), 0.0);
       reset_block_values(p, vp);
       assemble_elements(m, elements, x.data(), v.data(), c, &p, vp.data(), rp.data());
       size_t expected = 0;
       for (size_t k = 0; k < full.rows.size(); ++k) {
-        const int r = full.rows[k], q = full.cols[k];
+        const int  r = full.rows[k], q = full.cols[k];
         const bool crosses = !lower.part_offsets.empty() && ((r < n / 3) != (q < n / 3));
         expected += (r <= q || crosses) ? 1 : 0;
       }
@@ -399,7 +419,9 @@ TEST_CASE("upper-triangle patterns: kept blocks equal the full assembly's, lower
         const bool crosses = !lower.part_offsets.empty() && ((p.rows[k] < n / 3) != (p.cols[k] < n / 3));
         CHECK((p.rows[k] <= p.cols[k] || crosses));
         const int f = full_slot.at({p.rows[k], p.cols[k]});
-        for (int j = 0; j < 9; ++j) diff = std::max(diff, std::fabs(vp[9 * k + j] - vf[9 * f + j])), scale = std::max(scale, std::fabs(vf[9 * f + j]));
+        for (int j = 0; j < 9; ++j)
+          diff  = std::max(diff, std::fabs(vp[9 * k + j] - vf[9 * f + j])),
+          scale = std::max(scale, std::fabs(vf[9 * f + j]));
       }
       CHECK(diff == 0.0);
       CHECK(scale > 0);

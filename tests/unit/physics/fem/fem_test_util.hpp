@@ -24,26 +24,29 @@ struct LinearSystem {
 
 // A and rhs of one step with coefficients c (gravity force f_ext scaled by ext_scale added to rhs);
 // fixed rows are identity with zero right-hand side, exactly as the driver does it.
-inline LinearSystem assemble(const physics::FemModel &m, const std::vector<char> &fixed, const physics::StepCoefficients &c,
-                             const std::vector<double> &x, const std::vector<double> &v, const std::vector<double> &f_ext,
-                             double ext_scale)
+inline LinearSystem assemble(const physics::FemModel &m, const std::vector<char> &fixed,
+                             const physics::StepCoefficients &c, const std::vector<double> &x,
+                             const std::vector<double> &v, const std::vector<double> &f_ext, double ext_scale)
 {
-  const auto             elements = all_elements(m);
-  physics::BlockPattern  p        = physics::make_block_pattern(m, elements, fixed, 0, m.node_count(), true);
-  std::vector<double>    values;
+  const auto            elements = all_elements(m);
+  physics::BlockPattern p        = physics::make_block_pattern(m, elements, fixed, 0, m.node_count(), true);
+  std::vector<double>   values;
   physics::reset_block_values(p, values);
-  const int n = m.node_count();
+  const int    n = m.node_count();
   LinearSystem s;
   s.rhs = Eigen::VectorXd::Zero(3 * n);
   physics::assemble_elements(m, elements, x.data(), v.data(), c, &p, values.data(), s.rhs.data());
   std::vector<Eigen::Triplet<double>> t;
   for (size_t k = 0; k < p.rows.size(); ++k)
     for (int r = 0; r < 3; ++r)
-      for (int q = 0; q < 3; ++q) t.emplace_back(3 * p.rows[k] + r, 3 * p.cols[k] + q, values[9 * k + 3 * r + q]);
+      for (int q = 0; q < 3; ++q)
+        t.emplace_back(3 * p.rows[k] + r, 3 * p.cols[k] + q, values[9 * k + 3 * r + q]);
   s.A.resize(3 * n, 3 * n);
   s.A.setFromTriplets(t.begin(), t.end());
   for (int i = 0; i < n; ++i)
-    for (int d = 0; d < 3; ++d) s.rhs[3 * i + d] = fixed[i] ? 0.0 : s.rhs[3 * i + d] + ext_scale * (f_ext.empty() ? 0.0 : f_ext[3 * i + d]);
+    for (int d = 0; d < 3; ++d)
+      s.rhs[3 * i + d] =
+        fixed[i] ? 0.0 : s.rhs[3 * i + d] + ext_scale * (f_ext.empty() ? 0.0 : f_ext[3 * i + d]);
   return s;
 }
 
@@ -62,7 +65,8 @@ inline Eigen::SparseMatrix<double> mass_matrix(const physics::FemModel &m)
     for (int a = 0; a < m.npe; ++a)
       for (int b = 0; b < m.npe; ++b)
         for (int d = 0; d < 3; ++d)
-          t.emplace_back(3 * nodes[a] + d, 3 * nodes[b] + d, m.settings.density * m.volume[e] * m.reference_mass(a, b));
+          t.emplace_back(3 * nodes[a] + d, 3 * nodes[b] + d,
+                         m.settings.density * m.volume[e] * m.reference_mass(a, b));
   }
   Eigen::SparseMatrix<double> M(3 * m.node_count(), 3 * m.node_count());
   M.setFromTriplets(t.begin(), t.end());

@@ -40,15 +40,16 @@ $EndElements
 // The same tetrahedron as a 10-node element, format 4.1; gmsh's edge order 01 12 20 30 32 31.
 std::string msh41_tet10()
 {
-  const double c[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-  const int    gmsh_edges[6][2] = {{0, 1}, {1, 2}, {2, 0}, {3, 0}, {3, 2}, {3, 1}};
+  const double       c[4][3]          = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  const int          gmsh_edges[6][2] = {{0, 1}, {1, 2}, {2, 0}, {3, 0}, {3, 2}, {3, 1}};
   std::ostringstream s;
   s << "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 0 1\n1 0 0 0 1 1 1 0 0\n$EndEntities\n";
   s << "$Nodes\n1 10 1 10\n3 1 0 10\n";
   for (int i = 1; i <= 10; ++i) s << i << "\n";
   for (int i = 0; i < 4; ++i) s << c[i][0] << " " << c[i][1] << " " << c[i][2] << "\n";
   for (const auto &e : gmsh_edges)
-    s << 0.5 * (c[e[0]][0] + c[e[1]][0]) << " " << 0.5 * (c[e[0]][1] + c[e[1]][1]) << " " << 0.5 * (c[e[0]][2] + c[e[1]][2]) << "\n";
+    s << 0.5 * (c[e[0]][0] + c[e[1]][0]) << " " << 0.5 * (c[e[0]][1] + c[e[1]][1]) << " "
+      << 0.5 * (c[e[0]][2] + c[e[1]][2]) << "\n";
   s << "$EndNodes\n$Elements\n1 1 1 1\n3 1 11 1\n1 1 2 3 4 5 6 7 8 9 10\n$EndElements\n";
   return s.str();
 }
@@ -91,7 +92,8 @@ TEST_CASE("msh 4.1 tet10: edge nodes land at the midpoints of our edges", "[fem]
   REQUIRE(m.element_count() == 1);
   for (int k = 0; k < 6; ++k) {
     const int a = m.elements[kTetEdges[k][0]], b = m.elements[kTetEdges[k][1]], mid = m.elements[4 + k];
-    for (int d = 0; d < 3; ++d) CHECK(m.nodes[3 * mid + d] == Approx(0.5 * (m.nodes[3 * a + d] + m.nodes[3 * b + d])));
+    for (int d = 0; d < 3; ++d)
+      CHECK(m.nodes[3 * mid + d] == Approx(0.5 * (m.nodes[3 * a + d] + m.nodes[3 * b + d])));
   }
 }
 
@@ -103,16 +105,21 @@ TEST_CASE("malformed msh files give clear errors", "[fem][msh]")
   CHECK_THAT(error_of(replace(good, "2.2 0 8", "3.0 0 8")), Catch::Contains("unsupported .msh version"));
   CHECK_THAT(error_of(replace(good, "$Nodes\n6", "$Nodes\n7")), Catch::Contains("section ended early"));
   CHECK_THAT(error_of(replace(good, "$Nodes\n6", "$Nodes\n5")), Catch::Contains("expected $EndNodes"));
-  CHECK_THAT(error_of(replace(good, "2 4 2 1 1 1 2 3 4", "2 4 2 1 1 1 2 3 8")), Catch::Contains("undefined node 8"));
+  CHECK_THAT(error_of(replace(good, "2 4 2 1 1 1 2 3 4", "2 4 2 1 1 1 2 3 8")),
+             Catch::Contains("undefined node 8"));
   CHECK_THAT(error_of(replace(good, "3 0 1 0", "3 0 x 0")), Catch::Contains("expected y"));
   CHECK_THAT(error_of(replace(good, "7 5 5 5", "1 5 5 5")), Catch::Contains("duplicate node tag 1"));
-  CHECK_THAT(error_of(replace(good, "2 4 2 1 1 1 2 3 4", "2 2 2 1 1 1 2 3")), Catch::Contains("no tetrahedra"));
-  CHECK_THAT(error_of(replace(good, "2 4 2 1 1 1 2 3 4", "2 4 2 1 1 1 3 2 4")), Catch::Contains("inverted or of zero volume"));
+  CHECK_THAT(error_of(replace(good, "2 4 2 1 1 1 2 3 4", "2 2 2 1 1 1 2 3")),
+             Catch::Contains("no tetrahedra"));
+  CHECK_THAT(error_of(replace(good, "2 4 2 1 1 1 2 3 4", "2 4 2 1 1 1 3 2 4")),
+             Catch::Contains("inverted or of zero volume"));
   CHECK_THAT(error_of(replace(good, "4 0 0 1", "4 1 1 0")), Catch::Contains("inverted or of zero volume"));
   // The inverted element is named by its tag in the file (2), not by its index in the mesh (0).
-  CHECK_THAT(error_of(replace(good, "2 4 2 1 1 1 2 3 4", "2 4 2 1 1 1 3 2 4")), Catch::Contains("first: element with tag 2 "));
+  CHECK_THAT(error_of(replace(good, "2 4 2 1 1 1 2 3 4", "2 4 2 1 1 1 3 2 4")),
+             Catch::Contains("first: element with tag 2 "));
   // A misspelt header is named where it stands, not skipped to the end of the file.
-  CHECK_THAT(error_of(replace(good, "$MeshFormat\n", "$MeshFmt\n")), Catch::Contains("test.msh:1: expected $MeshFormat as the first section, found '$MeshFmt'"));
+  CHECK_THAT(error_of(replace(good, "$MeshFormat\n", "$MeshFmt\n")),
+             Catch::Contains("test.msh:1: expected $MeshFormat as the first section, found '$MeshFmt'"));
   CHECK_THAT(error_of(replace(good, "$EndElements\n", "")), Catch::Contains("missing $EndElements"));
   const std::string no_elements = good.substr(0, good.find("$Elements"));
   CHECK_THAT(error_of(no_elements), Catch::Contains("no $Elements"));
@@ -123,7 +130,8 @@ TEST_CASE("malformed msh files give clear errors", "[fem][msh]")
   mixed             = replace(mixed, "$EndElements", "3 11 2 1 1 1 2 3 4 1 2 3 4 1 2\n$EndElements");
   CHECK_THAT(error_of(mixed), Catch::Contains("mixes linear"));
   // 4.1 count mismatch.
-  CHECK_THAT(error_of(replace(msh41_tet10(), "$Nodes\n1 10 1 10", "$Nodes\n1 11 1 11")), Catch::Contains("announces 11 nodes"));
+  CHECK_THAT(error_of(replace(msh41_tet10(), "$Nodes\n1 10 1 10", "$Nodes\n1 11 1 11")),
+             Catch::Contains("announces 11 nodes"));
   // Error messages carry the file name and line.
   CHECK_THAT(error_of(replace(good, "3 0 1 0", "3 0 x 0")), Catch::Contains("test.msh:12:"));
   CHECK_THROWS_WITH(read_msh_file("/nonexistent/file.msh"), Catch::Contains("cannot open"));

@@ -42,8 +42,8 @@ Chain make_chain(PetscInt n, double scale)
 
 std::vector<PetscScalar> solve_with(const char *mat_type, const Chain &c, PetscInt n, PetscErrorCode *err)
 {
-  BlockSystem sys;
-  SolveStats  stats;
+  BlockSystem              sys;
+  SolveStats               stats;
   std::vector<PetscScalar> rhs(3 * n), sol(3 * n, 0.0);
   for (PetscInt i = 0; i < 3 * n; ++i) rhs[i] = std::sin(0.7 * i) + 1.0;
   *err = PetscOptionsSetValue(nullptr, "-mat_type", mat_type);
@@ -78,12 +78,13 @@ double residual(const Chain &c, PetscInt n, const std::vector<PetscScalar> &x)
 
 } // namespace
 
-TEST_CASE("BlockSystem: same solution for aij, baij, sbaij and sell; duplicates summed; refill replaces", "[fem][sim_system]")
+TEST_CASE("BlockSystem: same solution for aij, baij, sbaij and sell; duplicates summed; refill replaces",
+          "[fem][sim_system]")
 {
   const PetscInt n = 40;
   const Chain    c = make_chain(n, 3.0);
   PetscErrorCode err;
-  const auto ref = solve_with("aij", c, n, &err);
+  const auto     ref = solve_with("aij", c, n, &err);
   REQUIRE(err == 0);
   CHECK(residual(c, n, ref) < 1e-9);
   for (const char *type : {"baij", "sbaij", "sell"}) {
@@ -107,7 +108,8 @@ TEST_CASE("BlockSystem: a GPU matrix type on this PETSc is a clear error", "[fem
 TEST_CASE("BlockSystem: out-of-range block indices are rejected", "[fem][sim_system]")
 {
   BlockSystem sys;
-  CHECK(BlockSystemCreate(PETSC_COMM_SELF, 2, PETSC_DECIDE, {0, 2}, {0, 0}, &sys) == PETSC_ERR_ARG_OUTOFRANGE);
+  CHECK(BlockSystemCreate(PETSC_COMM_SELF, 2, PETSC_DECIDE, {0, 2}, {0, 0}, &sys) ==
+        PETSC_ERR_ARG_OUTOFRANGE);
   CHECK(BlockSystemCreate(PETSC_COMM_SELF, 2, PETSC_DECIDE, {0, 1}, {0}, &sys) == PETSC_ERR_ARG_SIZ);
 }
 
@@ -139,9 +141,11 @@ TEST_CASE("BlockSystem: matrix dump loads back as the same aij matrix", "[fem][s
   std::remove((path + ".info").c_str());
 }
 
-TEST_CASE("BlockSystem with the binbcsr COO mirror: upper blocks give the whole matrix, lower ones are refused", "[fem][system]")
+TEST_CASE(
+  "BlockSystem with the binbcsr COO mirror: upper blocks give the whole matrix, lower ones are refused",
+  "[fem][system]")
 {
-  const PetscInt n = 12;
+  const PetscInt n    = 12;
   const Chain    full = make_chain(n, 1.0);
   Chain          upper;
   for (size_t k = 0; k < full.rows.size(); ++k)

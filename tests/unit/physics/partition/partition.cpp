@@ -16,7 +16,7 @@ namespace {
 // Hexahedral grid of nx*ny*nz cells as 8-node elements: node (i,j,k) = i + (nx+1)*(j + (ny+1)*k).
 std::vector<int> hex_grid(int nx, int ny, int nz, int &node_count)
 {
-  auto node = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
+  auto             node = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
   std::vector<int> conn;
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)
@@ -47,7 +47,8 @@ TEST_CASE("mesh graph: a hex element links its 8 nodes", "[partition]")
   CHECK(g.xadj[14] - g.xadj[13] == 26);
 }
 
-TEST_CASE("partition: parts are contiguous, balanced, and cut far fewer edges than a random split", "[partition]")
+TEST_CASE("partition: parts are contiguous, balanced, and cut far fewer edges than a random split",
+          "[partition]")
 {
   int        n;
   const auto conn = hex_grid(12, 12, 12, n);
@@ -66,7 +67,7 @@ TEST_CASE("partition: parts are contiguous, balanced, and cut far fewer edges th
     // balance within METIS' default 3% imbalance (+1 vertex)
     for (int p = 0; p < parts; ++p) CHECK(r.part_size(p) <= 1.03 * n / parts + 1);
     if (parts > 1) {
-      Renumbering random = r;
+      Renumbering  random = r;
       std::mt19937 rng(7);
       for (int v = 0; v < n; ++v) random.part_of_old[v] = static_cast<int>(rng() % parts);
       CHECK(cut_edges(g, r) * 3 < cut_edges(g, random));

@@ -13,7 +13,7 @@ namespace {
 // Hexahedral grid of nx*ny*nz cells as 8-node elements.
 AdjacencyGraph hex_grid_graph(int nx, int ny, int nz)
 {
-  auto node = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
+  auto             node = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
   std::vector<int> conn;
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)
@@ -62,7 +62,8 @@ TEST_CASE("group_by_degree: a permutation, non-increasing degree inside each win
     for (int begin = 0; begin < n; begin += window) {
       const int end = std::min(n, begin + window);
       // same set as the base window: rows move only inside their window
-      std::set<int> a(base.old_of_new.begin() + begin, base.old_of_new.begin() + end), b(r.old_of_new.begin() + begin, r.old_of_new.begin() + end);
+      std::set<int> a(base.old_of_new.begin() + begin, base.old_of_new.begin() + end),
+        b(r.old_of_new.begin() + begin, r.old_of_new.begin() + end);
       CHECK(a == b);
       for (int k = begin; k + 1 < end; ++k) {
         const int u = r.old_of_new[k], v = r.old_of_new[k + 1];
@@ -123,7 +124,8 @@ TEST_CASE("group_by_degree: padding of alternating row lengths drops", "[row_ord
   const double      after = bin_padding_overhead(row_lengths_in_new_order(length, r), 8);
   CHECK(after < 0.02);
   // window 8 (= bin width) cannot help: a sorted bin still has the same longest row
-  CHECK(bin_padding_overhead(row_lengths_in_new_order(length, group_by_degree(g, identity, 8)), 8) == Approx(before));
+  CHECK(bin_padding_overhead(row_lengths_in_new_order(length, group_by_degree(g, identity, 8)), 8) ==
+        Approx(before));
 }
 
 TEST_CASE("row lengths with fixed nodes, padding formula", "[row_order]")
@@ -144,7 +146,7 @@ TEST_CASE("group_by_row_length: bad input throws", "[row_order]")
   Renumbering broken = b;
   broken.old_of_new  = {0, 0, 1};
   CHECK_THROWS_AS(group_by_row_length({1, 2, 3}, broken, 4), std::invalid_argument);
-  broken            = b;
+  broken              = b;
   broken.part_offsets = {0, 2};
   CHECK_THROWS_AS(group_by_row_length({1, 2, 3}, broken, 4), std::invalid_argument);
   CHECK_THROWS_AS(row_lengths_without_fixed(g, {0, 1}), std::invalid_argument);
@@ -155,9 +157,9 @@ TEST_CASE("upper_row_lengths: the upper triangle of the pattern, per part, fixed
   // path 0-1-2-3 in two parts {0,1} {2,3}, identity order; vertex 3 fixed
   const AdjacencyGraph g = graph_from_edges(4, {{0, 1}, {1, 2}, {2, 3}});
   Renumbering          r;
-  r.new_of_old   = {0, 1, 2, 3};
-  r.old_of_new   = {0, 1, 2, 3};
-  r.part_offsets = {0, 2, 4};
+  r.new_of_old                  = {0, 1, 2, 3};
+  r.old_of_new                  = {0, 1, 2, 3};
+  r.part_offsets                = {0, 2, 4};
   const std::vector<char> fixed = {0, 0, 0, 1};
   // 0: diag + 1; 1: diag only (2 is in the other part); 2: diag only (3 is fixed); 3: fixed
   CHECK(upper_row_lengths(g, fixed, r) == std::vector<int>{2, 1, 1, 1});
@@ -169,14 +171,16 @@ TEST_CASE("upper_row_lengths: the upper triangle of the pattern, per part, fixed
   CHECK_THROWS_AS(upper_row_lengths(g, {0, 0}, r), std::invalid_argument);
 }
 
-TEST_CASE("group_by_upper_row_length: a permutation inside the parts, upper padding no worse and lower than degree grouping", "[row_order]")
+TEST_CASE(
+  "group_by_upper_row_length: a permutation inside the parts, upper padding no worse and lower than degree grouping",
+  "[row_order]")
 {
   const AdjacencyGraph    g = hex_grid_graph(12, 10, 9);
   const int               n = g.vertex_count();
   const std::vector<char> fixed(n, 0);
   PartitionOptions        po;
-  po.local_order         = LocalOrder::ReverseCuthillMcKee;
-  const Renumbering base = partition_graph(g, 2, po);
+  po.local_order              = LocalOrder::ReverseCuthillMcKee;
+  const Renumbering base      = partition_graph(g, 2, po);
   const Renumbering by_degree = group_by_degree(g, base, 64);
   const Renumbering by_upper  = group_by_upper_row_length(g, fixed, by_degree, 64, 8);
   check_permutation(by_upper, n);
@@ -186,7 +190,9 @@ TEST_CASE("group_by_upper_row_length: a permutation inside the parts, upper padd
     CHECK(by_upper.new_of_old[v] >= base.part_offsets[p]);
     CHECK(by_upper.new_of_old[v] < base.part_offsets[p + 1]);
   }
-  auto upper_padding = [&](const Renumbering &r) { return bin_padding_overhead(row_lengths_in_new_order(upper_row_lengths(g, fixed, r), r), 8); };
+  auto upper_padding = [&](const Renumbering &r) {
+    return bin_padding_overhead(row_lengths_in_new_order(upper_row_lengths(g, fixed, r), r), 8);
+  };
   // the stored upper triangle is the same size in every order of one partition: n + edges inside parts
   long long stored_degree = 0, stored_upper = 0;
   for (int l : upper_row_lengths(g, fixed, by_degree)) stored_degree += l;
@@ -194,5 +200,6 @@ TEST_CASE("group_by_upper_row_length: a permutation inside the parts, upper padd
   CHECK(stored_upper == stored_degree);
   CHECK(upper_padding(by_upper) <= upper_padding(by_degree));
   CHECK(upper_padding(by_upper) < 0.75 * upper_padding(by_degree));
-  INFO("upper padding by degree " << upper_padding(by_degree) << ", by upper length " << upper_padding(by_upper));
+  INFO("upper padding by degree " << upper_padding(by_degree) << ", by upper length "
+                                  << upper_padding(by_upper));
 }

@@ -44,7 +44,9 @@ double MultDifference(Mat A, Mat B)
 TEST_CASE("stencil block rows: counts, symmetry, strict diagonal dominance", "[bench][stencil]")
 {
   StencilGrid g;
-  g.nx = 4; g.ny = 3; g.nz = 5;
+  g.nx = 4;
+  g.ny = 3;
+  g.nz = 5;
   PetscInt    cols[27], ncols;
   PetscScalar vals[27 * 9];
   // Corner, edge, face and interior nodes have 8, 12, 18, 27 blocks.
@@ -83,7 +85,8 @@ TEST_CASE("stencil block rows: counts, symmetry, strict diagonal dominance", "[b
         if (cols_q[e] == node) back = e;
       REQUIRE(back >= 0);
       for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) REQUIRE(vals[a * 3 * ncols + 3 * c + b] == vals_q[b * 3 * ncols_q + 3 * back + a]);
+        for (int b = 0; b < 3; ++b)
+          REQUIRE(vals[a * 3 * ncols + 3 * c + b] == vals_q[b * 3 * ncols_q + 3 * back + a]);
     }
   }
 }
@@ -91,8 +94,10 @@ TEST_CASE("stencil block rows: counts, symmetry, strict diagonal dominance", "[b
 TEST_CASE("stencil matrix: same operator in aij, baij, sbaij, sell", "[bench][stencil]")
 {
   StencilGrid g;
-  g.nx = 5; g.ny = 4; g.nz = 3;
-  Mat aij = Stencil(g, MATAIJ);
+  g.nx         = 5;
+  g.ny         = 4;
+  g.nz         = 3;
+  Mat      aij = Stencil(g, MATAIJ);
   PetscInt m, n, bs;
   REQUIRE(MatGetSize(aij, &m, &n) == 0);
   CHECK(m == 3 * 60);
@@ -128,10 +133,10 @@ TEST_CASE("stencil matrix: type from the options, bad grids refused", "[bench][s
   MatDestroy(&A);
   REQUIRE(PetscOptionsClearValue(nullptr, "-bt_mat_type") == 0);
 
-  g.ny = 0;
+  g.ny    = 0;
   Mat bad = nullptr;
   CHECK(CreateStencilMatrix(PETSC_COMM_WORLD, g, MATAIJ, nullptr, &bad) != 0);
-  g.ny = 3;
+  g.ny    = 3;
   g.shift = 0;
   CHECK(CreateStencilMatrix(PETSC_COMM_WORLD, g, MATAIJ, nullptr, &bad) != 0);
 }
