@@ -63,6 +63,14 @@ typedef struct {
 #define MCG_FLOOR_DEPTH 0.1
 
 PETSC_INTERN PetscErrorCode KSPSolve_MCG(KSP);
+/* The passes of one iteration (mcg_passes.cpp). */
+PETSC_INTERN PetscErrorCode MCGChoosePath(KSP, Mat);
+PETSC_INTERN PetscErrorCode MCGUpdateDiagonal(KSP);
+PETSC_INTERN PetscErrorCode MCGReduce(KSP, PetscScalar *dots, PetscMPIInt count);
+PETSC_INTERN PetscErrorCode MCGMatMultDot(KSP, Mat A, Vec u, Vec w, PetscScalar *uw);
+PETSC_INTERN PetscErrorCode MCGPrecondition(KSP, Vec R, Vec U, PetscScalar *dots);
+PETSC_INTERN PetscErrorCode MCGUpdate(KSP, PetscScalar alpha, PetscScalar beta, Vec X, Vec R, Vec U, Vec W,
+                                      Vec P, Vec S, PetscScalar *dots);
 PETSC_INTERN PetscErrorCode MCGUpdateBlockDiagonal(KSP);
 /* Whether KSPMCG's own preconditioner data (built from the Pmat with id/state built_id/built_state; built:
    it exists) must be rebuilt: the Pmat changed and the PC is not told to reuse its preconditioner. */
