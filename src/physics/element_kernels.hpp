@@ -65,8 +65,9 @@ constexpr double kPolarDetTolerance = 1e-8;
 constexpr int kPolarSteps       = 5;
 constexpr int kPolarScaledSteps = 2;
 
-// Columns of cof(X) = det(X) X^-T (cross products of X's other two columns) and det X.
-BINBCSR_PHYS_HD void cofactor3(const double *X, double *C, double &det)
+// Columns of cof(X) = det(X) X^-T (cross products of X's other two columns) and det X. T: double for
+// one element, or a lane packet (polar_decomposition.cpp's batched Newton iteration).
+template <class T> BINBCSR_PHYS_HD void cofactor3(const T *X, T *C, T &det)
 {
   C[0] = X[4] * X[8] - X[5] * X[7];
   C[1] = X[5] * X[6] - X[3] * X[8];

@@ -1,4 +1,5 @@
 #include "physics/polar_decomposition.hpp"
+#include "physics/element_kernels.hpp"
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -82,19 +83,8 @@ void rotations_from_deformations(const Eigen::Matrix3d *F, Eigen::Matrix3d *R, s
   constexpr int kLanes = 8;
   using Lanes          = Eigen::Array<double, kLanes, 1>;
   Lanes X[9], C[9], det;
-  auto  cofactor = [&] { // X column-major (X[0..2] its first column); cof(X) = (x1 x x2, x2 x x0, x0 x x1)
-    C[0] = X[4] * X[8] - X[5] * X[7];
-    C[1] = X[5] * X[6] - X[3] * X[8];
-    C[2] = X[3] * X[7] - X[4] * X[6];
-    C[3] = X[7] * X[2] - X[8] * X[1];
-    C[4] = X[8] * X[0] - X[6] * X[2];
-    C[5] = X[6] * X[1] - X[7] * X[0];
-    C[6] = X[1] * X[5] - X[2] * X[4];
-    C[7] = X[2] * X[3] - X[0] * X[5];
-    C[8] = X[0] * X[4] - X[1] * X[3];
-    det  = X[0] * C[0] + X[1] * C[1] + X[2] * C[2];
-  };
-  auto set_identity = [&](int l) {
+  auto  cofactor     = [&] { kernels::cofactor3(X, C, det); }; // X column-major, X[0..2] its first column
+  auto  set_identity = [&](int l) {
     for (int j = 0; j < 9; ++j) X[j][l] = j % 4 == 0 ? 1.0 : 0.0;
   };
   for (std::size_t start = 0; start < n; start += kLanes) {
