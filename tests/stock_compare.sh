@@ -5,21 +5,23 @@
 # a relative tolerance (different summation orders may move the last printed digits) or an absolute
 # one (for quantities at rounding level, such as the error norm of an exactly solved system).
 #
-#   stock_compare.sh [--keep ERE] [--drop ERE] [--expect ERE] [--rtol R] [--atol A] \
+#   stock_compare.sh [--keep ERE] [--drop ERE] [--expect ERE] [--reject ERE] [--rtol R] [--atol A] \
 #                    --ref 'command and arguments' --test 'command and arguments'
 #
 # --keep: lines to compare (default: all); --drop: lines to ignore; --strip: text removed from every
 # line first (e.g. stored zeros in a matrix listing, which a fixed-pattern format keeps); --expect: a line the test run
-# must print (e.g. proof that the plug-in's type was used); --allow-empty: a program that prints
+# must print (e.g. proof that the plug-in's type was used); --reject: a line it must not print (e.g. a
+# view of an internal object); --allow-empty: a program that prints
 # nothing on success (and errors otherwise) may print nothing. Both runs must exit with status 0.
 set -u
-keep='.' drop='^$' strip='' expect='' rtol=1e-10 atol=0 ref='' test='' allow_empty=0
+keep='.' drop='^$' strip='' expect='' reject='' rtol=1e-10 atol=0 ref='' test='' allow_empty=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --keep) keep=$2; shift 2 ;;
     --drop) drop=$2; shift 2 ;;
     --strip) strip=$2; shift 2 ;;
     --expect) expect=$2; shift 2 ;;
+    --reject) reject=$2; shift 2 ;;
     --rtol) rtol=$2; shift 2 ;;
     --atol) atol=$2; shift 2 ;;
     --allow-empty) allow_empty=1; shift ;;
@@ -52,6 +54,9 @@ if [ ! -s "$out/ref.kept" ] && [ $allow_empty = 0 ]; then
 fi
 if [ -n "$expect" ] && ! grep -q -E -e "$expect" "$out/test.out"; then
   echo "stock_compare: the test run did not print a line matching: $expect"; cat "$out/test.out"; exit 1
+fi
+if [ -n "$reject" ] && grep -q -E -e "$reject" "$out/test.out"; then
+  echo "stock_compare: the test run printed a line matching: $reject"; cat "$out/test.out"; exit 1
 fi
 if [ ! -s "$out/ref.kept" ]; then
   [ ! -s "$out/test.kept" ] || { echo "stock_compare: the test run printed lines the reference did not:"; cat "$out/test.kept"; exit 1; }

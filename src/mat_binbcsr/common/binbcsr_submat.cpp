@@ -136,6 +136,9 @@ PetscErrorCode MatBinBCSRGetAIJShadow_Private(Mat A, Mat *S)
   todo[1] = (todo[0] || sh->state != state) ? 1 : 0; /* refill */
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, todo, 2, MPI_INT, MPI_MAX, PetscObjectComm((PetscObject)A)));
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIBINBCSR, &mpi));
+  /* The shadow is internal: its assemblies must not answer the user's -mat_view (on several ranks the
+     parts' views are per rank and unsynchronised, and interleave with rank 0's output). */
+  PetscCall(PetscOptionsPushGetViewerOff(PETSC_TRUE));
   if (todo[0]) {
     PetscCall(ClearParts(sh));
     PetscCall(MatDestroy(&sh->S));
@@ -146,6 +149,7 @@ PetscErrorCode MatBinBCSRGetAIJShadow_Private(Mat A, Mat *S)
     PetscCall(PetscObjectStateIncrease((PetscObject)sh->S));
   } else if (todo[1]) PetscCall(MatConvert(A, mpi ? MATMPIAIJ : MATSEQAIJ, MAT_REUSE_MATRIX, &sh->S));
   if (todo[1]) PetscCall(MatPropagateSymmetryOptions(A, sh->S)); /* external factors read them (MUMPS: SPD) */
+  PetscCall(PetscOptionsPopGetViewerOff());
   sh->state   = state;
   sh->nzstate = A->nonzerostate;
   *S          = sh->S;
