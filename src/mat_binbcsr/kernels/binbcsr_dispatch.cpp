@@ -3,34 +3,20 @@
 
 namespace binbcsr {
 
-/* Whether the CPU runs the set and this build compiled it (a stub's table is empty). */
+/* Whether the CPU runs the set (binbcsr_cpu.h) and this build compiled it (a stub's table is empty). */
 static bool probe(BodySet set)
 {
   Shape s = {3, 8, 1, false, false};
   Body  b = {};
-#if defined(__x86_64__) && defined(__GNUC__)
-  __builtin_cpu_init(); /* may run before the constructors that usually do it */
-#endif
+  if (!cpu_runs(set)) return false;
   switch (set) {
-  case BodySet::Auto:
-  case BodySet::Portable:
-    return true;
   case BodySet::AVX2:
-#if defined(__x86_64__) && defined(__GNUC__)
-    if (!(__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))) return false;
-    return bodies_avx2(s, b); /* false: this build's compiler could not target it */
-#else
-    return false;
-#endif
+    return bodies_avx2(s, b);
   case BodySet::AVX512:
-#if defined(__x86_64__) && defined(__GNUC__)
-    if (!(__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl"))) return false;
     return bodies_avx512(s, b);
-#else
-    return false;
-#endif
+  default:
+    return true;
   }
-  return false;
 }
 
 bool body_set_available(BodySet set)
@@ -52,21 +38,6 @@ BodySet best_body_set()
                               : body_set_available(BodySet::AVX2) ? BodySet::AVX2
                                                                   : BodySet::Portable;
   return best;
-}
-
-const char *body_set_name(BodySet set)
-{
-  switch (set) {
-  case BodySet::Auto:
-    return "auto";
-  case BodySet::Portable:
-    return "portable";
-  case BodySet::AVX2:
-    return "avx2";
-  case BodySet::AVX512:
-    return "avx512";
-  }
-  return "unknown";
 }
 
 Body select_body(const Shape &s, BodySet want)

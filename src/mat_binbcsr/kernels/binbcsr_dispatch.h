@@ -15,15 +15,9 @@
 #ifndef BINBCSR_DISPATCH_H
 #define BINBCSR_DISPATCH_H
 
-namespace binbcsr {
+#include "../../binbcsr_cpu.h" /* BodySet, body_set_name and the CPU query */
 
-/* The body sets, in the order of MatBinBCSRKernel (include/petscbinbcsr.h). */
-enum class BodySet : int {
-  Auto     = 0,
-  Portable = 1,
-  AVX2     = 2,
-  AVX512   = 3
-};
+namespace binbcsr {
 
 /* Everything a product reads, as plain pointers (32-bit indices, as the layout). */
 struct BinMatrix {
@@ -66,8 +60,6 @@ Body select_body(const Shape &s, BodySet want);
 bool body_set_available(BodySet);
 /* The best available set. */
 BodySet best_body_set();
-/* "auto", "portable", "avx2", "avx512" */
-const char *body_set_name(BodySet);
 
 /* Each body set's table (its translation unit): fills b for shape s and returns true when the set has
    a body for it. Only select_body calls them. */
