@@ -19,6 +19,7 @@
 #include "sim/summary.h"
 #include "physics/box_mesh.hpp"
 #include "physics/corotational_assembly.hpp"
+#include "physics/element_batch.hpp"
 #include "physics/fem_model.hpp"
 #include "physics/msh_reader.hpp"
 #include "physics/tet_mesh.hpp"
@@ -68,6 +69,7 @@ struct Options {
   PetscInt  element_bench            = 0;
   PetscBool cpu_timer                = PETSC_FALSE;
   PetscBool scalar_elements          = PETSC_FALSE;
+  PetscInt  element_body             = 0; // binbcsr::BodySet: auto
   PetscBool is_static                = PETSC_FALSE;
   PetscReal v0[3]                    = {0, 0, 0};
   PetscReal spin[3]                  = {0, 0, 0};
@@ -156,6 +158,13 @@ PetscErrorCode GetOptions(Options &o)
                                 2, kernels[k], &k, nullptr));
     o.scalar_elements = k == 1 ? PETSC_TRUE : PETSC_FALSE;
   }
+  {
+    const char *sets[4];
+    for (int k = 0; k < 4; ++k) sets[k] = binbcsr::body_set_name((binbcsr::BodySet)k);
+    PetscCall(PetscOptionsEList("-fem_element_body",
+                                "batched element loop compiled for: the best this CPU runs, or one set", "",
+                                sets, 4, sets[o.element_body], &o.element_body, nullptr));
+  }
   PetscCall(PetscOptionsBool("-fem_quiet", "no progress line per step", "", o.quiet, &o.quiet, nullptr));
   PetscCall(PetscOptionsBool("-static", "solve K(x) dx = f(x) + f_ext by Newton steps instead of time steps",
                              "", o.is_static, &o.is_static, nullptr));
@@ -173,6 +182,15 @@ PetscErrorCode GetOptions(Options &o)
   PetscOptionsEnd();
   PetscCheck(o.dt > 0 && std::isfinite(o.dt), PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
              "-dt must be positive");
+  {
+    // As -mat_binbcsr_kernel: a set this CPU does not run is an error, not a silent fallback.
+    const auto want = (binbcsr::BodySet)o.element_body;
+    auto       runs = [](binbcsr::BodySet b) { return physics::element_body_used(b) == b; };
+    PetscCheck(want == binbcsr::BodySet::Auto || runs(want), PETSC_COMM_WORLD, PETSC_ERR_SUP_SYS,
+               "-fem_element_body %s: this CPU (or this build) lacks it; available: portable%s%s",
+               binbcsr::body_set_name(want), runs(binbcsr::BodySet::AVX2) ? ", avx2" : "",
+               runs(binbcsr::BodySet::AVX512) ? ", avx512" : "");
+  }
   for (int d = 0; d < 3; ++d)
     PetscCheck(std::isfinite(o.gravity[d]) && std::isfinite(o.v0[d]) && std::isfinite(o.spin[d]),
                PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
@@ -354,6 +372,7 @@ int main(int argc, char **argv)
   PetscCall(FemSimulationCreate(comm, scene, &sim));
   sim.cpu_timer      = o.cpu_timer;
   sim.element_kernel = o.scalar_elements ? physics::ElementKernel::Scalar : physics::ElementKernel::Batched;
+  sim.element_body   = (binbcsr::BodySet)o.element_body;
   const physics::FemModel   &model   = sim.model;
   const int                  n_nodes = model.node_count(), npe = model.npe, tip = sim.new_of_old[tip_input];
   const std::vector<double> &X = model.mesh.nodes;
@@ -477,7 +496,8 @@ int main(int argc, char **argv)
       std::fill(sim.rhs_full.begin(), sim.rhs_full.end(), 0.0);
       const double c1 = cpu_ms();
       physics::assemble_elements(model, sim.elements, x.data(), v.data(), sim.coefficients, &sim.pattern,
-                                 sim.values.data(), sim.rhs_full.data(), nullptr, sim.element_kernel);
+                                 sim.values.data(), sim.rhs_full.data(), nullptr, sim.element_kernel,
+                                 sim.element_body);
       const double c2 = cpu_ms();
       reset_ms.push_back(c1 - c0);
       loop_ms.push_back(c2 - c1);
@@ -533,6 +553,10 @@ int main(int argc, char **argv)
   s.add("timer", std::string(o.cpu_timer ? "cpu" : "wall"));
   s.add("ms_per_step", 1e3 * t_total / steps_div);
   s.add("element_ms", 1e3 * t_element / steps_div);
+  // The element loop that ran: the scalar reference, or the batched one's body set.
+  s.add("element_body", std::string(o.scalar_elements ? "scalar"
+                                                      : binbcsr::body_set_name(
+                                                          physics::element_body_used(sim.element_body))));
   s.add("setvalues_ms", 1e3 * t_setvalues / steps_div);
   s.add("assembly_ms", 1e3 * (t_element + t_setvalues) / steps_div);
   s.add("comm_ms", 1e3 * t_comm / steps_div);

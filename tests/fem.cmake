@@ -80,3 +80,16 @@ add_test(NAME fem_geo_cache_keyed_on_contents
            nb=$(${FEM} -mesh $d/b/box.geo -steps 0 -fix xmin | sed -n 's/.* elements=\\([0-9]*\\) .*/\\1/p')
            echo elements a=$na b=$nb; test -n \"$na\" && test -n \"$nb\" && test $nb -ne $na")
 set_tests_properties(fem_geo_cache_keyed_on_contents PROPERTIES LABELS "fem" TIMEOUT 60)
+# The batched element loop's body sets (physics/element_batch.hpp): the summary names the set that ran,
+# and the portable set forced gives the default (best) set's trajectory within rounding, P1 and P2.
+fem_test(fem_element_body_portable 0 "element_body=portable .*status=ok" ${FEM} ${FEM_SMALL} -fem_element_body portable)
+fem_test(fem_element_body_scalar 0 "element_body=scalar .*status=ok" ${FEM} ${FEM_SMALL} -fem_element_kernel scalar)
+set(FEM_SAME ${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_same.sh)
+string(REPLACE ";" " " small "${FEM_SMALL}") # summary_same.sh takes each command as one string
+foreach(order 1 2)
+  set(run "${FEM} ${small} -fem_order ${order} -mat_type aij -ksp_type cg -ksp_rtol 1e-12")
+  add_test(NAME fem_p${order}_element_body_same
+           COMMAND ${FEM_SAME} "tip_dx:1e-13 tip_dy:1e-13 tip_dz:1e-13 centroid_dz:1e-13 kinetic:1e-12 elastic:1e-12" 1e-9
+                   "${run} -fem_element_body portable" "${run}")
+  set_tests_properties(fem_p${order}_element_body_same PROPERTIES LABELS "fem" TIMEOUT 60 WORKING_DIRECTORY ${FEM_SRC})
+endforeach()

@@ -245,17 +245,20 @@ void assemble_kernel_p1(const FemModel &model, const std::vector<int> &elements,
 
 } // namespace
 
+// The batched loop writes the rotations as 9 doubles each, into the caller's array of Matrix3d.
+static_assert(sizeof(Eigen::Matrix3d) == 9 * sizeof(double), "Matrix3d is not 9 packed doubles");
+
 long long assemble_elements(const FemModel &model, const std::vector<int> &elements, const double *x,
                             const double *v, const StepCoefficients &c, const BlockPattern *pattern,
                             double *block_values, double *rhs, Eigen::Matrix3d *rotations,
-                            ElementKernel kernel)
+                            ElementKernel kernel, binbcsr::BodySet body)
 {
   if (block_values && !pattern) throw std::invalid_argument("assemble_elements: block values need a pattern");
   if (pattern && pattern->element_slots.size() != elements.size() * model.npe * model.npe)
     throw std::invalid_argument("assemble_elements: pattern was built for another element list");
   if (kernel == ElementKernel::Batched)
     return assemble_elements_batched(model, elements, x, v, c, block_values ? pattern : nullptr, block_values,
-                                     rhs, rotations);
+                                     rhs, rotations ? rotations->data() : nullptr, body);
   if (model.npe == 4 && !model.gradients.empty())
     assemble_kernel_p1(model, elements, x, v, c, pattern, block_values, rhs, rotations);
   else if (model.npe == 4)

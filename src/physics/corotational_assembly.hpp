@@ -10,6 +10,7 @@
 // The coefficients come from the time integrator (see implicit_euler_coefficients) or from a static
 // solve (c_K = 1, a_f = 1).
 #pragma once
+#include "physics/element_batch.hpp"
 #include "physics/fem_model.hpp"
 
 #include <vector>
@@ -48,12 +49,7 @@ struct BlockPattern {
   std::vector<int> identity_slots; // COO blocks that hold the identity (fixed nodes)
   bool             merged = false; // element blocks summed into unique COO blocks by the caller
 };
-// Set in an element_slots entry (index = entry & kSlotIndexMask) where the element loop writes that
-// COO block first (elements in list order; per element the pairs a <= b in order, (a,b) before
-// (b,a)): the kernel stores instead of adding there, so the block values need no zeroing each step
-// (the reset pass, and the loads of the first write to each block, cost ~1 ms per rank of linear_38k).
-constexpr int kFirstContribution = 1 << 30;
-constexpr int kSlotIndexMask     = kFirstContribution - 1;
+// (kFirstContribution and kSlotIndexMask, the marks in element_slots: element_batch.hpp.)
 
 // Blocks below the block diagonal (row > column) that the matrix does not store: sbaij keeps only the
 // upper triangle; binbcsr with symmetric storage keeps the upper triangle of each rank's diagonal part
@@ -74,8 +70,8 @@ BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &e
 void reset_block_values(const BlockPattern &pattern, std::vector<double> &block_values);
 
 // Which element loop runs: Batched (element_batch.hpp: the kernels of element_kernels.hpp over SIMD
-// lanes, P2 from the barycentric gradients) or Scalar (one element at a time, P2 from the stored K0:
-// the reference the batched kernels are tested against).
+// lanes, P2 from the barycentric gradients, in the body set `body` of assemble_elements) or Scalar
+// (one element at a time, P2 from the stored K0: the reference the batched kernels are tested against).
 enum class ElementKernel {
   Batched,
   Scalar
@@ -90,7 +86,8 @@ enum class ElementKernel {
 long long assemble_elements(const FemModel &model, const std::vector<int> &elements, const double *x,
                             const double *v, const StepCoefficients &c, const BlockPattern *pattern,
                             double *block_values, double *rhs, Eigen::Matrix3d *rotations = nullptr,
-                            ElementKernel kernel = ElementKernel::Batched);
+                            ElementKernel    kernel = ElementKernel::Batched,
+                            binbcsr::BodySet body   = binbcsr::BodySet::Auto);
 
 // Elastic forces only (a_f = 1): f = sum_e f_e over all elements, 3 per node, overwritten.
 std::vector<double> elastic_forces(const FemModel &model, const double *x);

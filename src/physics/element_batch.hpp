@@ -1,23 +1,84 @@
 // The element loop over SIMD lanes: element_kernels.hpp's per-element functions run on batches of
-// kElementLanes elements held as structure of arrays (gathered positions, rest shapes, rotations,
-// outputs), one `omp simd` loop over the lanes per step, then the batch's blocks and forces are
-// written out lane after lane in element order (lanes may share nodes and COO blocks).
+// kElementLanes elements held as structure of arrays (element_batch_body.hpp). That body is compiled
+// three times from the one header, in element_batch_{portable,avx2,avx512}.cpp, each with its own
+// target flags (CMakeLists.txt), because the library's baseline (x86-64-v2) leaves the lane loops at
+// 128-bit SSE: built that way linear_38k's element loop took 24.5 ms per step, against 14.9 ms when
+// the whole build targeted the AVX-512 machine. assemble_elements_batched picks the best set this CPU
+// runs at run time (binbcsr_cpu.h, the same query as the matrix product's bodies), or the one asked for.
+//
+// This header is what the dispatch (element_batch.cpp) and the per-set bodies share, so it holds plain
+// data only: no Eigen, no STL code that a body could instantiate.
 #pragma once
-#include "physics/corotational_assembly.hpp"
+#include "binbcsr_cpu.h"
+#include "physics/element_kernels.hpp"
+
+#include <cstddef>
+#include <vector>
 
 namespace physics {
+
+struct FemModel;
+struct StepCoefficients;
+struct BlockPattern;
 
 // Elements per batch: 8 doubles fill an AVX-512 register, two AVX2 registers.
 constexpr int kElementLanes = 8;
 
-// assemble_elements' batched body (same contract; the checks are the caller's). Returns the number
-// of elements whose rotation took the scalar path (inverted, flat or not converged in the fixed
-// Newton steps).
+// Set in a BlockPattern::element_slots entry (index = entry & kSlotIndexMask) where the element loop
+// writes that COO block first (elements in list order; per element the pairs a <= b in order, (a,b)
+// before (b,a)): the kernel stores instead of adding there, so the block values need no zeroing each
+// step (the reset pass, and the loads of the first write to each block, cost ~1 ms per rank of
+// linear_38k).
+constexpr int kFirstContribution = 1 << 30;
+constexpr int kSlotIndexMask     = kFirstContribution - 1;
+
+// assemble_elements' batched body (same contract; the checks are the caller's), run by the body set
+// `body` (Auto: the best this CPU runs; a set it does not run or this build lacks: the best it does).
+// rotations: 9 per listed element (column-major), or null. Returns the number of elements whose
+// rotation took the scalar path (inverted, flat or not converged in the fixed Newton steps).
 long long assemble_elements_batched(const FemModel &model, const std::vector<int> &elements, const double *x,
                                     const double *v, const StepCoefficients &c, const BlockPattern *pattern,
-                                    double *block_values, double *rhs, Eigen::Matrix3d *rotations);
+                                    double *block_values, double *rhs, double *rotations,
+                                    binbcsr::BodySet body = binbcsr::BodySet::Auto);
+
+// The set assemble_elements_batched runs when asked for `want` (never Auto).
+binbcsr::BodySet element_body_used(binbcsr::BodySet want);
 
 // Estimated floating-point operations per element of the batched kernels (for -log_view's rates).
 double element_kernel_flops(int order, bool with_blocks);
+
+// ---- between the dispatch and the bodies ---------------------------------------------------------
+
+// One call's inputs and outputs as plain arrays (the model's, flattened by the dispatch).
+struct ElementBatchArgs {
+  int           npe                = 4;
+  bool          corotational       = true;
+  const int    *element_nodes      = nullptr; // npe per element (the mesh's)
+  const double *rest_positions     = nullptr; // 3 per node
+  const double *rest_shape_inverse = nullptr; // 9 per element: Dm^-1, column-major
+  const double *volume             = nullptr; // per element
+  const double *reference_mass     = nullptr; // npe x npe (symmetric), per unit density and volume
+  const int    *elements           = nullptr; // the listed elements ...
+  std::size_t   count              = 0;       // ... and their number
+  const int    *element_slots      = nullptr; // npe^2 per listed element (BlockPattern); null: no blocks
+  const double *x = nullptr, *v = nullptr;    // 3 per node
+  double       *values    = nullptr;          // 9 per COO block, or null
+  double       *rhs       = nullptr;          // 3 per node, accumulated
+  double       *rotations = nullptr;          // 9 per listed element, or null
+  kernels::ElementConstants k{};
+};
+
+// One body set's batch loop. Returns the elements that took the scalar rotation path.
+using ElementBatchBody = long long (*)(const ElementBatchArgs &);
+
+// Each set's body (its translation unit), or null where this build's compiler could not target the
+// set (the file then builds as a stub). Only the dispatch calls them.
+ElementBatchBody element_batch_portable();
+ElementBatchBody element_batch_avx2();
+ElementBatchBody element_batch_avx512();
+
+// The scalar rotation of the elements the fixed Newton steps refuse (rotation_from_deformation: the
+// sign-corrected SVD rotation). Compiled at the baseline (element_batch.cpp), since it runs Eigen.
+void element_fallback_rotation(const double *F, double *R);
 
 } // namespace physics

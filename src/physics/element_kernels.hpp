@@ -3,10 +3,10 @@
 // (rotated stiffness blocks and corotational forces). No allocation, no Eigen, no STL, no PETSc, so
 // that a GPU can run one element per thread (BINBCSR_PHYS_HD becomes __host__ __device__ under nvcc).
 //
-// Layout: entry k of an element's array is at p[k * S]. The CPU (element_batch.cpp) keeps a batch of
-// S elements as structure of arrays and calls the functions from an `omp simd` loop over the lanes,
-// with the pointers offset by the lane, so every access is a contiguous vector across the lanes; a
-// thread that owns one element calls them with S = 1. The bodies have no data-dependent branches
+// Layout: entry k of an element's array is at p[k * S]. The CPU (element_batch_body.hpp) keeps a
+// batch of S elements as structure of arrays and calls the functions from an `omp simd` loop over the
+// lanes, with the pointers offset by the lane, so every access is a contiguous vector across the
+// lanes; a thread that owns one element calls them with S = 1. The bodies have no data-dependent branches
 // (selects only) and fixed trip counts, which the compiler unrolls inside the lane loop.
 //
 // Conventions: 3x3 matrices F, R, Dm^-1 column-major (Eigen's order: (r, c) at 3 c + r); nodal
@@ -23,15 +23,25 @@
   #define BINBCSR_PHYS_UNROLL _Pragma("GCC unroll 64")
 #endif
 
+// The functions below are compiled once per body set (element_batch.hpp: portable, avx2, avx512, each
+// translation unit with its own target flags) and live in an inline namespace named after the set, so
+// the AVX-512 copy of an inline function can never stand in for the baseline one at link time. A file
+// that defines no set (the scalar code, the tests) gets `baseline`.
+#if !defined(BINBCSR_ELEMENT_SET)
+  #define BINBCSR_ELEMENT_SET baseline
+#endif
+
 namespace physics {
 namespace kernels {
 
 // What every element of a call shares: the integrator's coefficients (corotational_assembly.hpp) and
-// the material.
+// the material. (Data only: one type for every body set.)
 struct ElementConstants {
   double force, stiffness_rhs, mass_rhs, mass_matrix, stiffness_matrix; // a_f, a_K, a_M, c_M, c_K
   double lambda, mu, density;
 };
+
+inline namespace BINBCSR_ELEMENT_SET {
 
 // ---- deformation gradient -------------------------------------------------------------------------
 
@@ -232,6 +242,7 @@ BINBCSR_PHYS_HD void p1_element(const double *x, const double *v, const double *
   }
 }
 
+} // namespace BINBCSR_ELEMENT_SET
 } // namespace kernels
 } // namespace physics
 

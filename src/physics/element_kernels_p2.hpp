@@ -19,6 +19,7 @@
 
 namespace physics {
 namespace kernels {
+inline namespace BINBCSR_ELEMENT_SET {
 
 // Corners of the edge nodes 4..9 (tet_mesh.hpp's kTetEdges) and the edge of a corner pair.
 constexpr int kP2EdgeCorners[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
@@ -172,5 +173,6 @@ BINBCSR_PHYS_HD void p2_element(const double *x, const double *v, const double *
   for (int p = 0; p < 55; ++p) p2_block<S>(p, Q, vol, k, Mref, blocks + 9 * p * S);
 }
 
+} // namespace BINBCSR_ELEMENT_SET
 } // namespace kernels
 } // namespace physics

@@ -139,9 +139,9 @@ PetscErrorCode FemSimulationStep(FemSimulation *sim, FemStepInfo *info)
   physics::reset_block_values(sim->pattern, sim->values);
   std::fill(sim->rhs_full.begin(), sim->rhs_full.end(), 0.0);
   PetscCall(PetscLogEventBegin(FEM_Elements, 0, 0, 0, 0));
-  info->svd_rotations = physics::assemble_elements(sim->model, sim->elements, sim->x.data(), sim->v.data(),
-                                                   sim->coefficients, &sim->pattern, sim->values.data(),
-                                                   sim->rhs_full.data(), nullptr, sim->element_kernel);
+  info->svd_rotations = physics::assemble_elements(
+    sim->model, sim->elements, sim->x.data(), sim->v.data(), sim->coefficients, &sim->pattern,
+    sim->values.data(), sim->rhs_full.data(), nullptr, sim->element_kernel, sim->element_body);
   PetscCall(PetscLogFlops(physics::element_kernel_flops(sim->model.mesh.order, true) *
                           (PetscLogDouble)sim->elements.size()));
   PetscCall(PetscLogEventEnd(FEM_Elements, 0, 0, 0, 0));

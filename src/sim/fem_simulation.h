@@ -57,6 +57,7 @@ struct FemSimulation {
   bool                      is_static = false;
   bool                      cpu_timer = false; // FemStepInfo times in process CPU time instead of wall time
   physics::ElementKernel    element_kernel = physics::ElementKernel::Batched; // Scalar: the reference loop
+  binbcsr::BodySet element_body = binbcsr::BodySet::Auto; // the batched loop's body set (element_batch.hpp)
   // work arrays
   std::vector<double> values, rhs_full, rhs_local, dv_local, dv_full;
   std::vector<int>    counts, displs;
