@@ -97,6 +97,7 @@ typedef struct {
                               block (c, r), c < r, in ascending c: row r's lower part, transposed */
   MatScalar *val;        /* [nslots * bs2] when precision is double, else NULL */
   float     *valf;       /* [nslots * bs2] when precision is single, else NULL */
+  void      *val_mem;    /* the allocation val or valf lies in (MatSeqBinBCSRAllocValues_Private) */
 
   struct BinBCSRStaging *staging; /* non-NULL between MatSetUp/preallocation and the layout build */
 
@@ -141,6 +142,15 @@ static inline PetscInt BinBCSRDefaultBinWidth(PetscInt bs) { return bs == 1 ? 16
 
 /* The product body for a's shape and body set (binbcsr_mult.cpp; the choice is select_body's). */
 binbcsr::Body MatSeqBinBCSRSelectBody(const Mat_SeqBinBCSR *a);
+
+/* The value array of nv entries in the given precision (val or valf; the other stays NULL), 64-byte
+   aligned: PETSc's allocator aligns to PETSC_MEMALIGN (16 bytes here), and a value array at 16 bytes
+   past a cache line makes every 64-byte load of the AVX-512 bodies touch two lines; what the product
+   then costs depended on where malloc happened to put the array (on a Zen 4 core the 48^3 stencil
+   took 9 or 20 ms with the same layout). zero: the entries start at zero. Frees the previous array. */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRAllocValues_Private(Mat_SeqBinBCSR *, MatBinBCSRPrecision, size_t nv,
+                                                             PetscBool zero);
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRFreeValues_Private(Mat_SeqBinBCSR *);
 
 /* Lane of slot s, and the index into val/valf of entry e of slot s. */
 static inline PetscInt BinBCSRLane(PetscInt s, PetscInt bw) { return s % bw; }

@@ -1,6 +1,7 @@
 /* MATSEQBINBCSR: the bin layout built from a block pattern (at the first final assembly, and by
    conversion, load, duplication), the lower-part index of symmetric storage, and the slot lookup. */
 #include "binbcsr.h"
+#include <cstdint>
 #include <algorithm>
 #include <vector>
 
@@ -18,6 +19,33 @@ PetscInt MatSeqBinBCSRFindSlot(const Mat_SeqBinBCSR *a, PetscInt brow, PetscInt 
 }
 
 /* The symmetric-storage part of MatSeqBinBCSRBuildLayout: bins ordered by the colouring. */
+PetscErrorCode MatSeqBinBCSRFreeValues_Private(Mat_SeqBinBCSR *a)
+{
+  PetscFunctionBegin;
+  PetscCall(PetscFree(a->val_mem));
+  a->val  = nullptr;
+  a->valf = nullptr;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatSeqBinBCSRAllocValues_Private(Mat_SeqBinBCSR *a, MatBinBCSRPrecision p, size_t nv,
+                                                PetscBool zero)
+{
+  constexpr size_t line  = 64;
+  const size_t     bytes = nv * (p == MAT_BINBCSR_PRECISION_SINGLE ? sizeof(float) : sizeof(MatScalar));
+  char            *mem;
+
+  PetscFunctionBegin;
+  PetscCall(MatSeqBinBCSRFreeValues_Private(a));
+  PetscCall(PetscMalloc1(bytes + line, &mem));
+  char *v = mem + (line - (size_t)((uintptr_t)mem % line)) % line;
+  if (zero) PetscCall(PetscMemzero(v, bytes));
+  a->val_mem = mem;
+  if (p == MAT_BINBCSR_PRECISION_SINGLE) a->valf = (float *)v;
+  else a->val = (MatScalar *)v;
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MatSeqBinBCSRBuildLayoutSym(Mat A, const PetscInt bi[], const PetscInt bj[])
 {
   Mat_SeqBinBCSR       *a  = (Mat_SeqBinBCSR *)A->data;
@@ -72,9 +100,7 @@ static PetscErrorCode MatSeqBinBCSRBuildLayoutSym(Mat A, const PetscInt bi[], co
   a->nslots = a->bin_start[nbins];
   PetscCall(PetscMalloc1(a->nslots, &a->col));
   std::copy(allcol.begin(), allcol.end(), a->col);
-  if (a->precision == MAT_BINBCSR_PRECISION_DOUBLE)
-    PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->val));
-  else PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->valf));
+  PetscCall(MatSeqBinBCSRAllocValues_Private(a, a->precision, (size_t)a->nslots * a->bs2, PETSC_TRUE));
   PetscCall(PetscMalloc2((size_t)PetscMax(a->nbs, 1) * a->bs, &a->rowbuf_cols,
                          (size_t)PetscMax(a->nbs, 1) * a->bs,
                          &a->rowbuf_vals)); /* a full row, both triangles */
@@ -164,9 +190,7 @@ PetscErrorCode MatSeqBinBCSRBuildLayout(Mat A, const PetscInt bi[], const PetscI
     a->nslots = (PetscInt)nslots;
   }
   PetscCall(PetscMalloc1(a->nslots, &a->col));
-  if (a->precision == MAT_BINBCSR_PRECISION_DOUBLE)
-    PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->val));
-  else PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->valf));
+  PetscCall(MatSeqBinBCSRAllocValues_Private(a, a->precision, (size_t)a->nslots * a->bs2, PETSC_TRUE));
   binbcsr::bin_columns<PetscInt>(bi, bj, mbs, bw, a->bin_start, a->col, a->diag_slot);
   PetscCall(PetscMalloc2((size_t)a->max_row_nz * a->bs, &a->rowbuf_cols, (size_t)a->max_row_nz * a->bs,
                          &a->rowbuf_vals));

@@ -102,15 +102,11 @@ static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues
     PetscCall(PetscArraycpy(b->diag_slot, a->diag_slot, a->mbs));
     PetscCall(PetscMalloc1(a->nslots, &b->col));
     PetscCall(PetscArraycpy(b->col, a->col, a->nslots));
-    if (a->val) {
-      PetscCall(PetscMalloc1(nv, &b->val));
-      if (copyvalues) PetscCall(PetscArraycpy(b->val, a->val, nv));
-      else PetscCall(PetscArrayzero(b->val, nv));
-    } else {
-      PetscCall(PetscMalloc1(nv, &b->valf));
-      if (copyvalues) PetscCall(PetscArraycpy(b->valf, a->valf, nv));
-      else PetscCall(PetscArrayzero(b->valf, nv));
-    }
+    PetscCall(MatSeqBinBCSRAllocValues_Private(
+      b, a->val ? MAT_BINBCSR_PRECISION_DOUBLE : MAT_BINBCSR_PRECISION_SINGLE, nv,
+      copyvalues ? PETSC_FALSE : PETSC_TRUE));
+    if (copyvalues && a->val) PetscCall(PetscArraycpy(b->val, a->val, nv));
+    else if (copyvalues) PetscCall(PetscArraycpy(b->valf, a->valf, nv));
     if (a->sym) {
       PetscCall(PetscMalloc1(a->mbs + 1, &b->row_off));
       PetscCall(PetscArraycpy(b->row_off, a->row_off, a->mbs + 1));
