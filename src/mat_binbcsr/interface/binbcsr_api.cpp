@@ -413,19 +413,27 @@ PetscErrorCode MatMultDotLocal(Mat A, Vec x, Vec y, PetscScalar *xdoty)
   if (fused) {
     PetscCall(fused(A, x, y, xdoty));
   } else {
-    const PetscScalar *xa, *ya;
-    PetscInt           n;
-    PetscScalar        sum = 0;
     PetscCall(MatMult(A, x, y));
-    PetscCall(VecGetLocalSize(x, &n));
-    PetscCall(VecGetArrayRead(x, &xa));
-    PetscCall(VecGetArrayRead(y, &ya));
-    for (PetscInt i = 0; i < n; i++) sum += xa[i] * ya[i];
-    PetscCall(VecRestoreArrayRead(x, &xa));
-    PetscCall(VecRestoreArrayRead(y, &ya));
-    PetscCall(PetscLogFlops(2.0 * n));
-    *xdoty = sum;
+    PetscCall(MatBinBCSRVecDotLocal_Private(x, y, xdoty));
   }
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatBinBCSRVecDotLocal_Private(Vec x, Vec y, PetscScalar *xdoty)
+{
+  const PetscScalar *xa, *ya;
+  PetscInt           n;
+  PetscScalar        sum = 0;
+
+  PetscFunctionBegin;
+  PetscCall(VecGetLocalSize(x, &n));
+  PetscCall(VecGetArrayRead(x, &xa));
+  PetscCall(VecGetArrayRead(y, &ya));
+  for (PetscInt i = 0; i < n; i++) sum += xa[i] * ya[i];
+  PetscCall(VecRestoreArrayRead(x, &xa));
+  PetscCall(VecRestoreArrayRead(y, &ya));
+  PetscCall(PetscLogFlops(2.0 * n));
+  *xdoty = sum;
   PetscFunctionReturn(0);
 }
 
