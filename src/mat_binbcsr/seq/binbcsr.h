@@ -198,7 +198,10 @@ PETSC_INTERN PetscErrorCode MatSeqBinBCSRBuildLayout(Mat, const PetscInt bi[], c
    set explicitly, by timing products of a sample on this machine, or from the tuning cache
    (binbcsr_tune.cpp). A no-op with tuning off. */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRTune(Mat, const PetscInt bi[], const PetscInt bj[]);
-/* Sizes checked, any layout and staging dropped (binbcsr.cpp): where a layout build starts. */
+/* Block size and block counts from the layouts (set up here); the check every entry point shares
+   (binbcsr_assembly.cpp). */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRSetSizes(Mat);
+/* Sizes checked, any layout and staging dropped (binbcsr_assembly.cpp): where a layout build starts. */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRResetLayout(Mat);
 
 /* Before the layout exists: zero the staged values, keeping the staged pattern (MatZeroEntries). */
