@@ -1,5 +1,6 @@
 /* MATSEQBINBCSR: the bin layout built from a block pattern (at the first final assembly, and by
-   conversion, load, duplication), the lower-part index of symmetric storage, and the slot lookup. */
+   conversion, load, duplication), the lower-part index of symmetric storage, the slot lookup, and a
+   new matrix laid out for a pattern. */
 #include "binbcsr.h"
 #include <algorithm>
 #include <vector>
@@ -175,5 +176,26 @@ PetscErrorCode MatSeqBinBCSRBuildLayout(Mat A, const PetscInt bi[], const PetscI
   A->preallocated = PETSC_TRUE; /* a layout is an allocation, however it was built (convert, load, ...) */
   A->nonzerostate++;
   PetscCall(PetscLogEventEnd(MAT_BinBCSR_BuildLayout, A, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatSeqBinBCSRCreateWithPattern(Mat A, PetscBool transposed, const PetscInt bi[],
+                                              const PetscInt bj[], Mat *B)
+{
+  const Mat_SeqBinBCSR *a    = (const Mat_SeqBinBCSR *)A->data;
+  PetscLayout           rmap = transposed ? A->cmap : A->rmap, cmap = transposed ? A->rmap : A->cmap;
+
+  PetscFunctionBegin;
+  PetscCall(MatCreate(PetscObjectComm((PetscObject)A), B));
+  PetscCall(MatSetSizes(*B, rmap->n, cmap->n, rmap->N, cmap->N));
+  PetscCall(MatSetBlockSizes(*B, PetscAbs(rmap->bs), PetscAbs(cmap->bs)));
+  PetscCall(MatSetType(*B, MATSEQBINBCSR));
+  PetscCall(MatBinBCSRSetBinWidth(*B, a->bw));
+  PetscCall(MatBinBCSRSetPrecision(*B, a->precision));
+  PetscCall(MatBinBCSRSetSymmetricStorage(*B, a->sym));
+  PetscCall(PetscLayoutSetUp((*B)->rmap));
+  PetscCall(PetscLayoutSetUp((*B)->cmap));
+  PetscCall(MatSeqBinBCSRBuildLayout(*B, bi, bj));
+  (*B)->preallocated = PETSC_TRUE;
   PetscFunctionReturn(0);
 }
