@@ -5,6 +5,7 @@
 #include "binbcsr.h"
 #include "binbcsr_ops.h"
 #include "../common/binbcsr_type.h"
+#include "../kernels/binbcsr_value_kernels.h" /* binbcsr::row_extreme_kind */
 
 static PetscErrorCode MatSetOption_SeqBinBCSR(Mat A, MatOption op, PetscBool flg)
 {
@@ -202,10 +203,10 @@ static const struct _MatOps &MatOps_SeqBinBCSR(void)
     o.getinfo         = MatGetInfo_SeqBinBCSR;
     /* rows and columns (binbcsr_rowops.cpp) */
     o.diagonalscale       = MatDiagonalScale_SeqBinBCSR;
-    o.getrowmaxabs        = MatGetRowMaxAbs_SeqBinBCSR;
-    o.getrowmax           = MatGetRowMax_SeqBinBCSR;
-    o.getrowmin           = MatGetRowMin_SeqBinBCSR;
-    o.getrowminabs        = MatGetRowMinAbs_SeqBinBCSR;
+    o.getrowmaxabs        = MatGetRowExtreme_SeqBinBCSR<binbcsr::extreme_max_abs>;
+    o.getrowmax           = MatGetRowExtreme_SeqBinBCSR<binbcsr::extreme_max>;
+    o.getrowmin           = MatGetRowExtreme_SeqBinBCSR<binbcsr::extreme_min>;
+    o.getrowminabs        = MatGetRowExtreme_SeqBinBCSR<binbcsr::extreme_min_abs>;
     o.getcolumnreductions = MatGetColumnReductions_SeqBinBCSR;
     o.missingdiagonal     = MatMissingDiagonal_SeqBinBCSR;
     o.equal               = MatEqual_SeqBinBCSR;

@@ -60,8 +60,7 @@ PetscErrorCode MatSeqBinBCSRFreeStorage(Mat_SeqBinBCSR *a)
   PetscFunctionReturn(0);
 }
 
-/* Block size and block counts from the layouts; the check every entry point shares. */
-static PetscErrorCode MatSeqBinBCSRSetSizes(Mat A)
+PetscErrorCode MatSeqBinBCSRSetSizes(Mat A)
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
   PetscInt        rbs, cbs;

@@ -192,6 +192,21 @@ PetscErrorCode MatCopy_SeqBinBCSR(Mat A, Mat B, MatStructure str)
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode MatSeqBinBCSRAddBlockRowPattern(Mat X, PetscInt br, PetscInt bs, std::vector<PetscInt> &bcols)
+{
+  PetscFunctionBegin;
+  for (PetscInt r = br * bs; r < (br + 1) * bs; r++) {
+    PetscInt        n;
+    const PetscInt *cols;
+    PetscCall(MatGetRow(X, r, &n, &cols, nullptr));
+    for (PetscInt k = 0; k < n; k++) bcols.push_back(cols[k] / bs);
+    PetscCall(MatRestoreRow(X, r, &n, &cols, nullptr));
+  }
+  std::sort(bcols.begin(), bcols.end());
+  bcols.erase(std::unique(bcols.begin(), bcols.end()), bcols.end());
+  PetscFunctionReturn(0);
+}
+
 /* Any matrix with MatGetRow -> MATSEQBINBCSR, with the source's block size (1 if its row and column
    block sizes differ or do not divide the sizes). */
 PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat A, MatType type, MatReuse reuse, Mat *newmat)
@@ -237,15 +252,7 @@ PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat A, MatType type, MatReuse reuse, Ma
   std::vector<PetscInt> all;
   for (PetscInt br = 0; br < mbs; br++) {
     rowcols.clear();
-    for (PetscInt i = 0; i < bs; i++) {
-      PetscInt        n, r = br * bs + i;
-      const PetscInt *cols;
-      PetscCall(MatGetRow(A, r, &n, &cols, nullptr));
-      for (PetscInt k = 0; k < n; k++) rowcols.push_back(cols[k] / bs);
-      PetscCall(MatRestoreRow(A, r, &n, &cols, nullptr));
-    }
-    std::sort(rowcols.begin(), rowcols.end());
-    rowcols.erase(std::unique(rowcols.begin(), rowcols.end()), rowcols.end());
+    PetscCall(MatSeqBinBCSRAddBlockRowPattern(A, br, bs, rowcols));
     all.insert(all.end(), rowcols.begin(), rowcols.end());
     bi[br + 1] = (PetscInt)all.size();
   }
