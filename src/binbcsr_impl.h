@@ -81,6 +81,36 @@ PETSC_INTERN PetscErrorCode MatImaginaryPart_BinBCSR(Mat);
    applied through the public setters: common/binbcsr_options.cpp */
 PETSC_INTERN PetscErrorCode MatBinBCSRReadOptions_Private(Mat, PetscOptionItems *);
 
+/* The whole of a public setter or getter that only validates its arguments and calls the composed
+   "<Name>_C" of the object's actual type, doing nothing (setter) or leaving the documented default
+   (getter) on other types: each such function is one line under its manual page. A macro, not a helper
+   function, so that the argument checks and PETSc's traceback still name the public function. valid is
+   PETSc's check for the value: PetscValidLogicalCollective{Int,Bool,Enum} (setter),
+   PetscValid{Int,Bool,}Pointer (getter). */
+#define BINBCSR_TRY_SETTER(Name, Obj, classid, T, valid) \
+  PetscErrorCode Name(Obj obj, T v)                      \
+  {                                                      \
+    PetscFunctionBegin;                                  \
+    PetscValidHeaderSpecific(obj, classid, 1);           \
+    valid(obj, v, 2);                                    \
+    PetscTryMethod(obj, #Name "_C", (Obj, T), (obj, v)); \
+    PetscFunctionReturn(0);                              \
+  }
+#define BINBCSR_TRY_GETTER(Name, Obj, classid, T, valid, dflt) \
+  PetscErrorCode Name(Obj obj, T *v)                           \
+  {                                                            \
+    PetscFunctionBegin;                                        \
+    PetscValidHeaderSpecific(obj, classid, 1);                 \
+    valid(v, 2);                                               \
+    *v = dflt;                                                 \
+    PetscTryMethod(obj, #Name "_C", (Obj, T *), (obj, v));     \
+    PetscFunctionReturn(0);                                    \
+  }
+
+/* *xdoty = the local part of x.y (no reduction), flops logged: the fallback of MatMultDotLocal and
+   KSPMCG's transposed solve (interface/binbcsr_api.cpp) */
+PETSC_INTERN PetscErrorCode MatBinBCSRVecDotLocal_Private(Vec x, Vec y, PetscScalar *xdoty);
+
 /* A clear error unless v has n local entries (what: the argument's name in the message): interface/binbcsr_api.cpp */
 PETSC_INTERN PetscErrorCode MatBinBCSRCheckVecLocalSize(Vec v, PetscInt n, const char *what);
 

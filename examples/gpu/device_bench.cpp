@@ -8,6 +8,7 @@
 #include "device/device.h"
 #include "device/host_bins.h"
 
+#include <algorithm>
 #include <chrono>
 
 using namespace binbcsr::device;

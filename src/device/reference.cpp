@@ -4,6 +4,7 @@
 #include "reference.h"
 #include "mcg_driver.h"
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 

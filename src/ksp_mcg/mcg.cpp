@@ -282,21 +282,40 @@ PetscErrorCode KSPCreate_MCG(KSP ksp)
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode KSPMCGSetFixedIterations(KSP ksp, PetscInt n)
-{
-  PetscFunctionBegin;
-  PetscValidHeaderSpecific(ksp, KSP_CLASSID, 1);
-  PetscValidLogicalCollectiveInt(ksp, n, 2);
-  PetscTryMethod(ksp, "KSPMCGSetFixedIterations_C", (KSP, PetscInt), (ksp, n));
-  PetscFunctionReturn(0);
-}
+/*@
+   KSPMCGSetFixedIterations - Makes `KSPMCG` run exactly n iterations per solve, with no convergence test
 
-PetscErrorCode KSPMCGGetFixedIterations(KSP ksp, PetscInt *n)
-{
-  PetscFunctionBegin;
-  PetscValidHeaderSpecific(ksp, KSP_CLASSID, 1);
-  PetscValidIntPointer(n, 2);
-  *n = 0;
-  PetscTryMethod(ksp, "KSPMCGGetFixedIterations_C", (KSP, PetscInt *), (ksp, n));
-  PetscFunctionReturn(0);
-}
+   Logically Collective
+
+   Input Parameters:
++  ksp - the solver
+-  n   - the number of iterations; 0 turns it off (the tolerances decide)
+
+   Options Database Key:
+.  -ksp_mcg_fixed_iterations <n> - sets the number of iterations
+
+   Level: advanced
+
+   Note:
+   No residual norm is computed. A no-op on solvers of other types.
+
+.seealso: `KSPMCG`, `KSPMCGGetFixedIterations()`
+@*/
+BINBCSR_TRY_SETTER(KSPMCGSetFixedIterations, KSP, KSP_CLASSID, PetscInt, PetscValidLogicalCollectiveInt)
+
+/*@
+   KSPMCGGetFixedIterations - Gets the fixed number of iterations per solve of `KSPMCG`
+
+   Not Collective
+
+   Input Parameter:
+.  ksp - the solver
+
+   Output Parameter:
+.  n - the number of iterations; 0 when off and on solvers of other types
+
+   Level: advanced
+
+.seealso: `KSPMCG`, `KSPMCGSetFixedIterations()`
+@*/
+BINBCSR_TRY_GETTER(KSPMCGGetFixedIterations, KSP, KSP_CLASSID, PetscInt, PetscValidIntPointer, 0)

@@ -143,18 +143,8 @@ PetscErrorCode MCGMatMultDot(KSP ksp, Mat A, Vec u, Vec w, PetscScalar *uw)
   if (!ksp->transpose_solve) {
     PetscCall(MatMultDotLocal(A, u, w, uw));
   } else {
-    const PetscScalar *ua, *wa;
-    PetscInt           n;
-    PetscScalar        sum = 0;
     PetscCall(KSP_MatMult(ksp, A, u, w));
-    PetscCall(VecGetLocalSize(u, &n));
-    PetscCall(VecGetArrayRead(u, &ua));
-    PetscCall(VecGetArrayRead(w, &wa));
-    for (PetscInt i = 0; i < n; i++) sum += ua[i] * wa[i];
-    PetscCall(VecRestoreArrayRead(u, &ua));
-    PetscCall(VecRestoreArrayRead(w, &wa));
-    PetscCall(PetscLogFlops(2.0 * n));
-    *uw = sum;
+    PetscCall(MatBinBCSRVecDotLocal_Private(u, w, uw));
   }
   PetscFunctionReturn(0);
 }

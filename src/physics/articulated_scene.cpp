@@ -51,15 +51,22 @@ Eigen::Vector3d connector_position(const ArticulatedScene &scene, int body, cons
   return scene.bodies[body].position + scene.bodies[body].orientation * anchor;
 }
 
-void joint_errors(const ArticulatedScene &scene, std::vector<double> &errors)
+/* errors[3j..3j+2] = point(a) - point(b) of joint j: the position and the velocity constraint residuals
+   differ only in which point of a body's anchor they take. */
+template <typename Point>
+static void joint_differences(const ArticulatedScene &scene, std::vector<double> &errors, Point &&point)
 {
   errors.resize(3 * scene.joints.size());
   for (size_t j = 0; j < scene.joints.size(); ++j) {
     const BallJoint      &jt = scene.joints[j];
-    const Eigen::Vector3d e =
-      connector_position(scene, jt.body_a, jt.anchor_a) - connector_position(scene, jt.body_b, jt.anchor_b);
+    const Eigen::Vector3d e  = point(scene, jt.body_a, jt.anchor_a) - point(scene, jt.body_b, jt.anchor_b);
     for (int k = 0; k < 3; ++k) errors[3 * j + k] = e[k];
   }
+}
+
+void joint_errors(const ArticulatedScene &scene, std::vector<double> &errors)
+{
+  joint_differences(scene, errors, connector_position);
 }
 
 double max_joint_error(const ArticulatedScene &scene)
@@ -81,13 +88,7 @@ static Eigen::Vector3d point_velocity(const ArticulatedScene &scene, int body, c
 
 void joint_velocity_errors(const ArticulatedScene &scene, std::vector<double> &errors)
 {
-  errors.resize(3 * scene.joints.size());
-  for (size_t j = 0; j < scene.joints.size(); ++j) {
-    const BallJoint      &jt = scene.joints[j];
-    const Eigen::Vector3d u =
-      point_velocity(scene, jt.body_a, jt.anchor_a) - point_velocity(scene, jt.body_b, jt.anchor_b);
-    for (int k = 0; k < 3; ++k) errors[3 * j + k] = u[k];
-  }
+  joint_differences(scene, errors, point_velocity);
 }
 
 double total_energy(const ArticulatedScene &scene)

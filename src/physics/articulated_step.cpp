@@ -1,5 +1,6 @@
 #include "physics/articulated_step.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 

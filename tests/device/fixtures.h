@@ -3,6 +3,7 @@
 #include "device/device.h"
 #include "device/host_bins.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>

@@ -77,22 +77,18 @@ PetscErrorCode GetFactorFrom(Mat A, MatSolverType package, MatFactorType ftype, 
   PetscFunctionReturn(0);
 }
 
-/* MatSolverTypeRegister's factories are not told the package: one per package. */
-#if defined(PETSC_HAVE_MUMPS)
-PetscErrorCode GetFactor_MUMPS(Mat A, MatFactorType ftype, Mat *F)
+/* MatSolverTypeRegister's factories are not told the package: one instance per package. */
+template <const char *package> PetscErrorCode GetFactor(Mat A, MatFactorType ftype, Mat *F)
 {
   PetscFunctionBegin;
-  PetscCall(GetFactorFrom(A, MATSOLVERMUMPS, ftype, F));
+  PetscCall(GetFactorFrom(A, package, ftype, F));
   PetscFunctionReturn(0);
 }
+#if defined(PETSC_HAVE_MUMPS)
+constexpr char mumps[] = MATSOLVERMUMPS;
 #endif
 #if defined(PETSC_HAVE_SUPERLU_DIST)
-PetscErrorCode GetFactor_SuperLU_DIST(Mat A, MatFactorType ftype, Mat *F)
-{
-  PetscFunctionBegin;
-  PetscCall(GetFactorFrom(A, MATSOLVERSUPERLU_DIST, ftype, F));
-  PetscFunctionReturn(0);
-}
+constexpr char superlu_dist[] = MATSOLVERSUPERLU_DIST;
 #endif
 } // namespace
 
@@ -103,11 +99,11 @@ PetscErrorCode MatBinBCSRRegisterExternalFactors(void)
   PetscFunctionBegin;
   for (MatType type : {MATSEQBINBCSR, MATMPIBINBCSR}) {
 #if defined(PETSC_HAVE_MUMPS)
-    PetscCall(MatSolverTypeRegister(MATSOLVERMUMPS, type, MAT_FACTOR_LU, GetFactor_MUMPS));
-    PetscCall(MatSolverTypeRegister(MATSOLVERMUMPS, type, MAT_FACTOR_CHOLESKY, GetFactor_MUMPS));
+    PetscCall(MatSolverTypeRegister(MATSOLVERMUMPS, type, MAT_FACTOR_LU, GetFactor<mumps>));
+    PetscCall(MatSolverTypeRegister(MATSOLVERMUMPS, type, MAT_FACTOR_CHOLESKY, GetFactor<mumps>));
 #endif
 #if defined(PETSC_HAVE_SUPERLU_DIST)
-    PetscCall(MatSolverTypeRegister(MATSOLVERSUPERLU_DIST, type, MAT_FACTOR_LU, GetFactor_SuperLU_DIST));
+    PetscCall(MatSolverTypeRegister(MATSOLVERSUPERLU_DIST, type, MAT_FACTOR_LU, GetFactor<superlu_dist>));
 #endif
     (void)type;
   }

@@ -13,6 +13,9 @@
 #include <fstream>
 #include <string>
 #include <unistd.h>
+#if defined(__x86_64__) || defined(__i386__)
+  #include <emmintrin.h>
+#endif
 
 namespace binbcsr {
 
@@ -73,6 +76,21 @@ inline long last_level_cache_bytes()
     }
   }
   return bytes;
+}
+
+/* Writes back and drops the cache lines of [p, p + bytes) from every cache level (clflush, part of
+   SSE2, so of every x86-64), so that the next pass reads them from memory. A no-op elsewhere. */
+inline void evict_from_caches(const void *p, size_t bytes)
+{
+#if defined(__x86_64__) || defined(__i386__)
+  const char *c = (const char *)p;
+  for (size_t i = 0; i < bytes; i += 64) _mm_clflush(c + i);
+  if (bytes) _mm_clflush(c + bytes - 1);
+  _mm_mfence();
+#else
+  (void)p;
+  (void)bytes;
+#endif
 }
 
 } // namespace binbcsr

@@ -332,6 +332,34 @@ PetscErrorCode FromAIJ(Mat parent, PetscInt n, const IS irow[], const IS icol[],
   }
   PetscFunctionReturn(0);
 }
+
+/* The array forms (MatCreateSubMatrices, MatCreateSubMatricesMPI) take no MAT_INPLACE_MATRIX; op is the
+   caller's name for the message. */
+PetscErrorCode CheckArrayReuse(Mat A, MatReuse scall, const char *op)
+{
+  PetscFunctionBegin;
+  PetscCheck(scall == MAT_INITIAL_MATRIX || scall == MAT_REUSE_MATRIX, PetscObjectComm((PetscObject)A),
+             PETSC_ERR_ARG_WRONG, "%s takes MAT_INITIAL_MATRIX or MAT_REUSE_MATRIX", op);
+  PetscFunctionReturn(0);
+}
+
+/* What both array forms do with the shadow S: its submatrices, made by create and freed by destroy
+   (the pair that matches how create made them), turned into binbcsr ones in *submat (allocated here
+   with n + 1 entries on MAT_INITIAL_MATRIX). */
+PetscErrorCode
+ArrayFromShadow(Mat A, Mat S, PetscInt n, const IS irow[], const IS icol[], MatReuse scall, Mat *submat[],
+                PetscErrorCode (*create)(Mat, PetscInt, const IS[], const IS[], MatReuse, Mat *[]),
+                PetscErrorCode (*destroy)(PetscInt, Mat *[]))
+{
+  Mat *T;
+
+  PetscFunctionBegin;
+  PetscCall(create(S, n, irow, icol, MAT_INITIAL_MATRIX, &T));
+  if (scall == MAT_INITIAL_MATRIX) PetscCall(PetscCalloc1(n + 1, submat));
+  PetscCall(FromAIJ(A, n, irow, icol, T, scall, *submat));
+  PetscCall(destroy(n, &T));
+  PetscFunctionReturn(0);
+}
 } // namespace
 
 PetscErrorCode MatIncreaseOverlap_BinBCSR(Mat A, PetscInt n, IS is[], PetscInt ov)
@@ -363,20 +391,16 @@ PetscErrorCode MatConvert_BinBCSR_HYPRE(Mat A, MatType type, MatReuse reuse, Mat
 PetscErrorCode MatCreateSubMatrices_BinBCSR(Mat A, PetscInt n, const IS irow[], const IS icol[],
                                             MatReuse scall, Mat *submat[])
 {
-  Mat S, *T;
+  Mat S;
 
   PetscFunctionBegin;
-  PetscCheck(scall == MAT_INITIAL_MATRIX || scall == MAT_REUSE_MATRIX, PetscObjectComm((PetscObject)A),
-             PETSC_ERR_ARG_WRONG, "MatCreateSubMatrices takes MAT_INITIAL_MATRIX or MAT_REUSE_MATRIX");
+  PetscCall(CheckArrayReuse(A, scall, "MatCreateSubMatrices"));
   if (scall == MAT_REUSE_MATRIX) PetscCall(CheckReuse(n, irow, icol, *submat));
   PetscCall(MatBinBCSRGetAIJShadow_Private(A, &S));
   S->submat_singleis =
     A->submat_singleis; /* PCASM's hint: one index set on every rank; used once, as MPIAIJ does */
   A->submat_singleis = PETSC_FALSE;
-  PetscCall(MatCreateSubMatrices(S, n, irow, icol, MAT_INITIAL_MATRIX, &T));
-  if (scall == MAT_INITIAL_MATRIX) PetscCall(PetscCalloc1(n + 1, submat));
-  PetscCall(FromAIJ(A, n, irow, icol, T, scall, *submat));
-  PetscCall(MatDestroySubMatrices(n, &T));
+  PetscCall(ArrayFromShadow(A, S, n, irow, icol, scall, submat, MatCreateSubMatrices, MatDestroySubMatrices));
   PetscFunctionReturn(0);
 }
 
@@ -385,16 +409,13 @@ PetscErrorCode MatCreateSubMatrices_BinBCSR(Mat A, PetscInt n, const IS irow[], 
 PetscErrorCode MatCreateSubMatricesMPI_BinBCSR(Mat A, PetscInt n, const IS irow[], const IS icol[],
                                                MatReuse scall, Mat *submat[])
 {
-  Mat S, *T;
+  Mat S;
 
   PetscFunctionBegin;
-  PetscCheck(scall == MAT_INITIAL_MATRIX || scall == MAT_REUSE_MATRIX, PetscObjectComm((PetscObject)A),
-             PETSC_ERR_ARG_WRONG, "MatCreateSubMatricesMPI takes MAT_INITIAL_MATRIX or MAT_REUSE_MATRIX");
+  PetscCall(CheckArrayReuse(A, scall, "MatCreateSubMatricesMPI"));
   PetscCall(MatBinBCSRGetAIJShadow_Private(A, &S));
-  PetscCall(MatCreateSubMatricesMPI(S, n, irow, icol, MAT_INITIAL_MATRIX, &T));
-  if (scall == MAT_INITIAL_MATRIX) PetscCall(PetscCalloc1(n + 1, submat));
-  PetscCall(FromAIJ(A, n, irow, icol, T, scall, *submat));
-  PetscCall(MatDestroyMatrices(n, &T)); /* not MatDestroySubMatrices: these are parallel (as in PCGASM) */
+  /* MatDestroyMatrices, not MatDestroySubMatrices: these are parallel (as in PCGASM) */
+  PetscCall(ArrayFromShadow(A, S, n, irow, icol, scall, submat, MatCreateSubMatricesMPI, MatDestroyMatrices));
   PetscFunctionReturn(0);
 }
 

@@ -116,14 +116,7 @@ PetscErrorCode MatBinBCSRSetFromOptions(Mat A)
 
 .seealso: `MATBINBCSR`, `MatBinBCSRGetBinWidth()`
 @*/
-PetscErrorCode MatBinBCSRSetBinWidth(Mat A, PetscInt bw)
-{
-  PetscFunctionBegin;
-  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
-  PetscValidLogicalCollectiveInt(A, bw, 2);
-  PetscTryMethod(A, "MatBinBCSRSetBinWidth_C", (Mat, PetscInt), (A, bw));
-  PetscFunctionReturn(0);
-}
+BINBCSR_TRY_SETTER(MatBinBCSRSetBinWidth, Mat, MAT_CLASSID, PetscInt, PetscValidLogicalCollectiveInt)
 
 /*@
    MatBinBCSRGetBinWidth - Gets the number of rows (block rows) per bin of a `MATBINBCSR` matrix
@@ -140,15 +133,7 @@ PetscErrorCode MatBinBCSRSetBinWidth(Mat A, PetscInt bw)
 
 .seealso: `MATBINBCSR`, `MatBinBCSRSetBinWidth()`
 @*/
-PetscErrorCode MatBinBCSRGetBinWidth(Mat A, PetscInt *bw)
-{
-  PetscFunctionBegin;
-  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
-  PetscValidIntPointer(bw, 2);
-  *bw = 0;
-  PetscTryMethod(A, "MatBinBCSRGetBinWidth_C", (Mat, PetscInt *), (A, bw));
-  PetscFunctionReturn(0);
-}
+BINBCSR_TRY_GETTER(MatBinBCSRGetBinWidth, Mat, MAT_CLASSID, PetscInt, PetscValidIntPointer, 0)
 
 /*@
    MatBinBCSRSetPrecision - Sets the storage precision of the values of a `MATBINBCSR` matrix
@@ -171,14 +156,8 @@ PetscErrorCode MatBinBCSRGetBinWidth(Mat A, PetscInt *bw)
 
 .seealso: `MATBINBCSR`, `MatBinBCSRGetPrecision()`, `MatBinBCSRPrecision`
 @*/
-PetscErrorCode MatBinBCSRSetPrecision(Mat A, MatBinBCSRPrecision p)
-{
-  PetscFunctionBegin;
-  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
-  PetscValidLogicalCollectiveEnum(A, p, 2);
-  PetscTryMethod(A, "MatBinBCSRSetPrecision_C", (Mat, MatBinBCSRPrecision), (A, p));
-  PetscFunctionReturn(0);
-}
+BINBCSR_TRY_SETTER(MatBinBCSRSetPrecision, Mat, MAT_CLASSID, MatBinBCSRPrecision,
+                   PetscValidLogicalCollectiveEnum)
 
 /*@
    MatBinBCSRGetPrecision - Gets the storage precision of the values of a `MATBINBCSR` matrix
@@ -195,15 +174,8 @@ PetscErrorCode MatBinBCSRSetPrecision(Mat A, MatBinBCSRPrecision p)
 
 .seealso: `MATBINBCSR`, `MatBinBCSRSetPrecision()`
 @*/
-PetscErrorCode MatBinBCSRGetPrecision(Mat A, MatBinBCSRPrecision *p)
-{
-  PetscFunctionBegin;
-  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
-  PetscValidPointer(p, 2);
-  *p = MAT_BINBCSR_PRECISION_DOUBLE;
-  PetscTryMethod(A, "MatBinBCSRGetPrecision_C", (Mat, MatBinBCSRPrecision *), (A, p));
-  PetscFunctionReturn(0);
-}
+BINBCSR_TRY_GETTER(MatBinBCSRGetPrecision, Mat, MAT_CLASSID, MatBinBCSRPrecision, PetscValidPointer,
+                   MAT_BINBCSR_PRECISION_DOUBLE)
 
 /*@
    MatBinBCSRSetSymmetricStorage - Stores only the blocks on and above the block diagonal of a
@@ -230,14 +202,8 @@ PetscErrorCode MatBinBCSRGetPrecision(Mat A, MatBinBCSRPrecision *p)
 
 .seealso: `MATBINBCSR`, `MatBinBCSRGetSymmetricStorage()`, `MatBinBCSRSetCOOMirror()`
 @*/
-PetscErrorCode MatBinBCSRSetSymmetricStorage(Mat A, PetscBool flg)
-{
-  PetscFunctionBegin;
-  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
-  PetscValidLogicalCollectiveBool(A, flg, 2);
-  PetscTryMethod(A, "MatBinBCSRSetSymmetricStorage_C", (Mat, PetscBool), (A, flg));
-  PetscFunctionReturn(0);
-}
+BINBCSR_TRY_SETTER(MatBinBCSRSetSymmetricStorage, Mat, MAT_CLASSID, PetscBool,
+                   PetscValidLogicalCollectiveBool)
 
 /*@
    MatBinBCSRGetSymmetricStorage - Tells whether a `MATBINBCSR` matrix stores only its upper block triangle
@@ -254,15 +220,8 @@ PetscErrorCode MatBinBCSRSetSymmetricStorage(Mat A, PetscBool flg)
 
 .seealso: `MATBINBCSR`, `MatBinBCSRSetSymmetricStorage()`
 @*/
-PetscErrorCode MatBinBCSRGetSymmetricStorage(Mat A, PetscBool *flg)
-{
-  PetscFunctionBegin;
-  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
-  PetscValidBoolPointer(flg, 2);
-  *flg = PETSC_FALSE;
-  PetscTryMethod(A, "MatBinBCSRGetSymmetricStorage_C", (Mat, PetscBool *), (A, flg));
-  PetscFunctionReturn(0);
-}
+BINBCSR_TRY_GETTER(MatBinBCSRGetSymmetricStorage, Mat, MAT_CLASSID, PetscBool, PetscValidBoolPointer,
+                   PETSC_FALSE)
 
 /*@
    MatBinBCSRSetCOOMirror - Makes every COO entry of an off-diagonal block also add its value at the
@@ -287,14 +246,7 @@ PetscErrorCode MatBinBCSRGetSymmetricStorage(Mat A, PetscBool *flg)
 
 .seealso: `MATBINBCSR`, `MatBinBCSRGetCOOMirror()`, `MatSetPreallocationCOO()`, `MatSetValuesCOO()`
 @*/
-PetscErrorCode MatBinBCSRSetCOOMirror(Mat A, PetscBool flg)
-{
-  PetscFunctionBegin;
-  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
-  PetscValidLogicalCollectiveBool(A, flg, 2);
-  PetscTryMethod(A, "MatBinBCSRSetCOOMirror_C", (Mat, PetscBool), (A, flg));
-  PetscFunctionReturn(0);
-}
+BINBCSR_TRY_SETTER(MatBinBCSRSetCOOMirror, Mat, MAT_CLASSID, PetscBool, PetscValidLogicalCollectiveBool)
 
 /*@
    MatBinBCSRGetCOOMirror - Tells whether COO entries of a `MATBINBCSR` matrix are mirrored
@@ -311,15 +263,7 @@ PetscErrorCode MatBinBCSRSetCOOMirror(Mat A, PetscBool flg)
 
 .seealso: `MATBINBCSR`, `MatBinBCSRSetCOOMirror()`
 @*/
-PetscErrorCode MatBinBCSRGetCOOMirror(Mat A, PetscBool *flg)
-{
-  PetscFunctionBegin;
-  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
-  PetscValidBoolPointer(flg, 2);
-  *flg = PETSC_FALSE;
-  PetscTryMethod(A, "MatBinBCSRGetCOOMirror_C", (Mat, PetscBool *), (A, flg));
-  PetscFunctionReturn(0);
-}
+BINBCSR_TRY_GETTER(MatBinBCSRGetCOOMirror, Mat, MAT_CLASSID, PetscBool, PetscValidBoolPointer, PETSC_FALSE)
 
 /*@
    MatBinBCSRSetStreams - Sets how many runs of consecutive bins the product y = A x sweeps side by side
@@ -369,15 +313,70 @@ PetscErrorCode MatBinBCSRSetStreams(Mat A, PetscInt streams)
 
 .seealso: `MATBINBCSR`, `MatBinBCSRSetStreams()`
 @*/
-PetscErrorCode MatBinBCSRGetStreams(Mat A, PetscInt *streams)
+BINBCSR_TRY_GETTER(MatBinBCSRGetStreams, Mat, MAT_CLASSID, PetscInt, PetscValidIntPointer, 1)
+
+/*@
+   MatBinBCSRSetTune - Whether the layout build times the candidate bin widths and stream counts on
+   this machine and keeps the fastest (MAT_BINBCSR_TUNE_AUTO, the default) or takes the defaults
+   (MAT_BINBCSR_TUNE_OFF). A bin width or stream count set explicitly is never changed.
+
+   Logically collective; set before the layout is built. Option: -mat_binbcsr_tune auto|off
+@*/
+PetscErrorCode MatBinBCSRSetTune(Mat A, MatBinBCSRTune t)
 {
   PetscFunctionBegin;
   PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
-  PetscValidIntPointer(streams, 2);
-  *streams = 1;
-  PetscTryMethod(A, "MatBinBCSRGetStreams_C", (Mat, PetscInt *), (A, streams));
+  PetscValidLogicalCollectiveEnum(A, t, 2);
+  PetscCheck(t == MAT_BINBCSR_TUNE_OFF || t == MAT_BINBCSR_TUNE_AUTO, PetscObjectComm((PetscObject)A),
+             PETSC_ERR_ARG_OUTOFRANGE,
+             "Unknown tuning mode %d: MAT_BINBCSR_TUNE_OFF or MAT_BINBCSR_TUNE_AUTO", (int)t);
+  PetscTryMethod(A, "MatBinBCSRSetTune_C", (Mat, MatBinBCSRTune), (A, t));
   PetscFunctionReturn(0);
 }
+
+/*@
+   MatBinBCSRGetTune - Gets whether the layout build of a `MATBINBCSR` matrix tunes its bin width and
+   stream count on this machine
+
+   Not Collective
+
+   Input Parameter:
+.  A - the matrix
+
+   Output Parameter:
+.  t - the tuning mode; `MAT_BINBCSR_TUNE_OFF` on matrices of other types
+
+   Level: advanced
+
+.seealso: `MATBINBCSR`, `MatBinBCSRSetTune()`
+@*/
+BINBCSR_TRY_GETTER(MatBinBCSRGetTune, Mat, MAT_CLASSID, MatBinBCSRTune, PetscValidPointer,
+                   MAT_BINBCSR_TUNE_OFF)
+
+/*@
+   MatBinBCSRSetTuneCache - Whether the tuner reads and writes its cache file
+   ($XDG_CACHE_HOME/petscbinbcsr/tune.txt, else ~/.cache/petscbinbcsr/tune.txt).
+
+   Logically collective; set before the layout is built. Option: -mat_binbcsr_tune_cache <bool>
+@*/
+BINBCSR_TRY_SETTER(MatBinBCSRSetTuneCache, Mat, MAT_CLASSID, PetscBool, PetscValidLogicalCollectiveBool)
+
+/*@
+   MatBinBCSRGetTuneCache - Gets whether the tuner of a `MATBINBCSR` matrix reads and writes its cache file
+
+   Not Collective
+
+   Input Parameter:
+.  A - the matrix
+
+   Output Parameter:
+.  flg - `PETSC_TRUE` if it uses the cache; `PETSC_FALSE` on matrices of other types
+
+   Level: advanced
+
+.seealso: `MATBINBCSR`, `MatBinBCSRSetTuneCache()`
+@*/
+BINBCSR_TRY_GETTER(MatBinBCSRGetTuneCache, Mat, MAT_CLASSID, PetscBool, PetscValidBoolPointer, PETSC_FALSE)
 
 /*@
    MatMultDotLocal - Computes y = A x and the local part of the dot product x^T y in one pass over A
@@ -401,60 +400,6 @@ PetscErrorCode MatBinBCSRGetStreams(Mat A, PetscInt *streams)
 
 .seealso: `MATBINBCSR`, `KSPMCG`, `MatMult()`
 @*/
-/*@
-   MatBinBCSRSetTune - Whether the layout build times the candidate bin widths and stream counts on
-   this machine and keeps the fastest (MAT_BINBCSR_TUNE_AUTO, the default) or takes the defaults
-   (MAT_BINBCSR_TUNE_OFF). A bin width or stream count set explicitly is never changed.
-
-   Logically collective; set before the layout is built. Option: -mat_binbcsr_tune auto|off
-@*/
-PetscErrorCode MatBinBCSRSetTune(Mat A, MatBinBCSRTune t)
-{
-  PetscFunctionBegin;
-  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
-  PetscValidLogicalCollectiveEnum(A, t, 2);
-  PetscCheck(t == MAT_BINBCSR_TUNE_OFF || t == MAT_BINBCSR_TUNE_AUTO, PetscObjectComm((PetscObject)A),
-             PETSC_ERR_ARG_OUTOFRANGE,
-             "Unknown tuning mode %d: MAT_BINBCSR_TUNE_OFF or MAT_BINBCSR_TUNE_AUTO", (int)t);
-  PetscTryMethod(A, "MatBinBCSRSetTune_C", (Mat, MatBinBCSRTune), (A, t));
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode MatBinBCSRGetTune(Mat A, MatBinBCSRTune *t)
-{
-  PetscFunctionBegin;
-  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
-  PetscValidPointer(t, 2);
-  *t = MAT_BINBCSR_TUNE_OFF;
-  PetscTryMethod(A, "MatBinBCSRGetTune_C", (Mat, MatBinBCSRTune *), (A, t));
-  PetscFunctionReturn(0);
-}
-
-/*@
-   MatBinBCSRSetTuneCache - Whether the tuner reads and writes its cache file
-   ($XDG_CACHE_HOME/petscbinbcsr/tune.txt, else ~/.cache/petscbinbcsr/tune.txt).
-
-   Logically collective; set before the layout is built. Option: -mat_binbcsr_tune_cache <bool>
-@*/
-PetscErrorCode MatBinBCSRSetTuneCache(Mat A, PetscBool flg)
-{
-  PetscFunctionBegin;
-  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
-  PetscValidLogicalCollectiveBool(A, flg, 2);
-  PetscTryMethod(A, "MatBinBCSRSetTuneCache_C", (Mat, PetscBool), (A, flg));
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode MatBinBCSRGetTuneCache(Mat A, PetscBool *flg)
-{
-  PetscFunctionBegin;
-  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
-  PetscValidBoolPointer(flg, 2);
-  *flg = PETSC_FALSE;
-  PetscTryMethod(A, "MatBinBCSRGetTuneCache_C", (Mat, PetscBool *), (A, flg));
-  PetscFunctionReturn(0);
-}
-
 PetscErrorCode MatMultDotLocal(Mat A, Vec x, Vec y, PetscScalar *xdoty)
 {
   PetscErrorCode (*fused)(Mat, Vec, Vec, PetscScalar *) = nullptr;
@@ -468,19 +413,27 @@ PetscErrorCode MatMultDotLocal(Mat A, Vec x, Vec y, PetscScalar *xdoty)
   if (fused) {
     PetscCall(fused(A, x, y, xdoty));
   } else {
-    const PetscScalar *xa, *ya;
-    PetscInt           n;
-    PetscScalar        sum = 0;
     PetscCall(MatMult(A, x, y));
-    PetscCall(VecGetLocalSize(x, &n));
-    PetscCall(VecGetArrayRead(x, &xa));
-    PetscCall(VecGetArrayRead(y, &ya));
-    for (PetscInt i = 0; i < n; i++) sum += xa[i] * ya[i];
-    PetscCall(VecRestoreArrayRead(x, &xa));
-    PetscCall(VecRestoreArrayRead(y, &ya));
-    PetscCall(PetscLogFlops(2.0 * n));
-    *xdoty = sum;
+    PetscCall(MatBinBCSRVecDotLocal_Private(x, y, xdoty));
   }
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatBinBCSRVecDotLocal_Private(Vec x, Vec y, PetscScalar *xdoty)
+{
+  const PetscScalar *xa, *ya;
+  PetscInt           n;
+  PetscScalar        sum = 0;
+
+  PetscFunctionBegin;
+  PetscCall(VecGetLocalSize(x, &n));
+  PetscCall(VecGetArrayRead(x, &xa));
+  PetscCall(VecGetArrayRead(y, &ya));
+  for (PetscInt i = 0; i < n; i++) sum += xa[i] * ya[i];
+  PetscCall(VecRestoreArrayRead(x, &xa));
+  PetscCall(VecRestoreArrayRead(y, &ya));
+  PetscCall(PetscLogFlops(2.0 * n));
+  *xdoty = sum;
   PetscFunctionReturn(0);
 }
 

@@ -167,8 +167,7 @@ static PetscErrorCode MatBinBCSRSetTune_MPIBinBCSR(Mat mat, MatBinBCSRTune t)
 
   PetscFunctionBegin;
   b->tune = (PetscInt)t;
-  if (b->A) PetscCall(MatBinBCSRSetTune(b->A, t));
-  if (b->B) PetscCall(MatBinBCSRSetTune(b->B, t));
+  PetscCall(MatMPIBinBCSRSetOnParts(mat, MatBinBCSRSetTune, t));
   PetscFunctionReturn(0);
 }
 
@@ -188,8 +187,7 @@ static PetscErrorCode MatBinBCSRSetTuneCache_MPIBinBCSR(Mat mat, PetscBool flg)
 
   PetscFunctionBegin;
   b->tune_cache = flg ? 1 : 0;
-  if (b->A) PetscCall(MatBinBCSRSetTuneCache(b->A, flg));
-  if (b->B) PetscCall(MatBinBCSRSetTuneCache(b->B, flg));
+  PetscCall(MatMPIBinBCSRSetOnParts(mat, MatBinBCSRSetTuneCache, flg));
   PetscFunctionReturn(0);
 }
 

@@ -5,6 +5,7 @@
 #include "binbcsr.h"
 #include "binbcsr_ops.h"
 #include "../common/binbcsr_type.h"
+#include "../kernels/binbcsr_value_kernels.h" /* binbcsr::row_extreme_kind */
 
 static PetscErrorCode MatSetOption_SeqBinBCSR(Mat A, MatOption op, PetscBool flg)
 {
@@ -93,15 +94,17 @@ static PetscErrorCode MatBinBCSRSetPrecision_SeqBinBCSR(Mat A, MatBinBCSRPrecisi
              PETSC_ERR_ARG_OUTOFRANGE, "Unknown precision %d", (int)p);
   if (p == a->precision) PetscFunctionReturn(0);
   if (a->built) {
-    if (p == MAT_BINBCSR_PRECISION_SINGLE) {
-      PetscCall(PetscMalloc1(nv, &a->valf));
-      for (size_t i = 0; i < nv; i++) a->valf[i] = (float)a->val[i];
-      PetscCall(PetscFree(a->val));
-    } else {
-      PetscCall(PetscMalloc1(nv, &a->val));
-      for (size_t i = 0; i < nv; i++) a->val[i] = (MatScalar)a->valf[i];
-      PetscCall(PetscFree(a->valf));
-    }
+    /* the old array stays alive until the new one holds its values */
+    void            *old_mem = a->val_mem;
+    const MatScalar *oldd    = a->val;
+    const float     *olds    = a->valf;
+    a->val_mem               = nullptr;
+    PetscCall(MatSeqBinBCSRAllocValues_Private(a, p, nv, PETSC_FALSE));
+    if (p == MAT_BINBCSR_PRECISION_SINGLE)
+      for (size_t i = 0; i < nv; i++) a->valf[i] = (float)oldd[i];
+    else
+      for (size_t i = 0; i < nv; i++) a->val[i] = (MatScalar)olds[i];
+    PetscCall(PetscFree(old_mem));
     PetscCall(PetscObjectStateIncrease((PetscObject)A));
   }
   a->precision = p;
@@ -200,10 +203,10 @@ static const struct _MatOps &MatOps_SeqBinBCSR(void)
     o.getinfo         = MatGetInfo_SeqBinBCSR;
     /* rows and columns (binbcsr_rowops.cpp) */
     o.diagonalscale       = MatDiagonalScale_SeqBinBCSR;
-    o.getrowmaxabs        = MatGetRowMaxAbs_SeqBinBCSR;
-    o.getrowmax           = MatGetRowMax_SeqBinBCSR;
-    o.getrowmin           = MatGetRowMin_SeqBinBCSR;
-    o.getrowminabs        = MatGetRowMinAbs_SeqBinBCSR;
+    o.getrowmaxabs        = MatGetRowExtreme_SeqBinBCSR<binbcsr::extreme_max_abs>;
+    o.getrowmax           = MatGetRowExtreme_SeqBinBCSR<binbcsr::extreme_max>;
+    o.getrowmin           = MatGetRowExtreme_SeqBinBCSR<binbcsr::extreme_min>;
+    o.getrowminabs        = MatGetRowExtreme_SeqBinBCSR<binbcsr::extreme_min_abs>;
     o.getcolumnreductions = MatGetColumnReductions_SeqBinBCSR;
     o.missingdiagonal     = MatMissingDiagonal_SeqBinBCSR;
     o.equal               = MatEqual_SeqBinBCSR;

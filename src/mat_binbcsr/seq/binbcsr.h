@@ -97,6 +97,7 @@ typedef struct {
                               block (c, r), c < r, in ascending c: row r's lower part, transposed */
   MatScalar *val;        /* [nslots * bs2] when precision is double, else NULL */
   float     *valf;       /* [nslots * bs2] when precision is single, else NULL */
+  void      *val_mem;    /* the allocation val or valf lies in (MatSeqBinBCSRAllocValues_Private) */
 
   struct BinBCSRStaging *staging; /* non-NULL between MatSetUp/preallocation and the layout build */
 
@@ -141,6 +142,15 @@ static inline PetscInt BinBCSRDefaultBinWidth(PetscInt bs) { return bs == 1 ? 16
 
 /* The product body for a's shape and body set (binbcsr_mult.cpp; the choice is select_body's). */
 binbcsr::Body MatSeqBinBCSRSelectBody(const Mat_SeqBinBCSR *a);
+
+/* The value array of nv entries in the given precision (val or valf; the other stays NULL), 64-byte
+   aligned: PETSc's allocator aligns to PETSC_MEMALIGN (16 bytes here), and a value array at 16 bytes
+   past a cache line makes every 64-byte load of the AVX-512 bodies touch two lines; what the product
+   then costs depended on where malloc happened to put the array (on a Zen 4 core the 48^3 stencil
+   took 9 or 20 ms with the same layout). zero: the entries start at zero. Frees the previous array. */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRAllocValues_Private(Mat_SeqBinBCSR *, MatBinBCSRPrecision, size_t nv,
+                                                             PetscBool zero);
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRFreeValues_Private(Mat_SeqBinBCSR *);
 
 /* Lane of slot s, and the index into val/valf of entry e of slot s. */
 static inline PetscInt BinBCSRLane(PetscInt s, PetscInt bw) { return s % bw; }
@@ -194,11 +204,19 @@ PETSC_INTERN PetscInt MatSeqBinBCSRFindSlot(const Mat_SeqBinBCSR *, PetscInt bro
    each row. Values are zero, in the current precision. Drops staging and any COO map; increases the
    nonzero state. Used by assembly, COO preallocation, MatConvert and available to MatLoad. */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRBuildLayout(Mat, const PetscInt bi[], const PetscInt bj[]);
+/* A new MATSEQBINBCSR of A's sizes and block sizes (swapped when transposed) and A's bin width,
+   precision and storage, laid out for the block pattern bi/bj with zero values (binbcsr_build.cpp):
+   where an operation makes a matrix of another pattern (MatAXPY, MatTranspose). */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRCreateWithPattern(Mat A, PetscBool transposed, const PetscInt bi[],
+                                                           const PetscInt bj[], Mat *B);
 /* Before a layout build from the final pattern bi/bj: chooses a->bw and a->streams where they were not
    set explicitly, by timing products of a sample on this machine, or from the tuning cache
    (binbcsr_tune.cpp). A no-op with tuning off. */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRTune(Mat, const PetscInt bi[], const PetscInt bj[]);
-/* Sizes checked, any layout and staging dropped (binbcsr.cpp): where a layout build starts. */
+/* Block size and block counts from the layouts (set up here); the check every entry point shares
+   (binbcsr_assembly.cpp). */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRSetSizes(Mat);
+/* Sizes checked, any layout and staging dropped (binbcsr_assembly.cpp): where a layout build starts. */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRResetLayout(Mat);
 
 /* Before the layout exists: zero the staged values, keeping the staged pattern (MatZeroEntries). */
@@ -248,6 +266,10 @@ PETSC_INTERN PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat, MatType, MatReuse, Ma
 PETSC_INTERN PetscErrorCode MatConvert_SeqBinBCSR_SeqAIJ(Mat, MatType, MatReuse, Mat *);
 PETSC_INTERN PetscErrorCode MatConvert_SeqBinBCSR_SeqBAIJ(Mat, MatType, MatReuse, Mat *);
 PETSC_INTERN PetscErrorCode MatView_SeqBinBCSR(Mat, PetscViewer);
+/* Block row br's pattern from a matrix of any type with MatGetRow: the block columns (column / bs) of
+   its point rows br bs .. br bs + bs - 1 added to bcols, which is left sorted and unique (binbcsr_convert.cpp) */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRAddBlockRowPattern(Mat X, PetscInt br, PetscInt bs,
+                                                            std::vector<PetscInt> &bcols);
 /* Value maps to and from a seqaij matrix over the same point pattern (binbcsr_aijmap.cpp) */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRAIJValueMap(Mat B, Mat T, std::vector<PetscInt> &map);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRAIJGather(Mat B, const std::vector<PetscInt> &map, Mat T);

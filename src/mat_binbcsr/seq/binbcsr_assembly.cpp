@@ -24,8 +24,7 @@ static PetscErrorCode MatSeqBinBCSRFreeLayout(Mat_SeqBinBCSR *a)
   PetscCall(PetscFree(a->real_slot));
   PetscCall(PetscFree(a->lower_off));
   PetscCall(PetscFree(a->lower_slot));
-  PetscCall(PetscFree(a->val));
-  PetscCall(PetscFree(a->valf));
+  PetscCall(MatSeqBinBCSRFreeValues_Private(a));
   PetscCall(PetscFree2(a->rowbuf_cols, a->rowbuf_vals));
   PetscCall(PetscFree(a->idiag));
   PetscCall(PetscFree(a->sor_idiag));
@@ -61,8 +60,7 @@ PetscErrorCode MatSeqBinBCSRFreeStorage(Mat_SeqBinBCSR *a)
   PetscFunctionReturn(0);
 }
 
-/* Block size and block counts from the layouts; the check every entry point shares. */
-static PetscErrorCode MatSeqBinBCSRSetSizes(Mat A)
+PetscErrorCode MatSeqBinBCSRSetSizes(Mat A)
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
   PetscInt        rbs, cbs;

@@ -1,6 +1,8 @@
 /* MATSEQBINBCSR: the bin layout built from a block pattern (at the first final assembly, and by
-   conversion, load, duplication), the lower-part index of symmetric storage, and the slot lookup. */
+   conversion, load, duplication), the lower-part index of symmetric storage, the slot lookup, and a
+   new matrix laid out for a pattern. */
 #include "binbcsr.h"
+#include <cstdint>
 #include <algorithm>
 #include <vector>
 
@@ -17,7 +19,55 @@ PetscInt MatSeqBinBCSRFindSlot(const Mat_SeqBinBCSR *a, PetscInt brow, PetscInt 
   return -1;
 }
 
+/* The block pattern given to MatSeqBinBCSRBuildLayout (CSR over block rows, bi[mbs + 1], bj[]) is
+   checked before either layout is built from it: the builds trust every column and row length. */
+static PetscErrorCode CheckPattern(const Mat_SeqBinBCSR *a, const PetscInt bi[], const PetscInt bj[])
+{
+  PetscFunctionBegin;
+  for (PetscInt r = 0; r < a->mbs; r++) {
+    const PetscInt n = bi[r + 1] - bi[r];
+    PetscCheck(n >= 0 && n <= a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_CORRUPT,
+               "Block row %" PetscInt_FMT " has %" PetscInt_FMT " blocks", r, n);
+    for (PetscInt p = bi[r]; p < bi[r + 1]; p++) {
+      PetscCheck(bj[p] >= 0 && bj[p] < a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+                 "Block column %" PetscInt_FMT " of block row %" PetscInt_FMT
+                 " out of range [0, %" PetscInt_FMT ")",
+                 bj[p], r, a->nbs);
+      PetscCheck(p == bi[r] || bj[p] > bj[p - 1], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
+                 "Block columns of block row %" PetscInt_FMT " are not sorted and unique", r);
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
 /* The symmetric-storage part of MatSeqBinBCSRBuildLayout: bins ordered by the colouring. */
+PetscErrorCode MatSeqBinBCSRFreeValues_Private(Mat_SeqBinBCSR *a)
+{
+  PetscFunctionBegin;
+  PetscCall(PetscFree(a->val_mem));
+  a->val  = nullptr;
+  a->valf = nullptr;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatSeqBinBCSRAllocValues_Private(Mat_SeqBinBCSR *a, MatBinBCSRPrecision p, size_t nv,
+                                                PetscBool zero)
+{
+  constexpr size_t line  = 64;
+  const size_t     bytes = nv * (p == MAT_BINBCSR_PRECISION_SINGLE ? sizeof(float) : sizeof(MatScalar));
+  char            *mem;
+
+  PetscFunctionBegin;
+  PetscCall(MatSeqBinBCSRFreeValues_Private(a));
+  PetscCall(PetscMalloc1(bytes + line, &mem));
+  char *v = mem + (line - (size_t)((uintptr_t)mem % line)) % line;
+  if (zero) PetscCall(PetscMemzero(v, bytes));
+  a->val_mem = mem;
+  if (p == MAT_BINBCSR_PRECISION_SINGLE) a->valf = (float *)v;
+  else a->val = (MatScalar *)v;
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MatSeqBinBCSRBuildLayoutSym(Mat A, const PetscInt bi[], const PetscInt bj[])
 {
   Mat_SeqBinBCSR       *a  = (Mat_SeqBinBCSR *)A->data;
@@ -28,18 +78,7 @@ static PetscErrorCode MatSeqBinBCSRBuildLayoutSym(Mat A, const PetscInt bi[], co
   PetscCheck(A->rmap->n == A->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
              "Symmetric storage needs a square matrix, this one is %" PetscInt_FMT " x %" PetscInt_FMT,
              A->rmap->n, A->cmap->n);
-  for (PetscInt r = 0; r < mbs; r++) {
-    PetscCheck(bi[r + 1] - bi[r] >= 0 && bi[r + 1] - bi[r] <= a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_CORRUPT,
-               "Block row %" PetscInt_FMT " has %" PetscInt_FMT " blocks", r, bi[r + 1] - bi[r]);
-    for (PetscInt p = bi[r]; p < bi[r + 1]; p++) {
-      PetscCheck(bj[p] >= 0 && bj[p] < a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
-                 "Block column %" PetscInt_FMT " of block row %" PetscInt_FMT
-                 " out of range [0, %" PetscInt_FMT ")",
-                 bj[p], r, a->nbs);
-      PetscCheck(p == bi[r] || bj[p] > bj[p - 1], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
-                 "Block columns of block row %" PetscInt_FMT " are not sorted and unique", r);
-    }
-  }
+  PetscCall(CheckPattern(a, bi, bj));
   PetscCall(PetscMalloc1(mbs + 1, &a->row_off));
   a->row_off[0] = 0;
   for (PetscInt r = 0; r < mbs; r++) {
@@ -72,9 +111,7 @@ static PetscErrorCode MatSeqBinBCSRBuildLayoutSym(Mat A, const PetscInt bi[], co
   a->nslots = a->bin_start[nbins];
   PetscCall(PetscMalloc1(a->nslots, &a->col));
   std::copy(allcol.begin(), allcol.end(), a->col);
-  if (a->precision == MAT_BINBCSR_PRECISION_DOUBLE)
-    PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->val));
-  else PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->valf));
+  PetscCall(MatSeqBinBCSRAllocValues_Private(a, a->precision, (size_t)a->nslots * a->bs2, PETSC_TRUE));
   PetscCall(PetscMalloc2((size_t)PetscMax(a->nbs, 1) * a->bs, &a->rowbuf_cols,
                          (size_t)PetscMax(a->nbs, 1) * a->bs,
                          &a->rowbuf_vals)); /* a full row, both triangles */
@@ -141,19 +178,10 @@ PetscErrorCode MatSeqBinBCSRBuildLayout(Mat A, const PetscInt bi[], const PetscI
     PetscCall(PetscLogEventEnd(MAT_BinBCSR_BuildLayout, A, 0, 0, 0));
     PetscFunctionReturn(0);
   }
+  PetscCall(CheckPattern(a, bi, bj));
   for (PetscInt r = 0; r < mbs; r++) {
     const PetscInt n = bi[r + 1] - bi[r];
-    PetscCheck(n >= 0 && n <= a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_CORRUPT,
-               "Block row %" PetscInt_FMT " has %" PetscInt_FMT " blocks", r, n);
-    for (PetscInt p = bi[r]; p < bi[r + 1]; p++) {
-      PetscCheck(bj[p] >= 0 && bj[p] < a->nbs, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
-                 "Block column %" PetscInt_FMT " of block row %" PetscInt_FMT
-                 " out of range [0, %" PetscInt_FMT ")",
-                 bj[p], r, a->nbs);
-      PetscCheck(p == bi[r] || bj[p] > bj[p - 1], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
-                 "Block columns of block row %" PetscInt_FMT " are not sorted and unique", r);
-    }
-    a->row_nz[r] = n;
+    a->row_nz[r]     = n;
     a->nz += n;
     a->max_row_nz = PetscMax(a->max_row_nz, n);
   }
@@ -164,9 +192,7 @@ PetscErrorCode MatSeqBinBCSRBuildLayout(Mat A, const PetscInt bi[], const PetscI
     a->nslots = (PetscInt)nslots;
   }
   PetscCall(PetscMalloc1(a->nslots, &a->col));
-  if (a->precision == MAT_BINBCSR_PRECISION_DOUBLE)
-    PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->val));
-  else PetscCall(PetscCalloc1((size_t)a->nslots * a->bs2, &a->valf));
+  PetscCall(MatSeqBinBCSRAllocValues_Private(a, a->precision, (size_t)a->nslots * a->bs2, PETSC_TRUE));
   binbcsr::bin_columns<PetscInt>(bi, bj, mbs, bw, a->bin_start, a->col, a->diag_slot);
   PetscCall(PetscMalloc2((size_t)a->max_row_nz * a->bs, &a->rowbuf_cols, (size_t)a->max_row_nz * a->bs,
                          &a->rowbuf_vals));
@@ -174,5 +200,26 @@ PetscErrorCode MatSeqBinBCSRBuildLayout(Mat A, const PetscInt bi[], const PetscI
   A->preallocated = PETSC_TRUE; /* a layout is an allocation, however it was built (convert, load, ...) */
   A->nonzerostate++;
   PetscCall(PetscLogEventEnd(MAT_BinBCSR_BuildLayout, A, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatSeqBinBCSRCreateWithPattern(Mat A, PetscBool transposed, const PetscInt bi[],
+                                              const PetscInt bj[], Mat *B)
+{
+  const Mat_SeqBinBCSR *a    = (const Mat_SeqBinBCSR *)A->data;
+  PetscLayout           rmap = transposed ? A->cmap : A->rmap, cmap = transposed ? A->rmap : A->cmap;
+
+  PetscFunctionBegin;
+  PetscCall(MatCreate(PetscObjectComm((PetscObject)A), B));
+  PetscCall(MatSetSizes(*B, rmap->n, cmap->n, rmap->N, cmap->N));
+  PetscCall(MatSetBlockSizes(*B, PetscAbs(rmap->bs), PetscAbs(cmap->bs)));
+  PetscCall(MatSetType(*B, MATSEQBINBCSR));
+  PetscCall(MatBinBCSRSetBinWidth(*B, a->bw));
+  PetscCall(MatBinBCSRSetPrecision(*B, a->precision));
+  PetscCall(MatBinBCSRSetSymmetricStorage(*B, a->sym));
+  PetscCall(PetscLayoutSetUp((*B)->rmap));
+  PetscCall(PetscLayoutSetUp((*B)->cmap));
+  PetscCall(MatSeqBinBCSRBuildLayout(*B, bi, bj));
+  (*B)->preallocated = PETSC_TRUE;
   PetscFunctionReturn(0);
 }

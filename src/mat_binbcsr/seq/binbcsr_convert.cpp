@@ -102,15 +102,11 @@ static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues
     PetscCall(PetscArraycpy(b->diag_slot, a->diag_slot, a->mbs));
     PetscCall(PetscMalloc1(a->nslots, &b->col));
     PetscCall(PetscArraycpy(b->col, a->col, a->nslots));
-    if (a->val) {
-      PetscCall(PetscMalloc1(nv, &b->val));
-      if (copyvalues) PetscCall(PetscArraycpy(b->val, a->val, nv));
-      else PetscCall(PetscArrayzero(b->val, nv));
-    } else {
-      PetscCall(PetscMalloc1(nv, &b->valf));
-      if (copyvalues) PetscCall(PetscArraycpy(b->valf, a->valf, nv));
-      else PetscCall(PetscArrayzero(b->valf, nv));
-    }
+    PetscCall(MatSeqBinBCSRAllocValues_Private(
+      b, a->val ? MAT_BINBCSR_PRECISION_DOUBLE : MAT_BINBCSR_PRECISION_SINGLE, nv,
+      copyvalues ? PETSC_FALSE : PETSC_TRUE));
+    if (copyvalues && a->val) PetscCall(PetscArraycpy(b->val, a->val, nv));
+    else if (copyvalues) PetscCall(PetscArraycpy(b->valf, a->valf, nv));
     if (a->sym) {
       PetscCall(PetscMalloc1(a->mbs + 1, &b->row_off));
       PetscCall(PetscArraycpy(b->row_off, a->row_off, a->mbs + 1));
@@ -196,6 +192,21 @@ PetscErrorCode MatCopy_SeqBinBCSR(Mat A, Mat B, MatStructure str)
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode MatSeqBinBCSRAddBlockRowPattern(Mat X, PetscInt br, PetscInt bs, std::vector<PetscInt> &bcols)
+{
+  PetscFunctionBegin;
+  for (PetscInt r = br * bs; r < (br + 1) * bs; r++) {
+    PetscInt        n;
+    const PetscInt *cols;
+    PetscCall(MatGetRow(X, r, &n, &cols, nullptr));
+    for (PetscInt k = 0; k < n; k++) bcols.push_back(cols[k] / bs);
+    PetscCall(MatRestoreRow(X, r, &n, &cols, nullptr));
+  }
+  std::sort(bcols.begin(), bcols.end());
+  bcols.erase(std::unique(bcols.begin(), bcols.end()), bcols.end());
+  PetscFunctionReturn(0);
+}
+
 /* Any matrix with MatGetRow -> MATSEQBINBCSR, with the source's block size (1 if its row and column
    block sizes differ or do not divide the sizes). */
 PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat A, MatType type, MatReuse reuse, Mat *newmat)
@@ -241,15 +252,7 @@ PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat A, MatType type, MatReuse reuse, Ma
   std::vector<PetscInt> all;
   for (PetscInt br = 0; br < mbs; br++) {
     rowcols.clear();
-    for (PetscInt i = 0; i < bs; i++) {
-      PetscInt        n, r = br * bs + i;
-      const PetscInt *cols;
-      PetscCall(MatGetRow(A, r, &n, &cols, nullptr));
-      for (PetscInt k = 0; k < n; k++) rowcols.push_back(cols[k] / bs);
-      PetscCall(MatRestoreRow(A, r, &n, &cols, nullptr));
-    }
-    std::sort(rowcols.begin(), rowcols.end());
-    rowcols.erase(std::unique(rowcols.begin(), rowcols.end()), rowcols.end());
+    PetscCall(MatSeqBinBCSRAddBlockRowPattern(A, br, bs, rowcols));
     all.insert(all.end(), rowcols.begin(), rowcols.end());
     bi[br + 1] = (PetscInt)all.size();
   }

@@ -21,20 +21,15 @@ PetscErrorCode BuildSlotMap(Mat A, const PetscInt *perm, long n);
 static PetscErrorCode PreallocateCOO(Mat A, PetscCount n, const PetscInt ci[], const PetscInt cj[])
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-  PetscInt        rbs, cbs, bs, mbs, nvalid = 0, *rowptr, *bi, *bj, *vk, *fill;
+  PetscInt        bs, mbs, nvalid = 0, *rowptr, *bi, *bj, *vk, *fill;
   uint64_t       *key; /* (block column << 32) | coo index, sorted per block row */
 
   PetscFunctionBegin;
   PetscCheck(n <= PETSC_MAX_INT, PETSC_COMM_SELF, PETSC_ERR_SUP,
              "%" PetscCount_FMT " COO entries overflow the 32-bit indices of MATSEQBINBCSR", n);
-  PetscCall(PetscLayoutSetUp(A->rmap));
-  PetscCall(PetscLayoutSetUp(A->cmap));
-  PetscCall(MatGetBlockSizes(A, &rbs, &cbs));
-  PetscCheck(rbs == cbs, PETSC_COMM_SELF, PETSC_ERR_ARG_INCOMP,
-             "MATSEQBINBCSR needs equal row and column block sizes, got %" PetscInt_FMT " and %" PetscInt_FMT,
-             rbs, cbs);
-  bs  = rbs;
-  mbs = A->rmap->n / bs;
+  PetscCall(MatSeqBinBCSRSetSizes(A));
+  bs  = a->bs;
+  mbs = a->mbs;
 
   /* negative indices drop the entry, out-of-range ones are errors (checked before any allocation) */
   for (PetscCount k = 0; k < n; k++) {

@@ -174,29 +174,11 @@ PetscErrorCode AXPYUnion(Mat Y, PetscScalar a, Mat X)
   for (PetscInt r = 0; r < mbs; r++) {
     row.clear();
     for (PetscInt k = 0; k < y->row_nz[r]; k++) row.push_back(y->col[BinBCSRSlot(y, r, k)]);
-    for (PetscInt i = r * bs; i < (r + 1) * bs; i++) {
-      PetscInt        n;
-      const PetscInt *cols;
-      PetscCall(MatGetRow(X, i, &n, &cols, nullptr));
-      for (PetscInt k = 0; k < n; k++) row.push_back(cols[k] / bs);
-      PetscCall(MatRestoreRow(X, i, &n, &cols, nullptr));
-    }
-    std::sort(row.begin(), row.end());
-    row.erase(std::unique(row.begin(), row.end()), row.end());
+    PetscCall(MatSeqBinBCSRAddBlockRowPattern(X, r, bs, row));
     bj.insert(bj.end(), row.begin(), row.end());
     bi[r + 1] = (PetscInt)bj.size();
   }
-  PetscCall(MatCreate(PetscObjectComm((PetscObject)Y), &B));
-  PetscCall(MatSetSizes(B, Y->rmap->n, Y->cmap->n, Y->rmap->N, Y->cmap->N));
-  PetscCall(MatSetBlockSizesFromMats(B, Y, Y));
-  PetscCall(MatSetType(B, MATSEQBINBCSR));
-  PetscCall(MatBinBCSRSetBinWidth(B, y->bw));
-  PetscCall(MatBinBCSRSetPrecision(B, y->precision));
-  PetscCall(MatBinBCSRSetSymmetricStorage(B, y->sym));
-  PetscCall(PetscLayoutSetUp(B->rmap));
-  PetscCall(PetscLayoutSetUp(B->cmap));
-  PetscCall(MatSeqBinBCSRBuildLayout(B, bi.data(), bj.data()));
-  B->preallocated = PETSC_TRUE;
+  PetscCall(MatSeqBinBCSRCreateWithPattern(Y, PETSC_FALSE, bi.data(), bj.data(), &B));
   {
     Mat_SeqBinBCSR *b = (Mat_SeqBinBCSR *)B->data;
     for (PetscInt r = 0; r < mbs; r++)

@@ -27,13 +27,11 @@ PETSC_INTERN PetscErrorCode MatTranspose_SeqBinBCSR(Mat, MatReuse, Mat *);
 
 /* Rows and columns of the full matrix (binbcsr_rowops.cpp) */
 PETSC_INTERN PetscErrorCode MatDiagonalScale_SeqBinBCSR(Mat, Vec, Vec);
-PETSC_INTERN PetscErrorCode MatGetRowMaxAbs_SeqBinBCSR(Mat, Vec, PetscInt[]);
-PETSC_INTERN PetscErrorCode MatGetRowMax_SeqBinBCSR(Mat, Vec, PetscInt[]);
-PETSC_INTERN PetscErrorCode MatGetRowMin_SeqBinBCSR(Mat, Vec, PetscInt[]);
-PETSC_INTERN PetscErrorCode MatGetRowMinAbs_SeqBinBCSR(Mat, Vec, PetscInt[]);
-PETSC_INTERN PetscErrorCode MatGetColumnReductions_SeqBinBCSR(Mat, PetscInt, PetscReal *);
-PETSC_INTERN PetscErrorCode MatMissingDiagonal_SeqBinBCSR(Mat, PetscBool *, PetscInt *);
-PETSC_INTERN PetscErrorCode MatEqual_SeqBinBCSR(Mat, Mat, PetscBool *);
+/* MatGetRowMaxAbs/Max/Min/MinAbs, kind a binbcsr::row_extreme_kind (instantiated for the four) */
+template <int kind> PetscErrorCode MatGetRowExtreme_SeqBinBCSR(Mat, Vec, PetscInt[]);
+PETSC_INTERN PetscErrorCode        MatGetColumnReductions_SeqBinBCSR(Mat, PetscInt, PetscReal *);
+PETSC_INTERN PetscErrorCode        MatMissingDiagonal_SeqBinBCSR(Mat, PetscBool *, PetscInt *);
+PETSC_INTERN PetscErrorCode        MatEqual_SeqBinBCSR(Mat, Mat, PetscBool *);
 /* red[j] (cmap->n, zeroed here) = the binbcsr::reduction_kind over point column j of the full matrix */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRColumnReductions(Mat, int kind, double *red);
 

@@ -235,33 +235,20 @@ PetscErrorCode MatDiagonalScale_SeqBinBCSR(Mat A, Vec ll, Vec rr)
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode MatGetRowMaxAbs_SeqBinBCSR(Mat A, Vec v, PetscInt idx[])
+/* MatGetRowMaxAbs, MatGetRowMax, MatGetRowMin, MatGetRowMinAbs: kind (binbcsr::row_extreme_kind) a
+   template argument, so that each is an ops-table slot of its own with one body. */
+template <int kind> PetscErrorCode MatGetRowExtreme_SeqBinBCSR(Mat A, Vec v, PetscInt idx[])
 {
-  PetscFunctionBegin;
-  PetscCall(RowExtremes(A, v, idx, binbcsr::extreme_max_abs, "MatGetRowMaxAbs"));
-  PetscFunctionReturn(0);
-}
+  static const char *const op[] = {"MatGetRowMaxAbs", "MatGetRowMax", "MatGetRowMin", "MatGetRowMinAbs"};
 
-PetscErrorCode MatGetRowMax_SeqBinBCSR(Mat A, Vec v, PetscInt idx[])
-{
   PetscFunctionBegin;
-  PetscCall(RowExtremes(A, v, idx, binbcsr::extreme_max, "MatGetRowMax"));
+  PetscCall(RowExtremes(A, v, idx, kind, op[kind]));
   PetscFunctionReturn(0);
 }
-
-PetscErrorCode MatGetRowMin_SeqBinBCSR(Mat A, Vec v, PetscInt idx[])
-{
-  PetscFunctionBegin;
-  PetscCall(RowExtremes(A, v, idx, binbcsr::extreme_min, "MatGetRowMin"));
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode MatGetRowMinAbs_SeqBinBCSR(Mat A, Vec v, PetscInt idx[])
-{
-  PetscFunctionBegin;
-  PetscCall(RowExtremes(A, v, idx, binbcsr::extreme_min_abs, "MatGetRowMinAbs"));
-  PetscFunctionReturn(0);
-}
+template PetscErrorCode MatGetRowExtreme_SeqBinBCSR<binbcsr::extreme_max_abs>(Mat, Vec, PetscInt[]);
+template PetscErrorCode MatGetRowExtreme_SeqBinBCSR<binbcsr::extreme_max>(Mat, Vec, PetscInt[]);
+template PetscErrorCode MatGetRowExtreme_SeqBinBCSR<binbcsr::extreme_min>(Mat, Vec, PetscInt[]);
+template PetscErrorCode MatGetRowExtreme_SeqBinBCSR<binbcsr::extreme_min_abs>(Mat, Vec, PetscInt[]);
 
 /* As AIJ, *d is the first point row whose diagonal entry has no place in the pattern (BAIJ gives the
    block row); it is left alone when nothing is missing. */

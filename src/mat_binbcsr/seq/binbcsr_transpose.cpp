@@ -31,16 +31,7 @@ PetscErrorCode MatTranspose_SeqBinBCSR(Mat A, MatReuse reuse, Mat *B)
   for (PetscInt r = 0; r < a->mbs; r++)
     for (PetscInt k = 0; k < a->row_nz[r]; k++) bj[fill[a->col[BinBCSRSlot(a, r, k)]]++] = r;
 
-  PetscCall(MatCreate(PetscObjectComm((PetscObject)A), &C));
-  PetscCall(MatSetSizes(C, A->cmap->n, A->rmap->n, A->cmap->N, A->rmap->N));
-  PetscCall(MatSetBlockSizes(C, PetscAbs(A->cmap->bs), PetscAbs(A->rmap->bs)));
-  PetscCall(MatSetType(C, MATSEQBINBCSR));
-  PetscCall(MatBinBCSRSetBinWidth(C, a->bw));
-  PetscCall(MatBinBCSRSetPrecision(C, a->precision));
-  PetscCall(PetscLayoutSetUp(C->rmap));
-  PetscCall(PetscLayoutSetUp(C->cmap));
-  PetscCall(MatSeqBinBCSRBuildLayout(C, bi.data(), bj.data()));
-  C->preallocated = PETSC_TRUE;
+  PetscCall(MatSeqBinBCSRCreateWithPattern(A, PETSC_TRUE, bi.data(), bj.data(), &C));
   {
     Mat_SeqBinBCSR *c = (Mat_SeqBinBCSR *)C->data;
     for (PetscInt r = 0; r < a->mbs; r++)

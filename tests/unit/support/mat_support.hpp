@@ -2,6 +2,7 @@
 // stencils, wildly different row lengths) built identically as seqaij and as seqbinbcsr, and
 // comparisons with tolerances derived from the arithmetic (not loose constants).
 #pragma once
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <petscbinbcsr.h>
 #include <cfloat>

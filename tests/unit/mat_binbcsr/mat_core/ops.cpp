@@ -1,6 +1,7 @@
 // MatGetDiagonal, MatInvertBlockDiagonal, MatGetRow, MatDuplicate, MatCopy, MatConvert (both ways),
 // precision switching and MatView of MATSEQBINBCSR against seqaij/seqbaij.
 #include "support/mat_support.hpp"
+#include <algorithm>
 #include <petsc/private/matimpl.h>
 #include <cstdio>
 #include <fstream>

@@ -2,6 +2,7 @@
 // a dense block-SOR reference computed here, against seqaij's MatSOR for bs 1, through PCSOR in CG,
 // and its errors.
 #include "support_sym.hpp"
+#include <algorithm>
 #include <petscksp.h>
 
 using namespace mat_sym;

@@ -3,6 +3,7 @@
 #pragma once
 #include "support/mat_support.hpp"
 #include "mat_binbcsr/seq/binbcsr.h"
+#include <algorithm>
 #include <map>
 
 namespace mat_sym {
