@@ -195,7 +195,9 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
       PetscCall(KSPSetOptionsPrefix(smoother, "grid_mg_coarse_"));
       continue; // PCMG's default: LU (redundant on more ranks)
     }
-    PetscCall(KSPSetOptionsPrefix(smoother, "grid_mg_levels_"));
+    char prefix[64]; // -grid_mg_levels_N_* for level N (PCMG's numbering), -grid_mg_levels_* for all
+    PetscCall(PetscSNPrintf(prefix, sizeof prefix, "grid_mg_levels_%d_", (int)l));
+    PetscCall(KSPSetOptionsPrefix(smoother, prefix));
     PetscCall(KSPSetType(smoother, KSPRICHARDSON));
     PetscCall(KSPSetTolerances(smoother, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT, 1));
     PetscCall(PCSetType(spc, PCSOR));
