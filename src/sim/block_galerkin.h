@@ -19,7 +19,8 @@ struct BlockGalerkin {
     PetscInt dst; // block of Ac (index into its value array / 9)
     double   w;
   };
-  std::vector<Term> terms;
+  std::vector<Term>     terms; // sorted by dst
+  std::vector<PetscInt> start; // terms of Ac's block b: [start[b], start[b + 1])
 };
 
 // The source: nblocks 3x3 blocks (row[k], col[k]) in fine node numbering, 9 values each, row-major when
