@@ -146,7 +146,7 @@ int main(int argc, char **argv)
   if (is_mg) {
     PetscCall(GridMGSetUp(rs.sys.ksp, cloth.n, cloth.fixed, rs.new_of_old, rs.row_offsets, sys.block_row,
                           sys.block_col, rs.upper_only, &mg));
-    PetscCall(PetscPrintf(comm, "cloth: grid multigrid, %zu levels:", mg.sides.size()));
+    PetscCall(PetscPrintf(comm, "cloth: grid multigrid, %zu level(s):", mg.sides.size()));
     for (PetscInt side : mg.sides) PetscCall(PetscPrintf(comm, " %" PetscInt_FMT "^2", side));
     PetscCall(PetscPrintf(comm, " nodes, coarse operators by %s\n", mg.own_galerkin ? "blocks" : "MatPtAP"));
     // The coarse operators follow every refill of the fine matrix (timed with it: setvalues_ms).

@@ -35,11 +35,15 @@ add_test(NAME cloth_mg_converges_like_tight
          COMMAND sh -c "${CLOTH_MG} -pc_type pbjacobi -ksp_rtol 1e-10 -write_positions cloth_mg_ref.txt >/dev/null && ${SUMMARY_CHECK} 'cg_its<=10 && unconverged_steps==0 && diverged_solves==0 && rms_position_diff<5e-4' -- ${CLOTH_MG} -reference_positions cloth_mg_ref.txt")
 add_test(NAME cloth_mg_energy_as_tight
          COMMAND ${SUMMARY_SAME} "energy_final:0" 1e-3 "${CLOTH_MG} -pc_type pbjacobi -ksp_rtol 1e-10" "${CLOTH_MG}")
+# A grid of at most -grid_mg_coarse_nodes particles is one level, solved directly: one iteration per step.
+add_test(NAME cloth_mg_single_level_direct
+         COMMAND ${SUMMARY_CHECK} "cg_its<=1.01 && unconverged_steps==0" -- ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 8 -steps 5 -progress_every 1000)
 add_test(NAME cloth_mg_bad_coarse_nodes
          COMMAND ${EXPECT_RUN} nonzero "grid_mg_coarse_nodes must be at least 4" -- ${CLOTH} -cloth_n 8 -pc_type mg -grid_mg_coarse_nodes 2)
 add_test(NAME cloth_mg_blocks_one_rank
          COMMAND ${EXPECT_RUN} nonzero "runs on one rank only" -- ${MPIEXEC_CMD} -n 2 ${CLOTH} -cloth_n 8 -pc_type mg -grid_mg_galerkin blocks)
-set_tests_properties(cloth_mg_converges_like_tight cloth_mg_energy_as_tight cloth_mg_bad_coarse_nodes PROPERTIES LABELS "cloth" TIMEOUT 60)
+set_tests_properties(cloth_mg_converges_like_tight cloth_mg_energy_as_tight cloth_mg_single_level_direct cloth_mg_bad_coarse_nodes
+                     PROPERTIES LABELS "cloth" TIMEOUT 60)
 set_tests_properties(cloth_mg_blocks_one_rank PROPERTIES LABELS "cloth;mpi" PROCESSORS 2 TIMEOUT 60)
 add_test(NAME cloth_bad_dt COMMAND ${EXPECT_RUN} nonzero "time step must be positive" -- ${CLOTH} -cloth_n 4 -dt 0)
 add_test(NAME cloth_bad_n COMMAND ${EXPECT_RUN} nonzero "at least 2 x 2" -- ${CLOTH} -cloth_n 1)

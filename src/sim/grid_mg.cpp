@@ -193,6 +193,10 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
     PetscCall(KSPGetPC(smoother, &spc));
     if (l == 0) {
       PetscCall(KSPSetOptionsPrefix(smoother, "grid_mg_coarse_"));
+      if (nlev == 1) { // PCMG makes a lone level a smoother; a grid this small is solved directly
+        PetscCall(KSPSetType(smoother, KSPPREONLY));
+        PetscCall(PCSetType(spc, size > 1 ? PCREDUNDANT : PCLU));
+      }
       continue; // PCMG's default: LU (redundant on more ranks)
     }
     char prefix[64]; // -grid_mg_levels_N_* for level N (PCMG's numbering), -grid_mg_levels_* for all
