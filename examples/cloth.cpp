@@ -1,5 +1,6 @@
 // Implicit cloth (physics/cloth_step.hpp): an n x n particle grid, one 3x3-block system per step refilled in
-// place and solved through PETSc with the configured -mat_type/-ksp_type/-pc_type.
+// place and solved through PETSc with the configured -mat_type/-ksp_type/-pc_type; -pc_type mg is a geometric
+// multigrid on the particle grid (sim/grid_mg.h).
 //
 //   cloth -options_file options/cloth.opts [-cloth_n 160] [-steps N] [-mat_type binbcsr] [-ksp_type mcg]
 //

@@ -43,7 +43,8 @@ GridLevel Coarsen(const GridLevel &f)
   return c;
 }
 
-// The coarse nodes (lo, lo + 1) around fine index i along one side and the weight of lo + 1 (0 or 1/2).
+// The coarse nodes (lo, lo + 1) around fine index i along one side and the weight of lo + 1: 0 or 1/2, and 1
+// for the last node of an odd side (it is coarse node lo + 1).
 void Bracket(PetscInt i, PetscInt cside, PetscInt *lo, double *a)
 {
   *lo = std::min(i / 2, cside - 2);

@@ -2,13 +2,14 @@
 // the fine operator's Mat type: the driver knows the grid, PETSc does not.
 //
 // Levels: every coarsening keeps every other node per side (n -> n / 2 + 1), until a level has at most
-// -grid_mg_coarse_nodes nodes (default 150; the 160 x 160 cloth gets 160, 81, 41, 21, 11). Interpolation: bilinear, the same weights for
-// each of the 3 components, one AIJ matrix per level, built once (the grid does not change). Rows of fixed
-// (Dirichlet) fine nodes are zero: their equations hold only the mass, the smoother solves them exactly,
-// and a coarse correction must not move them. Coarse operators: Galerkin, P^T A P for every new set of
-// values, by default from the driver's COO blocks (block_galerkin.h, SeqBAIJ coarse levels, one rank), with
-// -grid_mg_galerkin pcmg (the default on more ranks) by PCMG's MatPtAP (AIJ) at its set-up. The smoothers and
-// the coarse solve come from the -mg_levels_* and -mg_coarse_* options.
+// -grid_mg_coarse_nodes nodes (default 150; the 160 x 160 cloth gets 160, 81, 41, 21, 11). Interpolation:
+// bilinear, the same weights for each of the 3 components, one AIJ matrix per level, built once (the grid
+// does not change). Rows of fixed (Dirichlet) fine nodes are zero: their equations hold only the mass, the
+// smoother solves them exactly, and a coarse correction must not move them. Coarse operators: Galerkin,
+// P^T A P for every new set of values, by default from the driver's COO blocks (block_galerkin.h, SeqBAIJ
+// coarse levels, one rank), with -grid_mg_galerkin pcmg (the default on more ranks) by PCMG's MatPtAP (AIJ)
+// at its set-up. Smoothers: -grid_mg_levels_[N_]* (default one symmetric Gauss-Seidel sweep), coarse solve:
+// -grid_mg_coarse_* (default LU, redundant on more ranks); GAMG's -mg_levels_* do not reach them.
 //
 // On P ranks the fine rows are those of the solver's numbering (new_of_old, rows row_offsets[r] ..
 // row_offsets[r + 1] on rank r); each coarse node belongs to the rank owning the fine node nearest to it.
