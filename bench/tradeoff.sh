@@ -202,6 +202,11 @@ if [ -x "$clothx" ]; then
       IFS='|' read -r name args <<<"$s"
       scene_point cloth "$name" "${cbase[@]}" -ksp_max_it 5000 $args -reference_positions "$out/tradeoff_cloth_reference.txt"
     done
+    # The driver's geometric multigrid on the particle grid (cloth only; cloth.opts' own setting at 1e-4).
+    for t in 1e-4 1e-6; do
+      scene_point cloth "gridmg_rtol$t" "${cbase[@]}" -ksp_max_it 5000 -pc_type mg -ksp_mcg_fixed_iterations 0 \
+        -ksp_rtol $t -reference_positions "$out/tradeoff_cloth_reference.txt"
+    done
   else
     note "cloth reference run failed (see $out/tradeoff_cloth_reference.log)"
   fi

@@ -1,5 +1,6 @@
 // Implicit cloth (physics/cloth_step.hpp): an n x n particle grid, one 3x3-block system per step refilled in
-// place and solved through PETSc with the configured -mat_type/-ksp_type/-pc_type.
+// place and solved through PETSc with the configured -mat_type/-ksp_type/-pc_type; -pc_type mg is a geometric
+// multigrid on the particle grid (sim/grid_mg.h).
 //
 //   cloth -options_file options/cloth.opts [-cloth_n 160] [-steps N] [-mat_type binbcsr] [-ksp_type mcg]
 //
@@ -12,6 +13,7 @@
 // position difference against another run, sim/position_file.h), and a final `summary key=value ...` line; -cloth_timer cpu times
 // in process CPU time instead of wall time (a shared machine).
 #include "sim/run_guard.h"
+#include "sim/grid_mg.h"
 #include "sim/position_file.h"
 #include "sim/sim_driver.h"
 #include "physics/cloth_step.hpp"
@@ -133,9 +135,32 @@ int main(int argc, char **argv)
       cloth, own, [&](int row, int col) { return ReplicatedSolverStoresBlock(&rs, row, col); });
   }
   PetscCall(ReplicatedSolverSetLocalPattern(&rs, sys.block_row, sys.block_col));
-  const physics::BlockLinearSolver linear = ReplicatedSolverAdapter(&rs);
-  PetscInt                         nnz;
-  const char                      *mat_type, *ksp_type;
+  // -pc_type mg: geometric multigrid on the particle grid (sim/grid_mg.h); PCMG alone knows no levels.
+  physics::BlockLinearSolver linear = ReplicatedSolverAdapter(&rs);
+  GridMG                     mg;
+  PetscBool                  is_mg;
+  {
+    PC pc;
+    PetscCall(KSPGetPC(rs.sys.ksp, &pc));
+    PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &is_mg));
+  }
+  if (is_mg) {
+    PetscCall(GridMGSetUp(rs.sys.ksp, cloth.n, cloth.fixed, rs.new_of_old, rs.row_offsets, sys.block_row,
+                          sys.block_col, rs.upper_only, &mg));
+    PetscCall(PetscPrintf(comm, "cloth: grid multigrid, %zu level(s):", mg.sides.size()));
+    for (PetscInt side : mg.sides) PetscCall(PetscPrintf(comm, " %" PetscInt_FMT "^2", side));
+    PetscCall(PetscPrintf(comm, " nodes, coarse operators by %s\n", mg.own_galerkin ? "blocks" : "MatPtAP"));
+    // The coarse operators follow every refill of the fine matrix (timed with it: setvalues_ms).
+    linear.set_matrix = [&rs, &mg, fine = linear.set_matrix](const std::vector<double> &values) {
+      fine(values);
+      const auto   now = rs.cpu_timer ? ProcessCpuTime : WallTime;
+      const double t0  = now();
+      if (!rs.error) rs.error = GridMGRefill(&mg, values.data());
+      rs.setvalues_ms += 1e3 * (now() - t0);
+    };
+  }
+  PetscInt    nnz;
+  const char *mat_type, *ksp_type;
   PetscCall(BlockSystemGetInfo(&rs.sys, &nnz, &mat_type, &ksp_type));
   PetscCall(PetscPrintf(comm,
                         "cloth: %d x %d particles (%d unknowns), %zu springs, %" PetscInt_FMT
@@ -242,6 +267,7 @@ int main(int argc, char **argv)
   RunGuardAddSummary(s, guard);
   PetscCall(PrintSummary(comm, s));
 
+  PetscCall(GridMGDestroy(&mg));
   PetscCall(ReplicatedSolverDestroy(&rs));
   PetscCall(PetscFinalize());
   return guard.exit_code;

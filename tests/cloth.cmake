@@ -23,7 +23,28 @@ add_test(NAME cloth_same_result_mat_types
          COMMAND ${SUMMARY_SAME} "energy_final:1e-9 max_stretch:1e-9 contacts:0" 1e-6
                  "${CLOTH_SAME} -mat_type aij" "${CLOTH_SAME} -mat_type baij" "${CLOTH_SAME} -mat_type aij -ksp_type pipecg"
                  "${CLOTH_SAME} -mat_type binbcsr" "${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg"
-                 "${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg -mat_binbcsr_symmetric_storage")
+                 "${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg -mat_binbcsr_symmetric_storage"
+                 "${CLOTH_SAME} -mat_type aij -pc_type mg -grid_mg_coarse_nodes 10"
+                 "${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg -mat_binbcsr_symmetric_storage -pc_type mg -grid_mg_coarse_nodes 10 -rows_group_window 64"
+                 "${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg -pc_type mg -grid_mg_coarse_nodes 10 -grid_mg_galerkin pcmg")
+# The scene's geometric multigrid (options/cloth.opts) at 32 x 32 over 30 steps: a few V-cycles per step
+# (5.5 measured; pbjacobi needs 270), and the motion of a tight solve (pbjacobi to 1e-10): rms position
+# difference 1.0e-4 m measured, final energy 8e-5 apart. rtol 1e-2 fails both (1.7e-3 m, 0.5%).
+set(CLOTH_MG "${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 32 -steps 30 -progress_every 1000")
+add_test(NAME cloth_mg_converges_like_tight
+         COMMAND sh -c "${CLOTH_MG} -pc_type pbjacobi -ksp_rtol 1e-10 -write_positions cloth_mg_ref.txt >/dev/null && ${SUMMARY_CHECK} 'cg_its<=10 && unconverged_steps==0 && diverged_solves==0 && rms_position_diff<5e-4' -- ${CLOTH_MG} -reference_positions cloth_mg_ref.txt")
+add_test(NAME cloth_mg_energy_as_tight
+         COMMAND ${SUMMARY_SAME} "energy_final:0" 1e-3 "${CLOTH_MG} -pc_type pbjacobi -ksp_rtol 1e-10" "${CLOTH_MG}")
+# A grid of at most -grid_mg_coarse_nodes particles is one level, solved directly: one iteration per step.
+add_test(NAME cloth_mg_single_level_direct
+         COMMAND ${SUMMARY_CHECK} "cg_its<=1.01 && unconverged_steps==0" -- ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 8 -steps 5 -progress_every 1000)
+add_test(NAME cloth_mg_bad_coarse_nodes
+         COMMAND ${EXPECT_RUN} nonzero "grid_mg_coarse_nodes must be at least 4" -- ${CLOTH} -cloth_n 8 -pc_type mg -grid_mg_coarse_nodes 2)
+add_test(NAME cloth_mg_blocks_one_rank
+         COMMAND ${EXPECT_RUN} nonzero "runs on one rank only" -- ${MPIEXEC_CMD} -n 2 ${CLOTH} -cloth_n 8 -pc_type mg -grid_mg_galerkin blocks)
+set_tests_properties(cloth_mg_converges_like_tight cloth_mg_energy_as_tight cloth_mg_single_level_direct cloth_mg_bad_coarse_nodes
+                     PROPERTIES LABELS "cloth" TIMEOUT 60)
+set_tests_properties(cloth_mg_blocks_one_rank PROPERTIES LABELS "cloth;mpi" PROCESSORS 2 TIMEOUT 60)
 add_test(NAME cloth_bad_dt COMMAND ${EXPECT_RUN} nonzero "time step must be positive" -- ${CLOTH} -cloth_n 4 -dt 0)
 add_test(NAME cloth_bad_n COMMAND ${EXPECT_RUN} nonzero "at least 2 x 2" -- ${CLOTH} -cloth_n 1)
 add_test(NAME cloth_bad_pins COMMAND ${EXPECT_RUN} nonzero "unknown -cloth_pins elbows" -- ${CLOTH} -cloth_n 4 -cloth_pins elbows)
@@ -36,7 +57,8 @@ add_test(NAME cloth_mpi_np2
                  "${CLOTH_SAME}" "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME}" "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg"
                  "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg -mat_binbcsr_symmetric_storage"
                  "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type sbaij"
-                 "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg -mat_binbcsr_coo_mirror")
+                 "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg -mat_binbcsr_coo_mirror"
+                 "${MPIEXEC_LINE} -n 2 ${CLOTH_SAME} -mat_type binbcsr -ksp_type mcg -mat_binbcsr_symmetric_storage -pc_type mg -grid_mg_coarse_nodes 10")
 set_tests_properties(cloth_mpi_np2 PROPERTIES LABELS "cloth;mpi" TIMEOUT 60)
 
 # The error measure of bench/tradeoff.sh: a run against its own positions differs by exactly 0, against a

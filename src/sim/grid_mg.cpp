@@ -1,0 +1,243 @@
+#include "sim/grid_mg.h"
+
+#include <algorithm>
+
+namespace {
+
+// One level's nodes: side x side, row-major; num[node] is its global index in the level's numbering,
+// offsets[r] .. offsets[r + 1] the indices rank r owns.
+struct GridLevel {
+  PetscInt         side = 0;
+  std::vector<int> num, offsets;
+};
+
+int OwnerOf(const std::vector<int> &offsets, int index)
+{
+  return (int)(std::upper_bound(offsets.begin(), offsets.end(), index) - offsets.begin()) - 1;
+}
+
+// The coarse grid keeps every other node per side, coarse node I at fine node 2 I: n / 2 + 1 per side.
+// For an even n the last coarse line lies one spacing beyond the grid (fine node n - 1 is the mean of two
+// coarse lines, as every odd one is), so the weights are always 1 or 1/2 and a fine node has at most 4.
+GridLevel Coarsen(const GridLevel &f)
+{
+  GridLevel c;
+  c.side                 = f.side / 2 + 1;
+  const int        ranks = (int)f.offsets.size() - 1;
+  std::vector<int> owner(c.side * c.side);
+  for (PetscInt I = 0; I < c.side; ++I)
+    for (PetscInt J = 0; J < c.side; ++J) {
+      // The coarse node goes with its fine node (the nearest one beyond the grid), so P's rows and
+      // columns mostly share ranks.
+      const PetscInt fi = std::min(2 * I, f.side - 1), fj = std::min(2 * J, f.side - 1);
+      owner[I * c.side + J] = OwnerOf(f.offsets, f.num[fi * f.side + fj]);
+    }
+  c.num.resize(owner.size());
+  c.offsets.assign(ranks + 1, 0);
+  int next = 0;
+  for (int r = 0; r < ranks; ++r) {
+    for (size_t k = 0; k < owner.size(); ++k)
+      if (owner[k] == r) c.num[k] = next++;
+    c.offsets[r + 1] = next;
+  }
+  return c;
+}
+
+// The coarse nodes (lo, lo + 1) around fine index i along one side and the weight of lo + 1: 0 or 1/2, and 1
+// for the last node of an odd side (it is coarse node lo + 1).
+void Bracket(PetscInt i, PetscInt cside, PetscInt *lo, double *a)
+{
+  *lo = std::min(i / 2, cside - 2);
+  *a  = i - 2 * *lo == 0 ? 0.0 : (i - 2 * *lo == 1 ? 0.5 : 1.0);
+}
+
+// Bilinear interpolation from c to f, one row of weights per fine node (physics numbering of the level);
+// fixed (may be empty) marks fine nodes whose rows stay zero, unless a coarse node would then interpolate
+// to nothing (all its fine nodes fixed: its Galerkin row would be zero and the coarse operator singular).
+std::vector<std::vector<BlockWeight>> Weights(const GridLevel &f, const GridLevel &c,
+                                              const std::vector<char> &fixed)
+{
+  std::vector<std::vector<BlockWeight>> rows(f.side * f.side);
+  std::vector<int>                      support(c.side * c.side, 0);
+  for (PetscInt i = 0; i < f.side; ++i)
+    for (PetscInt j = 0; j < f.side; ++j) {
+      PetscInt I, J;
+      double   a, b;
+      Bracket(i, c.side, &I, &a);
+      Bracket(j, c.side, &J, &b);
+      const double wi[2] = {1 - a, a}, wj[2] = {1 - b, b};
+      for (int di = 0; di < 2; ++di)
+        for (int dj = 0; dj < 2; ++dj) {
+          const double w = wi[di] * wj[dj];
+          if (w == 0) continue; // a node on a coarse line interpolates from that line only
+          const PetscInt cn = (I + di) * c.side + J + dj;
+          rows[i * f.side + j].push_back({cn, w});
+          if (fixed.empty() || !fixed[i * f.side + j]) support[cn]++;
+        }
+    }
+  if (!fixed.empty())
+    for (size_t node = 0; node < rows.size(); ++node)
+      if (fixed[node]) {
+        std::vector<BlockWeight> keep;
+        for (const BlockWeight &w : rows[node])
+          if (!support[w.coarse]) keep.push_back(w);
+        rows[node] = keep;
+      }
+  return rows;
+}
+
+// The interpolation as PCMG applies it: AIJ, rows and columns in the levels' (solver) numbering.
+PetscErrorCode Interpolation(MPI_Comm comm, const GridLevel &f, const GridLevel &c,
+                             const std::vector<std::vector<BlockWeight>> &rows, Mat *P)
+{
+  PetscMPIInt rank;
+
+  PetscFunctionBegin;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  const PetscInt nf   = f.side * f.side;
+  const PetscInt mloc = 3 * (f.offsets[rank + 1] - f.offsets[rank]);
+  const PetscInt nloc = 3 * (c.offsets[rank + 1] - c.offsets[rank]);
+  PetscCall(MatCreate(comm, P));
+  PetscCall(MatSetSizes(*P, mloc, nloc, 3 * nf, 3 * c.side * c.side));
+  PetscCall(MatSetBlockSizes(*P, 3, 3));
+  PetscCall(MatSetType(*P, MATAIJ));
+  PetscCall(MatSeqAIJSetPreallocation(*P, 4, nullptr));
+  PetscCall(MatMPIAIJSetPreallocation(*P, 4, nullptr, 4, nullptr));
+  for (PetscInt node = 0; node < nf; ++node) {
+    if (OwnerOf(f.offsets, f.num[node]) != rank) continue;
+    for (const BlockWeight &w : rows[node])
+      for (PetscInt k = 0; k < 3; ++k) {
+        const PetscInt    row = 3 * f.num[node] + k, col = 3 * c.num[w.coarse] + k;
+        const PetscScalar v = w.w;
+        PetscCall(MatSetValues(*P, 1, &row, 1, &col, &v, INSERT_VALUES));
+      }
+  }
+  PetscCall(MatAssemblyBegin(*P, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(*P, MAT_FINAL_ASSEMBLY));
+  PetscFunctionReturn(0);
+}
+
+} // namespace
+
+PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
+                           const std::vector<int> &new_of_old, const std::vector<int> &row_offsets,
+                           const std::vector<int> &coo_row, const std::vector<int> &coo_col,
+                           PetscBool coo_mirrored, GridMG *mg)
+{
+  MPI_Comm    comm;
+  PC          pc;
+  PetscBool   is_mg;
+  PetscInt    coarse_nodes = 150, galerkin = 0;
+  PetscMPIInt size;
+  const char *galerkins[] = {"blocks", "pcmg"};
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectGetComm((PetscObject)ksp, &comm));
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &is_mg));
+  PetscCheck(is_mg, comm, PETSC_ERR_ARG_WRONG, "the grid multigrid needs -pc_type mg");
+  PetscCheck(
+    n >= 2 && (PetscInt)new_of_old.size() == n * n && (fixed.empty() || (PetscInt)fixed.size() == n * n),
+    comm, PETSC_ERR_ARG_SIZ, "grid multigrid: %" PetscInt_FMT " x %" PetscInt_FMT " grid, %zu rows numbered",
+    n, n, new_of_old.size());
+  PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-grid_mg_coarse_nodes", &coarse_nodes, nullptr));
+  PetscCheck(coarse_nodes >= 4, comm, PETSC_ERR_ARG_OUTOFRANGE,
+             "-grid_mg_coarse_nodes must be at least 4 (a 2 x 2 grid), got %" PetscInt_FMT, coarse_nodes);
+  if (size > 1) galerkin = 1;
+  PetscCall(PetscOptionsGetEList(nullptr, nullptr, "-grid_mg_galerkin", galerkins, 2, &galerkin, nullptr));
+  PetscCheck(size == 1 || galerkin == 1, comm, PETSC_ERR_SUP,
+             "-grid_mg_galerkin blocks runs on one rank only (%d ranks): use -grid_mg_galerkin pcmg",
+             (int)size);
+  mg->own_galerkin = galerkin == 0;
+  mg->pc           = pc;
+
+  std::vector<GridLevel> levels(1);
+  levels[0].side    = n;
+  levels[0].num     = new_of_old;
+  levels[0].offsets = row_offsets;
+  while (levels.back().side * levels.back().side > coarse_nodes &&
+         levels.back().side / 2 + 1 < levels.back().side)
+    levels.push_back(Coarsen(levels.back()));
+  mg->sides.clear();
+  for (const GridLevel &l : levels) mg->sides.push_back(l.side);
+
+  // PCMG counts levels from the coarsest (0); ours count from the finest.
+  const PetscInt nlev = (PetscInt)levels.size();
+  PetscCall(PCMGSetLevels(pc, nlev, nullptr));
+  mg->galerkin.assign(nlev - 1, BlockGalerkin());
+  for (PetscInt l = 0; l + 1 < nlev; ++l) {
+    Mat        P;
+    const auto w = Weights(levels[l], levels[l + 1], l == 0 ? fixed : std::vector<char>());
+    PetscCall(Interpolation(comm, levels[l], levels[l + 1], w, &P));
+    PetscCall(PCMGSetInterpolation(pc, nlev - 1 - l, P));
+    PetscCall(MatDestroy(&P)); // PCMG holds a reference
+    if (!mg->own_galerkin) continue;
+    // The first product reads the driver's COO blocks (physics numbering, as the weights), the others
+    // the level above's BAIJ values.
+    std::vector<PetscInt> rows, cols;
+    if (l == 0) rows.assign(coo_row.begin(), coo_row.end()), cols.assign(coo_col.begin(), coo_col.end());
+    else PetscCall(BlockGalerkinBlocksOf(mg->galerkin[l - 1].Ac, &rows, &cols));
+    PetscCall(BlockGalerkinCreate(rows, cols, l == 0, l == 0 && coo_mirrored, w,
+                                  levels[l + 1].side * levels[l + 1].side, &mg->galerkin[l]));
+    PetscCall(PCMGSetOperators(pc, nlev - 2 - l, mg->galerkin[l].Ac, mg->galerkin[l].Ac));
+  }
+  PetscCall(PCMGSetGalerkin(pc, mg->own_galerkin ? PC_MG_GALERKIN_NONE : PC_MG_GALERKIN_BOTH));
+  // Smoothers: one symmetric Gauss-Seidel sweep (processor-local on more ranks), so that the V-cycle is
+  // symmetric positive definite for CG whatever the values (Chebyshev needs eigenvalue estimates, which
+  // turned the cycle indefinite on the cloth when they were short). Their own prefixes keep GAMG's
+  // -mg_levels_* options (a scene file may hold both) away from them.
+  for (PetscInt l = 0; l < nlev; ++l) {
+    KSP smoother;
+    PC  spc;
+    PetscCall(PCMGGetSmoother(pc, l, &smoother));
+    PetscCall(KSPGetPC(smoother, &spc));
+    if (l == 0) {
+      PetscCall(KSPSetOptionsPrefix(smoother, "grid_mg_coarse_"));
+      if (nlev == 1) { // PCMG makes a lone level a smoother; a grid this small is solved directly
+        PetscCall(KSPSetType(smoother, KSPPREONLY));
+        PetscCall(PCSetType(spc, size > 1 ? PCREDUNDANT : PCLU));
+      }
+      continue; // PCMG's default: LU (redundant on more ranks)
+    }
+    char prefix[64]; // -grid_mg_levels_N_* for level N (PCMG's numbering), -grid_mg_levels_* for all
+    PetscCall(PetscSNPrintf(prefix, sizeof prefix, "grid_mg_levels_%d_", (int)l));
+    PetscCall(KSPSetOptionsPrefix(smoother, prefix));
+    PetscCall(KSPSetType(smoother, KSPRICHARDSON));
+    PetscCall(KSPSetTolerances(smoother, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT, 1));
+    PetscCall(PCSetType(spc, PCSOR));
+    PetscCall(PCSORSetSymmetric(spc, SOR_LOCAL_SYMMETRIC_SWEEP));
+  }
+  PetscCall(KSPSetFromOptions(ksp)); // the new levels' smoothers and coarse solve take their options
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode GridMGRefill(GridMG *mg, const PetscScalar *coo_values)
+{
+  PetscFunctionBegin;
+  if (!mg->own_galerkin) PetscFunctionReturn(0); // PCMG recomputes its products at its set-up
+  for (size_t l = 0; l < mg->galerkin.size(); ++l) {
+    const PetscScalar *src = coo_values;
+    PetscScalar       *a   = nullptr;
+    if (l > 0) {
+      PetscCall(MatSeqBAIJGetArray(mg->galerkin[l - 1].Ac, &a));
+      src = a;
+    }
+    PetscCall(BlockGalerkinRefill(&mg->galerkin[l], src));
+    if (l > 0) PetscCall(MatSeqBAIJRestoreArray(mg->galerkin[l - 1].Ac, &a));
+    // Handing the level its operator again makes its smoother set up anew (Chebyshev's eigenvalue
+    // estimate; a KSP whose operators were set once keeps its first estimate) and the coarse solve refactor.
+    KSP smoother;
+    PetscCall(PCMGGetSmoother(mg->pc, (PetscInt)(mg->galerkin.size() - 1 - l), &smoother));
+    PetscCall(KSPSetOperators(smoother, mg->galerkin[l].Ac, mg->galerkin[l].Ac));
+  }
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode GridMGDestroy(GridMG *mg)
+{
+  PetscFunctionBegin;
+  for (BlockGalerkin &g : mg->galerkin) PetscCall(BlockGalerkinDestroy(&g));
+  mg->galerkin.clear();
+  PetscFunctionReturn(0);
+}

@@ -1,0 +1,38 @@
+// Geometric multigrid (PCMG) for a square n x n grid of nodes with 3 unknowns each (the cloth), whatever
+// the fine operator's Mat type: the driver knows the grid, PETSc does not.
+//
+// Levels: every coarsening keeps every other node per side (n -> n / 2 + 1), until a level has at most
+// -grid_mg_coarse_nodes nodes (default 150; the 160 x 160 cloth gets 160, 81, 41, 21, 11). Interpolation:
+// bilinear, the same weights for each of the 3 components, one AIJ matrix per level, built once (the grid
+// does not change). Rows of fixed (Dirichlet) fine nodes are zero: their equations hold only the mass, the
+// smoother solves them exactly, and a coarse correction must not move them. Coarse operators: Galerkin,
+// P^T A P for every new set of values, by default from the driver's COO blocks (block_galerkin.h, SeqBAIJ
+// coarse levels, one rank), with -grid_mg_galerkin pcmg (the default on more ranks) by PCMG's MatPtAP (AIJ)
+// at its set-up. Smoothers: -grid_mg_levels_[N_]* (default one symmetric Gauss-Seidel sweep), coarse solve:
+// -grid_mg_coarse_* (default LU, redundant on more ranks); GAMG's -mg_levels_* do not reach them.
+//
+// On P ranks the fine rows are those of the solver's numbering (new_of_old, rows row_offsets[r] ..
+// row_offsets[r + 1] on rank r); each coarse node belongs to the rank owning the fine node nearest to it.
+#pragma once
+#include "sim/block_galerkin.h"
+
+#include <petscksp.h>
+#include <vector>
+
+struct GridMG {
+  std::vector<PetscInt> sides;                // nodes per side, finest first
+  bool                  own_galerkin = false; // coarse operators from block_galerkin.h, else PCMG's MatPtAP
+  std::vector<BlockGalerkin> galerkin;        // level l + 1 from level l
+  PC                         pc = nullptr;
+};
+
+// ksp's PC must be PCMG (-pc_type mg). fixed: n * n flags (row-major, physics numbering). coo_row, coo_col:
+// the driver's COO list of 3x3 blocks (physics numbering; coo_mirrored: blocks off the diagonal stand for
+// their transposes too), whose values GridMGRefill takes.
+PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
+                           const std::vector<int> &new_of_old, const std::vector<int> &row_offsets,
+                           const std::vector<int> &coo_row, const std::vector<int> &coo_col,
+                           PetscBool coo_mirrored, GridMG *mg);
+// The coarse operators for new fine values (9 per COO block, row-major), after the fine matrix's refill.
+PetscErrorCode GridMGRefill(GridMG *mg, const PetscScalar *coo_values);
+PetscErrorCode GridMGDestroy(GridMG *mg);
