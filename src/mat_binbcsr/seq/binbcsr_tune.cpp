@@ -280,8 +280,17 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
 
   /* the sample: about twice the last-level cache (so it streams from memory as the matrix does), at
      most what 20 products read in the budget at ~20 GB/s */
-  const long   llc       = binbcsr::last_level_cache_bytes();
-  const size_t target    = std::min<size_t>(llc > 0 ? 2 * (size_t)llc : (size_t)64 << 20, (size_t)48 << 20);
+  const long llc    = binbcsr::last_level_cache_bytes();
+  size_t     target = std::min<size_t>(llc > 0 ? 2 * (size_t)llc : (size_t)64 << 20, (size_t)48 << 20);
+  {
+    PetscInt  mib = 0;
+    PetscBool set;
+    PetscCall(PetscOptionsGetInt(((PetscObject)A)->options, ((PetscObject)A)->prefix,
+                                 "-mat_binbcsr_tune_sample_mib", &mib, &set));
+    PetscCheck(!set || mib > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+               "-mat_binbcsr_tune_sample_mib %" PetscInt_FMT " must be > 0", mib);
+    if (set) target = (size_t)mib << 20;
+  }
   const double row_bytes = mbs ? (double)(vbytes + (size_t)nz * sizeof(PetscInt)) / mbs : 1;
   PetscInt nr = (PetscInt)std::min<double>((double)mbs, std::max(64.0, target / std::max(row_bytes, 1.0)));
   if (nr < mbs) nr = std::max<PetscInt>(32, nr / 32 * 32);
