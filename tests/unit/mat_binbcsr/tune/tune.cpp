@@ -255,7 +255,7 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
     ss << in.rdbuf();
     content = ss.str();
   }
-  CHECK(content.rfind("# petscbinbcsr tune cache v1\n", 0) == 0);
+  CHECK(content.rfind("# petscbinbcsr tune cache v2\n", 0) == 0);
   CHECK(content.find("bs 3 double whole") != std::string::npos);
   // the second matrix of the class takes the choice from the file
   Mat B = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
@@ -274,13 +274,15 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
   MatDestroy(&B);
   o.set("-mat_binbcsr_tune_cache", "1");
 
-  // corrupt files: garbage, a bad choice, a choice the block size cannot take, an empty file
+  // corrupt files: garbage, a bad choice, a choice the block size cannot take, an empty file; and a
+  // well-formed file of an older tuner version, whose choices must not be taken either
   const std::string key =
     content.substr(content.find('\n') + 1, content.rfind('\t') - content.find('\n') - 1);
   for (const std::string bad :
-       {std::string("garbage\n\x01\x02"), std::string("# petscbinbcsr tune cache v1\n") + key + "\t7 3\n",
-        std::string("# petscbinbcsr tune cache v1\n") + key + "\t32 1\n",
-        std::string("# petscbinbcsr tune cache v1\n") + key + "\tx\n", std::string("")}) {
+       {std::string("garbage\n\x01\x02"), std::string("# petscbinbcsr tune cache v2\n") + key + "\t7 3\n",
+        std::string("# petscbinbcsr tune cache v2\n") + key + "\t32 1\n",
+        std::string("# petscbinbcsr tune cache v2\n") + key + "\tx\n", std::string(""),
+        std::string("# petscbinbcsr tune cache v1\n") + key + "\t16 1 auto\n"}) {
     CAPTURE(bad);
     {
       std::ofstream out(file, std::ios::trunc);
@@ -296,7 +298,7 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
     std::ifstream in(file); // rewritten, valid
     std::string   first;
     std::getline(in, first);
-    CHECK(first == "# petscbinbcsr tune cache v1");
+    CHECK(first == "# petscbinbcsr tune cache v2");
   }
   // an unreadable cache folder: no file written, no error
   setenv("XDG_CACHE_HOME", "/proc/no/such/folder", 1);
@@ -366,7 +368,7 @@ TEST_CASE("tuning cache check", "[.cache_check]")
   REQUIRE(in.good());
   std::string line;
   std::getline(in, line);
-  CHECK(line == "# petscbinbcsr tune cache v1");
+  CHECK(line == "# petscbinbcsr tune cache v2");
   int n = 0;
   while (std::getline(in, line)) {
     CAPTURE(line);
