@@ -203,10 +203,14 @@ PetscErrorCode BuildCandidate(MPI_Comm comm, const MatrixSource &src, Mat aij_fi
   } else {
     PetscCall(CreateStencilMatrix(comm, src.grid, c->spec.type.c_str(), nullptr, &c->A));
   }
-  if (c->spec.sym) PetscCall(ReplaceWithBinBCSRSymmetric(&c->A)); /* the same entries, upper triangle kept */
+  /* the same entries, upper triangle kept for _sym; single storage set before the layout build, as a
+     driver's -mat_binbcsr_precision is, so that the tuner chooses for single */
+  if (c->spec.sym || c->spec.single)
+    PetscCall(
+      ReplaceWithBinBCSR(&c->A, c->spec.sym ? PETSC_TRUE : PETSC_FALSE,
+                         c->spec.single ? MAT_BINBCSR_PRECISION_SINGLE : MAT_BINBCSR_PRECISION_DOUBLE));
   if (c->spec.single) {
     MatBinBCSRPrecision p;
-    PetscCall(MatBinBCSRSetPrecision(c->A, MAT_BINBCSR_PRECISION_SINGLE));
     PetscCall(MatBinBCSRGetPrecision(c->A, &p));
     PetscCheck(p == MAT_BINBCSR_PRECISION_SINGLE, comm, PETSC_ERR_SUP, "single storage not available");
   }

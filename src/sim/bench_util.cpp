@@ -4,6 +4,11 @@
 
 PetscErrorCode ReplaceWithBinBCSRSymmetric(Mat *A)
 {
+  return ReplaceWithBinBCSR(A, PETSC_TRUE, MAT_BINBCSR_PRECISION_DOUBLE);
+}
+
+PetscErrorCode ReplaceWithBinBCSR(Mat *A, PetscBool symmetric, MatBinBCSRPrecision precision)
+{
   Mat       S;
   PetscInt  bs, rlo, rhi, m, n;
   PetscBool sym;
@@ -15,7 +20,9 @@ PetscErrorCode ReplaceWithBinBCSRSymmetric(Mat *A)
   PetscCall(MatSetSizes(S, m, n, PETSC_DETERMINE, PETSC_DETERMINE));
   PetscCall(MatSetBlockSize(S, bs));
   PetscCall(MatSetType(S, MATBINBCSR));
-  PetscCall(MatBinBCSRSetSymmetricStorage(S, PETSC_TRUE));
+  PetscCall(MatBinBCSRSetSymmetricStorage(S, symmetric));
+  PetscCall(
+    MatBinBCSRSetPrecision(S, precision)); /* before the layout build: the tuner times this precision */
   PetscCall(MatSetUp(S));
   PetscCall(MatGetOwnershipRange(*A, &rlo, &rhi));
   for (PetscInt r = rlo; r < rhi; r++) {
@@ -29,7 +36,8 @@ PetscErrorCode ReplaceWithBinBCSRSymmetric(Mat *A)
   PetscCall(MatAssemblyBegin(S, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(S, MAT_FINAL_ASSEMBLY));
   PetscCall(MatBinBCSRGetSymmetricStorage(S, &sym));
-  PetscCheck(sym, PetscObjectComm((PetscObject)S), PETSC_ERR_SUP, "symmetric storage not available");
+  PetscCheck(sym == symmetric, PetscObjectComm((PetscObject)S), PETSC_ERR_SUP,
+             "symmetric storage not available");
   PetscCall(MatDestroy(A));
   *A = S;
   PetscFunctionReturn(0);

@@ -1,12 +1,18 @@
 // Small helpers shared by the benchmark programs.
 #pragma once
 #include <petscmat.h>
+#include <petscbinbcsr.h>
 #include <string>
 #include <vector>
 
 // Replaces *A (any assembled matrix type) by a MATBINBCSR copy with symmetric storage: all its rows
 // are handed over, the type keeps the upper block triangle (the _sym formats of the benchmarks).
 PetscErrorCode ReplaceWithBinBCSRSymmetric(Mat *A);
+
+// The same with the storage and the value precision chosen (set before the layout is built, so the
+// tuner times the layout in that precision; a precision changed after the build keeps the bin width
+// and stream count tuned for the old one).
+PetscErrorCode ReplaceWithBinBCSR(Mat *A, PetscBool symmetric, MatBinBCSRPrecision precision);
 
 // "a,b,,c" -> {"a", "b", "c"}: comma lists given as options.
 std::vector<std::string> SplitList(const std::string &s);

@@ -22,7 +22,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-static const char *const cache_header = "# petscbinbcsr tune cache v2";
+static const char *const cache_header      = "# petscbinbcsr tune cache v2";
 static const char *const cache_header_stem = "# petscbinbcsr tune cache v"; /* of every version */
 
 const std::string &BinBCSRTuneMachineKey(void)
@@ -52,8 +52,10 @@ static bool ReadCache(const std::string &path, std::map<std::string, BinBCSRTune
   std::string   line;
   if (!in) return true; /* no file yet (or unreadable): nothing cached */
   if (std::getline(in, line) && line != cache_header && line.rfind(cache_header_stem, 0) == 0) {
-    PetscCallAbort(PETSC_COMM_SELF, PetscInfo(nullptr, "Tuning cache %s is from another tuner version (\"%s\"): "
-                                                       "not used, measured again\n", path.c_str(), line.c_str()));
+    PetscCallAbort(PETSC_COMM_SELF, PetscInfo(nullptr,
+                                              "Tuning cache %s is from another tuner version (\"%s\"): "
+                                              "not used, measured again\n",
+                                              path.c_str(), line.c_str()));
     return true; /* another version's choices: none cached */
   }
   if (line != cache_header) {
