@@ -1,4 +1,5 @@
 #include "sim/block_galerkin.h"
+#include <petsc/private/matimpl.h> /* assembled, was_assembled: see BlockGalerkinRefill */
 
 #include <algorithm>
 
@@ -119,7 +120,12 @@ PetscErrorCode BlockGalerkinRefill(BlockGalerkin *g, const PetscScalar *values)
     for (int k = 0; k < 9; ++k) a[9 * b + k] = acc[k];
   }
   PetscCall(MatSeqBAIJRestoreArray(g->Ac, &a));
-  // A new state, so that the level's smoother and factorisation see the new values.
+  // A new state, so that the level's smoother and factorisation see the new values. Assembled as a
+  // first assembly: a re-assembly without new nonzeros returns (PETSc 3.22) before it marks BAIJ's
+  // cached inverses of the diagonal blocks stale, and SOR then smoothed with the previous step's
+  // inverses (the V-cycle turned indefinite at the third step of the cloth).
+  g->Ac->assembled     = PETSC_FALSE;
+  g->Ac->was_assembled = PETSC_FALSE;
   PetscCall(MatAssemblyBegin(g->Ac, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(g->Ac, MAT_FINAL_ASSEMBLY));
   PetscCall(PetscLogFlops(18.0 * g->terms.size()));
