@@ -40,7 +40,7 @@ static PetscErrorCode CheckPattern(const Mat_SeqBinBCSR *a, const PetscInt bi[],
   PetscFunctionReturn(0);
 }
 
-/* The symmetric-storage part of MatSeqBinBCSRBuildLayout: bins ordered by the colouring. */
+/* The value arrays (binbcsr.h: 64-byte aligned inside val_mem). */
 PetscErrorCode MatSeqBinBCSRFreeValues_Private(Mat_SeqBinBCSR *a)
 {
   PetscFunctionBegin;
@@ -68,6 +68,7 @@ PetscErrorCode MatSeqBinBCSRAllocValues_Private(Mat_SeqBinBCSR *a, MatBinBCSRPre
   PetscFunctionReturn(0);
 }
 
+/* The symmetric-storage part of MatSeqBinBCSRBuildLayout: bins ordered by the colouring. */
 static PetscErrorCode MatSeqBinBCSRBuildLayoutSym(Mat A, const PetscInt bi[], const PetscInt bj[])
 {
   Mat_SeqBinBCSR       *a  = (Mat_SeqBinBCSR *)A->data;
