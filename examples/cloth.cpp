@@ -149,7 +149,9 @@ int main(int argc, char **argv)
                           sys.block_col, rs.upper_only, &mg));
     PetscCall(PetscPrintf(comm, "cloth: grid multigrid, %zu level(s):", mg.sides.size()));
     for (PetscInt side : mg.sides) PetscCall(PetscPrintf(comm, " %" PetscInt_FMT "^2", side));
-    PetscCall(PetscPrintf(comm, " nodes, coarse operators by %s\n", mg.own_galerkin ? "blocks" : "MatPtAP"));
+    PetscCall(PetscPrintf(comm, " nodes, coarse operators by %s, smoothers on %s\n",
+                          mg.own_galerkin ? "blocks" : "MatPtAP",
+                          mg.single_smoothers ? "single-precision copies" : "the operators"));
     // The coarse operators follow every refill of the fine matrix (timed with it: setvalues_ms).
     linear.set_matrix = [&rs, &mg, fine = linear.set_matrix](const std::vector<double> &values) {
       fine(values);

@@ -36,6 +36,15 @@ add_test(NAME cloth_mg_converges_like_tight
 add_test(NAME cloth_mg_energy_as_tight
          COMMAND ${SUMMARY_SAME} "energy_final:0" 1e-3 "${CLOTH_MG} -pc_type pbjacobi -ksp_rtol 1e-10" "${CLOTH_MG}")
 # A grid of at most -grid_mg_coarse_nodes particles is one level, solved directly: one iteration per step.
+# The smoothers on double operators (the scene sweeps single-precision copies): the same few V-cycles.
+add_test(NAME cloth_mg_double_smoothers_converge_like_tight
+         COMMAND sh -c "${CLOTH_MG} -pc_type pbjacobi -ksp_rtol 1e-10 -write_positions cloth_mg_ref_double.txt >/dev/null && ${SUMMARY_CHECK} 'cg_its<=10 && unconverged_steps==0 && diverged_solves==0 && rms_position_diff<5e-4' -- ${CLOTH_MG} -grid_mg_smoother_precision double -reference_positions cloth_mg_ref_double.txt")
+add_test(NAME cloth_mg_single_smoothers_need_binbcsr
+         COMMAND ${EXPECT_RUN} nonzero "needs a binbcsr fine operator" -- ${CLOTH} -cloth_n 8 -steps 1 -mat_type aij -pc_type mg -grid_mg_coarse_nodes 10 -grid_mg_smoother_precision single)
+add_test(NAME cloth_mg_single_smoothers_only_with_blocks
+         COMMAND ${EXPECT_RUN} 0 "coarse operators by MatPtAP, smoothers on the operators" -- ${CLOTH} -cloth_n 8 -steps 1 -mat_type binbcsr -pc_type mg -grid_mg_coarse_nodes 10 -grid_mg_galerkin pcmg -grid_mg_smoother_precision single)
+add_test(NAME cloth_mg_bad_smoother_precision
+         COMMAND ${EXPECT_RUN} nonzero "half" -- ${CLOTH} -cloth_n 8 -steps 1 -pc_type mg -grid_mg_smoother_precision half)
 add_test(NAME cloth_mg_single_level_direct
          COMMAND ${SUMMARY_CHECK} "cg_its<=1.01 && unconverged_steps==0" -- ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 8 -steps 5 -progress_every 1000)
 add_test(NAME cloth_mg_bad_coarse_nodes
@@ -43,6 +52,8 @@ add_test(NAME cloth_mg_bad_coarse_nodes
 add_test(NAME cloth_mg_blocks_one_rank
          COMMAND ${EXPECT_RUN} nonzero "runs on one rank only" -- ${MPIEXEC_CMD} -n 2 ${CLOTH} -cloth_n 8 -pc_type mg -grid_mg_galerkin blocks)
 set_tests_properties(cloth_mg_converges_like_tight cloth_mg_energy_as_tight cloth_mg_single_level_direct cloth_mg_bad_coarse_nodes
+                     cloth_mg_double_smoothers_converge_like_tight cloth_mg_single_smoothers_need_binbcsr
+                     cloth_mg_single_smoothers_only_with_blocks cloth_mg_bad_smoother_precision
                      PROPERTIES LABELS "cloth" TIMEOUT 60)
 set_tests_properties(cloth_mg_blocks_one_rank PROPERTIES LABELS "cloth;mpi" PROCESSORS 2 TIMEOUT 60)
 add_test(NAME cloth_bad_dt COMMAND ${EXPECT_RUN} nonzero "time step must be positive" -- ${CLOTH} -cloth_n 4 -dt 0)

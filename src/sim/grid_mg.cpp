@@ -1,5 +1,7 @@
 #include "sim/grid_mg.h"
 
+#include <petscbinbcsr.h>
+
 #include <algorithm>
 
 namespace {
@@ -219,13 +221,81 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
       PetscCall(PCSORSetSymmetric(spc, SOR_LOCAL_SYMMETRIC_SWEEP));
     }
   }
+  {
+    const char *precisions[] = {"double", "single"};
+    PetscInt    precision    = 0;
+    PetscCall(PetscOptionsGetEList(nullptr, nullptr, "-grid_mg_smoother_precision", precisions, 2, &precision,
+                                   nullptr));
+    // PCMG's own products (-grid_mg_galerkin pcmg, more ranks) would be taken from the copies: there the
+    // smoothers stay on the operators (the driver's set-up line says which)
+    mg->single_smoothers = precision == 1 && mg->own_galerkin;
+    mg->smoother_mats.assign(nlev, nullptr);
+  }
   PetscCall(KSPSetFromOptions(ksp)); // the new levels' smoothers and coarse solve take their options
+  PetscFunctionReturn(0);
+}
+
+/* The single-precision copy `copy` of level `level`'s operator A, made on the first call and handed to the
+   level's smoothers (residuals stay on A), refilled after. The fine operator (binbcsr) is duplicated and
+   its values converted; a coarse BAIJ operator is read into an upper-triangle binbcsr through a COO
+   list in the order of its value array. Sweeps on the copy read a half (fine level) or a quarter
+   (coarse levels) of the bytes. */
+static PetscErrorCode RefillSmootherCopy(GridMG *mg, PetscInt level, Mat A, Mat *copy)
+{
+  PetscBool baij;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectTypeCompare((PetscObject)A, MATSEQBAIJ, &baij));
+  if (!*copy) {
+    if (baij) {
+      std::vector<PetscInt> brow, bcol, i, j;
+      PetscCall(BlockGalerkinBlocksOf(A, &brow, &bcol));
+      for (size_t b = 0; b < brow.size(); ++b)
+        for (PetscInt c = 0; c < 3; ++c) // BAIJ blocks are column-major
+          for (PetscInt r = 0; r < 3; ++r) i.push_back(3 * brow[b] + r), j.push_back(3 * bcol[b] + c);
+      PetscInt m;
+      PetscCall(MatGetSize(A, &m, nullptr));
+      PetscCall(MatCreate(PETSC_COMM_SELF, copy));
+      PetscCall(MatSetSizes(*copy, m, m, m, m));
+      PetscCall(MatSetBlockSize(*copy, 3));
+      PetscCall(MatSetType(*copy, MATSEQBINBCSR));
+      PetscCall(MatBinBCSRSetSymmetricStorage(*copy, PETSC_TRUE));
+      PetscCall(MatBinBCSRSetPrecision(*copy, MAT_BINBCSR_PRECISION_SINGLE));
+      PetscCall(MatSetPreallocationCOO(*copy, (PetscCount)i.size(), i.data(), j.data()));
+    } else {
+      PetscBool binbcsr;
+      MatType   type;
+      PetscCall(MatGetType(A, &type));
+      PetscCall(PetscObjectTypeCompareAny((PetscObject)A, &binbcsr, MATSEQBINBCSR, MATMPIBINBCSR, ""));
+      PetscCheck(
+        binbcsr, PetscObjectComm((PetscObject)A), PETSC_ERR_SUP,
+        "-grid_mg_smoother_precision single needs a binbcsr fine operator (-mat_type binbcsr), not %s", type);
+      PetscCall(MatDuplicate(A, MAT_COPY_VALUES, copy));
+      PetscCall(MatBinBCSRSetPrecision(*copy, MAT_BINBCSR_PRECISION_SINGLE));
+    }
+    KSP sides[2];
+    PetscCall(PCMGGetSmootherDown(mg->pc, level, &sides[0]));
+    PetscCall(PCMGGetSmootherUp(mg->pc, level, &sides[1]));
+    for (KSP smoother : sides) PetscCall(KSPSetOperators(smoother, A, *copy));
+    if (!baij) PetscFunctionReturn(0);
+  }
+  if (baij) {
+    PetscScalar *a;
+    PetscCall(MatSeqBAIJGetArray(A, &a));
+    PetscCall(MatSetValuesCOO(*copy, a, INSERT_VALUES));
+    PetscCall(MatSeqBAIJRestoreArray(A, &a));
+  } else PetscCall(MatCopy(A, *copy, SAME_NONZERO_PATTERN));
   PetscFunctionReturn(0);
 }
 
 PetscErrorCode GridMGRefill(GridMG *mg, const PetscScalar *coo_values)
 {
   PetscFunctionBegin;
+  if (mg->single_smoothers && mg->smoother_mats.size() > 1) { // a lone level is solved directly
+    Mat A;
+    PetscCall(PCGetOperators(mg->pc, &A, nullptr));
+    PetscCall(RefillSmootherCopy(mg, (PetscInt)mg->smoother_mats.size() - 1, A, &mg->smoother_mats.back()));
+  }
   if (!mg->own_galerkin) PetscFunctionReturn(0); // PCMG recomputes its products at its set-up
   for (size_t l = 0; l < mg->galerkin.size(); ++l) {
     const PetscScalar *src = coo_values;
@@ -243,7 +313,10 @@ PetscErrorCode GridMGRefill(GridMG *mg, const PetscScalar *coo_values)
     PetscCall(PCMGGetSmootherDown(mg->pc, level, &sides[0]));
     sides[1] = sides[0];
     if (level > 0) PetscCall(PCMGGetSmootherUp(mg->pc, level, &sides[1])); // the coarse solve has one
-    for (KSP smoother : sides) PetscCall(KSPSetOperators(smoother, mg->galerkin[l].Ac, mg->galerkin[l].Ac));
+    if (mg->single_smoothers && level > 0)
+      PetscCall(RefillSmootherCopy(mg, level, mg->galerkin[l].Ac, &mg->smoother_mats[level]));
+    else
+      for (KSP smoother : sides) PetscCall(KSPSetOperators(smoother, mg->galerkin[l].Ac, mg->galerkin[l].Ac));
   }
   PetscFunctionReturn(0);
 }
@@ -252,6 +325,8 @@ PetscErrorCode GridMGDestroy(GridMG *mg)
 {
   PetscFunctionBegin;
   for (BlockGalerkin &g : mg->galerkin) PetscCall(BlockGalerkinDestroy(&g));
+  for (Mat &m : mg->smoother_mats) PetscCall(MatDestroy(&m));
+  mg->smoother_mats.clear();
   mg->galerkin.clear();
   PetscFunctionReturn(0);
 }
