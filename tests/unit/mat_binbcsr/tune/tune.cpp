@@ -339,6 +339,20 @@ TEST_CASE("tuning: bad values give clear errors", "[tune]")
   CHECK(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY) != 0);
   REQUIRE(PetscOptionsClearValue(nullptr, "-mat_binbcsr_tune") == 0);
   MatDestroy(&A);
+  // the benchmark knobs: sizes and budgets must be positive
+  for (const char *knob : {"-mat_binbcsr_tune_sample_mib", "-mat_binbcsr_tune_budget_ms"}) {
+    CAPTURE(knob);
+    Opts o(false);
+    o.set(knob, "0");
+    REQUIRE(MatCreate(PETSC_COMM_SELF, &A) == 0);
+    REQUIRE(MatSetSizes(A, p.m, p.n, p.m, p.n) == 0);
+    REQUIRE(MatSetBlockSize(A, 3) == 0);
+    REQUIRE(MatSetType(A, MATSEQBINBCSR) == 0);
+    REQUIRE(MatSetUp(A) == 0);
+    REQUIRE(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY) == 0);
+    CHECK(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY) == PETSC_ERR_ARG_OUTOFRANGE);
+    MatDestroy(&A);
+  }
   // other types: no-ops
   REQUIRE(MatCreateSeqAIJ(PETSC_COMM_SELF, 4, 4, 1, nullptr, &A) == 0);
   CHECK(MatBinBCSRSetTune(A, MAT_BINBCSR_TUNE_AUTO) == 0);
