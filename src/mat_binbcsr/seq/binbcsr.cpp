@@ -106,6 +106,8 @@ static PetscErrorCode MatBinBCSRSetPrecision_SeqBinBCSR(Mat A, MatBinBCSRPrecisi
       for (size_t i = 0; i < nv; i++) a->val[i] = (MatScalar)olds[i];
     PetscCall(PetscFree(old_mem));
     PetscCall(PetscObjectStateIncrease((PetscObject)A));
+    a->precision = p;
+    PetscCall(MatSeqBinBCSRRetune(A));
   }
   a->precision = p;
   PetscFunctionReturn(0);

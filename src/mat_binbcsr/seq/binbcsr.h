@@ -213,6 +213,9 @@ PETSC_INTERN PetscErrorCode MatSeqBinBCSRCreateWithPattern(Mat A, PetscBool tran
    set explicitly, by timing products of a sample on this machine, or from the tuning cache
    (binbcsr_tune.cpp). A no-op with tuning off. */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRTune(Mat, const PetscInt bi[], const PetscInt bj[]);
+/* After a precision change of a built matrix: the stream count and body set the tuner chose, timed
+   again in the new precision at the layout's bin width (binbcsr_tune.cpp). */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRRetune(Mat);
 /* Block size and block counts from the layouts (set up here); the check every entry point shares
    (binbcsr_assembly.cpp). */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRSetSizes(Mat);

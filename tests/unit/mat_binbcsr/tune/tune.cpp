@@ -239,6 +239,39 @@ TEST_CASE("tuning: explicit settings win", "[tune]")
   }
 }
 
+TEST_CASE("tuning: a precision change times the streams again, at the layout's width", "[tune]")
+{
+  Restore r;
+  fresh_cache("tune_precision");
+  Opts o(false);
+  for (bool sym : {false, true}) {
+    CAPTURE(sym);
+    const Pattern  p  = sym_pattern(7, 3);
+    Mat            A  = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, sym, MAT_BINBCSR_TUNE_AUTO);
+    const PetscInt bw = bin_width(A);
+    REQUIRE(MatBinBCSRSetPrecision(A, MAT_BINBCSR_PRECISION_SINGLE) == 0);
+    const auto txt = info_view(A);
+    CAPTURE(txt);
+    CHECK(txt.find("after the precision change, at the layout's bin width: bin width " + std::to_string(bw)) !=
+          std::string::npos);
+    CHECK(bin_width(A) == bw);
+    const PetscInt k = streams(A);
+    CHECK((k == 1 || k == 2 || k == 4 || k == 8));
+    Mat R = build_tuned(p, MAT_BINBCSR_PRECISION_SINGLE, sym, MAT_BINBCSR_TUNE_OFF, bw, k);
+    check_same(A, R, p); // the values converted once, the products those of the fixed configuration
+    MatDestroy(&R);
+    MatDestroy(&A);
+    // explicit streams and kernel: nothing is timed again
+    o.set("-mat_binbcsr_kernel", "portable");
+    A = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, sym, MAT_BINBCSR_TUNE_AUTO, 0, 2);
+    REQUIRE(MatBinBCSRSetPrecision(A, MAT_BINBCSR_PRECISION_SINGLE) == 0);
+    CHECK(info_view(A).find("after the precision change") == std::string::npos);
+    CHECK(streams(A) == 2);
+    MatDestroy(&A);
+    PetscOptionsClearValue(nullptr, "-mat_binbcsr_kernel");
+  }
+}
+
 TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
 {
   Restore           r;
