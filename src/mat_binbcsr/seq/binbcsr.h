@@ -98,6 +98,7 @@ typedef struct {
   MatScalar *val;        /* [nslots * bs2] when precision is double, else NULL */
   float     *valf;       /* [nslots * bs2] when precision is single, else NULL */
   void      *val_mem;    /* the allocation val or valf lies in (MatSeqBinBCSRAllocValues_Private) */
+  size_t     val_map;    /* bytes of val_mem when it is a mapping of its own (large arrays), else 0 */
 
   struct BinBCSRStaging *staging; /* non-NULL between MatSetUp/preallocation and the layout build */
 
@@ -151,6 +152,8 @@ binbcsr::Body MatSeqBinBCSRSelectBody(const Mat_SeqBinBCSR *a);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRAllocValues_Private(Mat_SeqBinBCSR *, MatBinBCSRPrecision, size_t nv,
                                                              PetscBool zero);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRFreeValues_Private(Mat_SeqBinBCSR *);
+/* Frees a val_mem of map bytes (0: PetscMalloc'd), when the caller took it out of the matrix. */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRReleaseValues_Private(void *mem, size_t map);
 
 /* Lane of slot s, and the index into val/valf of entry e of slot s. */
 static inline PetscInt BinBCSRLane(PetscInt s, PetscInt bw) { return s % bw; }
