@@ -151,7 +151,8 @@ struct Timer {
 struct Tried {
   PetscInt bw, K;
   double   sec;
-  PetscInt kernel; /* MatBinBCSRKernel; AUTO: the dispatch's default body */
+  PetscInt kernel;       /* MatBinBCSRKernel; AUTO: the dispatch's default body */
+  PetscInt products = 0; /* timed so far */
 };
 
 } // namespace
@@ -364,11 +365,13 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
         PetscCall(tm.Time(T, c.K, &t));
         Tried &e = entry(c);
         e.sec    = std::min(e.sec, t);
+        e.products++;
       }
-      /* a candidate 25% behind the best after a round is out: the noise of one product is smaller */
+      /* a candidate 30% behind the best after two rounds is out; after one round a product slowed by
+         another process's memory traffic (1.8x here) would decide alone */
       double lead = 1e30;
       for (const Tried &c : cs) lead = std::min(lead, entry(c).sec);
-      cs.erase(std::remove_if(cs.begin(), cs.end(), [&](const Tried &c) { return entry(c).sec > 1.25 * lead; }),
+      cs.erase(std::remove_if(cs.begin(), cs.end(), [&](const Tried &c) { return entry(c).products >= 2 && entry(c).sec > 1.3 * lead; }),
                cs.end());
       if (cs.size() < 2) break;
     }
