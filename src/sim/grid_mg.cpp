@@ -186,27 +186,38 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
   // Smoothers: one symmetric Gauss-Seidel sweep (processor-local on more ranks), so that the V-cycle is
   // symmetric positive definite for CG whatever the values (Chebyshev needs eigenvalue estimates, which
   // turned the cycle indefinite on the cloth when they were short). Their own prefixes keep GAMG's
-  // -mg_levels_* options (a scene file may hold both) away from them.
+  // -mg_levels_* options (a scene file may hold both) away from them. The pre- and post-smoother are
+  // distinct objects with the same settings: PCMG then tells the pre-smoother that its initial guess is
+  // zero (one KSP serving both must assume a nonzero one), and the first half of its sweep skips the
+  // product with the upper triangle, a third of the pre-smoothing on binbcsr's upper-triangle storage.
+  PetscCall(PCMGSetDistinctSmoothUp(pc));
   for (PetscInt l = 0; l < nlev; ++l) {
-    KSP smoother;
-    PC  spc;
-    PetscCall(PCMGGetSmoother(pc, l, &smoother));
-    PetscCall(KSPGetPC(smoother, &spc));
     if (l == 0) {
-      PetscCall(KSPSetOptionsPrefix(smoother, "grid_mg_coarse_"));
+      KSP coarse;
+      PC  cpc;
+      PetscCall(PCMGGetSmoother(pc, l, &coarse));
+      PetscCall(KSPGetPC(coarse, &cpc));
+      PetscCall(KSPSetOptionsPrefix(coarse, "grid_mg_coarse_"));
       if (nlev == 1) { // PCMG makes a lone level a smoother; a grid this small is solved directly
-        PetscCall(KSPSetType(smoother, KSPPREONLY));
-        PetscCall(PCSetType(spc, size > 1 ? PCREDUNDANT : PCLU));
+        PetscCall(KSPSetType(coarse, KSPPREONLY));
+        PetscCall(PCSetType(cpc, size > 1 ? PCREDUNDANT : PCLU));
       }
       continue; // PCMG's default: LU (redundant on more ranks)
     }
     char prefix[64]; // -grid_mg_levels_N_* for level N (PCMG's numbering), -grid_mg_levels_* for all
     PetscCall(PetscSNPrintf(prefix, sizeof prefix, "grid_mg_levels_%d_", (int)l));
-    PetscCall(KSPSetOptionsPrefix(smoother, prefix));
-    PetscCall(KSPSetType(smoother, KSPRICHARDSON));
-    PetscCall(KSPSetTolerances(smoother, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT, 1));
-    PetscCall(PCSetType(spc, PCSOR));
-    PetscCall(PCSORSetSymmetric(spc, SOR_LOCAL_SYMMETRIC_SWEEP));
+    KSP sides[2];
+    PetscCall(PCMGGetSmootherDown(pc, l, &sides[0]));
+    PetscCall(PCMGGetSmootherUp(pc, l, &sides[1]));
+    for (KSP smoother : sides) {
+      PC spc;
+      PetscCall(KSPGetPC(smoother, &spc));
+      PetscCall(KSPSetOptionsPrefix(smoother, prefix));
+      PetscCall(KSPSetType(smoother, KSPRICHARDSON));
+      PetscCall(KSPSetTolerances(smoother, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT, 1));
+      PetscCall(PCSetType(spc, PCSOR));
+      PetscCall(PCSORSetSymmetric(spc, SOR_LOCAL_SYMMETRIC_SWEEP));
+    }
   }
   PetscCall(KSPSetFromOptions(ksp)); // the new levels' smoothers and coarse solve take their options
   PetscFunctionReturn(0);
@@ -227,9 +238,12 @@ PetscErrorCode GridMGRefill(GridMG *mg, const PetscScalar *coo_values)
     if (l > 0) PetscCall(MatSeqBAIJRestoreArray(mg->galerkin[l - 1].Ac, &a));
     // Handing the level its operator again makes its smoother set up anew (Chebyshev's eigenvalue
     // estimate; a KSP whose operators were set once keeps its first estimate) and the coarse solve refactor.
-    KSP smoother;
-    PetscCall(PCMGGetSmoother(mg->pc, (PetscInt)(mg->galerkin.size() - 1 - l), &smoother));
-    PetscCall(KSPSetOperators(smoother, mg->galerkin[l].Ac, mg->galerkin[l].Ac));
+    const PetscInt level = (PetscInt)(mg->galerkin.size() - 1 - l);
+    KSP            sides[2];
+    PetscCall(PCMGGetSmootherDown(mg->pc, level, &sides[0]));
+    sides[1] = sides[0];
+    if (level > 0) PetscCall(PCMGGetSmootherUp(mg->pc, level, &sides[1])); // the coarse solve has one
+    for (KSP smoother : sides) PetscCall(KSPSetOperators(smoother, mg->galerkin[l].Ac, mg->galerkin[l].Ac));
   }
   PetscFunctionReturn(0);
 }

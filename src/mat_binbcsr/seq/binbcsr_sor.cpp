@@ -5,9 +5,10 @@
 
    One row update: x_r = (1 - omega) x_r + omega (D_r + shift I)^-1 (b_r - sum_{c != r} A_rc x_c) with the
    newest x (SOR on A + shift I, as PETSc's AIJ defines the shift). The row products reuse the per-slot
-   kernels of MatMult (slot_mult, and slot_mult_transpose for the lower triangle that symmetric
-   storage keeps in other rows). Sweeps are sequential over rows by nature: they walk
-   the bin layout one lane at a time and do not get the SIMD speed of MatMult.
+   kernels of MatMult (slot_mult, and slot_mult_transpose for the lower triangle that upper-triangle
+   storage keeps in other rows, pushed from those rows: sweep_upper_storage). Sweeps are sequential
+   over rows by nature: they walk the bin layout one lane at a time and do not get the SIMD speed of
+   MatMult.
 
    PCEISENSTAT's operations as well: SOR_EISENSTAT applies (L + E)^-1 A (U + E)^-1, E = (D + shift I) / omega,
    with one backward and one forward sweep from zero (Eisenstat's trick, as PETSc's AIJ: about one matrix
@@ -21,23 +22,14 @@
 
 namespace {
 
-/* acc = sum over c < r (lower) or c > r (upper) of A_rc x_c for block row r: the row's stored
-   blocks and, with symmetric storage, the transposed blocks (c, r), c < r, stored in the rows above
-   (the lower index). The diagonal block is left out. */
+/* acc = sum over c < r (lower) or c > r (upper) of A_rc x_c for block row r from the row's stored
+   blocks: whole storage, or the upper half of upper-triangle storage. The diagonal block is left out. */
 template <int BS, typename V>
 void row_half_product(const Mat_SeqBinBCSR *a, const V *val, PetscInt r, bool lower, const double *x,
                       double *acc)
 {
   const int bs = BS ? BS : (int)a->bs, bs2 = bs * bs, bw = (int)a->bw;
   for (int i = 0; i < bs; i++) acc[i] = 0.0;
-  if (a->sym && lower) {
-    for (PetscInt p = a->lower_off[r]; p < a->lower_off[r + 1]; p++) {
-      const PetscInt s = a->lower_slot[2 * p], c = a->lower_slot[2 * p + 1];
-      binbcsr::slot_mult_transpose<BS, V>(val + BinBCSRValueIndex(s, 0, bw, bs2), bw, bs, x + (size_t)c * bs,
-                                          acc);
-    }
-    return;
-  }
   /* Whole storage keeps each row's columns ascending: the diagonal's position splits the row. */
   PetscInt k0 = 0, k1 = a->row_nz[r];
   if (!a->sym && a->diag_slot[r] >= 0) {
@@ -63,10 +55,131 @@ struct HalfSums {
   bool    lower_ok, upper_ok; /* still valid for the current x */
 };
 
+/* The row update both sweeps share: x_r = (1 - omega) x_r + omega (D_r + shift I)^-1 (b_r - L_r - U_r),
+   with L_r, U_r kept for the next sweep (see HalfSums). */
+template <int BS>
+inline void relax_row(int bs_rt, PetscInt r, const MatScalar *idiag, PetscReal omega, const double *b,
+                      const double *lo, const double *up, double *Lr, double *Ur, double *res, double *xr)
+{
+  const int bs = BS ? BS : bs_rt;
+  for (int i = 0; i < bs; i++) {
+    res[i] = b[(size_t)r * bs + i] - lo[i] - up[i];
+    Lr[i]  = lo[i];
+    Ur[i]  = up[i];
+  }
+  const MatScalar *d = idiag + (size_t)r * bs * bs;
+  for (int i = 0; i < bs; i++) {
+    double s = 0.0;
+    for (int j = 0; j < bs; j++) s += d[j * bs + i] * res[j];
+    xr[i] = (1.0 - omega) * xr[i] + omega * s;
+  }
+}
+
+/* lower = L x for upper-triangle storage: each stored block (c, r), r > c, adds its transpose times x_c
+   to row r, one pass in storage order. */
+template <int BS, typename V>
+void lower_products(const Mat_SeqBinBCSR *a, const V *val, const double *x, double *lower)
+{
+  const int bs = BS ? BS : (int)a->bs, bs2 = bs * bs, bw = (int)a->bw;
+  for (PetscInt i = 0; i < a->mbs * bs; i++) lower[i] = 0.0;
+  for (PetscInt c = 0; c < a->mbs; c++)
+    for (PetscInt k = 0; k < a->row_nz[c]; k++) {
+      const PetscInt s = BinBCSRSlot(a, c, k), r = a->col[s];
+      if (r != c)
+        binbcsr::slot_mult_transpose<BS, V>(val + BinBCSRValueIndex(s, 0, bw, bs2), bw, bs,
+                                            x + (size_t)c * bs, lower + (size_t)r * bs);
+    }
+}
+
+/* Requests part `part` of `parts` of bin b's values into the caches. A sweep walks one lane of a bin at
+   a time, and the first lane of a bin meets each line of the bin's values as a miss the prefetchers
+   did not foresee; one part per row spreads the requests over the bin before. */
+template <typename V>
+inline void prefetch_bin(const Mat_SeqBinBCSR *a, const V *val, PetscInt b, int part, int parts)
+{
+  if (b < 0 || b >= a->nbins) return;
+  const char  *p0    = (const char *)(val + (size_t)a->bin_start[b] * a->bs2);
+  const char  *p1    = (const char *)(val + (size_t)a->bin_start[b + 1] * a->bs2);
+  const size_t lines = (size_t)(p1 - p0) / 64, l0 = lines * part / parts, l1 = lines * (part + 1) / parts;
+  for (size_t l = l0; l < l1; l++) __builtin_prefetch(p0 + 64 * l);
+}
+
+/* The sweep for upper-triangle storage. Row r keeps only its blocks (r, c), c > r; the lower half L_r is
+   spread over the rows above. Gathering it row by row (the lower index) reads one block of another
+   bin per term, scattered over the whole array. Instead the sweep walks each row once, in storage
+   order: a forward sweep pushes A_rc^T x_r into row c's L_c as soon as x_r is new (L_c then holds
+   the newest x when the sweep reaches c); a backward sweep needs only U_r from its own row, with L_r
+   kept from the forward sweep before it, or computed for the starting x in one pass.
+   A sweep runs at a fraction of the product's speed (one lane at a time, scalar arithmetic, a chain of
+   dependences from row to row), so the instructions per block count: the bin width is a compile-time
+   constant where it can be (a tile's entries at constant offsets), U_r is summed in two halves (so
+   that consecutive slots do not queue their additions behind one another), and the next bin's values
+   are requested a part per row ahead of the lane that first meets them. Against the gathered lower
+   half: 20-35% less time per symmetric sweep on the 160 x 160 cloth's matrix (docs/cloth.md). */
+template <int BS, int BW, typename V>
+void sweep_upper_storage(const Mat_SeqBinBCSR *a, const V *val, const MatScalar *idiag, PetscReal omega,
+                         const double *b, double *x, bool forward, HalfSums &h, double *work)
+{
+  const int bs = BS ? BS : (int)a->bs, bs2 = bs * bs, bw = BW ? BW : (int)a->bw;
+  double    fixed[BS ? 4 * BS : 1]; /* small fixed block sizes: the sums stay in registers */
+  double   *u0 = BS ? fixed : work, *u1 = u0 + bs, *up = u0 + 2 * bs, *res = u0 + 3 * bs;
+  if (forward)
+    for (PetscInt i = 0; i < a->mbs * bs; i++) h.lower[i] = 0.0;
+  else if (!h.lower_ok) lower_products<BS, V>(a, val, x, h.lower);
+  const bool upper_kept = forward && h.upper_ok;
+  const auto tile       = [&](PetscInt s) { return val + BinBCSRValueIndex(s, 0, bw, bs2); };
+  for (PetscInt q = 0; q < a->mbs; q++) {
+    const PetscInt r = forward ? q : a->mbs - 1 - q, nz = a->row_nz[r];
+    double        *xr = x + (size_t)r * bs, *Lr = h.lower + (size_t)r * bs, *Ur = h.upper + (size_t)r * bs;
+    prefetch_bin<V>(a, val, forward ? r / bw + 1 : r / bw - 1, forward ? r % bw : bw - 1 - r % bw, bw);
+    if (upper_kept)
+      for (int i = 0; i < bs; i++) up[i] = Ur[i];
+    else {
+      for (int i = 0; i < bs; i++) u0[i] = u1[i] = 0.0;
+      PetscInt k = 0;
+      for (; k + 1 < nz; k += 2) {
+        const PetscInt s0 = BinBCSRSlot(a, r, k), c0 = a->col[s0], s1 = BinBCSRSlot(a, r, k + 1),
+                       c1 = a->col[s1];
+        if (c0 != r) binbcsr::slot_mult<BS, V>(tile(s0), bw, bs, x + (size_t)c0 * bs, u0);
+        if (c1 != r) binbcsr::slot_mult<BS, V>(tile(s1), bw, bs, x + (size_t)c1 * bs, u1);
+      }
+      if (k < nz) {
+        const PetscInt s0 = BinBCSRSlot(a, r, k), c0 = a->col[s0];
+        if (c0 != r) binbcsr::slot_mult<BS, V>(tile(s0), bw, bs, x + (size_t)c0 * bs, u0);
+      }
+      for (int i = 0; i < bs; i++) up[i] = u0[i] + u1[i];
+    }
+    relax_row<BS>(bs, r, idiag, omega, b, Lr, up, Lr, Ur, res, xr);
+    if (forward)
+      for (PetscInt k = 0; k < nz; k++) {
+        const PetscInt s = BinBCSRSlot(a, r, k), c = a->col[s];
+        if (c != r) binbcsr::slot_mult_transpose<BS, V>(tile(s), bw, bs, xr, h.lower + (size_t)c * bs);
+      }
+  }
+  h.lower_ok = forward;
+  h.upper_ok = !forward;
+}
+
+/* sweep_upper_storage with the bin width as a constant for 3x3 blocks at the widths the tuner picks. */
+template <int BS, typename V>
+void sweep_upper_any_width(const Mat_SeqBinBCSR *a, const V *val, const MatScalar *idiag, PetscReal omega,
+                           const double *b, double *x, bool forward, HalfSums &h, double *work)
+{
+  if (BS == 3 && a->bw == 4) sweep_upper_storage<BS, 4, V>(a, val, idiag, omega, b, x, forward, h, work);
+  else if (BS == 3 && a->bw == 8) sweep_upper_storage<BS, 8, V>(a, val, idiag, omega, b, x, forward, h, work);
+  else if (BS == 3 && a->bw == 16)
+    sweep_upper_storage<BS, 16, V>(a, val, idiag, omega, b, x, forward, h, work);
+  else sweep_upper_storage<BS, 0, V>(a, val, idiag, omega, b, x, forward, h, work);
+}
+
 template <int BS, typename V>
 void sweep(const Mat_SeqBinBCSR *a, const V *val, const MatScalar *idiag, PetscReal omega, const double *b,
            double *x, bool forward, HalfSums &h, double *work)
 {
+  if (a->sym) {
+    sweep_upper_any_width<BS, V>(a, val, idiag, omega, b, x, forward, h, work);
+    return;
+  }
   const int bs = BS ? BS : (int)a->bs, bs2 = bs * bs;
   double   *lo = work, *up = work + bs, *res = work + 2 * bs;
   for (PetscInt q = 0; q < a->mbs; q++) {
@@ -79,17 +192,7 @@ void sweep(const Mat_SeqBinBCSR *a, const V *val, const MatScalar *idiag, PetscR
     if (!forward || !h.upper_ok) row_half_product<BS, V>(a, val, r, false, x, up);
     else
       for (int i = 0; i < bs; i++) up[i] = Ur[i];
-    for (int i = 0; i < bs; i++) {
-      res[i] = b[(size_t)r * bs + i] - lo[i] - up[i];
-      Lr[i]  = lo[i];
-      Ur[i]  = up[i];
-    }
-    const MatScalar *d = idiag + (size_t)r * bs2;
-    for (int i = 0; i < bs; i++) {
-      double s = 0.0;
-      for (int j = 0; j < bs; j++) s += d[j * bs + i] * res[j];
-      xr[i] = (1.0 - omega) * xr[i] + omega * s;
-    }
+    relax_row<BS>(bs, r, idiag, omega, b, lo, up, Lr, Ur, res, xr);
   }
   h.lower_ok = forward;
   h.upper_ok = !forward;
@@ -191,7 +294,7 @@ PetscErrorCode SOREisenstat(Mat A, PetscReal omega, PetscReal fshift, const doub
   HalfSums        h = {nullptr, nullptr, false, false};
 
   PetscFunctionBegin;
-  PetscCall(PetscMalloc5(3 * a->bs, &work, n, &h.lower, n, &h.upper, n, &t, n, &z));
+  PetscCall(PetscMalloc5(4 * a->bs, &work, n, &h.lower, n, &h.upper, n, &t, n, &z));
   zero_start(n, x, h);
   sweep_any(a, omega, b, x, false, h, work);
   PetscCall(PetscArraycpy(t, b, n));
@@ -259,7 +362,6 @@ PetscErrorCode MatSOR_SeqBinBCSR(Mat A, Vec bb, PetscReal omega, MatSORType flag
   PetscCheck(!PetscIsInfOrNanReal(omega) && !PetscIsInfOrNanReal(fshift) && omega != 0.0, PETSC_COMM_SELF,
              PETSC_ERR_ARG_WRONG, "MatSOR: omega (%g) must be finite and nonzero, the shift finite",
              (double)omega);
-  if (a->sym) PetscCall(MatSeqBinBCSRBuildLowerIndex(a));
   if (flag == SOR_APPLY_UPPER) {
     PetscCall(VecGetArrayRead(bb, &b));
     PetscCall(VecGetArrayWrite(xx, &x));
@@ -293,7 +395,7 @@ PetscErrorCode MatSOR_SeqBinBCSR(Mat A, Vec bb, PetscReal omega, MatSORType flag
   PetscCall(VecGetArray(xx, &x));
   const size_t n = (size_t)a->mbs * a->bs;
   HalfSums     h = {nullptr, nullptr, false, false};
-  PetscCall(PetscMalloc3(3 * a->bs, &work, n, &h.lower, n, &h.upper));
+  PetscCall(PetscMalloc3(4 * a->bs, &work, n, &h.lower, n, &h.upper));
   if (flag & SOR_ZERO_INITIAL_GUESS) zero_start((PetscInt)n, x, h);
   for (PetscInt it = 0; it < its * lits; it++) {
     if (forward) sweep_any(a, omega, b, x, true, h, work);

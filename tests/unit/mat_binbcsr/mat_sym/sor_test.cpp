@@ -98,8 +98,12 @@ TEST_CASE(
 {
   const Pattern cases[] = {fem_pattern(4, 3, 5, 3), fem_pattern(5, 4, 3, 1), fem_pattern(3, 3, 3, 2),
                            end_rows_pattern(21, 3)};
-  const int flags[] = {SOR_FORWARD_SWEEP | SOR_ZERO_INITIAL_GUESS, SOR_BACKWARD_SWEEP, SOR_SYMMETRIC_SWEEP,
-                       SOR_LOCAL_SYMMETRIC_SWEEP | SOR_ZERO_INITIAL_GUESS};
+  const int     flags[] = {SOR_FORWARD_SWEEP | SOR_ZERO_INITIAL_GUESS,
+                           SOR_BACKWARD_SWEEP,
+                           SOR_BACKWARD_SWEEP | SOR_ZERO_INITIAL_GUESS,
+                           SOR_FORWARD_SWEEP,
+                           SOR_SYMMETRIC_SWEEP,
+                           SOR_LOCAL_SYMMETRIC_SWEEP | SOR_ZERO_INITIAL_GUESS};
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     for (MatBinBCSRPrecision prec : {MAT_BINBCSR_PRECISION_DOUBLE, MAT_BINBCSR_PRECISION_SINGLE}) {
       const Pattern &p  = cases[c];
@@ -109,7 +113,7 @@ TEST_CASE(
       std::vector<double> x0(p.m);
       for (PetscInt i = 0; i < p.m; i++) x0[i] = 0.1 * std::sin(1.0 + i);
       for (bool sym : {false, true})
-        for (PetscInt bw : {4, 8}) {
+        for (PetscInt bw : {4, 8, 16}) { // 3x3 blocks: each width has its own compiled sweep
           Mat A = build_sym(p, bw, prec, sym);
           for (double omega : {1.0, 1.4})
             for (double shift : {0.0, 0.3})
