@@ -154,7 +154,8 @@ int main(int argc, char **argv)
       PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-stencil_sizes", sizes, &nsizes, &flg));
       if (!flg) nsizes = 2;
       PetscCall(PetscPrintf(PETSC_COMM_SELF,
-                            "binbcsr_tune -sweep: ms per MatMult, median of %" PetscInt_FMT " rounds of %" PetscInt_FMT
+                            "binbcsr_tune -sweep: ms per MatMult, median of %" PetscInt_FMT
+                            " rounds of %" PetscInt_FMT
                             " (%s time); best/tuned as bin width/streams; tuned/best and x baij: median"
                             " of the rounds' ratios (min: the ratio of the minima)\n",
                             s.repeats, s.batch, use_wall ? "wall" : "thread CPU"));

@@ -39,13 +39,13 @@ PetscErrorCode MakeBinBCSR(Mat src, PetscInt bs, PetscInt bw, PetscInt streams, 
 namespace {
 
 struct Variant {
-  Mat              A  = nullptr;
-  PetscInt         bw = 0, streams = 0;              // streams set before each batch (0: the matrix's own)
-  MatBinBCSRKernel kernel = MAT_BINBCSR_KERNEL_AUTO; // set before each batch
-  bool             owner  = false;
-  double           best   = 1e300;
+  Mat                 A  = nullptr;
+  PetscInt            bw = 0, streams = 0;              // streams set before each batch (0: the matrix's own)
+  MatBinBCSRKernel    kernel = MAT_BINBCSR_KERNEL_AUTO; // set before each batch
+  bool                owner  = false;
+  double              best   = 1e300;
   std::vector<double> t; // ms per MatMult of each round
-  double median() const
+  double              median() const
   {
     std::vector<double> u = t;
     std::sort(u.begin(), u.end());
@@ -174,12 +174,13 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
     PetscCall(PetscPrintf(
       PETSC_COMM_SELF,
       "%-14s %-9s %-6s best %2" PetscInt_FMT "/%" PetscInt_FMT "/%-8s %8.4f   tuned %2" PetscInt_FMT
-      "/%" PetscInt_FMT "/%-8s %8.4f   tuned/best %5.3f (min %5.3f)   %s %8.4f  tuned x %s %5.2f   tuning %6.1f ms "
+      "/%" PetscInt_FMT
+      "/%-8s %8.4f   tuned/best %5.3f (min %5.3f)   %s %8.4f  tuned x %s %5.2f   tuning %6.1f ms "
       "(build %.0f ms)\n",
-      name.c_str(), storage, p, best->bw, best->streams, MatBinBCSRKernels[best->kernel], 1e3 * best->median(),
-      tuned.bw, tuned.streams, MatBinBCSRKernels[tuned.kernel], 1e3 * tuned.median(), PairedRatio(tuned, *best),
-      tuned.best / best->best, bs > 1 ? "baij" : "aij", 1e3 * base.median(), bs > 1 ? "baij" : "aij",
-      PairedRatio(base, tuned), cost, 1e3 * (t1 - t0)));
+      name.c_str(), storage, p, best->bw, best->streams, MatBinBCSRKernels[best->kernel],
+      1e3 * best->median(), tuned.bw, tuned.streams, MatBinBCSRKernels[tuned.kernel], 1e3 * tuned.median(),
+      PairedRatio(tuned, *best), tuned.best / best->best, bs > 1 ? "baij" : "aij", 1e3 * base.median(),
+      bs > 1 ? "baij" : "aij", PairedRatio(base, tuned), cost, 1e3 * (t1 - t0)));
     for (Variant &v : vars)
       if (v.owner) PetscCall(MatDestroy(&v.A));
     PetscCall(MatDestroy(&tuned.A));

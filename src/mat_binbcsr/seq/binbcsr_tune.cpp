@@ -102,11 +102,11 @@ PetscErrorCode SampleMatrix(const Mat_SeqBinBCSR *a, const Sample &s, PetscInt b
 
 struct Timer {
   Vec      x = nullptr, y = nullptr;
-  PetscInt products = 0;
-  double   seconds  = 0;     /* time in timed products */
-  double   budget   = 0;     /* seconds of product time */
+  PetscInt products     = 0;
+  double   seconds      = 0; /* time in timed products */
+  double   budget       = 0; /* seconds of product time */
   PetscInt max_products = 0;
-  bool     cold     = false; /* the sample's arrays dropped from the caches before each product */
+  bool     cold         = false; /* the sample's arrays dropped from the caches before each product */
 
   /* CPU seconds of this thread: on a machine shared with other work the wall clock also counts the
      time the process waits for a core, which would decide the choice by chance */
@@ -161,11 +161,11 @@ struct Tried {
    prefix), else auto, cache on, and the defaults of the benchmark knobs. */
 PetscErrorCode BinBCSRTuneSettingsGet(Mat A, BinBCSRTuneSettings *st)
 {
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-  PetscOptions    db = ((PetscObject)A)->options;
+  Mat_SeqBinBCSR *a   = (Mat_SeqBinBCSR *)A->data;
+  PetscOptions    db  = ((PetscObject)A)->options;
   const char     *pre = ((PetscObject)A)->prefix;
   PetscBool       set, flg;
-  PetscEnum       v = (PetscEnum)MAT_BINBCSR_TUNE_AUTO;
+  PetscEnum       v   = (PetscEnum)MAT_BINBCSR_TUNE_AUTO;
   PetscInt        kib = min_tune_kib, mib = 0, ms = -1;
 
   PetscFunctionBegin;
@@ -211,12 +211,12 @@ static std::string Fmt(const char *f, double x)
 
 PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[])
 {
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  Mat_SeqBinBCSR     *a = (Mat_SeqBinBCSR *)A->data;
   BinBCSRTuneSettings set;
   PetscBool           found;
-  const PetscInt  bs = a->bs, mbs = a->mbs, bw_default = BinBCSRDefaultBinWidth(bs);
-  const size_t    vsize = a->precision == MAT_BINBCSR_PRECISION_SINGLE ? sizeof(float) : sizeof(MatScalar);
-  PetscLogDouble  t_start, t_end;
+  const PetscInt      bs = a->bs, mbs = a->mbs, bw_default = BinBCSRDefaultBinWidth(bs);
+  const size_t   vsize = a->precision == MAT_BINBCSR_PRECISION_SINGLE ? sizeof(float) : sizeof(MatScalar);
+  PetscLogDouble t_start, t_end;
 
   PetscFunctionBegin;
   a->tune_info[0] = 0;
@@ -262,7 +262,8 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
   const size_t vbytes = (size_t)nz * a->bs2 * vsize;
   if (vbytes < set.min_bytes) {
     SetInfo(a, "none: " + std::to_string(vbytes >> 10) + " KiB of values (below " +
-                 std::to_string(set.min_bytes >> 10) + " KiB any layout is as fast; -mat_binbcsr_tune_min_kib)");
+                 std::to_string(set.min_bytes >> 10) +
+                 " KiB any layout is as fast; -mat_binbcsr_tune_min_kib)");
     PetscCall(PetscLogEventEnd(MAT_BinBCSR_Tune, A, 0, 0, 0));
     PetscFunctionReturn(0);
   }
@@ -320,8 +321,8 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
      share that cache, and a 35 MB matrix (the 32^3 stencil in single, values and columns) streams from
      memory through a 32 MiB one, while its 24 MB sample stayed in it and ranked the bodies by how fast
      they compute (the tuned choice was 1.2-1.4x slower than the best on the whole matrix) */
-  tm.cold = vbytes + (size_t)nz * sizeof(PetscInt) > (llc > 0 ? (size_t)llc : (size_t)32 << 20) / 2;
-  tm.budget = set.budget;
+  tm.cold         = vbytes + (size_t)nz * sizeof(PetscInt) > (llc > 0 ? (size_t)llc : (size_t)32 << 20) / 2;
+  tm.budget       = set.budget;
   tm.max_products = set.products;
   std::vector<Tried> tried; /* every configuration timed, in the order first timed */
   std::vector<Mat>   layouts(widths.size(), nullptr);
@@ -352,9 +353,11 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
     for (int round = 0; round < rounds; round++) {
       double per = 0; /* the slowest known product of the round */
       for (const Tried &c : cs) per = std::max(per, entry(c).sec);
-      if ((tm.products || round) && !tm.Admits((PetscInt)cs.size(), per < 1e29 ? per : tm.seconds / tm.products)) {
+      if ((tm.products || round) &&
+          !tm.Admits((PetscInt)cs.size(), per < 1e29 ? per : tm.seconds / tm.products)) {
         if (round == 0) /* the configurations never timed are left out */
-          skipped += (PetscInt)std::count_if(cs.begin(), cs.end(), [&](const Tried &c) { return entry(c).sec >= 1e29; });
+          skipped += (PetscInt)std::count_if(cs.begin(), cs.end(),
+                                             [&](const Tried &c) { return entry(c).sec >= 1e29; });
         break;
       }
       for (const Tried &c : cs) {
@@ -371,8 +374,10 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
          another process's memory traffic (1.8x here) would decide alone */
       double lead = 1e30;
       for (const Tried &c : cs) lead = std::min(lead, entry(c).sec);
-      cs.erase(std::remove_if(cs.begin(), cs.end(), [&](const Tried &c) { return entry(c).products >= 2 && entry(c).sec > 1.3 * lead; }),
-               cs.end());
+      cs.erase(
+        std::remove_if(cs.begin(), cs.end(),
+                       [&](const Tried &c) { return entry(c).products >= 2 && entry(c).sec > 1.3 * lead; }),
+        cs.end());
       if (cs.size() < 2) break;
     }
     PetscFunctionReturn(0);
@@ -496,7 +501,7 @@ PetscErrorCode MatSeqBinBCSRRetune(Mat A)
         bj.push_back(a->col[binbcsr::row_slot(a->bin_start, a->bw, r, k)]);
     bi.push_back((PetscInt)bj.size());
   }
-  a->bw_set = PETSC_TRUE;
+  a->bw_set           = PETSC_TRUE;
   PetscErrorCode ierr = MatSeqBinBCSRTune(A, bi.data(), bj.data());
   a->bw_set           = bw_set;
   PetscCall(ierr);

@@ -252,8 +252,8 @@ TEST_CASE("tuning: a precision change times the streams again, at the layout's w
     REQUIRE(MatBinBCSRSetPrecision(A, MAT_BINBCSR_PRECISION_SINGLE) == 0);
     const auto txt = info_view(A);
     CAPTURE(txt);
-    CHECK(txt.find("after the precision change, at the layout's bin width: bin width " + std::to_string(bw)) !=
-          std::string::npos);
+    CHECK(txt.find("after the precision change, at the layout's bin width: bin width " +
+                   std::to_string(bw)) != std::string::npos);
     CHECK(bin_width(A) == bw);
     const PetscInt k = streams(A);
     CHECK((k == 1 || k == 2 || k == 4 || k == 8));
@@ -362,29 +362,28 @@ TEST_CASE("tuning: bad values give clear errors", "[tune]")
   MatDestroy(&A);
   // read at the layout build when MatSetFromOptions was not called
   const Pattern p = fem_pattern(4, 4, 4, 3);
+  // an empty assembly of p's sizes: where the layout build reads the options
+  auto assemble = [&]() {
+    Mat B;
+    REQUIRE(MatCreate(PETSC_COMM_SELF, &B) == 0);
+    REQUIRE(MatSetSizes(B, p.m, p.n, p.m, p.n) == 0);
+    REQUIRE(MatSetBlockSize(B, 3) == 0);
+    REQUIRE(MatSetType(B, MATSEQBINBCSR) == 0);
+    REQUIRE(MatSetUp(B) == 0);
+    REQUIRE(MatAssemblyBegin(B, MAT_FINAL_ASSEMBLY) == 0);
+    const PetscErrorCode ierr = MatAssemblyEnd(B, MAT_FINAL_ASSEMBLY);
+    MatDestroy(&B);
+    return ierr;
+  };
   REQUIRE(PetscOptionsSetValue(nullptr, "-mat_binbcsr_tune", "never") == 0);
-  REQUIRE(MatCreate(PETSC_COMM_SELF, &A) == 0);
-  REQUIRE(MatSetSizes(A, p.m, p.n, p.m, p.n) == 0);
-  REQUIRE(MatSetBlockSize(A, 3) == 0);
-  REQUIRE(MatSetType(A, MATSEQBINBCSR) == 0);
-  REQUIRE(MatSetUp(A) == 0);
-  REQUIRE(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY) == 0);
-  CHECK(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY) != 0);
+  CHECK(assemble() != 0);
   REQUIRE(PetscOptionsClearValue(nullptr, "-mat_binbcsr_tune") == 0);
-  MatDestroy(&A);
   // the benchmark knobs: sizes and budgets must be positive
   for (const char *knob : {"-mat_binbcsr_tune_sample_mib", "-mat_binbcsr_tune_budget_ms"}) {
     CAPTURE(knob);
     Opts o(false);
     o.set(knob, "0");
-    REQUIRE(MatCreate(PETSC_COMM_SELF, &A) == 0);
-    REQUIRE(MatSetSizes(A, p.m, p.n, p.m, p.n) == 0);
-    REQUIRE(MatSetBlockSize(A, 3) == 0);
-    REQUIRE(MatSetType(A, MATSEQBINBCSR) == 0);
-    REQUIRE(MatSetUp(A) == 0);
-    REQUIRE(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY) == 0);
-    CHECK(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY) == PETSC_ERR_ARG_OUTOFRANGE);
-    MatDestroy(&A);
+    CHECK(assemble() == PETSC_ERR_ARG_OUTOFRANGE);
   }
   // other types: no-ops
   REQUIRE(MatCreateSeqAIJ(PETSC_COMM_SELF, 4, 4, 1, nullptr, &A) == 0);
