@@ -18,6 +18,54 @@ StepCoefficients implicit_euler_coefficients(double dt, double alpha, double bet
   return c;
 }
 
+namespace {
+
+// BlockPattern::plan from the element slots (marks ignored) of `count` listed elements.
+BlockPattern::WritePlan make_write_plan(const std::vector<int> &element_slots, int npe, size_t count,
+                                        size_t blocks)
+{
+  BlockPattern::WritePlan plan;
+  const int               nb = packed_block_count(npe), group = kElementLanes * write_group_batches(npe);
+  static_assert(2 * kElementLanes * write_group_batches(4) * packed_block_count(4) <= 65536 &&
+                  2 * kElementLanes * write_group_batches(10) * packed_block_count(10) <= 65536,
+                "a write term must fit 16 bits");
+  std::vector<char>                           written(blocks, 0);
+  std::vector<std::pair<int, unsigned short>> terms; // (COO block, term) of one group
+  plan.group_offsets.push_back(0);
+  plan.write_offsets.push_back(0);
+  for (size_t g0 = 0; g0 < count; g0 += group) {
+    terms.clear();
+    for (size_t i = g0; i < std::min(count, g0 + group); ++i) {
+      const int *slot = &element_slots[i * npe * npe];
+      int        p    = 0;
+      for (int a = 0; a < npe; ++a)
+        for (int b = a; b < npe; ++b, ++p) {
+          const int term = 2 * (static_cast<int>(i - g0) * nb + p);
+          const int sab = slot[a * npe + b] & kSlotIndexMask, sba = slot[b * npe + a] & kSlotIndexMask;
+          if (slot[a * npe + b] >= 0) terms.emplace_back(sab, static_cast<unsigned short>(term));
+          if (b != a && slot[b * npe + a] >= 0)
+            terms.emplace_back(sba, static_cast<unsigned short>(term + 1));
+        }
+    }
+    std::stable_sort(terms.begin(), terms.end(),
+                     [](const auto &x, const auto &y) { return x.first < y.first; });
+    for (size_t k = 0; k < terms.size(); ++k) { // the group's blocks ascending, each with its terms
+      const int s = terms[k].first;
+      if (k == 0 || s != terms[k - 1].first) {
+        if (k > 0) plan.write_offsets.push_back(static_cast<int>(plan.write_terms.size()));
+        plan.write_slots.push_back(written[s] ? s : s | kFirstContribution);
+        written[s] = 1;
+      }
+      plan.write_terms.push_back(terms[k].second);
+    }
+    if (!terms.empty()) plan.write_offsets.push_back(static_cast<int>(plan.write_terms.size()));
+    plan.group_offsets.push_back(static_cast<int>(plan.write_slots.size()));
+  }
+  return plan;
+}
+
+} // namespace
+
 BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &elements,
                                 const std::vector<char> &fixed, int owned_begin, int owned_end, bool merge,
                                 const LowerTriangle &lower)
@@ -67,6 +115,7 @@ BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &e
           written[*s] = 1;
           *s |= kFirstContribution;
         }
+  p.plan = make_write_plan(p.element_slots, npe, elements.size(), p.rows.size());
   for (int v = owned_begin; v < owned_end; ++v)
     if (fixed[v]) {
       p.identity_slots.push_back(static_cast<int>(p.rows.size()));

@@ -48,6 +48,15 @@ struct BlockPattern {
                                    // kFirstContribution set on the kernels' first write to the block
   std::vector<int> identity_slots; // COO blocks that hold the identity (fixed nodes)
   bool             merged = false; // element blocks summed into unique COO blocks by the caller
+  // The batched loop's write-out (element_batch.hpp's write groups): group g writes the COO blocks
+  // write_slots[group_offsets[g] .. group_offsets[g+1]) (ascending; kFirstContribution set in the
+  // first group that writes the block), block k the sum of its terms
+  // write_terms[write_offsets[k] .. write_offsets[k+1]) in element order, each term
+  // 2 (element in the group * upper blocks per element + packed pair) + 1 where its block goes in transposed.
+  struct WritePlan {
+    std::vector<int>            group_offsets, write_slots, write_offsets;
+    std::vector<unsigned short> write_terms;
+  } plan;
 };
 // (kFirstContribution and kSlotIndexMask, the marks in element_slots: element_batch.hpp.)
 

@@ -59,7 +59,6 @@ long long assemble_elements_batched(const FemModel &model, const std::vector<int
   args.reference_mass     = Mref;
   args.elements           = elements.data();
   args.count              = elements.size();
-  args.element_slots      = values ? pattern->element_slots.data() : nullptr;
   args.x                  = x;
   args.v                  = v;
   args.values             = values;
@@ -68,6 +67,12 @@ long long assemble_elements_batched(const FemModel &model, const std::vector<int
   args.k                  = kernels::ElementConstants{c.force,       c.stiffness_rhs,       c.mass_rhs,
                                      c.mass_matrix, c.stiffness_matrix,    model.lame.lambda,
                                      model.lame.mu, model.settings.density};
+  if (values) {
+    args.group_offsets = pattern->plan.group_offsets.data();
+    args.write_slots   = pattern->plan.write_slots.data();
+    args.write_offsets = pattern->plan.write_offsets.data();
+    args.write_terms   = pattern->plan.write_terms.data();
+  }
   return body_of(element_body_used(body))(args);
 }
 

@@ -9,13 +9,21 @@
 // Newton steps refuse.
 //
 // A batch holds kElementLanes elements as structure of arrays (gathered positions, rest shapes,
-// rotations, outputs), one `omp simd` loop over the lanes per step, then the batch's blocks and forces
-// are written out lane after lane in element order (lanes may share nodes and COO blocks).
+// rotations, outputs), one `omp simd` loop over the lanes per step, then the batch's forces are added
+// lane after lane in element order (lanes may share nodes) and its blocks go to the stage of its
+// write group (element_batch.hpp); after the group's last batch each COO block the group touches
+// gets the sum of the group's contributions to it, once (BlockPattern::plan).
 #pragma once
 #if !defined(BINBCSR_ELEMENT_SET)
   #error "define BINBCSR_ELEMENT_SET (the body set's name) before including element_batch_body.hpp"
 #endif
 #include "physics/element_batch.hpp"
+#if defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512BW__) && defined(__AVX512DQ__)
+  #define BINBCSR_ELEMENT_BATCH_AVX512 1
+  #include "physics/element_batch_avx512.hpp"
+#else
+  #define BINBCSR_ELEMENT_BATCH_AVX512 0
+#endif
 
 namespace physics {
 namespace kernels {
@@ -30,7 +38,7 @@ template <int N> struct alignas(64) Batch {
   double               x[3 * N * W], v[3 * N * W], X[3 * N * W];
   double               Dinv[9 * W], F[9 * W], R[9 * W], vol[W];
   double               rhs[3 * N * W], blocks[NB * 9 * W];
-  double               Q[N == 10 ? 16 * 9 * W : 1]; // P2: the rotated gradient pairs
+  double               Q[N == 10 ? 16 * 9 * W : W]; // P2: the rotated gradient pairs (W: rows stay aligned)
   double               ok[W];                       // polar_rotation's acceptance per lane
 };
 
@@ -51,11 +59,9 @@ template <int N> inline void gather(const ElementBatchArgs &a, int e, int l, Bat
   b.vol[l] = a.volume[e];
 }
 
-// Asks for the cache lines batch [start, start + m) will touch: its nodes' entries of x, v, X and rhs and
-// its COO blocks. The write-out adds into blocks spread over several MB (6.7 MB of values for
-// linear_38k): one batch ahead took the loop from 12-14 to 10.3-10.7 ms there (further ahead: no
-// better).
-template <int N, bool Blocks> inline void prefetch_batch(const ElementBatchArgs &a, std::size_t start, int m)
+// Asks for the cache lines batch [start, start + m) will touch in x, v, X and rhs (its nodes'
+// entries), one batch ahead.
+template <int N> inline void prefetch_nodes(const ElementBatchArgs &a, std::size_t start, int m)
 {
   for (int l = 0; l < m; ++l) {
     const int *nodes = a.element_nodes + static_cast<std::size_t>(a.elements[start + l]) * N;
@@ -66,29 +72,82 @@ template <int N, bool Blocks> inline void prefetch_batch(const ElementBatchArgs 
       __builtin_prefetch(a.rest_positions + n);
       __builtin_prefetch(a.rhs + n, 1);
     }
-    if (!Blocks) continue;
-    const int *slot = a.element_slots + (start + l) * N * N;
-    for (int k = 0; k < N * N; ++k) {
-      if (slot[k] < 0) continue;
-      const double *out = a.values + 9 * static_cast<std::size_t>(slot[k] & kSlotIndexMask);
-      __builtin_prefetch(out, 1);
-      __builtin_prefetch(out + 8, 1);
-    }
   }
 }
 
-// Adds the row-major 3x3 block B (entry j at B[j * W]) into COO block s, or stores it where s is the
-// block's first write (kFirstContribution); transposed: B^T.
-inline void write_block(double *values, int s, const double *B, bool transposed)
+// And the COO blocks write_slots[k0, k1) (the group's write-out, a share per batch: the values are
+// several MB, 6.7 for linear_38k, so most blocks come from L3).
+inline void prefetch_blocks(const ElementBatchArgs &a, int k0, int k1)
 {
-  double *out = values + 9 * static_cast<std::size_t>(s & kSlotIndexMask);
-  double  t[9];
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) t[3 * i + j] = transposed ? B[(3 * j + i) * W] : B[(3 * i + j) * W];
-  if (s & kFirstContribution)
-    for (int j = 0; j < 9; ++j) out[j] = t[j];
-  else
-    for (int j = 0; j < 9; ++j) out[j] += t[j];
+  for (int k = k0; k < k1; ++k) {
+    const double *out = a.values + 9 * static_cast<std::size_t>(a.write_slots[k] & kSlotIndexMask);
+    __builtin_prefetch(out, 1);
+    __builtin_prefetch(out + 8, 1);
+  }
+}
+
+// A write group's blocks, lane-major: entries 0..7 of (element in the group e, packed pair p) at
+// head[e * NB + p], entry 8 at tail[e * NB + p] (the AVX-512 body moves 8 entries as one register).
+template <int N> struct alignas(64) Stage {
+  static constexpr int G = W * write_group_batches(N), NB = N * (N + 1) / 2;
+  double               head[G * NB][8], tail[G * NB];
+};
+
+// Batch j of the group into the stage.
+template <int N> inline void stage_batch(const Batch<N> &b, int j, Stage<N> &st)
+{
+  constexpr int NB = Batch<N>::NB;
+  for (int p = 0; p < NB; ++p) {
+#if BINBCSR_ELEMENT_BATCH_AVX512
+    __m512d r[8];
+    for (int e = 0; e < 8; ++e) r[e] = _mm512_load_pd(b.blocks + (9 * p + e) * W);
+    avx512::transpose8(r);
+    for (int l = 0; l < W; ++l) _mm512_store_pd(st.head[(j * W + l) * NB + p], r[l]);
+#else
+    for (int l = 0; l < W; ++l)
+      for (int e = 0; e < 8; ++e) st.head[(j * W + l) * NB + p][e] = b.blocks[(9 * p + e) * W + l];
+#endif
+    for (int l = 0; l < W; ++l) st.tail[(j * W + l) * NB + p] = b.blocks[(9 * p + 8) * W + l];
+  }
+}
+
+// Group g's write-out: each of its COO blocks gets the sum of its terms (stored where the group is the
+// first to write the block, added otherwise).
+// Group g's write-out: each of its COO blocks gets the sum of its terms (stored where the group is the
+// first to write the block, added otherwise).
+template <int N> inline void write_group(const ElementBatchArgs &a, std::size_t g, const Stage<N> &st)
+{
+  // (Locals: the stores into the values may alias anything, so fields of `a` would be read again.)
+  const int *const slots = a.write_slots, *const offsets = a.write_offsets;
+  const unsigned short *const terms  = a.write_terms;
+  double *const               values = a.values;
+  const int                   k1     = a.group_offsets[g + 1];
+  for (int k = a.group_offsets[g]; k < k1; ++k) {
+    const unsigned short *t = terms + offsets[k], *const end = terms + offsets[k + 1];
+#if BINBCSR_ELEMENT_BATCH_AVX512
+    __m512d acc  = avx512::term(st.head[*t >> 1], *t & 1);
+    double  acc8 = st.tail[*t >> 1];
+    for (++t; t < end; ++t) {
+      acc = _mm512_add_pd(acc, avx512::term(st.head[*t >> 1], *t & 1));
+      acc8 += st.tail[*t >> 1];
+    }
+    avx512::write_block(values, slots[k], acc, acc8);
+#else
+    constexpr int kT[2][8] = {{0, 1, 2, 3, 4, 5, 6, 7}, {0, 3, 6, 1, 4, 7, 2, 5}}; // B, B^T
+    double        acc[9];
+    for (int e = 0; e < 8; ++e) acc[e] = st.head[*t >> 1][kT[*t & 1][e]];
+    acc[8] = st.tail[*t >> 1];
+    for (++t; t < end; ++t) {
+      for (int e = 0; e < 8; ++e) acc[e] += st.head[*t >> 1][kT[*t & 1][e]];
+      acc[8] += st.tail[*t >> 1];
+    }
+    double *out = values + 9 * static_cast<std::size_t>(slots[k] & kSlotIndexMask);
+    if (slots[k] & kFirstContribution)
+      for (int e = 0; e < 9; ++e) out[e] = acc[e];
+    else
+      for (int e = 0; e < 9; ++e) out[e] += acc[e];
+#endif
+  }
 }
 
 template <int N, bool Blocks, bool MassDamping> long long run(const ElementBatchArgs &a)
@@ -101,64 +160,63 @@ template <int N, bool Blocks, bool MassDamping> long long run(const ElementBatch
   if (!a.corotational)
     for (int j = 0; j < 9; ++j)
       for (int l = 0; l < W; ++l) b.R[j * W + l] = j % 4 == 0 ? 1.0 : 0.0;
-  const std::size_t n = a.count;
-  for (std::size_t start = 0; start < n; start += W) {
-    const int m = n - start < W ? static_cast<int>(n - start) : W;
-    if (start + W < n) prefetch_batch<N, Blocks>(a, start + W, n - start - W < W ? int(n - start - W) : W);
-    // Lanes past the end repeat the last element; nothing of theirs is written out.
-    for (int l = 0; l < W; ++l) gather<N>(a, a.elements[start + (l < m ? l : m - 1)], l, b);
-    if (a.corotational) {
+  const std::size_t n  = a.count;
+  constexpr int     GB = write_group_batches(N);
+  Stage<N>          st;
+  for (std::size_t g = 0, start = 0; start < n; ++g) {
+    const int k0 = Blocks ? a.group_offsets[g] : 0, kn = Blocks ? a.group_offsets[g + 1] - k0 : 0;
+    for (int jb = 0; jb < GB && start < n; ++jb, start += W) {
+      const int m = n - start < W ? static_cast<int>(n - start) : W;
+      if (start + W < n) prefetch_nodes<N>(a, start + W, n - start - W < W ? int(n - start - W) : W);
+      if (Blocks) prefetch_blocks(a, k0 + kn * jb / GB, k0 + kn * (jb + 1) / GB);
+      // Lanes past the end repeat the last element; nothing of theirs is written out.
+      for (int l = 0; l < W; ++l) gather<N>(a, a.elements[start + (l < m ? l : m - 1)], l, b);
+      if (a.corotational) {
 #pragma omp simd
-      for (int l = 0; l < W; ++l) deformation_gradient<W>(b.x + l, b.Dinv + l, b.F + l);
+        for (int l = 0; l < W; ++l) deformation_gradient<W>(b.x + l, b.Dinv + l, b.F + l);
 #pragma omp simd
-      for (int l = 0; l < W; ++l) b.ok[l] = polar_rotation<W>(b.F + l, b.R + l);
+        for (int l = 0; l < W; ++l) b.ok[l] = polar_rotation<W>(b.F + l, b.R + l);
+        for (int l = 0; l < m; ++l) {
+          if (b.ok[l] != 0) continue; // rare: inverted, flat or strongly stretched elements
+          double F[9], R[9];
+          for (int j = 0; j < 9; ++j) F[j] = b.F[j * W + l];
+          element_fallback_rotation(F, R);
+          for (int j = 0; j < 9; ++j) b.R[j * W + l] = R[j];
+          ++fallbacks;
+        }
+      }
+      if constexpr (N == 4) {
+#pragma omp simd
+        for (int l = 0; l < W; ++l)
+          p1_element<W, Blocks, MassDamping>(b.x + l, b.v + l, b.X + l, b.Dinv + l, b.R + l, b.vol[l], k,
+                                             b.rhs + l, b.blocks + l);
+      } else {
+#pragma omp simd
+        for (int l = 0; l < W; ++l)
+          p2_forces<W, MassDamping>(b.x + l, b.v + l, b.X + l, b.Dinv + l, b.R + l, b.vol[l], k, Mref,
+                                    b.rhs + l);
+        if (Blocks) {
+#pragma omp simd
+          for (int l = 0; l < W; ++l) p2_gradient_pairs<W>(b.Dinv + l, b.R + l, b.vol[l], k, b.Q + l);
+          for (int p = 0; p < 55; ++p) {
+#pragma omp simd
+            for (int l = 0; l < W; ++l) p2_block<W>(p, b.Q + l, b.vol[l], k, Mref, b.blocks + 9 * p * W + l);
+          }
+        }
+      }
+      // Forces (and rotations) out in element order, lane after lane; the blocks to the stage.
       for (int l = 0; l < m; ++l) {
-        if (b.ok[l] != 0) continue; // rare: inverted, flat or strongly stretched elements
-        double F[9], R[9];
-        for (int j = 0; j < 9; ++j) F[j] = b.F[j * W + l];
-        element_fallback_rotation(F, R);
-        for (int j = 0; j < 9; ++j) b.R[j * W + l] = R[j];
-        ++fallbacks;
+        const std::size_t i     = start + l;
+        const int        *nodes = a.element_nodes + static_cast<std::size_t>(a.elements[i]) * N;
+        if (a.rotations)
+          for (int q = 0; q < 9; ++q) a.rotations[9 * i + q] = b.R[q * W + l];
+        for (int c = 0; c < N; ++c)
+          for (int d = 0; d < 3; ++d)
+            a.rhs[3 * static_cast<std::size_t>(nodes[c]) + d] += b.rhs[(3 * c + d) * W + l];
       }
+      if (Blocks) stage_batch<N>(b, jb, st);
     }
-    if constexpr (N == 4) {
-#pragma omp simd
-      for (int l = 0; l < W; ++l)
-        p1_element<W, Blocks, MassDamping>(b.x + l, b.v + l, b.X + l, b.Dinv + l, b.R + l, b.vol[l], k,
-                                           b.rhs + l, b.blocks + l);
-    } else {
-#pragma omp simd
-      for (int l = 0; l < W; ++l)
-        p2_forces<W, MassDamping>(b.x + l, b.v + l, b.X + l, b.Dinv + l, b.R + l, b.vol[l], k, Mref,
-                                  b.rhs + l);
-      if (Blocks) {
-#pragma omp simd
-        for (int l = 0; l < W; ++l) p2_gradient_pairs<W>(b.Dinv + l, b.R + l, b.vol[l], k, b.Q + l);
-        for (int p = 0; p < 55; ++p) {
-#pragma omp simd
-          for (int l = 0; l < W; ++l) p2_block<W>(p, b.Q + l, b.vol[l], k, Mref, b.blocks + 9 * p * W + l);
-        }
-      }
-    }
-    // Out in element order, lane after lane: the first-write marks of the slot map follow that order.
-    for (int l = 0; l < m; ++l) {
-      const std::size_t i     = start + l;
-      const int        *nodes = a.element_nodes + static_cast<std::size_t>(a.elements[i]) * N;
-      if (a.rotations)
-        for (int j = 0; j < 9; ++j) a.rotations[9 * i + j] = b.R[j * W + l];
-      for (int c = 0; c < N; ++c)
-        for (int d = 0; d < 3; ++d)
-          a.rhs[3 * static_cast<std::size_t>(nodes[c]) + d] += b.rhs[(3 * c + d) * W + l];
-      if (!Blocks) continue;
-      const int *slot = a.element_slots + i * N * N;
-      int        p    = 0;
-      for (int r = 0; r < N; ++r)
-        for (int c = r; c < N; ++c, ++p) {
-          const int src = slot[r * N + c], scr = slot[c * N + r];
-          if (src >= 0) write_block(a.values, src, b.blocks + 9 * p * W + l, false);
-          if (c != r && scr >= 0) write_block(a.values, scr, b.blocks + 9 * p * W + l, true);
-        }
-    }
+    if (Blocks) write_group<N>(a, g, st);
   }
   return fallbacks;
 }

@@ -1,0 +1,84 @@
+// The batched loop's grouped write-out (BlockPattern::plan): on a mesh whose elements share blocks
+// within and across write groups, the plan lists every element block contribution once and marks one
+// first write per COO block, and the batched loop's sums equal the scalar loop's (element order) to
+// rounding, in every body set, merged or not, whole matrix or upper triangle.
+#include <catch2/catch.hpp>
+
+#include "physics/box_mesh.hpp"
+#include "physics/corotational_assembly.hpp"
+#include "physics/element_batch.hpp"
+#include "physics/tet_mesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+using namespace physics;
+
+TEST_CASE("grouped write-out: one term per element block, one first write per COO block, the scalar sums",
+          "[fem][kernel][batch]")
+{
+  for (int order : {1, 2})
+    for (bool merge : {true, false})
+      for (bool drop : {false, true}) {
+        INFO("order " << order << " merge " << merge << " drop lower " << drop);
+        TetMesh mesh = make_box_mesh(1.0, 0.8, 0.6, 6, 5, 4);
+        if (order == 2) mesh = promote_to_quadratic(mesh);
+        const FemModel   m = make_fem_model(mesh, FemSettings{});
+        const int        n = m.element_count(), npe = m.npe;
+        std::vector<int> elements(n);
+        std::iota(elements.begin(), elements.end(), 0);
+        std::reverse(elements.begin() + n / 3, elements.end()); // far apart and near in one list
+        std::vector<char> fixed(mesh.node_count(), 0);
+        fixed[0] = fixed[7] = 1;
+        LowerTriangle lower;
+        lower.drop               = drop;
+        const BlockPattern p     = make_block_pattern(m, elements, fixed, 0, mesh.node_count(), merge, lower);
+        const int          group = kElementLanes * write_group_batches(npe);
+        REQUIRE(n > 3 * group);
+        const BlockPattern::WritePlan &w = p.plan;
+        REQUIRE(w.group_offsets.size() == static_cast<size_t>((n + group - 1) / group + 1));
+        REQUIRE(w.write_offsets.size() == w.write_slots.size() + 1);
+        CHECK(w.write_offsets.back() == static_cast<int>(w.write_terms.size()));
+        size_t contributions = 0;
+        for (int s : p.element_slots) contributions += s >= 0;
+        // (the diagonal entry (a, a) of element_slots is one contribution, like any other)
+        CHECK(w.write_terms.size() == contributions);
+        std::vector<int> firsts(p.rows.size(), 0);
+        for (size_t g = 0; g + 1 < w.group_offsets.size(); ++g)
+          for (int k = w.group_offsets[g]; k < w.group_offsets[g + 1]; ++k) {
+            const int s = w.write_slots[k];
+            if (s & kFirstContribution) ++firsts[s & kSlotIndexMask];
+            if (k > w.group_offsets[g]) CHECK((w.write_slots[k - 1] & kSlotIndexMask) < (s & kSlotIndexMask));
+          }
+        for (int s : p.identity_slots) firsts[s] = 1;
+        CHECK(std::count(firsts.begin(), firsts.end(), 1) == static_cast<long>(p.rows.size()));
+
+        std::vector<double> x(mesh.nodes), v(x.size());
+        for (size_t k = 0; k < x.size(); ++k)
+          x[k] = x[k] * 1.03 + 0.01 * std::sin(1.7 * k), v[k] = std::cos(0.3 * k);
+        const StepCoefficients c   = implicit_euler_coefficients(0.01, 0.2, 0.001);
+        auto                   run = [&](ElementKernel kernel, binbcsr::BodySet body) {
+          std::vector<double> values(9 * p.rows.size(), std::nan("")), rhs(x.size(), 0.0);
+          reset_block_values(p, values);
+          assemble_elements(m, elements, x.data(), v.data(), c, &p, values.data(), rhs.data(), nullptr,
+                                              kernel, body);
+          return values;
+        };
+        const std::vector<double> scalar = run(ElementKernel::Scalar, binbcsr::BodySet::Auto);
+        double                    scale  = 0;
+        for (double e : scalar) scale = std::max(scale, std::fabs(e));
+        for (binbcsr::BodySet body :
+             {binbcsr::BodySet::Portable, binbcsr::BodySet::AVX2, binbcsr::BodySet::AVX512}) {
+          if (element_body_used(body) != body) continue;
+          INFO("element body " << binbcsr::body_set_name(body));
+          const std::vector<double> batched = run(ElementKernel::Batched, body);
+          double                    diff    = 0;
+          for (size_t k = 0; k < scalar.size(); ++k) {
+            REQUIRE(std::isfinite(batched[k]));
+            diff = std::max(diff, std::fabs(batched[k] - scalar[k]));
+          }
+          CHECK(diff <= 1e-12 * scale);
+        }
+      }
+}
