@@ -33,14 +33,14 @@
 #include <vector>
 
 namespace {
-/* Process CPU time: on a machine shared with other jobs it leaves out the time we are descheduled
-   (memory contention still counts). -timer wall switches to MPI_Wtime. */
+/* This thread's CPU time, the tuner's clock: on a machine shared with other jobs it leaves out the
+   time we are descheduled (memory contention still counts). -timer wall switches to MPI_Wtime. */
 PetscBool use_wall = PETSC_FALSE;
 double    Now()
 {
   if (use_wall) return MPI_Wtime();
   timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
@@ -154,9 +154,11 @@ int main(int argc, char **argv)
       PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-stencil_sizes", sizes, &nsizes, &flg));
       if (!flg) nsizes = 2;
       PetscCall(PetscPrintf(PETSC_COMM_SELF,
-                            "binbcsr_tune -sweep: ms per MatMult, minimum of %" PetscInt_FMT
-                            " rounds of %" PetscInt_FMT " (%s time); best/tuned as bin width/streams\n",
-                            s.repeats, s.batch, use_wall ? "wall" : "process CPU"));
+                            "binbcsr_tune -sweep: ms per MatMult, median of %" PetscInt_FMT
+                            " rounds of %" PetscInt_FMT
+                            " (%s time); best/tuned as bin width/streams; tuned/best and x baij: median"
+                            " of the rounds' ratios (min: the ratio of the minima)\n",
+                            s.repeats, s.batch, use_wall ? "wall" : "thread CPU"));
       for (PetscInt i = 0; i < nsizes; i++) {
         if (sizes[i] <= 0) continue;
         StencilGrid g;
@@ -217,7 +219,7 @@ int main(int argc, char **argv)
   PetscCall(PetscPrintf(PETSC_COMM_SELF,
                         "stencil %" PetscInt_FMT "^3, bs %" PetscInt_FMT ", %" PetscInt_FMT
                         " rounds of %" PetscInt_FMT " MatMults, minimum per MatMult (%s time)\n",
-                        grid.nx, bs, repeats, batch, use_wall ? "wall" : "process CPU"));
+                        grid.nx, bs, repeats, batch, use_wall ? "wall" : "thread CPU"));
   PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-20s %10s %8s %8s\n", "variant", "ms", "x baij", "x aij"));
   for (Variant &v : vars)
     PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-20s %10.4f %8.2f %8.2f\n", v.name.c_str(), 1e3 * v.best,

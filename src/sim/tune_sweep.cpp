@@ -3,6 +3,7 @@
 #include <petsctime.h>
 #include <cstdio>
 #include <cstring>
+#include <algorithm>
 #include <vector>
 
 PetscErrorCode MakeBinBCSR(Mat src, PetscInt bs, PetscInt bw, PetscInt streams, MatBinBCSRPrecision prec,
@@ -38,12 +39,30 @@ PetscErrorCode MakeBinBCSR(Mat src, PetscInt bs, PetscInt bw, PetscInt streams, 
 namespace {
 
 struct Variant {
-  Mat              A  = nullptr;
-  PetscInt         bw = 0, streams = 0;              // streams set before each batch (0: the matrix's own)
-  MatBinBCSRKernel kernel = MAT_BINBCSR_KERNEL_AUTO; // set before each batch
-  bool             owner  = false;
-  double           best   = 1e300;
+  Mat                 A  = nullptr;
+  PetscInt            bw = 0, streams = 0;              // streams set before each batch (0: the matrix's own)
+  MatBinBCSRKernel    kernel = MAT_BINBCSR_KERNEL_AUTO; // set before each batch
+  bool                owner  = false;
+  double              best   = 1e300;
+  std::vector<double> t; // ms per MatMult of each round
+  double              median() const
+  {
+    std::vector<double> u = t;
+    std::sort(u.begin(), u.end());
+    return u.empty() ? 1e300 : u[u.size() / 2];
+  }
 };
+
+// The median over the rounds of a's time over b's in the same round: the rounds take the variants in
+// turn, so a drift of the machine (its memory bandwidth moves by 30% from one second to the next)
+// scales both alike and cancels.
+double PairedRatio(const Variant &a, const Variant &b)
+{
+  std::vector<double> q;
+  for (size_t r = 0; r < a.t.size() && r < b.t.size(); r++) q.push_back(a.t[r] / b.t[r]);
+  std::sort(q.begin(), q.end());
+  return q.empty() ? 0 : q[q.size() / 2];
+}
 
 // The "cost X ms" of the tuner's line in -mat_view ::ascii_info, or -1.
 PetscErrorCode TuneCost(Mat A, double *ms, std::string *line)
@@ -132,12 +151,14 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
         PetscCall(MatMult(v->A, x, y)); // warm
         const double a = s.now();
         for (PetscInt b = 0; b < s.batch; b++) PetscCall(MatMult(v->A, x, y));
-        v->best = PetscMin(v->best, (s.now() - a) / s.batch);
+        v->t.push_back((s.now() - a) / s.batch);
+        v->best = PetscMin(v->best, v->t.back());
       }
     }
+    // the best: the lowest median (a minimum over rounds picks the luckiest of many variants)
     const Variant *best = &vars[0];
     for (const Variant &v : vars)
-      if (v.best < best->best) best = &v;
+      if (v.median() < best->median()) best = &v;
     double      cost;
     std::string line;
     PetscCall(TuneCost(tuned.A, &cost, &line));
@@ -147,18 +168,19 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
       for (const Variant &v : vars)
         PetscCall(PetscPrintf(
           PETSC_COMM_SELF, "  %-14s %-9s %-6s bw %2" PetscInt_FMT " K %" PetscInt_FMT " %-8s %9.4f ms\n",
-          name.c_str(), storage, p, v.bw, v.streams, MatBinBCSRKernels[v.kernel], 1e3 * v.best));
+          name.c_str(), storage, p, v.bw, v.streams, MatBinBCSRKernels[v.kernel], 1e3 * v.median()));
       PetscCall(PetscPrintf(PETSC_COMM_SELF, "  tuner: %s\n", line.c_str()));
     }
     PetscCall(PetscPrintf(
       PETSC_COMM_SELF,
       "%-14s %-9s %-6s best %2" PetscInt_FMT "/%" PetscInt_FMT "/%-8s %8.4f   tuned %2" PetscInt_FMT
       "/%" PetscInt_FMT
-      "/%-8s %8.4f   tuned/best %5.3f   %s %8.4f  tuned x %s %5.2f   tuning %6.1f ms (build %.0f ms)\n",
-      name.c_str(), storage, p, best->bw, best->streams, MatBinBCSRKernels[best->kernel], 1e3 * best->best,
-      tuned.bw, tuned.streams, MatBinBCSRKernels[tuned.kernel], 1e3 * tuned.best, tuned.best / best->best,
-      bs > 1 ? "baij" : "aij", 1e3 * base.best, bs > 1 ? "baij" : "aij", base.best / tuned.best, cost,
-      1e3 * (t1 - t0)));
+      "/%-8s %8.4f   tuned/best %5.3f (min %5.3f)   %s %8.4f  tuned x %s %5.2f   tuning %6.1f ms "
+      "(build %.0f ms)\n",
+      name.c_str(), storage, p, best->bw, best->streams, MatBinBCSRKernels[best->kernel],
+      1e3 * best->median(), tuned.bw, tuned.streams, MatBinBCSRKernels[tuned.kernel], 1e3 * tuned.median(),
+      PairedRatio(tuned, *best), tuned.best / best->best, bs > 1 ? "baij" : "aij", 1e3 * base.median(),
+      bs > 1 ? "baij" : "aij", PairedRatio(base, tuned), cost, 1e3 * (t1 - t0)));
     for (Variant &v : vars)
       if (v.owner) PetscCall(MatDestroy(&v.A));
     PetscCall(MatDestroy(&tuned.A));

@@ -8,8 +8,20 @@
 #ifndef BINBCSR_TUNE_H
 #define BINBCSR_TUNE_H
 
-#include <petscsys.h>
+#include <petscmat.h>
 #include <string>
+
+/* What the tuner runs with (seq/binbcsr_tune.cpp reads it: the value set by MatBinBCSRSetTune*, else
+   the options database under the matrix's prefix, else the default). */
+struct BinBCSRTuneSettings {
+  PetscBool tune         = PETSC_TRUE; /* -mat_binbcsr_tune auto|off */
+  PetscBool cache        = PETSC_TRUE; /* -mat_binbcsr_tune_cache */
+  size_t    min_bytes    = 0;          /* -mat_binbcsr_tune_min_kib: smaller matrices keep the defaults */
+  size_t    sample_bytes = 0;          /* -mat_binbcsr_tune_sample_mib; 0: the default sample */
+  double    budget       = 0;          /* seconds of product time (-mat_binbcsr_tune_budget_ms) */
+  PetscInt  products     = 0;          /* at most this many timed products (no limit with a budget set) */
+};
+PETSC_INTERN PetscErrorCode BinBCSRTuneSettingsGet(Mat, BinBCSRTuneSettings *);
 
 /* One choice of the tuner; what the cache file stores per key. */
 struct BinBCSRTuneChoice {

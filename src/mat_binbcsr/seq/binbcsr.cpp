@@ -96,16 +96,20 @@ static PetscErrorCode MatBinBCSRSetPrecision_SeqBinBCSR(Mat A, MatBinBCSRPrecisi
   if (a->built) {
     /* the old array stays alive until the new one holds its values */
     void            *old_mem = a->val_mem;
+    const size_t     old_map = a->val_map;
     const MatScalar *oldd    = a->val;
     const float     *olds    = a->valf;
     a->val_mem               = nullptr;
+    a->val_map               = 0;
     PetscCall(MatSeqBinBCSRAllocValues_Private(a, p, nv, PETSC_FALSE));
     if (p == MAT_BINBCSR_PRECISION_SINGLE)
       for (size_t i = 0; i < nv; i++) a->valf[i] = (float)oldd[i];
     else
       for (size_t i = 0; i < nv; i++) a->val[i] = (MatScalar)olds[i];
-    PetscCall(PetscFree(old_mem));
+    PetscCall(MatSeqBinBCSRReleaseValues_Private(old_mem, old_map));
     PetscCall(PetscObjectStateIncrease((PetscObject)A));
+    a->precision = p;
+    PetscCall(MatSeqBinBCSRRetune(A));
   }
   a->precision = p;
   PetscFunctionReturn(0);

@@ -98,6 +98,7 @@ typedef struct {
   MatScalar *val;        /* [nslots * bs2] when precision is double, else NULL */
   float     *valf;       /* [nslots * bs2] when precision is single, else NULL */
   void      *val_mem;    /* the allocation val or valf lies in (MatSeqBinBCSRAllocValues_Private) */
+  size_t     val_map;    /* bytes of val_mem when it is a mapping of its own (large arrays), else 0 */
 
   struct BinBCSRStaging *staging; /* non-NULL between MatSetUp/preallocation and the layout build */
 
@@ -151,6 +152,8 @@ binbcsr::Body MatSeqBinBCSRSelectBody(const Mat_SeqBinBCSR *a);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRAllocValues_Private(Mat_SeqBinBCSR *, MatBinBCSRPrecision, size_t nv,
                                                              PetscBool zero);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRFreeValues_Private(Mat_SeqBinBCSR *);
+/* Frees a val_mem of map bytes (0: PetscMalloc'd), when the caller took it out of the matrix. */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRReleaseValues_Private(void *mem, size_t map);
 
 /* Lane of slot s, and the index into val/valf of entry e of slot s. */
 static inline PetscInt BinBCSRLane(PetscInt s, PetscInt bw) { return s % bw; }
@@ -213,6 +216,9 @@ PETSC_INTERN PetscErrorCode MatSeqBinBCSRCreateWithPattern(Mat A, PetscBool tran
    set explicitly, by timing products of a sample on this machine, or from the tuning cache
    (binbcsr_tune.cpp). A no-op with tuning off. */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRTune(Mat, const PetscInt bi[], const PetscInt bj[]);
+/* After a precision change of a built matrix: the stream count and body set the tuner chose, timed
+   again in the new precision at the layout's bin width (binbcsr_tune.cpp). */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRRetune(Mat);
 /* Block size and block counts from the layouts (set up here); the check every entry point shares
    (binbcsr_assembly.cpp). */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRSetSizes(Mat);

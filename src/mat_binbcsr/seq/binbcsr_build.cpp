@@ -3,6 +3,7 @@
    new matrix laid out for a pattern. */
 #include "binbcsr.h"
 #include <cstdint>
+#include <sys/mman.h>
 #include <algorithm>
 #include <vector>
 
@@ -40,13 +41,51 @@ static PetscErrorCode CheckPattern(const Mat_SeqBinBCSR *a, const PetscInt bi[],
   PetscFunctionReturn(0);
 }
 
-/* The value arrays (binbcsr.h: 64-byte aligned inside val_mem). */
+/* Asks for transparent huge pages for the 2 MiB-aligned part of a fresh array of `bytes` at p, before
+   its pages are first touched (a no-op when the kernel has them off, and for arrays under 4 MiB).
+   Why: a product streams the values and columns once; with 4 KiB pages it takes a TLB miss every
+   4 KiB and the hardware prefetchers stop at each page boundary. On a Zen 4 core (Linux THP mode
+   madvise, the Debian default) the 48^3 stencil's products ran 10-34% faster with 2 MiB pages. */
+static void HugePages(void *p, size_t bytes)
+{
+#if defined(MADV_HUGEPAGE)
+  constexpr uintptr_t huge = (uintptr_t)2 << 20;
+  if (bytes < 2 * huge) return;
+  const uintptr_t b = ((uintptr_t)p + huge - 1) & ~(huge - 1), e = ((uintptr_t)p + bytes) & ~(huge - 1);
+  if (e > b) (void)madvise((void *)b, e - b, MADV_HUGEPAGE);
+#else
+  (void)p;
+  (void)bytes;
+#endif
+}
+
+/* The value arrays (binbcsr.h: 64-byte aligned inside val_mem). Of 4 MiB and more they get a mapping
+   of their own (val_map bytes), 2 MiB-aligned and marked for huge pages before any page is touched:
+   from malloc they often reused heap pages a freed matrix had faulted in with 4 KiB pages, which the
+   hint cannot change, and then the same layout ran 1.2-1.45x slower than a copy made later in the
+   program (the 32^3 stencil, symmetric storage, after other matrices were freed). */
+PetscErrorCode MatSeqBinBCSRReleaseValues_Private(void *mem, size_t map)
+{
+  PetscFunctionBegin;
+#if defined(MADV_HUGEPAGE)
+  if (map) {
+    PetscCheck(munmap(mem, map) == 0, PETSC_COMM_SELF, PETSC_ERR_SYS, "munmap of the value array failed");
+    PetscFunctionReturn(0);
+  }
+#endif
+  (void)map;
+  PetscCall(PetscFree(mem));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode MatSeqBinBCSRFreeValues_Private(Mat_SeqBinBCSR *a)
 {
   PetscFunctionBegin;
-  PetscCall(PetscFree(a->val_mem));
-  a->val  = nullptr;
-  a->valf = nullptr;
+  PetscCall(MatSeqBinBCSRReleaseValues_Private(a->val_mem, a->val_map));
+  a->val_mem = nullptr;
+  a->val_map = 0;
+  a->val     = nullptr;
+  a->valf    = nullptr;
   PetscFunctionReturn(0);
 }
 
@@ -55,12 +94,28 @@ PetscErrorCode MatSeqBinBCSRAllocValues_Private(Mat_SeqBinBCSR *a, MatBinBCSRPre
 {
   constexpr size_t line  = 64;
   const size_t     bytes = nv * (p == MAT_BINBCSR_PRECISION_SINGLE ? sizeof(float) : sizeof(MatScalar));
-  char            *mem;
+  char            *mem = nullptr, *v = nullptr;
 
   PetscFunctionBegin;
   PetscCall(MatSeqBinBCSRFreeValues_Private(a));
-  PetscCall(PetscMalloc1(bytes + line, &mem));
-  char *v = mem + (line - (size_t)((uintptr_t)mem % line)) % line;
+#if defined(MADV_HUGEPAGE)
+  constexpr size_t huge = (size_t)2 << 20;
+  if (bytes >= 2 * huge) {
+    const size_t map = (bytes + huge - 1) / huge * huge + huge; /* room to align the start */
+    void        *m   = mmap(nullptr, map, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (m != MAP_FAILED) { /* else malloc below */
+      mem        = (char *)m;
+      v          = (char *)(((uintptr_t)m + huge - 1) & ~(uintptr_t)(huge - 1));
+      a->val_map = map;
+      (void)madvise(v, map - (size_t)(v - mem), MADV_HUGEPAGE);
+      zero = PETSC_FALSE; /* a fresh mapping reads as zero */
+    }
+  }
+#endif
+  if (!mem) {
+    PetscCall(PetscMalloc1(bytes + line, &mem));
+    v = mem + (line - (size_t)((uintptr_t)mem % line)) % line;
+  }
   if (zero) PetscCall(PetscMemzero(v, bytes));
   a->val_mem = mem;
   if (p == MAT_BINBCSR_PRECISION_SINGLE) a->valf = (float *)v;
@@ -111,6 +166,7 @@ static PetscErrorCode MatSeqBinBCSRBuildLayoutSym(Mat A, const PetscInt bi[], co
   }
   a->nslots = a->bin_start[nbins];
   PetscCall(PetscMalloc1(a->nslots, &a->col));
+  HugePages(a->col, (size_t)a->nslots * sizeof(PetscInt));
   std::copy(allcol.begin(), allcol.end(), a->col);
   PetscCall(MatSeqBinBCSRAllocValues_Private(a, a->precision, (size_t)a->nslots * a->bs2, PETSC_TRUE));
   PetscCall(PetscMalloc2((size_t)PetscMax(a->nbs, 1) * a->bs, &a->rowbuf_cols,
@@ -193,6 +249,7 @@ PetscErrorCode MatSeqBinBCSRBuildLayout(Mat A, const PetscInt bi[], const PetscI
     a->nslots = (PetscInt)nslots;
   }
   PetscCall(PetscMalloc1(a->nslots, &a->col));
+  HugePages(a->col, (size_t)a->nslots * sizeof(PetscInt));
   PetscCall(MatSeqBinBCSRAllocValues_Private(a, a->precision, (size_t)a->nslots * a->bs2, PETSC_TRUE));
   binbcsr::bin_columns<PetscInt>(bi, bj, mbs, bw, a->bin_start, a->col, a->diag_slot);
   PetscCall(PetscMalloc2((size_t)a->max_row_nz * a->bs, &a->rowbuf_cols, (size_t)a->max_row_nz * a->bs,

@@ -239,6 +239,39 @@ TEST_CASE("tuning: explicit settings win", "[tune]")
   }
 }
 
+TEST_CASE("tuning: a precision change times the streams again, at the layout's width", "[tune]")
+{
+  Restore r;
+  fresh_cache("tune_precision");
+  Opts o(false);
+  for (bool sym : {false, true}) {
+    CAPTURE(sym);
+    const Pattern  p  = sym_pattern(7, 3);
+    Mat            A  = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, sym, MAT_BINBCSR_TUNE_AUTO);
+    const PetscInt bw = bin_width(A);
+    REQUIRE(MatBinBCSRSetPrecision(A, MAT_BINBCSR_PRECISION_SINGLE) == 0);
+    const auto txt = info_view(A);
+    CAPTURE(txt);
+    CHECK(txt.find("after the precision change, at the layout's bin width: bin width " +
+                   std::to_string(bw)) != std::string::npos);
+    CHECK(bin_width(A) == bw);
+    const PetscInt k = streams(A);
+    CHECK((k == 1 || k == 2 || k == 4 || k == 8));
+    Mat R = build_tuned(p, MAT_BINBCSR_PRECISION_SINGLE, sym, MAT_BINBCSR_TUNE_OFF, bw, k);
+    check_same(A, R, p); // the values converted once, the products those of the fixed configuration
+    MatDestroy(&R);
+    MatDestroy(&A);
+    // explicit streams and kernel: nothing is timed again
+    o.set("-mat_binbcsr_kernel", "portable");
+    A = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, sym, MAT_BINBCSR_TUNE_AUTO, 0, 2);
+    REQUIRE(MatBinBCSRSetPrecision(A, MAT_BINBCSR_PRECISION_SINGLE) == 0);
+    CHECK(info_view(A).find("after the precision change") == std::string::npos);
+    CHECK(streams(A) == 2);
+    MatDestroy(&A);
+    PetscOptionsClearValue(nullptr, "-mat_binbcsr_kernel");
+  }
+}
+
 TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
 {
   Restore           r;
@@ -329,16 +362,29 @@ TEST_CASE("tuning: bad values give clear errors", "[tune]")
   MatDestroy(&A);
   // read at the layout build when MatSetFromOptions was not called
   const Pattern p = fem_pattern(4, 4, 4, 3);
+  // an empty assembly of p's sizes: where the layout build reads the options
+  auto assemble = [&]() {
+    Mat B;
+    REQUIRE(MatCreate(PETSC_COMM_SELF, &B) == 0);
+    REQUIRE(MatSetSizes(B, p.m, p.n, p.m, p.n) == 0);
+    REQUIRE(MatSetBlockSize(B, 3) == 0);
+    REQUIRE(MatSetType(B, MATSEQBINBCSR) == 0);
+    REQUIRE(MatSetUp(B) == 0);
+    REQUIRE(MatAssemblyBegin(B, MAT_FINAL_ASSEMBLY) == 0);
+    const PetscErrorCode ierr = MatAssemblyEnd(B, MAT_FINAL_ASSEMBLY);
+    MatDestroy(&B);
+    return ierr;
+  };
   REQUIRE(PetscOptionsSetValue(nullptr, "-mat_binbcsr_tune", "never") == 0);
-  REQUIRE(MatCreate(PETSC_COMM_SELF, &A) == 0);
-  REQUIRE(MatSetSizes(A, p.m, p.n, p.m, p.n) == 0);
-  REQUIRE(MatSetBlockSize(A, 3) == 0);
-  REQUIRE(MatSetType(A, MATSEQBINBCSR) == 0);
-  REQUIRE(MatSetUp(A) == 0);
-  REQUIRE(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY) == 0);
-  CHECK(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY) != 0);
+  CHECK(assemble() != 0);
   REQUIRE(PetscOptionsClearValue(nullptr, "-mat_binbcsr_tune") == 0);
-  MatDestroy(&A);
+  // the benchmark knobs: sizes and budgets must be positive
+  for (const char *knob : {"-mat_binbcsr_tune_sample_mib", "-mat_binbcsr_tune_budget_ms"}) {
+    CAPTURE(knob);
+    Opts o(false);
+    o.set(knob, "0");
+    CHECK(assemble() == PETSC_ERR_ARG_OUTOFRANGE);
+  }
   // other types: no-ops
   REQUIRE(MatCreateSeqAIJ(PETSC_COMM_SELF, 4, 4, 1, nullptr, &A) == 0);
   CHECK(MatBinBCSRSetTune(A, MAT_BINBCSR_TUNE_AUTO) == 0);
