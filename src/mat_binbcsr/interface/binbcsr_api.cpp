@@ -89,9 +89,13 @@ PetscErrorCode MatBinBCSRSetFromOptions(Mat A)
   PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
   PetscCall(PetscObjectQueryFunction((PetscObject)A, "MatBinBCSRSetBinWidth_C", &is_binbcsr));
   if (!is_binbcsr || !A->ops->setfromoptions) PetscFunctionReturn(0);
+  /* a bad value is an error the caller may handle: the options block (a scope of its own) is ended
+     either way, so that its strings are not left behind */
+  PetscErrorCode ierr;
   PetscObjectOptionsBegin((PetscObject)A);
-  PetscCall((*A->ops->setfromoptions)(A, PetscOptionsObject));
+  ierr = (*A->ops->setfromoptions)(A, PetscOptionsObject);
   PetscOptionsEnd();
+  PetscCall(ierr);
   PetscFunctionReturn(0);
 }
 
