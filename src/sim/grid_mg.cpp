@@ -119,6 +119,17 @@ PetscErrorCode Interpolation(MPI_Comm comm, const GridLevel &f, const GridLevel 
   PetscFunctionReturn(0);
 }
 
+// The pre- and post-smoother of PCMG level `level` (distinct objects, see GridMGSetUp); the coarse
+// solve, level 0, is one KSP, returned twice.
+PetscErrorCode LevelSmoothers(PC pc, PetscInt level, KSP sides[2])
+{
+  PetscFunctionBegin;
+  PetscCall(PCMGGetSmootherDown(pc, level, &sides[0]));
+  sides[1] = sides[0];
+  if (level > 0) PetscCall(PCMGGetSmootherUp(pc, level, &sides[1]));
+  PetscFunctionReturn(0);
+}
+
 } // namespace
 
 PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
@@ -209,8 +220,7 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
     char prefix[64]; // -grid_mg_levels_N_* for level N (PCMG's numbering), -grid_mg_levels_* for all
     PetscCall(PetscSNPrintf(prefix, sizeof prefix, "grid_mg_levels_%d_", (int)l));
     KSP sides[2];
-    PetscCall(PCMGGetSmootherDown(pc, l, &sides[0]));
-    PetscCall(PCMGGetSmootherUp(pc, l, &sides[1]));
+    PetscCall(LevelSmoothers(pc, l, sides));
     for (KSP smoother : sides) {
       PC spc;
       PetscCall(KSPGetPC(smoother, &spc));
@@ -235,56 +245,70 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
   PetscFunctionReturn(0);
 }
 
-/* The single-precision copy `copy` of level `level`'s operator A, made on the first call and handed to the
-   level's smoothers (residuals stay on A), refilled after. The fine operator (binbcsr) is duplicated and
-   its values converted; a coarse BAIJ operator is read into an upper-triangle binbcsr through a COO
-   list in the order of its value array. Sweeps on the copy read a half (fine level) or a quarter
-   (coarse levels) of the bytes. */
-static PetscErrorCode RefillSmootherCopy(GridMG *mg, PetscInt level, Mat A, Mat *copy)
+/* The single-precision copy `copy` of a level operator A for its smoothers, made on the first call and
+   refilled after. The fine operator (binbcsr) is duplicated and its values converted; a coarse BAIJ
+   operator is read into an upper-triangle binbcsr through a COO list in the order of its value array.
+   Sweeps on the copy read a half (fine level) or a quarter (coarse levels) of the bytes. */
+static PetscErrorCode RefillSmootherCopy(Mat A, Mat *copy)
 {
   PetscBool baij;
 
   PetscFunctionBegin;
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATSEQBAIJ, &baij));
-  if (!*copy) {
-    if (baij) {
-      std::vector<PetscInt> brow, bcol, i, j;
-      PetscCall(BlockGalerkinBlocksOf(A, &brow, &bcol));
-      for (size_t b = 0; b < brow.size(); ++b)
-        for (PetscInt c = 0; c < 3; ++c) // BAIJ blocks are column-major
-          for (PetscInt r = 0; r < 3; ++r) i.push_back(3 * brow[b] + r), j.push_back(3 * bcol[b] + c);
-      PetscInt m;
-      PetscCall(MatGetSize(A, &m, nullptr));
-      PetscCall(MatCreate(PETSC_COMM_SELF, copy));
-      PetscCall(MatSetSizes(*copy, m, m, m, m));
-      PetscCall(MatSetBlockSize(*copy, 3));
-      PetscCall(MatSetType(*copy, MATSEQBINBCSR));
-      PetscCall(MatBinBCSRSetSymmetricStorage(*copy, PETSC_TRUE));
-      PetscCall(MatBinBCSRSetPrecision(*copy, MAT_BINBCSR_PRECISION_SINGLE));
-      PetscCall(MatSetPreallocationCOO(*copy, (PetscCount)i.size(), i.data(), j.data()));
-    } else {
-      PetscBool binbcsr;
-      MatType   type;
-      PetscCall(MatGetType(A, &type));
-      PetscCall(PetscObjectTypeCompareAny((PetscObject)A, &binbcsr, MATSEQBINBCSR, MATMPIBINBCSR, ""));
-      PetscCheck(
-        binbcsr, PetscObjectComm((PetscObject)A), PETSC_ERR_SUP,
-        "-grid_mg_smoother_precision single needs a binbcsr fine operator (-mat_type binbcsr), not %s", type);
+  if (!baij) {
+    PetscBool binbcsr;
+    MatType   type;
+    PetscCall(MatGetType(A, &type));
+    PetscCall(PetscObjectTypeCompareAny((PetscObject)A, &binbcsr, MATSEQBINBCSR, MATMPIBINBCSR, ""));
+    PetscCheck(binbcsr, PetscObjectComm((PetscObject)A), PETSC_ERR_SUP,
+               "-grid_mg_smoother_precision single needs a binbcsr fine operator (-mat_type binbcsr), not %s",
+               type);
+    if (*copy) PetscCall(MatCopy(A, *copy, SAME_NONZERO_PATTERN));
+    else {
       PetscCall(MatDuplicate(A, MAT_COPY_VALUES, copy));
       PetscCall(MatBinBCSRSetPrecision(*copy, MAT_BINBCSR_PRECISION_SINGLE));
     }
-    KSP sides[2];
-    PetscCall(PCMGGetSmootherDown(mg->pc, level, &sides[0]));
-    PetscCall(PCMGGetSmootherUp(mg->pc, level, &sides[1]));
-    for (KSP smoother : sides) PetscCall(KSPSetOperators(smoother, A, *copy));
-    if (!baij) PetscFunctionReturn(0);
+    PetscFunctionReturn(0);
   }
-  if (baij) {
-    PetscScalar *a;
-    PetscCall(MatSeqBAIJGetArray(A, &a));
-    PetscCall(MatSetValuesCOO(*copy, a, INSERT_VALUES));
-    PetscCall(MatSeqBAIJRestoreArray(A, &a));
-  } else PetscCall(MatCopy(A, *copy, SAME_NONZERO_PATTERN));
+  if (!*copy) {
+    std::vector<PetscInt> brow, bcol, i, j;
+    PetscCall(BlockGalerkinBlocksOf(A, &brow, &bcol));
+    for (size_t b = 0; b < brow.size(); ++b)
+      for (PetscInt c = 0; c < 3; ++c) // BAIJ blocks are column-major
+        for (PetscInt r = 0; r < 3; ++r) i.push_back(3 * brow[b] + r), j.push_back(3 * bcol[b] + c);
+    PetscInt m;
+    PetscCall(MatGetSize(A, &m, nullptr));
+    PetscCall(MatCreate(PETSC_COMM_SELF, copy));
+    PetscCall(MatSetSizes(*copy, m, m, m, m));
+    PetscCall(MatSetBlockSize(*copy, 3));
+    PetscCall(MatSetType(*copy, MATSEQBINBCSR));
+    PetscCall(MatBinBCSRSetSymmetricStorage(*copy, PETSC_TRUE));
+    PetscCall(MatBinBCSRSetPrecision(*copy, MAT_BINBCSR_PRECISION_SINGLE));
+    PetscCall(MatSetPreallocationCOO(*copy, (PetscCount)i.size(), i.data(), j.data()));
+  }
+  PetscScalar *a;
+  PetscCall(MatSeqBAIJGetArray(A, &a));
+  PetscCall(MatSetValuesCOO(*copy, a, INSERT_VALUES));
+  PetscCall(MatSeqBAIJRestoreArray(A, &a));
+  PetscFunctionReturn(0);
+}
+
+/* Hands level `level`'s smoothers their operators after a refill of A: A itself, or A with its
+   single-precision copy as the matrix they sweep. Handing them again makes a smoother set up anew
+   (Chebyshev's eigenvalue estimate: a KSP whose operators were set once keeps its first estimate)
+   and the coarse solve refactor. */
+static PetscErrorCode SetLevelOperators(GridMG *mg, PetscInt level, Mat A)
+{
+  Mat sweep = A;
+  KSP sides[2];
+
+  PetscFunctionBegin;
+  if (mg->single_smoothers && level > 0) {
+    PetscCall(RefillSmootherCopy(A, &mg->smoother_mats[level]));
+    sweep = mg->smoother_mats[level];
+  }
+  PetscCall(LevelSmoothers(mg->pc, level, sides));
+  for (KSP smoother : sides) PetscCall(KSPSetOperators(smoother, A, sweep));
   PetscFunctionReturn(0);
 }
 
@@ -294,7 +318,7 @@ PetscErrorCode GridMGRefill(GridMG *mg, const PetscScalar *coo_values)
   if (mg->single_smoothers && mg->smoother_mats.size() > 1) { // a lone level is solved directly
     Mat A;
     PetscCall(PCGetOperators(mg->pc, &A, nullptr));
-    PetscCall(RefillSmootherCopy(mg, (PetscInt)mg->smoother_mats.size() - 1, A, &mg->smoother_mats.back()));
+    PetscCall(SetLevelOperators(mg, (PetscInt)mg->smoother_mats.size() - 1, A));
   }
   if (!mg->own_galerkin) PetscFunctionReturn(0); // PCMG recomputes its products at its set-up
   for (size_t l = 0; l < mg->galerkin.size(); ++l) {
@@ -306,17 +330,7 @@ PetscErrorCode GridMGRefill(GridMG *mg, const PetscScalar *coo_values)
     }
     PetscCall(BlockGalerkinRefill(&mg->galerkin[l], src));
     if (l > 0) PetscCall(MatSeqBAIJRestoreArray(mg->galerkin[l - 1].Ac, &a));
-    // Handing the level its operator again makes its smoother set up anew (Chebyshev's eigenvalue
-    // estimate; a KSP whose operators were set once keeps its first estimate) and the coarse solve refactor.
-    const PetscInt level = (PetscInt)(mg->galerkin.size() - 1 - l);
-    KSP            sides[2];
-    PetscCall(PCMGGetSmootherDown(mg->pc, level, &sides[0]));
-    sides[1] = sides[0];
-    if (level > 0) PetscCall(PCMGGetSmootherUp(mg->pc, level, &sides[1])); // the coarse solve has one
-    if (mg->single_smoothers && level > 0)
-      PetscCall(RefillSmootherCopy(mg, level, mg->galerkin[l].Ac, &mg->smoother_mats[level]));
-    else
-      for (KSP smoother : sides) PetscCall(KSPSetOperators(smoother, mg->galerkin[l].Ac, mg->galerkin[l].Ac));
+    PetscCall(SetLevelOperators(mg, (PetscInt)(mg->galerkin.size() - 1 - l), mg->galerkin[l].Ac));
   }
   PetscFunctionReturn(0);
 }
