@@ -38,8 +38,8 @@ void project_out_of_sphere(Cloth &cloth, const std::vector<int> *candidates, std
     for (int p : *candidates) project(p);
 }
 
-// One stretch spring as the sweeps need it, gathered once per call: the sweeps visit every spring
-// every time (most are within the bound), so what a visit reads is what the limiting costs.
+// One stretch spring as the sweeps need it, gathered once per call: what a visit reads is what the
+// limiting costs (a sweep visits thousands of springs, most of them within the bound).
 struct LimitedSpring {
   int    a, b;
   double lmax;    // the bound on its length
@@ -98,17 +98,16 @@ StrainLimitReport limit_strain(Cloth &cloth, const StrainLimit &limit, double dt
     const bool down = sweep % 2; // alternate the direction so that no corner is favoured
     moved.clear();
     for (size_t wi = 0; wi < words; ++wi) {
-      const size_t w    = down ? words - 1 - wi : wi;
-      int          last = down ? 64 : -1; // the bit of word w visited last
+      const size_t  w      = down ? words - 1 - wi : wi;
+      std::uint64_t passed = 0; // the bits of word w this sweep has reached
       for (;;) {
         // the springs still ahead in this word, including any a correction just marked
-        const std::uint64_t below = last == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << last) - 1;
-        const std::uint64_t ahead = visit[w] & (down         ? below
-                                                : last == 63 ? 0
-                                                             : ~std::uint64_t(0) << (last + 1));
+        const std::uint64_t ahead = visit[w] & ~passed;
         if (!ahead) break;
-        last                    = down ? 63 - __builtin_clzll(ahead) : __builtin_ctzll(ahead);
-        const LimitedSpring &sp = stretch[64 * w + last];
+        const int           bit  = down ? 63 - __builtin_clzll(ahead) : __builtin_ctzll(ahead);
+        const std::uint64_t mask = std::uint64_t(1) << bit;
+        passed |= down ? ~(mask - 1) : (mask << 1) - 1; // this bit and all before it in the sweep's order
+        const LimitedSpring &sp = stretch[64 * w + bit];
         Eigen::Vector3d      d  = cloth.position[sp.b] - cloth.position[sp.a];
         if (!(d.squaredNorm() > sp.trigger)) continue;
         const double          l    = d.norm();

@@ -135,18 +135,16 @@ void sweep_upper_storage(const Mat_SeqBinBCSR *a, const V *val, const MatScalar 
     if (upper_kept)
       for (int i = 0; i < bs; i++) up[i] = Ur[i];
     else {
+      const auto add = [&](PetscInt k, double *acc) { /* slot k's block times x, unless the diagonal */
+                                                      const PetscInt s = BinBCSRSlot(a, r, k), c = a->col[s];
+                                                      if (c != r)
+                                                        binbcsr::slot_mult<BS, V>(tile(s), bw, bs,
+                                                                                  x + (size_t)c * bs, acc);
+      };
       for (int i = 0; i < bs; i++) u0[i] = u1[i] = 0.0;
       PetscInt k = 0;
-      for (; k + 1 < nz; k += 2) {
-        const PetscInt s0 = BinBCSRSlot(a, r, k), c0 = a->col[s0], s1 = BinBCSRSlot(a, r, k + 1),
-                       c1 = a->col[s1];
-        if (c0 != r) binbcsr::slot_mult<BS, V>(tile(s0), bw, bs, x + (size_t)c0 * bs, u0);
-        if (c1 != r) binbcsr::slot_mult<BS, V>(tile(s1), bw, bs, x + (size_t)c1 * bs, u1);
-      }
-      if (k < nz) {
-        const PetscInt s0 = BinBCSRSlot(a, r, k), c0 = a->col[s0];
-        if (c0 != r) binbcsr::slot_mult<BS, V>(tile(s0), bw, bs, x + (size_t)c0 * bs, u0);
-      }
+      for (; k + 1 < nz; k += 2) add(k, u0), add(k + 1, u1);
+      if (k < nz) add(k, u0);
       for (int i = 0; i < bs; i++) up[i] = u0[i] + u1[i];
     }
     relax_row<BS>(bs, r, idiag, omega, b, Lr, up, Lr, Ur, res, xr);
