@@ -115,7 +115,7 @@ inline void prefetch_bin(const Mat_SeqBinBCSR *a, const V *val, PetscInt b, int 
    constant where it can be (a tile's entries at constant offsets), U_r is summed in two halves (so
    that consecutive slots do not queue their additions behind one another), and the next bin's values
    are requested a part per row ahead of the lane that first meets them. Against the gathered lower
-   half: 20-35% less time per symmetric sweep on the 160 x 160 cloth's matrix (docs/cloth.md). */
+   half: 16-35% less time per symmetric sweep on the 160 x 160 cloth's matrix (docs/cloth.md). */
 template <int BS, int BW, typename V>
 void sweep_upper_storage(const Mat_SeqBinBCSR *a, const V *val, const MatScalar *idiag, PetscReal omega,
                          const double *b, double *x, bool forward, HalfSums &h, double *work)
