@@ -68,6 +68,7 @@ struct Options {
   PetscBool quiet                    = PETSC_FALSE;
   PetscInt  element_bench            = 0;
   PetscBool cpu_timer                = PETSC_FALSE;
+  PetscInt  guess_order              = 0;
   PetscBool scalar_elements          = PETSC_FALSE;
   PetscInt  element_body             = 0; // binbcsr::BodySet: auto
   PetscBool is_static                = PETSC_FALSE;
@@ -149,6 +150,14 @@ PetscErrorCode GetOptions(Options &o)
                                 "per-step timings in wall time or process CPU time (a shared machine)", "",
                                 timers, 2, timers[t], &t, nullptr));
     o.cpu_timer = t == 1 ? PETSC_TRUE : PETSC_FALSE;
+  }
+  {
+    const char *guesses[] = {"last", "linear", "quadratic"};
+    PetscCall(
+      PetscOptionsEList("-fem_initial_guess",
+                        "with -ksp_initial_guess_nonzero: the last step's dv, or dv extrapolated from "
+                        "the last two or three steps",
+                        "", guesses, 3, guesses[o.guess_order], &o.guess_order, nullptr));
   }
   {
     const char *kernels[] = {"batched", "scalar"};
@@ -373,6 +382,7 @@ int main(int argc, char **argv)
   sim.cpu_timer      = o.cpu_timer;
   sim.element_kernel = o.scalar_elements ? physics::ElementKernel::Scalar : physics::ElementKernel::Batched;
   sim.element_body   = (binbcsr::BodySet)o.element_body;
+  sim.guess_order    = (int)o.guess_order;
   const physics::FemModel   &model   = sim.model;
   const int                  n_nodes = model.node_count(), npe = model.npe, tip = sim.new_of_old[tip_input];
   const std::vector<double> &X = model.mesh.nodes;
@@ -563,6 +573,12 @@ int main(int argc, char **argv)
   s.add("solve_ms", 1e3 * t_solve / steps_div);
   s.add("element_share", t_total > 0 ? t_element / t_total : 0.0);
   s.add("cg_its", (double)its_total / steps_div);
+  {
+    int levels, transfers; // -gamg_smoother_precision single: what runs on single-precision copies
+    GAMGSmootherCopiesCount(sim.sys.gamg_copies, &levels, &transfers);
+    s.add("smoother_copies", (long long)levels);
+    s.add("transfer_copies", (long long)transfers);
+  }
   s.add("tip_dx", x[3 * tip] - X[3 * tip]);
   s.add("tip_dy", x[3 * tip + 1] - X[3 * tip + 1]);
   s.add("tip_dz", x[3 * tip + 2] - X[3 * tip + 2]);

@@ -45,6 +45,40 @@ set(FEM_BEAM_GAMG -mesh_box 1,0.1,0.1,16,3,3 -fix xmin -steps 3 -fem_quiet -mat_
 fem_test(fem_gamg_rigid_body_modes 0 "cg_its=(1[0-9]|2[0-5])[. ].*status=ok" ${FEM} ${FEM_BEAM_GAMG})
 fem_test(fem_mpi2_gamg_rigid_body_modes 0 "ranks=2 .*cg_its=(1[0-9]|2[0-5])[. ].*status=ok" ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_BEAM_GAMG})
 set_tests_properties(fem_mpi2_gamg_rigid_body_modes PROPERTIES LABELS "fem;mpi")
+# -gamg_smoother_precision single: GAMG's levels smooth, compute residuals and transfer on single-precision
+# binbcsr copies; the outer CG on the operator reaches the same answer in the same iterations. On 2 ranks the
+# fine level has its copy (binbcsr) and the MPIAIJ coarse levels keep theirs. An aij fine operator is copied
+# too (one rank).
+set(FEM_SUMMARY_SAME ${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_same.sh)
+set(FEM_SUMMARY_CHECK ${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_check.sh)
+string(REPLACE ";" " " FEM_BEAM_GAMG_STR "${FEM_BEAM_GAMG}")
+string(REPLACE ";" " " FEM_MPIEXEC_STR "${MPIEXEC_CMD}")
+add_test(NAME fem_gamg_single_smoothers_same_answer
+         COMMAND ${FEM_SUMMARY_SAME} "cg_its:1 tip_dz:1e-9 kinetic:1e-9" 1e-5 "${FEM} ${FEM_BEAM_GAMG_STR}"
+                 "${FEM} ${FEM_BEAM_GAMG_STR} -gamg_smoother_precision single"
+                 "${FEM} ${FEM_BEAM_GAMG_STR} -gamg_smoother_precision single -mat_type aij"
+                 "${FEM_MPIEXEC_STR} -n 2 ${FEM} ${FEM_BEAM_GAMG_STR} -gamg_smoother_precision single")
+set_tests_properties(fem_gamg_single_smoothers_same_answer PROPERTIES LABELS "fem;mpi" TIMEOUT 120 PROCESSORS 2
+                     WORKING_DIRECTORY ${FEM_SRC})
+add_test(NAME fem_gamg_single_smoothers_used
+         COMMAND ${FEM_SUMMARY_CHECK} "smoother_copies==2 && transfer_copies==2 && status==\"ok\""
+                 -- ${FEM} ${FEM_BEAM_GAMG} -gamg_smoother_precision single)
+add_test(NAME fem_mpi2_gamg_single_smoothers_fine_only
+         COMMAND ${FEM_SUMMARY_CHECK} "smoother_copies==1 && transfer_copies==0 && status==\"ok\""
+                 -- ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_BEAM_GAMG} -gamg_smoother_precision single)
+set_tests_properties(fem_gamg_single_smoothers_used fem_mpi2_gamg_single_smoothers_fine_only PROPERTIES LABELS "fem"
+                     TIMEOUT 60 WORKING_DIRECTORY ${FEM_SRC})
+set_tests_properties(fem_mpi2_gamg_single_smoothers_fine_only PROPERTIES LABELS "fem;mpi" PROCESSORS 2)
+fem_test(fem_gamg_bad_smoother_precision nonzero "Unknown option half for -gamg_smoother_precision" ${FEM} ${FEM_BEAM_GAMG}
+         -gamg_smoother_precision half)
+# -fem_initial_guess linear|quadratic: the solve starts from dv extrapolated from the last two or three
+# steps; to the same tolerance the answer is the same (the beam: 20.75 -> 20.4 / 20.1 CG iterations).
+add_test(NAME fem_initial_guess_extrapolated_same_answer
+         COMMAND ${FEM_SUMMARY_SAME} "tip_dz:1e-9 kinetic:1e-9" 1e-5 "${FEM} ${FEM_BEAM_GAMG_STR} -steps 8 -ksp_initial_guess_nonzero"
+                 "${FEM} ${FEM_BEAM_GAMG_STR} -steps 8 -ksp_initial_guess_nonzero -fem_initial_guess linear"
+                 "${FEM} ${FEM_BEAM_GAMG_STR} -steps 8 -ksp_initial_guess_nonzero -fem_initial_guess quadratic")
+set_tests_properties(fem_initial_guess_extrapolated_same_answer PROPERTIES LABELS "fem" TIMEOUT 60
+                     WORKING_DIRECTORY ${FEM_SRC})
 fem_test(fem_gamg_translations_only 0 "cg_its=(3[5-9]|4[0-9]|5[0-5])[. ].*status=ok" ${FEM} ${FEM_BEAM_GAMG} -fem_rigid_body_modes 0)
 
 # When the physics or the solver breaks the run says so (src/sim/run_guard.h). A body that

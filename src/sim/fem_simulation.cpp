@@ -131,6 +131,28 @@ PetscErrorCode FemSimulationCreate(MPI_Comm comm, const FemScene &scene, FemSimu
   PetscFunctionReturn(0);
 }
 
+namespace {
+
+// dv_local (the last step's dv, when a step was solved) becomes the next solve's guess, extrapolated by
+// sim->guess_order from the dv before it, and joins the history.
+PetscErrorCode ExtrapolateGuess(FemSimulation *sim)
+{
+  PetscFunctionBegin;
+  if (sim->guess_order <= 0 || sim->dv_solved == 0 || sim->is_static) PetscFunctionReturn(0); // (Newton: dx)
+  std::vector<double> &dv = sim->dv_local, &b1 = sim->dv_before[0], &b2 = sim->dv_before[1];
+  std::vector<double>  last  = dv;
+  const int            order = std::min(sim->guess_order, sim->dv_solved - 1); // what the history allows
+  if (order == 1)
+    for (size_t k = 0; k < dv.size(); ++k) dv[k] = 2 * last[k] - b1[k];
+  else if (order == 2)
+    for (size_t k = 0; k < dv.size(); ++k) dv[k] = 3 * (last[k] - b1[k]) + b2[k];
+  std::swap(b1, b2);
+  b1 = std::move(last);
+  PetscFunctionReturn(0);
+}
+
+} // namespace
+
 PetscErrorCode FemSimulationStep(FemSimulation *sim, FemStepInfo *info)
 {
   PetscFunctionBegin;
@@ -158,6 +180,7 @@ PetscErrorCode FemSimulationStep(FemSimulation *sim, FemStepInfo *info)
   const double t2 = now();
   PetscCall(BlockSystemSetValues(&sim->sys, sim->values.data()));
   const double t3 = now();
+  PetscCall(ExtrapolateGuess(sim));
   PetscCall(BlockSystemSolve(&sim->sys, sim->rhs_local.data(), sim->dv_local.data(), &info->stats));
   const double t4 = now();
   if (sim->size > 1)
@@ -178,7 +201,9 @@ PetscErrorCode FemSimulationStep(FemSimulation *sim, FemStepInfo *info)
     }
   } else {
     std::fill(sim->dv_local.begin(), sim->dv_local.end(), 0.0); // not a usable initial guess
+    sim->dv_solved = 0;
   }
+  if (info->finite) ++sim->dv_solved;
   const double t5    = now();
   info->element_ms   = 1e3 * (t1 - t0);
   info->comm_ms      = 1e3 * ((t2 - t1) + (t5 - t4));

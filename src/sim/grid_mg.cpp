@@ -1,4 +1,5 @@
 #include "sim/grid_mg.h"
+#include "sim/smoother_copy.h"
 
 #include <petscbinbcsr.h>
 
@@ -245,54 +246,6 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
   PetscFunctionReturn(0);
 }
 
-/* The single-precision copy `copy` of a level operator A for its smoothers, made on the first call and
-   refilled after. The fine operator (binbcsr) is duplicated and its values converted; a coarse BAIJ
-   operator is read into an upper-triangle binbcsr through a COO list in the order of its value array.
-   Sweeps on the copy read a half (fine level) or a quarter (coarse levels) of the bytes. */
-static PetscErrorCode RefillSmootherCopy(Mat A, Mat *copy)
-{
-  PetscBool baij;
-
-  PetscFunctionBegin;
-  PetscCall(PetscObjectTypeCompare((PetscObject)A, MATSEQBAIJ, &baij));
-  if (!baij) {
-    PetscBool binbcsr;
-    MatType   type;
-    PetscCall(MatGetType(A, &type));
-    PetscCall(PetscObjectTypeCompareAny((PetscObject)A, &binbcsr, MATSEQBINBCSR, MATMPIBINBCSR, ""));
-    PetscCheck(binbcsr, PetscObjectComm((PetscObject)A), PETSC_ERR_SUP,
-               "-grid_mg_smoother_precision single needs a binbcsr fine operator (-mat_type binbcsr), not %s",
-               type);
-    if (*copy) PetscCall(MatCopy(A, *copy, SAME_NONZERO_PATTERN));
-    else {
-      PetscCall(MatDuplicate(A, MAT_COPY_VALUES, copy));
-      PetscCall(MatBinBCSRSetPrecision(*copy, MAT_BINBCSR_PRECISION_SINGLE));
-    }
-    PetscFunctionReturn(0);
-  }
-  if (!*copy) {
-    std::vector<PetscInt> brow, bcol, i, j;
-    PetscCall(BlockGalerkinBlocksOf(A, &brow, &bcol));
-    for (size_t b = 0; b < brow.size(); ++b)
-      for (PetscInt c = 0; c < 3; ++c) // BAIJ blocks are column-major
-        for (PetscInt r = 0; r < 3; ++r) i.push_back(3 * brow[b] + r), j.push_back(3 * bcol[b] + c);
-    PetscInt m;
-    PetscCall(MatGetSize(A, &m, nullptr));
-    PetscCall(MatCreate(PETSC_COMM_SELF, copy));
-    PetscCall(MatSetSizes(*copy, m, m, m, m));
-    PetscCall(MatSetBlockSize(*copy, 3));
-    PetscCall(MatSetType(*copy, MATSEQBINBCSR));
-    PetscCall(MatBinBCSRSetSymmetricStorage(*copy, PETSC_TRUE));
-    PetscCall(MatBinBCSRSetPrecision(*copy, MAT_BINBCSR_PRECISION_SINGLE));
-    PetscCall(MatSetPreallocationCOO(*copy, (PetscCount)i.size(), i.data(), j.data()));
-  }
-  PetscScalar *a;
-  PetscCall(MatSeqBAIJGetArray(A, &a));
-  PetscCall(MatSetValuesCOO(*copy, a, INSERT_VALUES));
-  PetscCall(MatSeqBAIJRestoreArray(A, &a));
-  PetscFunctionReturn(0);
-}
-
 /* Hands level `level`'s smoothers their operators after a refill of A: A itself, or A with its
    single-precision copy as the matrix they sweep. Handing them again makes a smoother set up anew
    (Chebyshev's eigenvalue estimate: a KSP whose operators were set once keeps its first estimate)
@@ -304,7 +257,16 @@ static PetscErrorCode SetLevelOperators(GridMG *mg, PetscInt level, Mat A)
 
   PetscFunctionBegin;
   if (mg->single_smoothers && level > 0) {
-    PetscCall(RefillSmootherCopy(A, &mg->smoother_mats[level]));
+    if (level == (PetscInt)mg->smoother_mats.size() - 1) { // the fine operator: the driver's Mat type
+      PetscBool binbcsr;
+      MatType   type;
+      PetscCall(MatGetType(A, &type));
+      PetscCall(PetscObjectTypeCompareAny((PetscObject)A, &binbcsr, MATSEQBINBCSR, MATMPIBINBCSR, ""));
+      PetscCheck(
+        binbcsr, PetscObjectComm((PetscObject)A), PETSC_ERR_SUP,
+        "-grid_mg_smoother_precision single needs a binbcsr fine operator (-mat_type binbcsr), not %s", type);
+    }
+    PetscCall(SmootherCopyRefill(A, &mg->smoother_mats[level]));
     sweep = mg->smoother_mats[level];
   }
   PetscCall(LevelSmoothers(mg->pc, level, sides));

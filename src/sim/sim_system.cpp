@@ -252,6 +252,7 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
     PetscCall(PCSetType(pc, PCJACOBI)); // what the seed uses; works for every Mat type
   }
   PetscCall(KSPSetFromOptions(sys->ksp));
+  PetscCall(GAMGSmootherCopiesFromOptions(comm, &sys->gamg_copies));
   PetscFunctionReturn(0);
 }
 
@@ -311,6 +312,7 @@ PetscErrorCode BlockSystemSolve(BlockSystem *sys, const PetscScalar *rhs_local, 
     PetscCall(VecRestoreArrayWrite(sys->x, &a));
   }
   const double t0 = MPI_Wtime();
+  PetscCall(GAMGSmootherCopiesUpdate(sys->ksp, &sys->gamg_copies));
   PetscCall(KSPSolve(sys->ksp, sys->b, sys->x));
   const double       t1 = MPI_Wtime();
   const PetscScalar *xa;
@@ -383,6 +385,7 @@ PetscErrorCode BlockSystemDestroy(BlockSystem *sys)
 {
   PetscFunctionBegin;
   if (!sys) PetscFunctionReturn(0);
+  PetscCall(GAMGSmootherCopiesDestroy(&sys->gamg_copies));
   PetscCall(KSPDestroy(&sys->ksp));
   PetscCall(VecDestroy(&sys->x));
   PetscCall(VecDestroy(&sys->b));

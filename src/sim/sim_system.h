@@ -21,6 +21,7 @@
 // of those types. A -mat_type that needs a GPU this PETSc was not built for (aijcusparse, ...) is a
 // clear PETSC_ERR_SUP error.
 #pragma once
+#include "sim/smoother_copy.h"
 #include <petscksp.h>
 #include <vector>
 
@@ -38,6 +39,7 @@ struct BlockSystem {
                  // symmetric storage or COO mirror): the caller lists the upper triangle
   std::vector<PetscInt> coo_block_row, coo_block_col; // kept for the fallback path and for dumps
   const PetscScalar    *last_values = nullptr; // the caller's array from the last SetValues (for dumps)
+  GAMGSmootherCopies    gamg_copies;           // -gamg_smoother_precision single (smoother_copy.h)
 };
 
 struct SolveStats {

@@ -1,0 +1,233 @@
+#include "sim/smoother_copy.h"
+
+#include <petscbinbcsr.h>
+#include <petsc/private/pcmgimpl.h> // the levels' smoothers as they are
+#include <petsc/private/petscimpl.h> // PetscObjectStateGet
+
+#include <cstring>
+
+namespace {
+
+PetscErrorCode IsBinBCSR(Mat A, PetscBool *binbcsr)
+{
+  PetscFunctionBegin;
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)A, binbcsr, MATSEQBINBCSR, MATMPIBINBCSR, ""));
+  PetscFunctionReturn(0);
+}
+
+// A single-precision binbcsr for the scalar COO list (i, j) of an m x n operator (block size 3 where m
+// and n allow, else 1), upper-triangle storage if `upper`, its values to come in the list's order.
+// (PETSc 3.18's MatSetPreallocationCOO may reorder the lists it is given: they are the callee's.)
+PetscErrorCode CreateSingle(PetscInt m, PetscInt n, PetscBool upper, std::vector<PetscInt> i,
+                            std::vector<PetscInt> j, Mat *copy)
+{
+  PetscFunctionBegin;
+  PetscCall(MatCreate(PETSC_COMM_SELF, copy));
+  PetscCall(MatSetSizes(*copy, m, n, m, n));
+  PetscCall(MatSetBlockSize(*copy, m % 3 == 0 && n % 3 == 0 ? 3 : 1));
+  PetscCall(MatSetType(*copy, MATSEQBINBCSR));
+  if (upper) PetscCall(MatBinBCSRSetSymmetricStorage(*copy, PETSC_TRUE));
+  PetscCall(MatBinBCSRSetPrecision(*copy, MAT_BINBCSR_PRECISION_SINGLE));
+  PetscCall(MatSetPreallocationCOO(*copy, (PetscCount)i.size(), i.data(), j.data()));
+  PetscFunctionReturn(0);
+}
+
+// SeqBAIJ (block size 3, the block Galerkin products): the COO list in the order of the value array.
+PetscErrorCode RefillFromBAIJ(Mat A, Mat *copy)
+{
+  PetscFunctionBegin;
+  if (!*copy) {
+    PetscInt bs, m, nb;
+    const PetscInt *ia, *ja;
+    PetscBool       done;
+    PetscCall(MatGetBlockSize(A, &bs));
+    PetscCall(MatGetSize(A, &m, nullptr));
+    PetscCall(MatGetRowIJ(A, 0, PETSC_FALSE, PETSC_TRUE, &nb, &ia, &ja, &done)); // block rows
+    PetscCheck(done, PETSC_COMM_SELF, PETSC_ERR_SUP, "SmootherCopyRefill: no row structure from this BAIJ matrix");
+    std::vector<PetscInt> i, j;
+    i.reserve((size_t)ia[nb] * bs * bs);
+    j.reserve((size_t)ia[nb] * bs * bs);
+    for (PetscInt br = 0; br < nb; ++br)
+      for (PetscInt k = ia[br]; k < ia[br + 1]; ++k)
+        for (PetscInt c = 0; c < bs; ++c) // BAIJ blocks are column-major
+          for (PetscInt r = 0; r < bs; ++r) i.push_back(bs * br + r), j.push_back(bs * ja[k] + c);
+    PetscCall(MatRestoreRowIJ(A, 0, PETSC_FALSE, PETSC_TRUE, &nb, &ia, &ja, &done));
+    PetscCall(CreateSingle(m, m, PETSC_TRUE, i, j, copy));
+  }
+  PetscScalar *a;
+  PetscCall(MatSeqBAIJGetArray(A, &a));
+  PetscCall(MatSetValuesCOO(*copy, a, INSERT_VALUES));
+  PetscCall(MatSeqBAIJRestoreArray(A, &a));
+  PetscFunctionReturn(0);
+}
+
+// SeqAIJ (PCGAMG's coarse levels and transfers): the COO list in the order of the CSR value array;
+// `upper` for a symmetric level operator.
+PetscErrorCode RefillFromAIJ(Mat A, PetscBool upper, Mat *copy)
+{
+  PetscFunctionBegin;
+  if (!*copy) { // (MatGetRow: AIJ's MatGetRowIJ hands i-node matrices out compressed or not at all)
+    PetscInt              m, n;
+    std::vector<PetscInt> i, j;
+    PetscCall(MatGetSize(A, &m, &n));
+    for (PetscInt r = 0; r < m; ++r) {
+      PetscInt        ncols;
+      const PetscInt *cols;
+      PetscCall(MatGetRow(A, r, &ncols, &cols, nullptr));
+      for (PetscInt k = 0; k < ncols; ++k) i.push_back(r), j.push_back(cols[k]);
+      PetscCall(MatRestoreRow(A, r, &ncols, &cols, nullptr));
+    }
+    PetscCall(CreateSingle(m, n, upper, i, j, copy));
+  }
+  const PetscScalar *a;
+  PetscCall(MatSeqAIJGetArrayRead(A, &a));
+  PetscCall(MatSetValuesCOO(*copy, a, INSERT_VALUES));
+  PetscCall(MatSeqAIJRestoreArrayRead(A, &a));
+  PetscFunctionReturn(0);
+}
+
+} // namespace
+
+PetscErrorCode SmootherCopySupported(Mat A, PetscBool *supported)
+{
+  PetscFunctionBegin;
+  PetscCall(IsBinBCSR(A, supported));
+  if (!*supported) PetscCall(PetscObjectTypeCompareAny((PetscObject)A, supported, MATSEQAIJ, MATSEQBAIJ, ""));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode SmootherCopyRefill(Mat A, Mat *copy)
+{
+  PetscBool binbcsr, aij, baij;
+
+  PetscFunctionBegin;
+  PetscCall(IsBinBCSR(A, &binbcsr));
+  if (binbcsr) {
+    if (*copy) PetscCall(MatCopy(A, *copy, SAME_NONZERO_PATTERN));
+    else {
+      PetscCall(MatDuplicate(A, MAT_COPY_VALUES, copy));
+      PetscCall(MatBinBCSRSetPrecision(*copy, MAT_BINBCSR_PRECISION_SINGLE));
+    }
+    PetscFunctionReturn(0);
+  }
+  PetscCall(PetscObjectTypeCompare((PetscObject)A, MATSEQBAIJ, &baij));
+  PetscCall(PetscObjectTypeCompare((PetscObject)A, MATSEQAIJ, &aij));
+  if (baij) PetscCall(RefillFromBAIJ(A, copy));
+  else if (aij) PetscCall(RefillFromAIJ(A, PETSC_TRUE, copy));
+  else {
+    MatType type;
+    PetscCall(MatGetType(A, &type));
+    SETERRQ(PetscObjectComm((PetscObject)A), PETSC_ERR_SUP,
+            "single-precision smoother copies take binbcsr, seqaij or seqbaij level operators, not %s", type);
+  }
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode GAMGSmootherCopiesFromOptions(MPI_Comm comm, GAMGSmootherCopies *c)
+{
+  const char *precisions[] = {"double", "single"};
+  PetscInt    precision    = c->enabled ? 1 : 0;
+
+  PetscFunctionBegin;
+  PetscOptionsBegin(comm, nullptr, "Multigrid smoothers", "");
+  PetscCall(PetscOptionsEList("-gamg_smoother_precision",
+                              "PCGAMG: smooth, compute residuals and transfer on single-precision binbcsr copies "
+                              "of the levels' operators (the outer Krylov method stays on the operator)",
+                              "", precisions, 2, precisions[precision], &precision, nullptr));
+  PetscOptionsEnd();
+  c->enabled = precision == 1;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
+{
+  PC        pc;
+  PetscBool gamg;
+  PetscInt  nlev;
+
+  PetscFunctionBegin;
+  if (!c->enabled) PetscFunctionReturn(0);
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &gamg));
+  if (!gamg) PetscFunctionReturn(0);
+  PetscCall(KSPSetUp(ksp)); // PCGAMG's hierarchy: built at the first call, then rebuilt or reused
+  PetscCall(PCMGGetLevels(pc, &nlev));
+  if ((PetscInt)c->copy.size() != nlev) {
+    PetscCall(GAMGSmootherCopiesDestroy(c));
+    c->enabled = true;
+    c->source.assign(nlev, nullptr);
+    c->copy.assign(nlev, nullptr);
+    c->source_state.assign(nlev, 0);
+    c->interp_copy.assign(nlev, nullptr);
+    c->restrict_copy.assign(nlev, nullptr);
+    // GAMG would build the next hierarchy from the interpolation it finds in PCMG: keep its own then
+    PetscBool   reuse = PETSC_FALSE;
+    const char *prefix;
+    PetscCall(PCGetOptionsPrefix(pc, &prefix));
+    PetscCall(PetscOptionsGetBool(nullptr, prefix, "-pc_gamg_reuse_interpolation", &reuse, nullptr));
+    c->transfers = !reuse;
+  }
+  for (PetscInt l = 1; l < nlev; ++l) {
+    KSP       down, up;
+    Mat       Amat;
+    PetscBool supported;
+    // (PCMGGetSmootherUp would make a distinct post-smoother, without the pre-smoother's options)
+    down = ((PC_MG *)pc->data)->levels[l]->smoothd;
+    up   = ((PC_MG *)pc->data)->levels[l]->smoothu;
+    PetscCall(KSPGetOperators(down, &Amat, nullptr));
+    if (Amat != c->copy[l]) { // GAMG (re)built this level: a new copy of its operator
+      PetscCall(SmootherCopySupported(Amat, &supported));
+      if (!supported) continue;
+      PetscCall(MatDestroy(&c->copy[l]));
+      PetscCall(MatDestroy(&c->source[l]));
+      PetscCall(PetscObjectReference((PetscObject)Amat));
+      c->source[l] = Amat;
+      PetscCall(SmootherCopyRefill(Amat, &c->copy[l]));
+      PetscCall(KSPSetOperators(down, c->copy[l], c->copy[l]));
+      if (up != down) PetscCall(KSPSetOperators(up, c->copy[l], c->copy[l]));
+      PetscCall(PCMGSetResidual(pc, l, PCMGResidualDefault, c->copy[l]));
+    } else {
+      PetscObjectState state;
+      PetscCall(PetscObjectStateGet((PetscObject)c->source[l], &state));
+      if (state == c->source_state[l]) continue; // a reused coarse level: unchanged
+      PetscCall(SmootherCopyRefill(c->source[l], &c->copy[l]));
+    }
+    PetscCall(PetscObjectStateGet((PetscObject)c->source[l], &c->source_state[l]));
+  }
+  if (!c->transfers) PetscFunctionReturn(0);
+  for (PetscInt l = 1; l < nlev; ++l) { // the transfers into level l
+    Mat       P, R;
+    PetscBool aij;
+    PetscCall(PCMGGetInterpolation(pc, l, &P));
+    if (P == c->interp_copy[l]) continue;
+    PetscCall(PetscObjectTypeCompare((PetscObject)P, MATSEQAIJ, &aij));
+    if (!aij) continue;
+    PetscCall(MatDestroy(&c->interp_copy[l]));
+    PetscCall(MatDestroy(&c->restrict_copy[l]));
+    PetscCall(RefillFromAIJ(P, PETSC_FALSE, &c->interp_copy[l]));
+    PetscCall(MatTranspose(P, MAT_INITIAL_MATRIX, &R)); // restriction by products, not transposed ones
+    PetscCall(RefillFromAIJ(R, PETSC_FALSE, &c->restrict_copy[l]));
+    PetscCall(MatDestroy(&R));
+    PetscCall(PCMGSetInterpolation(pc, l, c->interp_copy[l]));
+    PetscCall(PCMGSetRestriction(pc, l, c->restrict_copy[l]));
+  }
+  PetscFunctionReturn(0);
+}
+
+void GAMGSmootherCopiesCount(const GAMGSmootherCopies &c, int *levels, int *transfers)
+{
+  *levels = *transfers = 0;
+  for (Mat m : c.copy) *levels += m != nullptr;
+  for (Mat m : c.interp_copy) *transfers += m != nullptr;
+}
+
+PetscErrorCode GAMGSmootherCopiesDestroy(GAMGSmootherCopies *c)
+{
+  PetscFunctionBegin;
+  for (Mat &m : c->copy) PetscCall(MatDestroy(&m));
+  for (Mat &m : c->source) PetscCall(MatDestroy(&m));
+  for (Mat &m : c->interp_copy) PetscCall(MatDestroy(&m));
+  for (Mat &m : c->restrict_copy) PetscCall(MatDestroy(&m));
+  *c = GAMGSmootherCopies{};
+  PetscFunctionReturn(0);
+}

@@ -1,0 +1,46 @@
+// Single-precision binbcsr copies of multigrid level operators for their smoothers.
+//
+// A smoother only has to damp the error, so its rounding does not reach the solution: the outer Krylov
+// method runs on the operator itself and keeps its tolerance on the true system. What the copy buys is
+// bytes: the sweeps and the Chebyshev products stream a half (a binbcsr operator, values converted) or
+// a quarter (a coarse AIJ/BAIJ operator, read into upper-triangle single-precision binbcsr) of them.
+//
+// SmootherCopyRefill is the one conversion, shared by the cloth's grid multigrid (grid_mg.h) and the
+// copies of a GAMG hierarchy below.
+#pragma once
+#include <petscksp.h>
+
+#include <vector>
+
+// The copy `*copy` of level operator A, made on the first call (*copy null) and refilled in place
+// after (same pattern). A may be binbcsr (any communicator; duplicated, values converted), SeqBAIJ or
+// SeqAIJ (read through a COO list into symmetric-storage binbcsr: A must be symmetric, which a Galerkin
+// product of a symmetric operator is). Other types: PETSC_ERR_SUP naming the type.
+PetscErrorCode SmootherCopyRefill(Mat A, Mat *copy);
+
+// Whether SmootherCopyRefill takes A.
+PetscErrorCode SmootherCopySupported(Mat A, PetscBool *supported);
+
+// -gamg_smoother_precision single: after PCGAMG has built its hierarchy, every level but the coarsest
+// smooths and computes its residual on a copy of its operator, and interpolates and restricts through
+// copies of the transfers; the copies follow the operators (the
+// fine one is refilled with each new set of values, a level that GAMG rebuilt gets a new copy).
+// Levels whose operator SmootherCopyRefill cannot take (MPIAIJ coarse levels on more ranks) keep it.
+struct GAMGSmootherCopies {
+  bool                          enabled = false;
+  std::vector<Mat>              source, copy;  // per PCMG level (0, the coarsest, is solved directly)
+  std::vector<PetscObjectState> source_state; // source's state when copy was last refilled
+  // the transfers into each level (SeqAIJ from GAMG): P and R = P^T as single-precision binbcsr, so
+  // that restriction is a product too; not with -pc_gamg_reuse_interpolation (GAMG rebuilds from P)
+  bool             transfers = true;
+  std::vector<Mat> interp_copy, restrict_copy;
+};
+
+// Reads -gamg_smoother_precision (double, the default, or single).
+PetscErrorCode GAMGSmootherCopiesFromOptions(MPI_Comm comm, GAMGSmootherCopies *c);
+// Call before each solve, after the operator's new values: sets the KSP up (so PCGAMG builds or
+// reuses its hierarchy) and brings the copies up to date. A no-op unless enabled and the PC is GAMG.
+PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c);
+// The levels smoothing on copies and the levels whose transfers are copies (on this rank).
+void GAMGSmootherCopiesCount(const GAMGSmootherCopies &c, int *levels, int *transfers);
+PetscErrorCode GAMGSmootherCopiesDestroy(GAMGSmootherCopies *c);
