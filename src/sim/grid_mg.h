@@ -11,10 +11,10 @@
 // at its set-up. Smoothers: -grid_mg_levels_[N_]* (default one symmetric Gauss-Seidel sweep), coarse solve:
 // -grid_mg_coarse_* (default LU, redundant on more ranks); GAMG's -mg_levels_* do not reach them.
 // -grid_mg_smoother_precision single (with the block Galerkin products; ignored with PCMG's): the smoothers sweep single-precision binbcsr
-// copies of the level operators (the fine one duplicated, the coarse BAIJ ones in upper-triangle storage),
-// while residuals, interpolation and the outer Krylov method stay on the operators themselves. A smoother
-// only has to damp the error, so its rounding does not reach the solution; the sweeps read a half (fine)
-// or a quarter (coarse) of the bytes.
+// copies of the level operators (the fine one duplicated, the coarse BAIJ ones in upper-triangle storage)
+// and the V-cycle's residuals are taken on them too, while interpolation, the Galerkin products and the
+// outer Krylov method stay on the operators themselves. The V-cycle only has to reduce the error, so its
+// rounding does not reach the solution; the sweeps read a half (fine) or a quarter (coarse) of the bytes.
 //
 // On P ranks the fine rows are those of the solver's numbering (new_of_old, rows row_offsets[r] ..
 // row_offsets[r + 1] on rank r); each coarse node belongs to the rank owning the fine node nearest to it.
@@ -30,7 +30,8 @@ struct GridMG {
   std::vector<BlockGalerkin> galerkin;        // level l + 1 from level l
   PC                         pc = nullptr;
   // -grid_mg_smoother_precision single: every level smooths on a single-precision binbcsr copy of its
-  // operator (upper triangle on the coarse levels); residuals and the outer CG keep the operators
+  // operator (upper triangle on the coarse levels) and takes its residual there; the outer CG keeps the
+  // operators
   bool             single_smoothers = false;
   std::vector<Mat> smoother_mats; // per PCMG level (0 unused): the copies, made at the first refill
 };
