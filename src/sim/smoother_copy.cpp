@@ -1,7 +1,7 @@
 #include "sim/smoother_copy.h"
 
 #include <petscbinbcsr.h>
-#include <petsc/private/pcmgimpl.h> // the levels' smoothers as they are
+#include <petsc/private/pcmgimpl.h>  // the levels' smoothers as they are
 #include <petsc/private/petscimpl.h> // PetscObjectStateGet
 
 #include <cstring>
@@ -37,13 +37,14 @@ PetscErrorCode RefillFromBAIJ(Mat A, Mat *copy)
 {
   PetscFunctionBegin;
   if (!*copy) {
-    PetscInt bs, m, nb;
+    PetscInt        bs, m, nb;
     const PetscInt *ia, *ja;
     PetscBool       done;
     PetscCall(MatGetBlockSize(A, &bs));
     PetscCall(MatGetSize(A, &m, nullptr));
     PetscCall(MatGetRowIJ(A, 0, PETSC_FALSE, PETSC_TRUE, &nb, &ia, &ja, &done)); // block rows
-    PetscCheck(done, PETSC_COMM_SELF, PETSC_ERR_SUP, "SmootherCopyRefill: no row structure from this BAIJ matrix");
+    PetscCheck(done, PETSC_COMM_SELF, PETSC_ERR_SUP,
+               "SmootherCopyRefill: no row structure from this BAIJ matrix");
     std::vector<PetscInt> i, j;
     i.reserve((size_t)ia[nb] * bs * bs);
     j.reserve((size_t)ia[nb] * bs * bs);
@@ -130,10 +131,11 @@ PetscErrorCode GAMGSmootherCopiesFromOptions(MPI_Comm comm, GAMGSmootherCopies *
 
   PetscFunctionBegin;
   PetscOptionsBegin(comm, nullptr, "Multigrid smoothers", "");
-  PetscCall(PetscOptionsEList("-gamg_smoother_precision",
-                              "PCGAMG: smooth, compute residuals and transfer on single-precision binbcsr copies "
-                              "of the levels' operators (the outer Krylov method stays on the operator)",
-                              "", precisions, 2, precisions[precision], &precision, nullptr));
+  PetscCall(
+    PetscOptionsEList("-gamg_smoother_precision",
+                      "PCGAMG: smooth, compute residuals and transfer on single-precision binbcsr copies "
+                      "of the levels' operators (the outer Krylov method stays on the operator)",
+                      "", precisions, 2, precisions[precision], &precision, nullptr));
   PetscOptionsEnd();
   c->enabled = precision == 1;
   PetscFunctionReturn(0);

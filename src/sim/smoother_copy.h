@@ -28,7 +28,7 @@ PetscErrorCode SmootherCopySupported(Mat A, PetscBool *supported);
 // Levels whose operator SmootherCopyRefill cannot take (MPIAIJ coarse levels on more ranks) keep it.
 struct GAMGSmootherCopies {
   bool                          enabled = false;
-  std::vector<Mat>              source, copy;  // per PCMG level (0, the coarsest, is solved directly)
+  std::vector<Mat>              source, copy; // per PCMG level (0, the coarsest, is solved directly)
   std::vector<PetscObjectState> source_state; // source's state when copy was last refilled
   // the transfers into each level (SeqAIJ from GAMG): P and R = P^T as single-precision binbcsr, so
   // that restriction is a product too; not with -pc_gamg_reuse_interpolation (GAMG rebuilds from P)
@@ -42,5 +42,5 @@ PetscErrorCode GAMGSmootherCopiesFromOptions(MPI_Comm comm, GAMGSmootherCopies *
 // reuses its hierarchy) and brings the copies up to date. A no-op unless enabled and the PC is GAMG.
 PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c);
 // The levels smoothing on copies and the levels whose transfers are copies (on this rank).
-void GAMGSmootherCopiesCount(const GAMGSmootherCopies &c, int *levels, int *transfers);
+void           GAMGSmootherCopiesCount(const GAMGSmootherCopies &c, int *levels, int *transfers);
 PetscErrorCode GAMGSmootherCopiesDestroy(GAMGSmootherCopies *c);
