@@ -1,6 +1,7 @@
 #include "sim/smoother_copy.h"
 
 #include <petscbinbcsr.h>
+#include <petsc/private/pcimpl.h>    // whether PCSetUp will rebuild
 #include <petsc/private/pcmgimpl.h>  // the levels' smoothers as they are
 #include <petsc/private/petscimpl.h> // PetscObjectStateGet
 
@@ -141,6 +142,51 @@ PetscErrorCode GAMGSmootherCopiesFromOptions(MPI_Comm comm, GAMGSmootherCopies *
   PetscFunctionReturn(0);
 }
 
+namespace {
+
+// Level l's pre- and post-smoother as PCMG holds them (PCMGGetSmootherUp would make a distinct
+// post-smoother, without the pre-smoother's options).
+void LevelSmoothers(PC pc, PetscInt l, KSP *down, KSP *up)
+{
+  *down = ((PC_MG *)pc->data)->levels[l]->smoothd;
+  *up   = ((PC_MG *)pc->data)->levels[l]->smoothu;
+}
+
+PetscErrorCode InstallLevel(PC pc, PetscInt l, Mat A)
+{
+  KSP down, up;
+
+  PetscFunctionBegin;
+  LevelSmoothers(pc, l, &down, &up);
+  PetscCall(KSPSetOperators(down, A, A));
+  if (up != down) PetscCall(KSPSetOperators(up, A, A));
+  PetscCall(PCMGSetResidual(pc, l, PCMGResidualDefault, A));
+  PetscFunctionReturn(0);
+}
+
+// Before a set-up that rebuilds the hierarchy: GAMG gets back its own operators and transfers, since
+// it builds the new coarse levels from what PCMG holds (with -pc_gamg_reuse_interpolation, the
+// default in PETSc 3.18: MatPtAP of the fine smoother's operator with PCMG's interpolation).
+PetscErrorCode RestoreGAMGOwn(PC pc, GAMGSmootherCopies *c)
+{
+  PetscFunctionBegin;
+  for (size_t l = 1; l < c->copy.size(); ++l) {
+    KSP down, up;
+    Mat Amat, P;
+    LevelSmoothers(pc, (PetscInt)l, &down, &up);
+    PetscCall(KSPGetOperators(down, &Amat, nullptr));
+    if (c->copy[l] && Amat == c->copy[l]) PetscCall(InstallLevel(pc, (PetscInt)l, c->source[l]));
+    PetscCall(PCMGGetInterpolation(pc, (PetscInt)l, &P));
+    if (c->interp_copy[l] && P == c->interp_copy[l]) {
+      PetscCall(PCMGSetInterpolation(pc, (PetscInt)l, c->interp_source[l]));
+      PetscCall(PCMGSetRestriction(pc, (PetscInt)l, c->interp_source[l]));
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
+} // namespace
+
 PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
 {
   PC        pc;
@@ -152,64 +198,86 @@ PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &gamg));
   if (!gamg) PetscFunctionReturn(0);
-  PetscCall(KSPSetUp(ksp)); // PCGAMG's hierarchy: built at the first call, then rebuilt or reused
+  if (pc->setupcalled && !pc->reusepreconditioner && pc->pmat) { // will PCSetUp rebuild?
+    PetscObjectState state;
+    PetscCall(PetscObjectStateGet((PetscObject)pc->pmat, &state));
+    if (state != pc->matstate) PetscCall(RestoreGAMGOwn(pc, c));
+  }
+  // PCGAMG's hierarchy, built at the first call, then rebuilt (the PC's operator changed) or reused,
+  // here rather than in KSPSolve: after a KSP's first solve KSPSetUp leaves the PC to KSPSolve
+  PetscCall(KSPSetUp(ksp));
+  PetscCall(PCSetUp(pc));
   PetscCall(PCMGGetLevels(pc, &nlev));
   if ((PetscInt)c->copy.size() != nlev) {
     PetscCall(GAMGSmootherCopiesDestroy(c));
     c->enabled = true;
-    c->source.assign(nlev, nullptr);
-    c->copy.assign(nlev, nullptr);
-    c->source_state.assign(nlev, 0);
-    c->interp_copy.assign(nlev, nullptr);
-    c->restrict_copy.assign(nlev, nullptr);
-    // GAMG would build the next hierarchy from the interpolation it finds in PCMG: keep its own then
-    PetscBool   reuse = PETSC_FALSE;
-    const char *prefix;
-    PetscCall(PCGetOptionsPrefix(pc, &prefix));
-    PetscCall(PetscOptionsGetBool(nullptr, prefix, "-pc_gamg_reuse_interpolation", &reuse, nullptr));
-    c->transfers = !reuse;
+    for (std::vector<Mat> *v : {&c->source, &c->copy, &c->interp_source, &c->interp_copy, &c->restrict_copy})
+      v->assign(nlev, nullptr);
+    for (std::vector<PetscObjectState> *v : {&c->source_state, &c->source_nzstate, &c->interp_state})
+      v->assign(nlev, 0);
   }
+  // A level's operator or transfer is copied when it serves its second solve: with the hierarchy reused
+  // (-ksp_reuse_preconditioner) from the second solve on; rebuilt at every solve without reusing its
+  // interpolation, GAMG's new coarse levels and transfers are not copied at all (copying them at every
+  // set-up cost more than it saved), while the fine operator, the same Mat refilled, is.
   for (PetscInt l = 1; l < nlev; ++l) {
-    KSP       down, up;
-    Mat       Amat;
-    PetscBool supported;
-    // (PCMGGetSmootherUp would make a distinct post-smoother, without the pre-smoother's options)
-    down = ((PC_MG *)pc->data)->levels[l]->smoothd;
-    up   = ((PC_MG *)pc->data)->levels[l]->smoothu;
+    KSP              down, up;
+    Mat              Amat;
+    PetscBool        supported;
+    PetscObjectState nz, state;
+    LevelSmoothers(pc, l, &down, &up);
     PetscCall(KSPGetOperators(down, &Amat, nullptr));
-    if (Amat != c->copy[l]) { // GAMG (re)built this level: a new copy of its operator
-      PetscCall(SmootherCopySupported(Amat, &supported));
-      if (!supported) continue;
+    if (c->copy[l] && Amat == c->copy[l]) { // installed: refilled when the operator's values changed
+      PetscCall(PetscObjectStateGet((PetscObject)c->source[l], &state));
+      if (state == c->source_state[l]) continue;
+      PetscCall(SmootherCopyRefill(c->source[l], &c->copy[l]));
+      c->source_state[l] = state;
+      continue;
+    }
+    PetscCall(SmootherCopySupported(Amat, &supported));
+    if (!supported) continue;
+    PetscCall(MatGetNonzeroState(Amat, &nz));
+    if (Amat != c->source[l] || nz != c->source_nzstate[l]) { // a new operator: remembered
       PetscCall(MatDestroy(&c->copy[l]));
       PetscCall(MatDestroy(&c->source[l]));
       PetscCall(PetscObjectReference((PetscObject)Amat));
-      c->source[l] = Amat;
-      PetscCall(SmootherCopyRefill(Amat, &c->copy[l]));
-      PetscCall(KSPSetOperators(down, c->copy[l], c->copy[l]));
-      if (up != down) PetscCall(KSPSetOperators(up, c->copy[l], c->copy[l]));
-      PetscCall(PCMGSetResidual(pc, l, PCMGResidualDefault, c->copy[l]));
-    } else {
-      PetscObjectState state;
-      PetscCall(PetscObjectStateGet((PetscObject)c->source[l], &state));
-      if (state == c->source_state[l]) continue; // a reused coarse level: unchanged
-      PetscCall(SmootherCopyRefill(c->source[l], &c->copy[l]));
+      c->source[l]         = Amat;
+      c->source_nzstate[l] = nz;
+      continue;
     }
-    PetscCall(PetscObjectStateGet((PetscObject)c->source[l], &c->source_state[l]));
+    // the same operator (and pattern) for another solve: its copy, made or refilled, goes in
+    PetscCall(PetscObjectStateGet((PetscObject)Amat, &state));
+    if (!c->copy[l] || state != c->source_state[l]) PetscCall(SmootherCopyRefill(Amat, &c->copy[l]));
+    c->source_state[l] = state;
+    PetscCall(InstallLevel(pc, l, c->copy[l]));
   }
-  if (!c->transfers) PetscFunctionReturn(0);
   for (PetscInt l = 1; l < nlev; ++l) { // the transfers into level l
-    Mat       P, R;
-    PetscBool aij;
+    Mat              P, R;
+    PetscBool        aij;
+    PetscObjectState state;
     PetscCall(PCMGGetInterpolation(pc, l, &P));
-    if (P == c->interp_copy[l]) continue;
+    if (c->interp_copy[l] && P == c->interp_copy[l]) continue;
     PetscCall(PetscObjectTypeCompare((PetscObject)P, MATSEQAIJ, &aij));
     if (!aij) continue;
-    PetscCall(MatDestroy(&c->interp_copy[l]));
-    PetscCall(MatDestroy(&c->restrict_copy[l]));
-    PetscCall(RefillFromAIJ(P, PETSC_FALSE, &c->interp_copy[l]));
-    PetscCall(MatTranspose(P, MAT_INITIAL_MATRIX, &R)); // restriction by products, not transposed ones
-    PetscCall(RefillFromAIJ(R, PETSC_FALSE, &c->restrict_copy[l]));
-    PetscCall(MatDestroy(&R));
+    PetscCall(PetscObjectStateGet((PetscObject)P, &state));
+    if (P != c->interp_source[l]) { // a new interpolation: remembered
+      PetscCall(MatDestroy(&c->interp_copy[l]));
+      PetscCall(MatDestroy(&c->restrict_copy[l]));
+      PetscCall(MatDestroy(&c->interp_source[l]));
+      PetscCall(PetscObjectReference((PetscObject)P));
+      c->interp_source[l] = P;
+      c->interp_state[l]  = state;
+      continue;
+    }
+    if (!c->interp_copy[l] || state != c->interp_state[l]) { // made, or made again for new values
+      PetscCall(MatDestroy(&c->interp_copy[l]));
+      PetscCall(MatDestroy(&c->restrict_copy[l]));
+      PetscCall(RefillFromAIJ(P, PETSC_FALSE, &c->interp_copy[l]));
+      PetscCall(MatTranspose(P, MAT_INITIAL_MATRIX, &R)); // restriction by products, not transposed ones
+      PetscCall(RefillFromAIJ(R, PETSC_FALSE, &c->restrict_copy[l]));
+      PetscCall(MatDestroy(&R));
+      c->interp_state[l] = state;
+    }
     PetscCall(PCMGSetInterpolation(pc, l, c->interp_copy[l]));
     PetscCall(PCMGSetRestriction(pc, l, c->restrict_copy[l]));
   }
@@ -229,6 +297,7 @@ PetscErrorCode GAMGSmootherCopiesDestroy(GAMGSmootherCopies *c)
   for (Mat &m : c->copy) PetscCall(MatDestroy(&m));
   for (Mat &m : c->source) PetscCall(MatDestroy(&m));
   for (Mat &m : c->interp_copy) PetscCall(MatDestroy(&m));
+  for (Mat &m : c->interp_source) PetscCall(MatDestroy(&m));
   for (Mat &m : c->restrict_copy) PetscCall(MatDestroy(&m));
   *c = GAMGSmootherCopies{};
   PetscFunctionReturn(0);

@@ -23,17 +23,21 @@ PetscErrorCode SmootherCopySupported(Mat A, PetscBool *supported);
 
 // -gamg_smoother_precision single: after PCGAMG has built its hierarchy, every level but the coarsest
 // smooths and computes its residual on a copy of its operator, and interpolates and restricts through
-// copies of the transfers; the copies follow the operators (the
-// fine one is refilled with each new set of values, a level that GAMG rebuilt gets a new copy).
+// copies of the transfers. An operator or transfer is copied once it serves a second solve (a reused
+// hierarchy: from the second solve on; one GAMG rebuilds at every solve keeps its own, except the fine
+// operator, which is the same Mat refilled); a copy is refilled when its operator's values change.
 // Levels whose operator SmootherCopyRefill cannot take (MPIAIJ coarse levels on more ranks) keep it.
 struct GAMGSmootherCopies {
-  bool                          enabled = false;
-  std::vector<Mat>              source, copy; // per PCMG level (0, the coarsest, is solved directly)
-  std::vector<PetscObjectState> source_state; // source's state when copy was last refilled
+  bool             enabled = false;
+  std::vector<Mat> source, copy; // per PCMG level (0, the coarsest, is solved directly)
+  // source: the level's operator as GAMG handed it over (copied when it comes again)
+  std::vector<PetscObjectState> source_state;   // source's state when copy was last refilled
+  std::vector<PetscObjectState> source_nzstate; // source's nonzero state when copy was made
   // the transfers into each level (SeqAIJ from GAMG): P and R = P^T as single-precision binbcsr, so
-  // that restriction is a product too; not with -pc_gamg_reuse_interpolation (GAMG rebuilds from P)
-  bool             transfers = true;
-  std::vector<Mat> interp_copy, restrict_copy;
+  // that restriction is a product too. interp_source: GAMG's P, handed back before a set-up that
+  // rebuilds the hierarchy (as the levels' own operators are), which reuses it
+  std::vector<Mat>              interp_copy, restrict_copy, interp_source;
+  std::vector<PetscObjectState> interp_state; // interp_source's state when its copies were made
 };
 
 // Reads -gamg_smoother_precision (double, the default, or single).
