@@ -14,7 +14,9 @@
 #include <string>
 #include <unistd.h>
 #if defined(__x86_64__) || defined(__i386__)
+  #include <cpuid.h>
   #include <emmintrin.h>
+  #include <immintrin.h>
 #endif
 
 namespace binbcsr {
@@ -78,14 +80,39 @@ inline long last_level_cache_bytes()
   return bytes;
 }
 
-/* Writes back and drops the cache lines of [p, p + bytes) from every cache level (clflush, part of
-   SSE2, so of every x86-64), so that the next pass reads them from memory. A no-op elsewhere. */
+#if defined(__x86_64__) || defined(__i386__)
+/* clflushopt (CPUID.7.0:EBX bit 23): clflush's weakly ordered form, whose flushes overlap. */
+inline bool has_clflushopt()
+{
+  static const bool has = [] {
+    unsigned a, b, c, d;
+    return __get_cpuid_count(7, 0, &a, &b, &c, &d) && ((b >> 23) & 1u);
+  }();
+  return has;
+}
+
+__attribute__((target("clflushopt"))) inline void flush_lines_opt(const char *c, size_t bytes)
+{
+  for (size_t i = 0; i < bytes; i += 64) _mm_clflushopt((void *)(c + i));
+  _mm_clflushopt((void *)(c + bytes - 1));
+}
+#endif
+
+/* Writes back and drops the cache lines of [p, p + bytes) from every cache level, so that the next
+   pass reads them from memory. clflushopt where the CPU has it: each clflush waits for the one before,
+   and on a Xeon VM (family 6 model 207) flushing a 24 MB tuning sample before each of 22 timed
+   products took 1.6 s against 49 ms of products. clflush (SSE2, every x86-64) otherwise; a no-op
+   off x86. */
 inline void evict_from_caches(const void *p, size_t bytes)
 {
 #if defined(__x86_64__) || defined(__i386__)
+  if (!bytes) return;
   const char *c = (const char *)p;
-  for (size_t i = 0; i < bytes; i += 64) _mm_clflush(c + i);
-  if (bytes) _mm_clflush(c + bytes - 1);
+  if (has_clflushopt()) flush_lines_opt(c, bytes);
+  else {
+    for (size_t i = 0; i < bytes; i += 64) _mm_clflush(c + i);
+    _mm_clflush(c + bytes - 1);
+  }
   _mm_mfence();
 #else
   (void)p;
