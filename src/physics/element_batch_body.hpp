@@ -113,8 +113,6 @@ template <int N> inline void stage_batch(const Batch<N> &b, int j, Stage<N> &st)
 
 // Group g's write-out: each of its COO blocks gets the sum of its terms (stored where the group is the
 // first to write the block, added otherwise).
-// Group g's write-out: each of its COO blocks gets the sum of its terms (stored where the group is the
-// first to write the block, added otherwise).
 template <int N> inline void write_group(const ElementBatchArgs &a, std::size_t g, const Stage<N> &st)
 {
   // (Locals: the stores into the values may alias anything, so fields of `a` would be read again.)
