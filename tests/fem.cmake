@@ -46,9 +46,10 @@ fem_test(fem_gamg_rigid_body_modes 0 "cg_its=(1[0-9]|2[0-5])[. ].*status=ok" ${F
 fem_test(fem_mpi2_gamg_rigid_body_modes 0 "ranks=2 .*cg_its=(1[0-9]|2[0-5])[. ].*status=ok" ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_BEAM_GAMG})
 set_tests_properties(fem_mpi2_gamg_rigid_body_modes PROPERTIES LABELS "fem;mpi")
 # -gamg_smoother_precision single: GAMG's levels smooth, compute residuals and transfer on single-precision
-# binbcsr copies; the outer CG on the operator reaches the same answer in the same iterations. On 2 ranks the
-# fine level has its copy (binbcsr) and the MPIAIJ coarse levels keep theirs. An aij fine operator is copied
-# too (one rank).
+# binbcsr copies; the outer CG on the operator reaches the same answer in the same iterations. An aij fine
+# operator is copied too (one rank). On 2 ranks the levels are copied (MPIAIJ ones into mpibinbcsr) where
+# every rank holds rows of them (the beam's coarse level lives on one rank and keeps its operator; the
+# 24 x 5 x 5 box has one copied on both), and the transfers stay GAMG's.
 set(FEM_SUMMARY_SAME ${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_same.sh)
 set(FEM_SUMMARY_CHECK ${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_check.sh)
 string(REPLACE ";" " " FEM_BEAM_GAMG_STR "${FEM_BEAM_GAMG}")
@@ -63,12 +64,19 @@ set_tests_properties(fem_gamg_single_smoothers_same_answer PROPERTIES LABELS "fe
 add_test(NAME fem_gamg_single_smoothers_used
          COMMAND ${FEM_SUMMARY_CHECK} "smoother_copies==2 && transfer_copies==2 && status==\"ok\""
                  -- ${FEM} ${FEM_BEAM_GAMG} -gamg_smoother_precision single)
-add_test(NAME fem_mpi2_gamg_single_smoothers_fine_only
+add_test(NAME fem_mpi2_gamg_single_smoothers_one_rank_level_kept
          COMMAND ${FEM_SUMMARY_CHECK} "smoother_copies==1 && transfer_copies==0 && status==\"ok\""
                  -- ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_BEAM_GAMG} -gamg_smoother_precision single)
-set_tests_properties(fem_gamg_single_smoothers_used fem_mpi2_gamg_single_smoothers_fine_only PROPERTIES LABELS "fem"
-                     TIMEOUT 60 WORKING_DIRECTORY ${FEM_SRC})
-set_tests_properties(fem_mpi2_gamg_single_smoothers_fine_only PROPERTIES LABELS "fem;mpi" PROCESSORS 2)
+set(FEM_BOX_GAMG -mesh_box 1,0.2,0.2,24,5,5 -fix xmin -steps 3 -fem_quiet -mat_type binbcsr -ksp_type cg -pc_type gamg
+    -ksp_rtol 1e-8)
+string(REPLACE ";" " " FEM_BOX_GAMG_STR "${FEM_BOX_GAMG}")
+add_test(NAME fem_mpi2_gamg_single_smoothers_mpiaij_same_answer
+         COMMAND sh -c "${FEM_SUMMARY_SAME} 'cg_its:1 tip_dz:1e-9 kinetic:1e-9' 1e-5 '${FEM_MPIEXEC_STR} -n 2 ${FEM} ${FEM_BOX_GAMG_STR}' '${FEM_MPIEXEC_STR} -n 2 ${FEM} ${FEM_BOX_GAMG_STR} -gamg_smoother_precision single' && ${FEM_SUMMARY_CHECK} 'smoother_copies==2 && status==\"ok\"' -- ${FEM_MPIEXEC_STR} -n 2 ${FEM} ${FEM_BOX_GAMG_STR} -gamg_smoother_precision single")
+set_tests_properties(fem_gamg_single_smoothers_used fem_mpi2_gamg_single_smoothers_one_rank_level_kept
+                     fem_mpi2_gamg_single_smoothers_mpiaij_same_answer PROPERTIES LABELS "fem" TIMEOUT 60
+                     WORKING_DIRECTORY ${FEM_SRC})
+set_tests_properties(fem_mpi2_gamg_single_smoothers_one_rank_level_kept
+                     fem_mpi2_gamg_single_smoothers_mpiaij_same_answer PROPERTIES LABELS "fem;mpi" PROCESSORS 2)
 fem_test(fem_gamg_bad_smoother_precision nonzero "Unknown option half for -gamg_smoother_precision" ${FEM} ${FEM_BEAM_GAMG}
          -gamg_smoother_precision half)
 # -fem_initial_guess linear|quadratic: the solve starts from dv extrapolated from the last two or three

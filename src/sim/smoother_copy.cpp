@@ -16,17 +16,27 @@ PetscErrorCode IsBinBCSR(Mat A, PetscBool *binbcsr)
   PetscFunctionReturn(0);
 }
 
-// A single-precision binbcsr for the scalar COO list (i, j) of an m x n operator (block size 3 where m
-// and n allow, else 1), upper-triangle storage if `upper`, its values to come in the list's order.
+// A single-precision binbcsr on comm for the scalar COO list (i, j) (global indices) of an operator
+// with A's row and column layout (block size 3 where every rank's share allows, else 1), upper-triangle
+// storage if `upper`, its values to come in the list's order.
 // (PETSc 3.18's MatSetPreallocationCOO may reorder the lists it is given: they are the callee's.)
-PetscErrorCode CreateSingle(PetscInt m, PetscInt n, PetscBool upper, std::vector<PetscInt> i,
-                            std::vector<PetscInt> j, Mat *copy)
+PetscErrorCode CreateSingle(Mat A, PetscBool upper, std::vector<PetscInt> i, std::vector<PetscInt> j,
+                            Mat *copy)
 {
+  MPI_Comm comm;
+  PetscInt m, n, M, N;
+  int      by3, all_by3;
+
   PetscFunctionBegin;
-  PetscCall(MatCreate(PETSC_COMM_SELF, copy));
-  PetscCall(MatSetSizes(*copy, m, n, m, n));
-  PetscCall(MatSetBlockSize(*copy, m % 3 == 0 && n % 3 == 0 ? 3 : 1));
-  PetscCall(MatSetType(*copy, MATSEQBINBCSR));
+  PetscCall(PetscObjectGetComm((PetscObject)A, &comm));
+  PetscCall(MatGetLocalSize(A, &m, &n));
+  PetscCall(MatGetSize(A, &M, &N));
+  by3 = m % 3 == 0 && n % 3 == 0;
+  PetscCallMPI(MPI_Allreduce(&by3, &all_by3, 1, MPI_INT, MPI_LAND, comm));
+  PetscCall(MatCreate(comm, copy));
+  PetscCall(MatSetSizes(*copy, m, n, M, N));
+  PetscCall(MatSetBlockSize(*copy, all_by3 ? 3 : 1));
+  PetscCall(MatSetType(*copy, MATBINBCSR));
   if (upper) PetscCall(MatBinBCSRSetSymmetricStorage(*copy, PETSC_TRUE));
   PetscCall(MatBinBCSRSetPrecision(*copy, MAT_BINBCSR_PRECISION_SINGLE));
   PetscCall(MatSetPreallocationCOO(*copy, (PetscCount)i.size(), i.data(), j.data()));
@@ -54,7 +64,7 @@ PetscErrorCode RefillFromBAIJ(Mat A, Mat *copy)
         for (PetscInt c = 0; c < bs; ++c) // BAIJ blocks are column-major
           for (PetscInt r = 0; r < bs; ++r) i.push_back(bs * br + r), j.push_back(bs * ja[k] + c);
     PetscCall(MatRestoreRowIJ(A, 0, PETSC_FALSE, PETSC_TRUE, &nb, &ia, &ja, &done));
-    PetscCall(CreateSingle(m, m, PETSC_TRUE, i, j, copy));
+    PetscCall(CreateSingle(A, PETSC_TRUE, i, j, copy));
   }
   PetscScalar *a;
   PetscCall(MatSeqBAIJGetArray(A, &a));
@@ -79,12 +89,43 @@ PetscErrorCode RefillFromAIJ(Mat A, PetscBool upper, Mat *copy)
       for (PetscInt k = 0; k < ncols; ++k) i.push_back(r), j.push_back(cols[k]);
       PetscCall(MatRestoreRow(A, r, &ncols, &cols, nullptr));
     }
-    PetscCall(CreateSingle(m, n, upper, i, j, copy));
+    PetscCall(CreateSingle(A, upper, i, j, copy));
   }
   const PetscScalar *a;
   PetscCall(MatSeqAIJGetArrayRead(A, &a));
   PetscCall(MatSetValuesCOO(*copy, a, INSERT_VALUES));
   PetscCall(MatSeqAIJRestoreArrayRead(A, &a));
+  PetscFunctionReturn(0);
+}
+
+// MPIAIJ (PCGAMG's levels on more ranks), symmetric: this rank's rows through MatGetRow (global
+// columns, the same order at every call), into upper-triangle storage.
+PetscErrorCode RefillFromMPIAIJ(Mat A, Mat *copy)
+{
+  PetscInt                 r0, r1;
+  std::vector<PetscScalar> v;
+
+  PetscFunctionBegin;
+  PetscCall(MatGetOwnershipRange(A, &r0, &r1));
+  if (!*copy) {
+    std::vector<PetscInt> i, j;
+    for (PetscInt r = r0; r < r1; ++r) {
+      PetscInt        ncols;
+      const PetscInt *cols;
+      PetscCall(MatGetRow(A, r, &ncols, &cols, nullptr));
+      for (PetscInt k = 0; k < ncols; ++k) i.push_back(r), j.push_back(cols[k]);
+      PetscCall(MatRestoreRow(A, r, &ncols, &cols, nullptr));
+    }
+    PetscCall(CreateSingle(A, PETSC_TRUE, i, j, copy));
+  }
+  for (PetscInt r = r0; r < r1; ++r) {
+    PetscInt           ncols;
+    const PetscScalar *vals;
+    PetscCall(MatGetRow(A, r, &ncols, nullptr, &vals));
+    v.insert(v.end(), vals, vals + ncols);
+    PetscCall(MatRestoreRow(A, r, &ncols, nullptr, &vals));
+  }
+  PetscCall(MatSetValuesCOO(*copy, v.data(), INSERT_VALUES));
   PetscFunctionReturn(0);
 }
 
@@ -95,12 +136,26 @@ PetscErrorCode SmootherCopySupported(Mat A, PetscBool *supported)
   PetscFunctionBegin;
   PetscCall(IsBinBCSR(A, supported));
   if (!*supported) PetscCall(PetscObjectTypeCompareAny((PetscObject)A, supported, MATSEQAIJ, MATSEQBAIJ, ""));
+  if (!*supported) { // MPIAIJ where every rank holds rows (GAMG may leave a coarse level to fewer ranks)
+    PetscBool mpiaij;
+    PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIAIJ, &mpiaij));
+    if (mpiaij) {
+      MPI_Comm comm;
+      PetscInt m;
+      int      rows, min_rows;
+      PetscCall(PetscObjectGetComm((PetscObject)A, &comm));
+      PetscCall(MatGetLocalSize(A, &m, nullptr));
+      rows = m > 0;
+      PetscCallMPI(MPI_Allreduce(&rows, &min_rows, 1, MPI_INT, MPI_MIN, comm));
+      *supported = min_rows ? PETSC_TRUE : PETSC_FALSE;
+    }
+  }
   PetscFunctionReturn(0);
 }
 
 PetscErrorCode SmootherCopyRefill(Mat A, Mat *copy)
 {
-  PetscBool binbcsr, aij, baij;
+  PetscBool binbcsr, aij, baij, mpiaij;
 
   PetscFunctionBegin;
   PetscCall(IsBinBCSR(A, &binbcsr));
@@ -114,13 +169,15 @@ PetscErrorCode SmootherCopyRefill(Mat A, Mat *copy)
   }
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATSEQBAIJ, &baij));
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATSEQAIJ, &aij));
+  PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIAIJ, &mpiaij));
   if (baij) PetscCall(RefillFromBAIJ(A, copy));
   else if (aij) PetscCall(RefillFromAIJ(A, PETSC_TRUE, copy));
+  else if (mpiaij) PetscCall(RefillFromMPIAIJ(A, copy));
   else {
     MatType type;
     PetscCall(MatGetType(A, &type));
     SETERRQ(PetscObjectComm((PetscObject)A), PETSC_ERR_SUP,
-            "single-precision smoother copies take binbcsr, seqaij or seqbaij level operators, not %s", type);
+            "single-precision smoother copies take binbcsr, aij or seqbaij level operators, not %s", type);
   }
   PetscFunctionReturn(0);
 }

@@ -13,9 +13,9 @@
 #include <vector>
 
 // The copy `*copy` of level operator A, made on the first call (*copy null) and refilled in place
-// after (same pattern). A may be binbcsr (any communicator; duplicated, values converted), SeqBAIJ or
-// SeqAIJ (read through a COO list into symmetric-storage binbcsr: A must be symmetric, which a Galerkin
-// product of a symmetric operator is). Other types: PETSC_ERR_SUP naming the type.
+// after (same pattern). A may be binbcsr (any communicator; duplicated, values converted), SeqBAIJ,
+// SeqAIJ or MPIAIJ (read through a COO list into symmetric-storage binbcsr: A must be symmetric, which a
+// Galerkin product of a symmetric operator is). Other types: PETSC_ERR_SUP naming the type.
 PetscErrorCode SmootherCopyRefill(Mat A, Mat *copy);
 
 // Whether SmootherCopyRefill takes A.
@@ -26,7 +26,8 @@ PetscErrorCode SmootherCopySupported(Mat A, PetscBool *supported);
 // copies of the transfers. An operator or transfer is copied once it serves a second solve (a reused
 // hierarchy: from the second solve on; one GAMG rebuilds at every solve keeps its own, except the fine
 // operator, which is the same Mat refilled); a copy is refilled when its operator's values change.
-// Levels whose operator SmootherCopyRefill cannot take (MPIAIJ coarse levels on more ranks) keep it.
+// Levels whose operator SmootherCopyRefill cannot take keep it (an MPIAIJ level some rank holds no rows
+// of), and so do transfers that are not SeqAIJ (on more ranks).
 struct GAMGSmootherCopies {
   bool             enabled = false;
   std::vector<Mat> source, copy; // per PCMG level (0, the coarsest, is solved directly)
