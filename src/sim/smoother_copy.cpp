@@ -73,51 +73,50 @@ PetscErrorCode RefillFromBAIJ(Mat A, Mat *copy)
   PetscFunctionReturn(0);
 }
 
-// SeqAIJ (PCGAMG's coarse levels and transfers): the COO list in the order of the CSR value array;
-// `upper` for a symmetric level operator.
+// The copy of an AIJ matrix (seq or MPI), made from this rank's rows through MatGetRow (global columns;
+// AIJ's MatGetRowIJ hands i-node matrices out compressed or not at all); `upper` for a symmetric level
+// operator, whole storage for a transfer.
+PetscErrorCode CreateFromAIJRows(Mat A, PetscBool upper, Mat *copy)
+{
+  PetscInt              r0, r1;
+  std::vector<PetscInt> i, j;
+
+  PetscFunctionBegin;
+  PetscCall(MatGetOwnershipRange(A, &r0, &r1));
+  for (PetscInt r = r0; r < r1; ++r) {
+    PetscInt        ncols;
+    const PetscInt *cols;
+    PetscCall(MatGetRow(A, r, &ncols, &cols, nullptr));
+    for (PetscInt k = 0; k < ncols; ++k) i.push_back(r), j.push_back(cols[k]);
+    PetscCall(MatRestoreRow(A, r, &ncols, &cols, nullptr));
+  }
+  PetscCall(CreateSingle(A, upper, i, j, copy));
+  PetscFunctionReturn(0);
+}
+
+// SeqAIJ (PCGAMG's coarse levels and transfers): values from the CSR array, in MatGetRow's order.
 PetscErrorCode RefillFromAIJ(Mat A, PetscBool upper, Mat *copy)
 {
-  PetscFunctionBegin;
-  if (!*copy) { // (MatGetRow: AIJ's MatGetRowIJ hands i-node matrices out compressed or not at all)
-    PetscInt              m, n;
-    std::vector<PetscInt> i, j;
-    PetscCall(MatGetSize(A, &m, &n));
-    for (PetscInt r = 0; r < m; ++r) {
-      PetscInt        ncols;
-      const PetscInt *cols;
-      PetscCall(MatGetRow(A, r, &ncols, &cols, nullptr));
-      for (PetscInt k = 0; k < ncols; ++k) i.push_back(r), j.push_back(cols[k]);
-      PetscCall(MatRestoreRow(A, r, &ncols, &cols, nullptr));
-    }
-    PetscCall(CreateSingle(A, upper, i, j, copy));
-  }
   const PetscScalar *a;
+
+  PetscFunctionBegin;
+  if (!*copy) PetscCall(CreateFromAIJRows(A, upper, copy));
   PetscCall(MatSeqAIJGetArrayRead(A, &a));
   PetscCall(MatSetValuesCOO(*copy, a, INSERT_VALUES));
   PetscCall(MatSeqAIJRestoreArrayRead(A, &a));
   PetscFunctionReturn(0);
 }
 
-// MPIAIJ (PCGAMG's levels on more ranks), symmetric: this rank's rows through MatGetRow (global
-// columns, the same order at every call), into upper-triangle storage.
+// MPIAIJ (PCGAMG's levels on more ranks), symmetric: values row by row through MatGetRow (the same
+// order at every call), into upper-triangle storage.
 PetscErrorCode RefillFromMPIAIJ(Mat A, Mat *copy)
 {
   PetscInt                 r0, r1;
   std::vector<PetscScalar> v;
 
   PetscFunctionBegin;
+  if (!*copy) PetscCall(CreateFromAIJRows(A, PETSC_TRUE, copy));
   PetscCall(MatGetOwnershipRange(A, &r0, &r1));
-  if (!*copy) {
-    std::vector<PetscInt> i, j;
-    for (PetscInt r = r0; r < r1; ++r) {
-      PetscInt        ncols;
-      const PetscInt *cols;
-      PetscCall(MatGetRow(A, r, &ncols, &cols, nullptr));
-      for (PetscInt k = 0; k < ncols; ++k) i.push_back(r), j.push_back(cols[k]);
-      PetscCall(MatRestoreRow(A, r, &ncols, &cols, nullptr));
-    }
-    PetscCall(CreateSingle(A, PETSC_TRUE, i, j, copy));
-  }
   for (PetscInt r = r0; r < r1; ++r) {
     PetscInt           ncols;
     const PetscScalar *vals;
