@@ -48,8 +48,8 @@ set_tests_properties(fem_mpi2_gamg_rigid_body_modes PROPERTIES LABELS "fem;mpi")
 # -gamg_smoother_precision single: GAMG's levels smooth, compute residuals and transfer on single-precision
 # binbcsr copies; the outer CG on the operator reaches the same answer in the same iterations. An aij fine
 # operator is copied too (one rank). On 2 ranks the levels are copied (MPIAIJ ones into mpibinbcsr) where
-# every rank holds rows of them (the beam's coarse level lives on one rank and keeps its operator; the
-# 24 x 5 x 5 box has one copied on both), and the transfers stay GAMG's.
+# every rank holds rows of them (the beam's coarse level, put on one rank by -pc_gamg_process_eq_limit,
+# keeps its operator; the 24 x 5 x 5 box has one copied on both), and the transfers stay GAMG's.
 set(FEM_SUMMARY_SAME ${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_same.sh)
 set(FEM_SUMMARY_CHECK ${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_check.sh)
 string(REPLACE ";" " " FEM_BEAM_GAMG_STR "${FEM_BEAM_GAMG}")
@@ -66,7 +66,8 @@ add_test(NAME fem_gamg_single_smoothers_used
                  -- ${FEM} ${FEM_BEAM_GAMG} -gamg_smoother_precision single)
 add_test(NAME fem_mpi2_gamg_single_smoothers_one_rank_level_kept
          COMMAND ${FEM_SUMMARY_CHECK} "smoother_copies==1 && transfer_copies==0 && status==\"ok\""
-                 -- ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_BEAM_GAMG} -gamg_smoother_precision single)
+                 -- ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_BEAM_GAMG} -gamg_smoother_precision single
+                 -pc_gamg_process_eq_limit 2000)
 set(FEM_BOX_GAMG -mesh_box 1,0.2,0.2,24,5,5 -fix xmin -steps 3 -fem_quiet -mat_type binbcsr -ksp_type cg -pc_type gamg
     -ksp_rtol 1e-8)
 string(REPLACE ";" " " FEM_BOX_GAMG_STR "${FEM_BOX_GAMG}")
