@@ -140,14 +140,15 @@ PetscErrorCode ExtrapolateGuess(FemSimulation *sim)
   PetscFunctionBegin;
   if (sim->guess_order <= 0 || sim->dv_solved == 0 || sim->is_static) PetscFunctionReturn(0); // (Newton: dx)
   std::vector<double> &dv = sim->dv_local, &b1 = sim->dv_before[0], &b2 = sim->dv_before[1];
-  std::vector<double>  last  = dv;
   const int            order = std::min(sim->guess_order, sim->dv_solved - 1); // what the history allows
-  if (order == 1)
-    for (size_t k = 0; k < dv.size(); ++k) dv[k] = 2 * last[k] - b1[k];
-  else if (order == 2)
-    for (size_t k = 0; k < dv.size(); ++k) dv[k] = 3 * (last[k] - b1[k]) + b2[k];
-  std::swap(b1, b2);
-  b1 = std::move(last);
+  b1.resize(dv.size());
+  b2.resize(dv.size());
+  for (size_t k = 0; k < dv.size(); ++k) { // one pass: the guess, and the history moved on
+    const double last = dv[k], before = b1[k];
+    dv[k] = order == 2 ? 3 * (last - before) + b2[k] : order == 1 ? 2 * last - before : last;
+    b2[k] = before;
+    b1[k] = last;
+  }
   PetscFunctionReturn(0);
 }
 

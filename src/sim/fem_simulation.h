@@ -60,7 +60,7 @@ struct FemSimulation {
   binbcsr::BodySet element_body = binbcsr::BodySet::Auto; // the batched loop's body set (element_batch.hpp)
   // The solve's initial guess (with a nonzero-guess KSP): the last dv (0), or extrapolated from the last
   // two (1, linear) or three (2, quadratic) dv: under smooth motion the next dv is close to that, and
-  // the solve starts closer to its answer (linear_38k, GAMG to rtol 1e-6: 16.1 -> 14.3 CG iterations)
+  // the solve starts closer to its answer (linear_38k, GAMG to rtol 1e-6: 16.1 -> 14.15 CG iterations)
   int                 guess_order = 0;
   std::vector<double> dv_before[2];  // the dv of the steps before the last one (local rows), newest first
   int                 dv_solved = 0; // solves since the start (or since a non-finite dv reset the guess)

@@ -5,8 +5,6 @@
 #include <petsc/private/pcmgimpl.h>  // the levels' smoothers as they are
 #include <petsc/private/petscimpl.h> // PetscObjectStateGet
 
-#include <cstring>
-
 namespace {
 
 PetscErrorCode IsBinBCSR(Mat A, PetscBool *binbcsr)
@@ -48,11 +46,10 @@ PetscErrorCode RefillFromBAIJ(Mat A, Mat *copy)
 {
   PetscFunctionBegin;
   if (!*copy) {
-    PetscInt        bs, m, nb;
+    PetscInt        bs, nb;
     const PetscInt *ia, *ja;
     PetscBool       done;
     PetscCall(MatGetBlockSize(A, &bs));
-    PetscCall(MatGetSize(A, &m, nullptr));
     PetscCall(MatGetRowIJ(A, 0, PETSC_FALSE, PETSC_TRUE, &nb, &ia, &ja, &done)); // block rows
     PetscCheck(done, PETSC_COMM_SELF, PETSC_ERR_SUP,
                "SmootherCopyRefill: no row structure from this BAIJ matrix");
@@ -208,6 +205,16 @@ void LevelSmoothers(PC pc, PetscInt l, KSP *down, KSP *up)
   *up   = ((PC_MG *)pc->data)->levels[l]->smoothu;
 }
 
+// *held <- A, referenced (the one held before released).
+PetscErrorCode Hold(Mat A, Mat *held)
+{
+  PetscFunctionBegin;
+  PetscCall(PetscObjectReference((PetscObject)A));
+  PetscCall(MatDestroy(held));
+  *held = A;
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode InstallLevel(PC pc, PetscInt l, Mat A)
 {
   KSP down, up;
@@ -295,9 +302,7 @@ PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
     PetscCall(MatGetNonzeroState(Amat, &nz));
     if (Amat != c->source[l] || nz != c->source_nzstate[l]) { // a new operator: remembered
       PetscCall(MatDestroy(&c->copy[l]));
-      PetscCall(MatDestroy(&c->source[l]));
-      PetscCall(PetscObjectReference((PetscObject)Amat));
-      c->source[l]         = Amat;
+      PetscCall(Hold(Amat, &c->source[l]));
       c->source_nzstate[l] = nz;
       continue;
     }
@@ -319,10 +324,8 @@ PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
     if (P != c->interp_source[l]) { // a new interpolation: remembered
       PetscCall(MatDestroy(&c->interp_copy[l]));
       PetscCall(MatDestroy(&c->restrict_copy[l]));
-      PetscCall(MatDestroy(&c->interp_source[l]));
-      PetscCall(PetscObjectReference((PetscObject)P));
-      c->interp_source[l] = P;
-      c->interp_state[l]  = state;
+      PetscCall(Hold(P, &c->interp_source[l]));
+      c->interp_state[l] = state;
       continue;
     }
     if (!c->interp_copy[l] || state != c->interp_state[l]) { // made, or made again for new values
