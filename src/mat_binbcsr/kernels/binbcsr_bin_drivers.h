@@ -139,7 +139,7 @@ inline void bins_sweep(const BinMatrix &m, const int *bins, const double *x, con
   if constexpr (BS == 3 && BW == 8) {
     double(*accq[K])[8];
     for (int q = 0; q < K; q++) accq[q] = acc[q];
-    avx512::bins_mult_3x8<K>(s.t, s.c, s.len, nz, x, accq);
+    avx512::bins_mult_3x8<K>(s.t, s.c, s.len, nz, x, m.nbs, accq);
   } else
 #endif
     interleave_groups<K>(s.len, [&](int q, int k) {

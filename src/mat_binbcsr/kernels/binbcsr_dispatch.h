@@ -21,15 +21,13 @@ namespace binbcsr {
 
 /* Everything a product reads, as plain pointers (32-bit indices, as the layout). */
 struct BinMatrix {
-  const int *bin_start; /* [nbins + 1] */
-  const int *col;       /* [nslots] */
-  const int *row_nz;    /* [mbs] real blocks of each row */
-  const unsigned
-               *lane_mask; /* [nslots / bw] bit l of group g: slot g * bw + l is real (bw <= 32), else NULL */
-  const int    *diag_slot; /* [mbs] */
-  const double *val;       /* double values, or NULL */
-  const float  *valf;      /* single values, or NULL */
-  int           nbins, mbs, bs, bw, streams;
+  const int    *bin_start;                        /* [nbins + 1] */
+  const int    *col;                              /* [nslots] */
+  const int    *row_nz;                           /* [mbs] real blocks of each row */
+  const int    *diag_slot;                        /* [mbs] */
+  const double *val;                              /* double values, or NULL */
+  const float  *valf;                             /* single values, or NULL */
+  int           nbins, mbs, nbs, bs, bw, streams; /* nbs: block columns (x has nbs * bs entries) */
   bool          sym;
 };
 

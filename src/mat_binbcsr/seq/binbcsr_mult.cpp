@@ -18,6 +18,7 @@ static binbcsr::BinMatrix BinMatrixOf(const Mat_SeqBinBCSR *a)
   m.valf               = a->valf;
   m.nbins              = (int)a->nbins;
   m.mbs                = (int)a->mbs;
+  m.nbs                = (int)a->nbs;
   m.bs                 = (int)a->bs;
   m.bw                 = (int)a->bw;
   m.streams            = (int)a->streams;
