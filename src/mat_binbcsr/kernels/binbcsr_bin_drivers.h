@@ -3,7 +3,8 @@
    binbcsr_kernels.h, and the table of one body set (bodies<>) that binbcsr_dispatch.cpp picks from.
    Every body set's translation unit includes this header once, after defining BINBCSR_BODY_SET (its
    name, an inline namespace: each set gets its own symbols) and, for the AVX-512 set,
-   BINBCSR_HAND_AVX512 (the hand-written 3x3, width 8 group bodies of avx512/binbcsr_avx512.h).
+   BINBCSR_HAND_AVX512 (the hand-written 3x3, width 8 group bodies of avx512/binbcsr_avx512.h) or, for
+   the AVX2 set, BINBCSR_HAND_AVX2 (3x3 at widths 4, 8 and 16, avx2/binbcsr_avx2.h).
 */
 #ifndef BINBCSR_BIN_DRIVERS_H
 #define BINBCSR_BIN_DRIVERS_H
@@ -12,6 +13,9 @@
 #include "binbcsr_kernels.h"
 #if defined(BINBCSR_HAND_AVX512)
   #include "avx512/binbcsr_avx512.h"
+#endif
+#if defined(BINBCSR_HAND_AVX2)
+  #include "avx2/binbcsr_avx2.h"
 #endif
 #include <cstddef>
 #include <type_traits>
@@ -142,6 +146,13 @@ inline void bins_sweep(const BinMatrix &m, const int *bins, const double *x, con
     avx512::bins_mult_3x8<K>(s.t, s.c, s.len, nz, x, m.nbs, accq);
   } else
 #endif
+#if defined(BINBCSR_HAND_AVX2)
+    if constexpr (BS == 3 && (BW == 4 || BW == 8 || BW == 16)) {
+    double(*accq[K])[BW];
+    for (int q = 0; q < K; q++) accq[q] = acc[q];
+    hand4::bins_mult_3x4<K, BW>(s.t, s.c, s.len, nz, x, m.nbs, accq);
+  } else
+#endif
     interleave_groups<K>(s.len, [&](int q, int k) {
       group_mult<BS, BW, V>(s.t[q] + (size_t)k * BW * BS2, s.c[q] + (size_t)k * BW, x, acc[q], k, nz[q]);
     });
@@ -212,6 +223,11 @@ void sym_mult_fixed(const BinMatrix &m, const double *x, const double *, double 
     diagonal_groups<Kc, BW>(m, bins, kd);
 #if defined(BINBCSR_HAND_AVX512)
     if constexpr (BS == 3 && BW == 8) avx512::sym_bins_mult_3x8<Kc>(s.t, s.c, s.len, r0, m.mbs, kd, x, y);
+    else
+#endif
+#if defined(BINBCSR_HAND_AVX2)
+      if constexpr (BS == 3 && (BW == 4 || BW == 8 || BW == 16))
+      hand4::sym_bins_mult_3x4<Kc, BW>(s.t, s.c, s.len, r0, m.mbs, kd, x, y);
     else
 #endif
       sym_bins_mult<Kc, BS, BW, V, int>(s.t, s.c, s.len, r0, m.mbs, kd, x, y);
