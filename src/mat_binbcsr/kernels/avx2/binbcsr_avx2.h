@@ -4,13 +4,14 @@
    (binbcsr_avx2.cpp, compiled with -mavx2 -mfma) plugs them into the bin drivers; the portable per-lane
    kernels stay the definition, and the unit tests compare both.
 
-   Why by hand: AVX2 has no masked loads of x by lane and its gathers are slow on some cores (a Zen 3
-   core ran the compiler-vectorised body at 1.1x seqbaij in double and single alike, that is bound by
-   the gathers, not by the bytes). Where the 4 lanes of a chunk read consecutive block columns but for
+   Why by hand: GCC vectorises the portable loop with a 4-wide gather per component in every group that
+   is not exactly unit stride, and AVX2 gathers are slow on some cores (a Zen 3 core ran that body at
+   1.1x seqbaij in double and single alike, bound by the gathers, not by the bytes). Where the 4 lanes of a chunk read consecutive block columns but for
    at most two (near_unit_3x4), x_c is 12 consecutive doubles: 3 loads, 2 blends, 1 lane swap and 3
    shuffles split it into its components (split_xyz4) and the odd lanes are patched by broadcast. The
-   symmetric product updates y_c the same way (add_xyz4, the split inverted) and scatters lane by lane
-   elsewhere (AVX2 has no scatter; the colouring keeps a group's lanes on distinct columns).
+   symmetric product updates y_c the same way (add_xyz4, the split inverted). Elsewhere x_c is read lane
+   by lane, one masked load each, and transposed (slow gathers avoided), and y_c updated lane by lane
+   (AVX2 has no scatter).
 
    The helpers live in the body set's inline namespace, as everything the set compiles: another set's
    translation unit gets its own copies, never this one's AVX2 instructions.
@@ -62,6 +63,46 @@ BINBCSR_AVX2_INLINE __m256d lanes_of(unsigned m)
 
 BINBCSR_AVX2_INLINE unsigned mask_of(__m128i v) { return (unsigned)_mm_movemask_ps(_mm_castsi128_ps(v)); }
 
+/* x_c of the 4 lanes of a chunk, zero outside real, without gathers: each lane's 3 doubles by one
+   masked load (the fourth element masked off, so the last column never reads past x; a lane outside
+   real loads nothing), then a 4x4 transpose (4 unpacks, 3 lane swaps) into one register per
+   component. On a Zen 3 core three 4-wide gathers instead made the products of unstructured FE
+   matrices 1.1-1.25x slower. */
+template <typename I>
+BINBCSR_AVX2_INLINE void load_lanes_xyz4(const I *c, unsigned real, const double *x, __m256d *xc)
+{
+  const __m256i xyz = _mm256_setr_epi64x(-1, -1, -1, 0), none = _mm256_setzero_si256();
+  const __m256d r0 = _mm256_maskload_pd(x + (long)c[0] * 3, real & 1 ? xyz : none);
+  const __m256d r1 = _mm256_maskload_pd(x + (long)c[1] * 3, real & 2 ? xyz : none);
+  const __m256d r2 = _mm256_maskload_pd(x + (long)c[2] * 3, real & 4 ? xyz : none);
+  const __m256d r3 = _mm256_maskload_pd(x + (long)c[3] * 3, real & 8 ? xyz : none);
+  const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1); /* x0 x1 z0 z1, y0 y1 0 0 */
+  const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
+  xc[0] = _mm256_permute2f128_pd(t0, t2, 0x20);
+  xc[1] = _mm256_permute2f128_pd(t1, t3, 0x20);
+  xc[2] = _mm256_permute2f128_pd(t0, t2, 0x31);
+}
+
+/* y_c[l] += (s0[l], s1[l], s2[l]) for the lanes l in m, one after the other (so right even where two
+   lanes share a column): the 4x4 transpose of load_lanes_xyz4 inverted, then per lane one 2-wide and one
+   scalar read-modify-write (AVX2 has no scatter). */
+template <typename I>
+BINBCSR_AVX2_INLINE void scatter_add_xyz4(const I *c, unsigned m, const __m256d *s, double *y)
+{
+  const __m256d t0      = _mm256_unpacklo_pd(s[0], s[1]),
+                t1      = _mm256_unpackhi_pd(s[0], s[1]); /* x0 y0 x2 y2, x1 y1 x3 y3 */
+  const __m256d t2      = _mm256_unpacklo_pd(s[2], s[2]),
+                t3      = _mm256_unpackhi_pd(s[2], s[2]); /* z0 z0 z2 z2, z1 z1 z3 z3 */
+  const __m256d lane[4] = {_mm256_permute2f128_pd(t0, t2, 0x20), _mm256_permute2f128_pd(t1, t3, 0x20),
+                           _mm256_permute2f128_pd(t0, t2, 0x31), _mm256_permute2f128_pd(t1, t3, 0x31)};
+  for (; m; m &= m - 1) {
+    const int l = __builtin_ctz(m);
+    double   *p = y + (long)c[l] * 3;
+    _mm_storeu_pd(p, _mm_add_pd(_mm_loadu_pd(p), _mm256_castpd256_pd128(lane[l])));
+    _mm_store_sd(p + 2, _mm_add_sd(_mm_load_sd(p + 2), _mm256_extractf128_pd(lane[l], 1)));
+  }
+}
+
 /* Where the real lanes of a chunk read consecutive block columns but for at most two: base, the
    column of lane 0 were the chunk unit-stride (from the first real lane, or the last where the first
    is the odd one), and off, the real lanes that do not follow it. The first or last row of a grid line
@@ -86,8 +127,7 @@ BINBCSR_AVX2_INLINE bool near_unit_3x4(const I *c, __m128i ci, unsigned real, in
 }
 
 /* x_c of a chunk's lanes as one register per component, zero in the lanes outside real: loaded where
-   the chunk is near-unit (the odd lanes by broadcast), gathered with 32-bit offsets elsewhere (a masked
-   gather reads nothing for the lanes outside real). Zero, not x: a padding slot's zero value times a
+   the chunk is near-unit (the odd lanes by broadcast), lane by lane elsewhere (load_lanes_xyz4). Zero, not x: a padding slot's zero value times a
    NaN or Inf of x would be a NaN the row does not have. Returns whether the chunk was near-unit. */
 template <typename I>
 BINBCSR_AVX2_INLINE bool load_xc_3x4(const I *c, __m128i ci, unsigned real, const double *x, int ncols,
@@ -105,8 +145,7 @@ BINBCSR_AVX2_INLINE bool load_xc_3x4(const I *c, __m128i ci, unsigned real, cons
     for (int j = 0; j < 3; j++) xc[j] = _mm256_and_pd(xc[j], rm);
     return true;
   }
-  const __m128i o = _mm_add_epi32(ci, _mm_add_epi32(ci, ci)); /* 3 c */
-  for (int j = 0; j < 3; j++) xc[j] = _mm256_mask_i32gather_pd(_mm256_setzero_pd(), x + j, o, rm, 8);
+  load_lanes_xyz4(c, real, x, xc);
   return false;
 }
 
@@ -220,12 +259,7 @@ BINBCSR_AVX2_INLINE void sym_chunk_group(SymChunk3x4 &b, const V *t, const I *c,
     add_xyz4(y + (long)base * 3, _mm256_and_pd(s[0], km), _mm256_and_pd(s[1], km), _mm256_and_pd(s[2], km));
   }
   if (odd) {
-    alignas(32) double sl[3][4];
-    for (int j = 0; j < 3; j++) _mm256_store_pd(sl[j], s[j]);
-    for (unsigned m = odd; m; m &= m - 1) {
-      const int l = __builtin_ctz(m);
-      for (int j = 0; j < 3; j++) y[(long)c[l] * 3 + j] += sl[j][l];
-    }
+    scatter_add_xyz4(c, odd, s, y);
   }
 }
 
