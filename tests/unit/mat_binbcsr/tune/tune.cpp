@@ -288,7 +288,7 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
     ss << in.rdbuf();
     content = ss.str();
   }
-  CHECK(content.rfind("# petscbinbcsr tune cache v2\n", 0) == 0);
+  CHECK(content.rfind("# petscbinbcsr tune cache v3\n", 0) == 0);
   CHECK(content.find("bs 3 double whole") != std::string::npos);
   // the second matrix of the class takes the choice from the file
   Mat B = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
@@ -312,10 +312,11 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
   const std::string key =
     content.substr(content.find('\n') + 1, content.rfind('\t') - content.find('\n') - 1);
   for (const std::string bad :
-       {std::string("garbage\n\x01\x02"), std::string("# petscbinbcsr tune cache v2\n") + key + "\t7 3\n",
-        std::string("# petscbinbcsr tune cache v2\n") + key + "\t32 1\n",
-        std::string("# petscbinbcsr tune cache v2\n") + key + "\tx\n", std::string(""),
-        std::string("# petscbinbcsr tune cache v1\n") + key + "\t16 1 auto\n"}) {
+       {std::string("garbage\n\x01\x02"), std::string("# petscbinbcsr tune cache v3\n") + key + "\t7 3\n",
+        std::string("# petscbinbcsr tune cache v3\n") + key + "\t32 1\n",
+        std::string("# petscbinbcsr tune cache v3\n") + key + "\tx\n", std::string(""),
+        std::string("# petscbinbcsr tune cache v1\n") + key + "\t16 1 auto\n",
+        std::string("# petscbinbcsr tune cache v2\n") + key + "\t16 1 auto\n"}) {
     CAPTURE(bad);
     {
       std::ofstream out(file, std::ios::trunc);
@@ -331,7 +332,7 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
     std::ifstream in(file); // rewritten, valid
     std::string   first;
     std::getline(in, first);
-    CHECK(first == "# petscbinbcsr tune cache v2");
+    CHECK(first == "# petscbinbcsr tune cache v3");
   }
   // an unreadable cache folder: no file written, no error
   setenv("XDG_CACHE_HOME", "/proc/no/such/folder", 1);
@@ -414,7 +415,7 @@ TEST_CASE("tuning cache check", "[.cache_check]")
   REQUIRE(in.good());
   std::string line;
   std::getline(in, line);
-  CHECK(line == "# petscbinbcsr tune cache v2");
+  CHECK(line == "# petscbinbcsr tune cache v3");
   int n = 0;
   while (std::getline(in, line)) {
     CAPTURE(line);
