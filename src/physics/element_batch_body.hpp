@@ -24,6 +24,12 @@
 #else
   #define BINBCSR_ELEMENT_BATCH_AVX512 0
 #endif
+#if !BINBCSR_ELEMENT_BATCH_AVX512 && defined(__AVX2__) && defined(__FMA__)
+  #define BINBCSR_ELEMENT_BATCH_AVX2 1
+  #include "physics/element_batch_avx2.hpp"
+#else
+  #define BINBCSR_ELEMENT_BATCH_AVX2 0
+#endif
 
 namespace physics {
 namespace kernels {
@@ -87,7 +93,8 @@ inline void prefetch_blocks(const ElementBatchArgs &a, int k0, int k1)
 }
 
 // A write group's blocks, lane-major: entries 0..7 of (element in the group e, packed pair p) at
-// head[e * NB + p], entry 8 at tail[e * NB + p] (the AVX-512 body moves 8 entries as one register).
+// head[e * NB + p], entry 8 at tail[e * NB + p] (the AVX-512 body moves 8 entries as one register,
+// the AVX2 one as two).
 template <int N> struct alignas(64) Stage {
   static constexpr int G = W * write_group_batches(N), NB = N * (N + 1) / 2;
   double               head[G * NB][8], tail[G * NB];
@@ -103,6 +110,15 @@ template <int N> inline void stage_batch(const Batch<N> &b, int j, Stage<N> &st)
     for (int e = 0; e < 8; ++e) r[e] = _mm512_load_pd(b.blocks + (9 * p + e) * W);
     avx512::transpose8(r);
     for (int l = 0; l < W; ++l) _mm512_store_pd(st.head[(j * W + l) * NB + p], r[l]);
+#elif BINBCSR_ELEMENT_BATCH_AVX2
+    static_assert(W % 4 == 0, "lanes in fours");
+    for (int l0 = 0; l0 < W; l0 += 4)
+      for (int e0 = 0; e0 < 8; e0 += 4) {
+        __m256d r[4];
+        for (int e = 0; e < 4; ++e) r[e] = _mm256_load_pd(b.blocks + (9 * p + e0 + e) * W + l0);
+        avx2::transpose4(r);
+        for (int l = 0; l < 4; ++l) _mm256_store_pd(st.head[(j * W + l0 + l) * NB + p] + e0, r[l]);
+      }
 #else
     for (int l = 0; l < W; ++l)
       for (int e = 0; e < 8; ++e) st.head[(j * W + l) * NB + p][e] = b.blocks[(9 * p + e) * W + l];
@@ -130,6 +146,17 @@ template <int N> inline void write_group(const ElementBatchArgs &a, std::size_t 
       acc8 += st.tail[*t >> 1];
     }
     avx512::write_block(values, slots[k], acc, acc8);
+#elif BINBCSR_ELEMENT_BATCH_AVX2
+    __m256d lo, hi, tlo, thi;
+    avx2::term(st.head[*t >> 1], *t & 1, lo, hi);
+    double acc8 = st.tail[*t >> 1];
+    for (++t; t < end; ++t) {
+      avx2::term(st.head[*t >> 1], *t & 1, tlo, thi);
+      lo = _mm256_add_pd(lo, tlo);
+      hi = _mm256_add_pd(hi, thi);
+      acc8 += st.tail[*t >> 1];
+    }
+    avx2::write_block(values, slots[k], lo, hi, acc8);
 #else
     constexpr int kT[2][8] = {{0, 1, 2, 3, 4, 5, 6, 7}, {0, 3, 6, 1, 4, 7, 2, 5}}; // B, B^T
     double        acc[9];
