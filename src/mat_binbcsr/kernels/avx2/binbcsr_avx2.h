@@ -133,7 +133,15 @@ template <typename I>
 BINBCSR_AVX2_INLINE bool load_xc_3x4(const I *c, __m128i ci, unsigned real, const double *x, int ncols,
                                      __m256d *xc, int &base, unsigned &off)
 {
-  const __m256d rm = lanes_of(real);
+  /* the common case first: 4 real lanes on consecutive columns (one compare, no lane masks) */
+  base = (int)c[0];
+  if (real == 0xF &&
+      mask_of(_mm_cmpeq_epi32(ci, _mm_add_epi32(_mm_set1_epi32(base), _mm_setr_epi32(0, 1, 2, 3)))) == 0xF &&
+      base + 4 <= ncols) {
+    off = 0;
+    split_xyz4(x + (long)base * 3, xc[0], xc[1], xc[2]);
+    return true;
+  }
   if (near_unit_3x4(c, ci, real, ncols, base, off)) {
     split_xyz4(x + (long)base * 3, xc[0], xc[1], xc[2]);
     for (unsigned m = off; m; m &= m - 1) {
@@ -142,7 +150,10 @@ BINBCSR_AVX2_INLINE bool load_xc_3x4(const I *c, __m128i ci, unsigned real, cons
       const double *p  = x + (long)c[l] * 3;
       for (int j = 0; j < 3; j++) xc[j] = _mm256_blendv_pd(xc[j], _mm256_broadcast_sd(p + j), lm);
     }
-    for (int j = 0; j < 3; j++) xc[j] = _mm256_and_pd(xc[j], rm);
+    if (real != 0xF) {
+      const __m256d rm = lanes_of(real);
+      for (int j = 0; j < 3; j++) xc[j] = _mm256_and_pd(xc[j], rm);
+    }
     return true;
   }
   load_lanes_xyz4(c, real, x, xc);
@@ -254,13 +265,12 @@ BINBCSR_AVX2_INLINE void sym_chunk_group(SymChunk3x4 &b, const V *t, const I *c,
   const unsigned keep = near ? scatter & ~off : 0, odd = scatter & ~keep;
   /* the lanes that follow base add into 12 consecutive y (a zero where a lane does not scatter), the
      others one by one after it: a column of both gets both, in turn */
-  if (keep) {
+  if (keep == 0xF) add_xyz4(y + (long)base * 3, s[0], s[1], s[2]);
+  else if (keep) {
     const __m256d km = lanes_of(keep);
     add_xyz4(y + (long)base * 3, _mm256_and_pd(s[0], km), _mm256_and_pd(s[1], km), _mm256_and_pd(s[2], km));
   }
-  if (odd) {
-    scatter_add_xyz4(c, odd, s, y);
-  }
+  if (odd) scatter_add_xyz4(c, odd, s, y);
 }
 
 BINBCSR_AVX2_INLINE void sym_chunk_end(const SymChunk3x4 &b, double *y)
