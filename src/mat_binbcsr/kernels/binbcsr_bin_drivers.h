@@ -147,11 +147,9 @@ inline void bins_sweep(const BinMatrix &m, const int *bins, const double *x, con
   } else
 #endif
 #if defined(BINBCSR_HAND_AVX2)
-    if constexpr (BS == 3 && (BW == 4 || BW == 8 || BW == 16)) {
-    double(*accq[K])[BW];
-    for (int q = 0; q < K; q++) accq[q] = acc[q];
-    hand4::bins_mult_3x4<K, BW>(s.t, s.c, s.len, nz, x, m.nbs, accq);
-  } else
+    if constexpr (BS == 3 && (BW == 4 || BW == 8 || BW == 16))
+    hand4::bins_mult_3x4<K, BW>(s.t, s.c, s.len, nz, x, m.nbs, acc);
+  else
 #endif
     interleave_groups<K>(s.len, [&](int q, int k) {
       group_mult<BS, BW, V>(s.t[q] + (size_t)k * BW * BS2, s.c[q] + (size_t)k * BW, x, acc[q], k, nz[q]);

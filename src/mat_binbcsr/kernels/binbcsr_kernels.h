@@ -50,8 +50,15 @@ template <typename V> BINBCSR_HD void prefetch_values(const V *tile, int nbytes)
 /* The slot groups of K bins swept together (len[q]: the groups of bin q): group(q, k) for group k of
    bin q, one group of each bin in turn while every bin has one left, then the rest of each bin. The
    products sweep several bins at once because the bins are then several streams for the hardware
-   prefetcher (bins_sweep in binbcsr_bin_drivers.h says why). */
-template <int K, class G> BINBCSR_HD void interleave_groups(const int *len, G &&group)
+   prefetcher (bins_sweep in binbcsr_bin_drivers.h says why). Forced inline on the host, so that a
+   hand-written body whose group is an always_inline lambda keeps its accumulators in registers (out
+   of line, GCC 12 passed them through memory, a call per slot group). */
+#if !defined(__CUDACC__) && !defined(__HIPCC__) && defined(__GNUC__)
+  #define BINBCSR_SWEEP_INLINE __attribute__((always_inline))
+#else
+  #define BINBCSR_SWEEP_INLINE
+#endif
+template <int K, class G> BINBCSR_HD BINBCSR_SWEEP_INLINE void interleave_groups(const int *len, G &&group)
 {
   int common = len[0];
   for (int q = 1; q < K; q++) common = len[q] < common ? len[q] : common;

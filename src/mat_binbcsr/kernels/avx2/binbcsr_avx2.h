@@ -180,12 +180,10 @@ BINBCSR_AVX2_INLINE void chunk_mult_3x4(const V *t, const I *c, const double *x,
 }
 
 /* bins_sweep's slot groups (binbcsr_bin_drivers.h) for 3x3 blocks, BW lanes (4, 8 or 16): the groups
-   of K bins in interleave_groups' order, written out (a lambda kept out of line would put the
-   accumulators in memory), and acc[q][i][l] += the rows' sums. */
+   of K bins in interleave_groups' order, and acc[q][i][l] += the rows' sums. */
 template <int K, int BW, typename V, typename I>
 BINBCSR_AVX2_INLINE void bins_mult_3x4(const V *const *bin_val, const I *const *bin_col, const int *len,
-                                       const int (*nz)[BW], const double *x, int ncols,
-                                       double (*const *acc)[BW])
+                                       const int (*nz)[BW], const double *x, int ncols, double (*acc)[3][BW])
 {
   constexpr int H = BW / 4;
   static_assert(BW % 4 == 0 && sizeof(I) == 4, "chunks of 4 lanes, 32-bit column indices");
@@ -196,19 +194,13 @@ BINBCSR_AVX2_INLINE void bins_mult_3x4(const V *const *bin_val, const I *const *
       n[q][h] = _mm_loadu_si128((const __m128i *)(nz[q] + 4 * h));
       for (int i = 0; i < 3; i++) a[q][h][i] = _mm256_loadu_pd(acc[q][i] + 4 * h);
     }
-  int common = len[0];
-  for (int q = 1; q < K; q++) common = len[q] < common ? len[q] : common;
-  const auto group = [&](int q, int k) __attribute__((always_inline))
-  {
-    const V *t = bin_val[q] + (long)k * 9 * BW;
-    const I *c = bin_col[q] + (long)k * BW;
-    prefetch_values(t, 9 * BW * (int)sizeof(V));
-    for (int h = 0; h < H; h++) chunk_mult_3x4<BW>(t + 4 * h, c + 4 * h, x, ncols, a[q][h], k, n[q][h]);
-  };
-  for (int k = 0; k < common; k++)
-    for (int q = 0; q < K; q++) group(q, k);
-  for (int q = 0; q < K; q++)
-    for (int k = common; k < len[q]; k++) group(q, k);
+  interleave_groups<K>(
+    len, [&](int q, int k) __attribute__((always_inline)) {
+      const V *t = bin_val[q] + (long)k * 9 * BW;
+      const I *c = bin_col[q] + (long)k * BW;
+      prefetch_values(t, 9 * BW * (int)sizeof(V));
+      for (int h = 0; h < H; h++) chunk_mult_3x4<BW>(t + 4 * h, c + 4 * h, x, ncols, a[q][h], k, n[q][h]);
+    });
   for (int q = 0; q < K; q++)
     for (int h = 0; h < H; h++)
       for (int i = 0; i < 3; i++) _mm256_storeu_pd(acc[q][i] + 4 * h, a[q][h][i]);
@@ -296,22 +288,15 @@ BINBCSR_AVX2_INLINE void sym_bins_mult_3x4(const V *const *bin_val, const I *con
   constexpr int H = BW / 4;
   static_assert(BW % 4 == 0 && sizeof(I) == 4, "chunks of 4 lanes, 32-bit column indices");
   SymChunk3x4 b[K][H];
-  int         common = len[0];
-  for (int q = 0; q < K; q++) {
-    for (int h = 0; h < H; h++) sym_chunk_begin(b[q][h], (int)r0[q] + 4 * h, (int)mbs, kd[q] + 4 * h, x);
-    common = len[q] < common ? len[q] : common;
-  }
-  const auto group = [&](int q, int k) __attribute__((always_inline))
-  {
-    const V *t = bin_val[q] + (long)k * 9 * BW;
-    const I *c = bin_col[q] + (long)k * BW;
-    prefetch_values(t, 9 * BW * (int)sizeof(V));
-    for (int h = 0; h < H; h++) sym_chunk_group<BW>(b[q][h], t + 4 * h, c + 4 * h, k, x, (int)mbs, y);
-  };
-  for (int k = 0; k < common; k++)
-    for (int q = 0; q < K; q++) group(q, k);
   for (int q = 0; q < K; q++)
-    for (int k = common; k < len[q]; k++) group(q, k);
+    for (int h = 0; h < H; h++) sym_chunk_begin(b[q][h], (int)r0[q] + 4 * h, (int)mbs, kd[q] + 4 * h, x);
+  interleave_groups<K>(
+    len, [&](int q, int k) __attribute__((always_inline)) {
+      const V *t = bin_val[q] + (long)k * 9 * BW;
+      const I *c = bin_col[q] + (long)k * BW;
+      prefetch_values(t, 9 * BW * (int)sizeof(V));
+      for (int h = 0; h < H; h++) sym_chunk_group<BW>(b[q][h], t + 4 * h, c + 4 * h, k, x, (int)mbs, y);
+    });
   for (int q = 0; q < K; q++)
     for (int h = 0; h < H; h++) sym_chunk_end(b[q][h], y);
 }
