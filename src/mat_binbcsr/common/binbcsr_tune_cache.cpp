@@ -30,9 +30,9 @@ static const char *const cache_header_stem = "# petscbinbcsr tune cache v"; /* o
 const std::string &BinBCSRTuneMachineKey(void)
 {
   static const char       *bodies = binbcsr::body_set_name(binbcsr::best_body_set());
-  static const std::string key =
-    (binbcsr::cpu_model().empty() ? std::string("unknown cpu") : binbcsr::cpu_model()) + " | " +
-    std::to_string(binbcsr::online_cpus()) + " cores | " + bodies;
+  const std::string       &model  = binbcsr::cpu_model();
+  static const std::string key    = (model.empty() ? std::string("unknown cpu") : model) + " | " +
+                                 std::to_string(binbcsr::online_cpus()) + " cores | " + bodies;
   return key;
 }
 
@@ -106,20 +106,60 @@ static PetscErrorCode WarnCorrupt(const std::string &path, const std::string &wh
   PetscFunctionReturn(0);
 }
 
+/* The file as last read by this process, with what identifies that version of it: a scene builds
+   several matrices (the cloth five), and reading and parsing the file again for each took 0.1-0.4 ms
+   on a VM. A store renames a new file over the old one, so a new inode (or size or mtime) means
+   another version, written by this process or another one. */
+struct CacheMemo {
+  std::string                              path;
+  bool                                     valid = false, parsed = false;
+  dev_t                                    dev   = 0;
+  ino_t                                    ino   = 0;
+  off_t                                    size  = 0;
+  struct timespec                          mtime = {0, 0};
+  std::map<std::string, BinBCSRTuneChoice> entries;
+  std::string                              why;
+};
+
+/* The parsed file (memo.parsed false: it does not parse, memo.why says why); no file: no entries. */
+static const CacheMemo &CachedFile(const std::string &path)
+{
+  static CacheMemo memo;
+  struct stat      st;
+  if (stat(path.c_str(), &st) != 0) {
+    memo        = CacheMemo();
+    memo.parsed = true;
+    return memo; /* no file: nothing cached, and nothing kept for a file that appears later */
+  }
+  if (memo.valid && memo.path == path && memo.dev == st.st_dev && memo.ino == st.st_ino &&
+      memo.size == st.st_size && memo.mtime.tv_sec == st.st_mtim.tv_sec &&
+      memo.mtime.tv_nsec == st.st_mtim.tv_nsec)
+    return memo;
+  memo        = CacheMemo();
+  memo.parsed = ReadCache(path, memo.entries, memo.why);
+  memo.path   = path;
+  memo.dev    = st.st_dev;
+  memo.ino    = st.st_ino;
+  memo.size   = st.st_size;
+  memo.mtime  = st.st_mtim;
+  memo.valid  = true;
+  return memo;
+}
+
 PetscErrorCode BinBCSRTuneCacheLookup(const std::string &key, BinBCSRTuneChoice *c, PetscBool *found)
 {
-  std::map<std::string, BinBCSRTuneChoice> entries;
-  std::string                              why, path = BinBCSRTuneCachePath();
+  std::string path = BinBCSRTuneCachePath();
 
   PetscFunctionBegin;
   *found = PETSC_FALSE;
   if (path.empty()) PetscFunctionReturn(0);
-  if (!ReadCache(path, entries, why)) {
-    PetscCall(WarnCorrupt(path, why));
+  const CacheMemo &file = CachedFile(path);
+  if (!file.parsed) {
+    PetscCall(WarnCorrupt(path, file.why));
     PetscFunctionReturn(0);
   }
-  auto it = entries.find(key);
-  if (it == entries.end()) PetscFunctionReturn(0);
+  auto it = file.entries.find(key);
+  if (it == file.entries.end()) PetscFunctionReturn(0);
   *c     = it->second;
   *found = PETSC_TRUE;
   PetscFunctionReturn(0);
