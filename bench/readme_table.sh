@@ -11,6 +11,11 @@ steps=$out/steps.csv
 [ -s "$spmv" ] || { echo "readme_table: no $spmv" >&2; exit 1; }
 
 cpu=$(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -1)
+# VMs of several CPU generations share one model name ("AMD EPYC" on Zen 3, 4 and 5): the family and
+# model say which one the figures come from.
+family=$(lscpu 2>/dev/null | sed -n 's/^CPU family: *//p' | head -1)
+model=$(lscpu 2>/dev/null | sed -n 's/^Model: *//p' | head -1)
+[ -n "$cpu" ] && [ -n "$family" ] && cpu="$cpu (family $family model ${model:-?})"
 triad=$(awk -F, 'NR > 1 && $NF == "ok" && $22 > best { best = $22 } END { if (best) printf "%.1f", best }' "$spmv")
 readbw=$(awk -F, 'NR > 1 && $NF == "ok" && $24 > best { best = $24 } END { if (best) printf "%.1f", best }' "$spmv")
 petsc=$(pkg-config --modversion PETSc 2>/dev/null || echo "?")
