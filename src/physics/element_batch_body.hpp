@@ -46,6 +46,7 @@ template <int N> struct alignas(64) Batch {
   double               rhs[3 * N * W], blocks[NB * 9 * W];
   double               Q[N == 10 ? 16 * 9 * W : W]; // P2: the rotated gradient pairs (W: rows stay aligned)
   double               ok[W];                       // polar_rotation's acceptance per lane
+  double               elastic[W], kinetic[W], inverted[W]; // the state's figures (ElementBatchArgs::energy)
 };
 
 // Lane l <- element e: its nodes' positions, velocities and rest positions, Dm^-1 and volume.
@@ -188,6 +189,7 @@ template <int N, bool Blocks, bool MassDamping> long long run(const ElementBatch
   const std::size_t n  = a.count;
   constexpr int     GB = write_group_batches(N);
   Stage<N>          st;
+  double            elastic = 0, kinetic = 0, inverted = 0;
   for (std::size_t g = 0, start = 0; start < n; ++g) {
     const int k0 = Blocks ? a.group_offsets[g] : 0, kn = Blocks ? a.group_offsets[g + 1] - k0 : 0;
     for (int jb = 0; jb < GB && start < n; ++jb, start += W) {
@@ -229,6 +231,25 @@ template <int N, bool Blocks, bool MassDamping> long long run(const ElementBatch
           }
         }
       }
+      if (a.energy) { // the state's energy from what the batch holds (R included): no second walk
+#pragma omp simd
+        for (int l = 0; l < W; ++l) {
+          b.elastic[l] =
+            N == 4 ? p1_elastic_energy<W>(b.x + l, b.X + l, b.Dinv + l, b.R + l, b.vol[l], k.lambda, k.mu)
+                   : p2_elastic_energy<W>(b.x + l, b.X + l, b.Dinv + l, b.R + l, b.vol[l], k.lambda, k.mu);
+          b.kinetic[l]  = kinetic_energy<W, N>(b.v + l, Mref, b.vol[l], k.density);
+          b.inverted[l] = corner_inverted<W>(b.x + l);
+        }
+        for (int l = 0; l < m; ++l) {
+          elastic += b.elastic[l];
+          kinetic += b.kinetic[l];
+          inverted += b.inverted[l];
+          if (a.element_energy) {
+            double *out = a.element_energy + 3 * (start + l);
+            out[0] = b.elastic[l], out[1] = b.kinetic[l], out[2] = b.inverted[l];
+          }
+        }
+      }
       // Forces (and rotations) out in element order, lane after lane; the blocks to the stage.
       for (int l = 0; l < m; ++l) {
         const std::size_t i     = start + l;
@@ -243,6 +264,7 @@ template <int N, bool Blocks, bool MassDamping> long long run(const ElementBatch
     }
     if (Blocks) write_group<N>(a, g, st);
   }
+  if (a.energy) a.energy[0] += elastic, a.energy[1] += kinetic, a.energy[2] += inverted;
   return fallbacks;
 }
 
