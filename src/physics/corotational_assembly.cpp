@@ -300,14 +300,26 @@ static_assert(sizeof(Eigen::Matrix3d) == 9 * sizeof(double), "Matrix3d is not 9 
 long long assemble_elements(const FemModel &model, const std::vector<int> &elements, const double *x,
                             const double *v, const StepCoefficients &c, const BlockPattern *pattern,
                             double *block_values, double *rhs, Eigen::Matrix3d *rotations,
-                            ElementKernel kernel, binbcsr::BodySet body)
+                            ElementKernel kernel, binbcsr::BodySet body, ElementEnergy *energy)
 {
   if (block_values && !pattern) throw std::invalid_argument("assemble_elements: block values need a pattern");
   if (pattern && pattern->element_slots.size() != elements.size() * model.npe * model.npe)
     throw std::invalid_argument("assemble_elements: pattern was built for another element list");
   if (kernel == ElementKernel::Batched)
     return assemble_elements_batched(model, elements, x, v, c, block_values ? pattern : nullptr, block_values,
-                                     rhs, rotations ? rotations->data() : nullptr, body);
+                                     rhs, rotations ? rotations->data() : nullptr, body, energy);
+  if (energy) // the reference loop's figures: the definition, element by element
+    for (size_t i = 0; i < elements.size(); ++i) {
+      const FemEnergy E   = element_energy(model, x, v, elements[i]);
+      const double    inv = element_signed_volume(model.mesh, x, elements[i]) > 0 ? 0.0 : 1.0;
+      energy->elastic += E.elastic;
+      energy->kinetic += E.kinetic;
+      energy->inverted += inv;
+      if (energy->per_element) {
+        double *out = energy->per_element + 3 * i;
+        out[0] = E.elastic, out[1] = E.kinetic, out[2] = inv;
+      }
+    }
   if (model.npe == 4 && !model.gradients.empty())
     assemble_kernel_p1(model, elements, x, v, c, pattern, block_values, rhs, rotations);
   else if (model.npe == 4)

@@ -91,12 +91,14 @@ enum class ElementKernel {
 // element contributions (the identity blocks are left as they are); may be null (forces only;
 // pattern may then be null too). rotations (optional): one per listed element. Returns the number of
 // elements whose rotation took the scalar SVD path (inverted or flat; Batched also counts elements
-// that the fixed Newton steps did not converge; Scalar returns 0).
+// that the fixed Newton steps did not converge; Scalar returns 0). energy (optional): the state's
+// energy and inverted elements over the listed elements, added (element_batch.hpp's ElementEnergy;
+// Scalar computes it by element_energy, the definition).
 long long assemble_elements(const FemModel &model, const std::vector<int> &elements, const double *x,
                             const double *v, const StepCoefficients &c, const BlockPattern *pattern,
                             double *block_values, double *rhs, Eigen::Matrix3d *rotations = nullptr,
                             ElementKernel    kernel = ElementKernel::Batched,
-                            binbcsr::BodySet body   = binbcsr::BodySet::Auto);
+                            binbcsr::BodySet body = binbcsr::BodySet::Auto, ElementEnergy *energy = nullptr);
 
 // Elastic forces only (a_f = 1): f = sum_e f_e over all elements, 3 per node, overwritten.
 std::vector<double> elastic_forces(const FemModel &model, const double *x);

@@ -41,7 +41,8 @@ void element_fallback_rotation(const double *F, double *R)
 
 long long assemble_elements_batched(const FemModel &model, const std::vector<int> &elements, const double *x,
                                     const double *v, const StepCoefficients &c, const BlockPattern *pattern,
-                                    double *values, double *rhs, double *rotations, binbcsr::BodySet body)
+                                    double *values, double *rhs, double *rotations, binbcsr::BodySet body,
+                                    ElementEnergy *energy)
 {
   if (elements.empty()) return 0;
   static_assert(sizeof(Eigen::Matrix3d) == 9 * sizeof(double), "Dm^-1 is read as 9 packed doubles");
@@ -64,7 +65,12 @@ long long assemble_elements_batched(const FemModel &model, const std::vector<int
   args.values             = values;
   args.rhs                = rhs;
   args.rotations          = rotations;
-  args.k                  = kernels::ElementConstants{c.force,       c.stiffness_rhs,       c.mass_rhs,
+  double sums[3]          = {0, 0, 0};
+  if (energy) {
+    args.energy         = sums;
+    args.element_energy = energy->per_element;
+  }
+  args.k = kernels::ElementConstants{c.force,       c.stiffness_rhs,       c.mass_rhs,
                                      c.mass_matrix, c.stiffness_matrix,    model.lame.lambda,
                                      model.lame.mu, model.settings.density};
   if (values) {
@@ -73,7 +79,13 @@ long long assemble_elements_batched(const FemModel &model, const std::vector<int
     args.write_offsets = pattern->plan.write_offsets.data();
     args.write_terms   = pattern->plan.write_terms.data();
   }
-  return body_of(element_body_used(body))(args);
+  const long long fallbacks = body_of(element_body_used(body))(args);
+  if (energy) {
+    energy->elastic += sums[0];
+    energy->kinetic += sums[1];
+    energy->inverted += sums[2];
+  }
+  return fallbacks;
 }
 
 double element_kernel_flops(int order, bool with_blocks)

@@ -40,6 +40,18 @@ constexpr int kSlotIndexMask     = kFirstContribution - 1;
 // blocks (quadratic_47k: 496k -> 344k into 202k). Groups of half or twice the size measured no better.
 constexpr int write_group_batches(int npe) { return npe == 4 ? 8 : 2; }
 
+// What the element loop can also measure of the state it assembles, the figures of the drivers' run
+// guard: the step's own element pass has each element's positions and rotation at hand, so the health
+// check need not walk the elements (and their stored K0) again. Sums over the listed elements, added to
+// what the fields hold (fem_energy's terms; on several ranks each rank sums its own elements).
+struct ElementEnergy {
+  double elastic  = 0; // sum of u^T K0 u / 2, u = R^T x - X
+  double kinetic  = 0; // sum of v^T M_e v / 2
+  double inverted = 0; // elements whose corner tetrahedron's signed volume is not > 0
+  // Optional: per listed element (elastic, kinetic, inverted 0 or 1), overwritten.
+  double *per_element = nullptr;
+};
+
 // assemble_elements' batched body (same contract; the checks are the caller's), run by the body set
 // `body` (Auto: the best this CPU runs; a set it does not run or this build lacks: the best it does).
 // rotations: 9 per listed element (column-major), or null. Returns the number of elements whose
@@ -47,7 +59,8 @@ constexpr int write_group_batches(int npe) { return npe == 4 ? 8 : 2; }
 long long assemble_elements_batched(const FemModel &model, const std::vector<int> &elements, const double *x,
                                     const double *v, const StepCoefficients &c, const BlockPattern *pattern,
                                     double *block_values, double *rhs, double *rotations,
-                                    binbcsr::BodySet body = binbcsr::BodySet::Auto);
+                                    binbcsr::BodySet body   = binbcsr::BodySet::Auto,
+                                    ElementEnergy   *energy = nullptr);
 
 // The set assemble_elements_batched runs when asked for `want` (never Auto).
 binbcsr::BodySet element_body_used(binbcsr::BodySet want);
@@ -69,12 +82,16 @@ struct ElementBatchArgs {
   const int    *elements           = nullptr; // the listed elements ...
   std::size_t   count              = 0;       // ... and their number
   // BlockPattern::plan; null: no blocks
-  const int                *group_offsets = nullptr, *write_slots = nullptr, *write_offsets = nullptr;
-  const unsigned short     *write_terms = nullptr;
-  const double             *x = nullptr, *v = nullptr; // 3 per node
-  double                   *values    = nullptr;       // 9 per COO block, or null
-  double                   *rhs       = nullptr;       // 3 per node, accumulated
-  double                   *rotations = nullptr;       // 9 per listed element, or null
+  const int            *group_offsets = nullptr, *write_slots = nullptr, *write_offsets = nullptr;
+  const unsigned short *write_terms = nullptr;
+  const double         *x = nullptr, *v = nullptr; // 3 per node
+  double               *values    = nullptr;       // 9 per COO block, or null
+  double               *rhs       = nullptr;       // 3 per node, accumulated
+  double               *rotations = nullptr;       // 9 per listed element, or null
+  // The state's figures (corotational_assembly.hpp's ElementEnergy), or null: elastic and kinetic
+  // energy and the inverted corner tetrahedra, summed over the listed elements and added to energy[0..2];
+  // per listed element the same three into element_energy (or null).
+  double                   *energy = nullptr, *element_energy = nullptr;
   kernels::ElementConstants k{};
 };
 

@@ -46,6 +46,7 @@ template <int N> struct alignas(64) Batch {
   double               rhs[3 * N * W], blocks[NB * 9 * W];
   double               Q[N == 10 ? 16 * 9 * W : W]; // P2: the rotated gradient pairs (W: rows stay aligned)
   double               ok[W];                       // polar_rotation's acceptance per lane
+  double               elastic[W], kinetic[W], inverted[W]; // the state's figures (ElementBatchArgs::energy)
 };
 
 // Lane l <- element e: its nodes' positions, velocities and rest positions, Dm^-1 and volume.
@@ -175,6 +176,33 @@ template <int N> inline void write_group(const ElementBatchArgs &a, std::size_t 
   }
 }
 
+// The state's figures of batch [start, start + m) from what the batch holds (R included), added to
+// sums (and per element to a.element_energy). Not inlined into run: inlined, it left the element
+// kernels' code slower by ~1 ms per step (quadratic_47k, Zen 5) even with the figures not asked for.
+template <int N>
+__attribute__((noinline)) void batch_energy(const ElementBatchArgs &a, Batch<N> &b, const double *Mref,
+                                            std::size_t start, int m, double sums[3])
+{
+  const ElementConstants &k = a.k;
+#pragma omp simd
+  for (int l = 0; l < W; ++l) {
+    if constexpr (N == 4)
+      b.elastic[l] = p1_elastic_energy<W>(b.x + l, b.X + l, b.Dinv + l, b.R + l, b.vol[l], k.lambda, k.mu);
+    else b.elastic[l] = p2_elastic_energy<W>(b.x + l, b.X + l, b.Dinv + l, b.R + l, b.vol[l], k.lambda, k.mu);
+    b.kinetic[l]  = kinetic_energy<W, N>(b.v + l, Mref, b.vol[l], k.density);
+    b.inverted[l] = corner_inverted<W>(b.x + l);
+  }
+  for (int l = 0; l < m; ++l) {
+    sums[0] += b.elastic[l];
+    sums[1] += b.kinetic[l];
+    sums[2] += b.inverted[l];
+    if (a.element_energy) {
+      double *out = a.element_energy + 3 * (start + l);
+      out[0] = b.elastic[l], out[1] = b.kinetic[l], out[2] = b.inverted[l];
+    }
+  }
+}
+
 template <int N, bool Blocks, bool MassDamping> long long run(const ElementBatchArgs &a)
 {
   const ElementConstants &k = a.k;
@@ -188,6 +216,7 @@ template <int N, bool Blocks, bool MassDamping> long long run(const ElementBatch
   const std::size_t n  = a.count;
   constexpr int     GB = write_group_batches(N);
   Stage<N>          st;
+  double            sums[3] = {0, 0, 0}; // elastic, kinetic, inverted (ElementBatchArgs::energy)
   for (std::size_t g = 0, start = 0; start < n; ++g) {
     const int k0 = Blocks ? a.group_offsets[g] : 0, kn = Blocks ? a.group_offsets[g + 1] - k0 : 0;
     for (int jb = 0; jb < GB && start < n; ++jb, start += W) {
@@ -229,6 +258,7 @@ template <int N, bool Blocks, bool MassDamping> long long run(const ElementBatch
           }
         }
       }
+      if (a.energy) batch_energy<N>(a, b, Mref, start, m, sums);
       // Forces (and rotations) out in element order, lane after lane; the blocks to the stage.
       for (int l = 0; l < m; ++l) {
         const std::size_t i     = start + l;
@@ -243,6 +273,8 @@ template <int N, bool Blocks, bool MassDamping> long long run(const ElementBatch
     }
     if (Blocks) write_group<N>(a, g, st);
   }
+  if (a.energy)
+    for (int j = 0; j < 3; ++j) a.energy[j] += sums[j];
   return fallbacks;
 }
 

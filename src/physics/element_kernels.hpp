@@ -249,6 +249,78 @@ BINBCSR_PHYS_HD void p1_element(const double *x, const double *v, const double *
   }
 }
 
+// ---- the state's energy (the run guard's figures) -----------------------------------------------
+
+// What fem_model.cpp's fem_energy (the definition) sums per element, and whether the corner
+// tetrahedron is inverted, computed in the element pass from what it has gathered, so that a step
+// does not walk the elements (and read 43 MB of K0 for linear_38k) a second time for its health check.
+
+// 1 where the corner tetrahedron's signed volume is not > 0 (element_signed_volume's expression, in
+// its order, so that without FMA contraction the test is the same to the bit), else 0.
+template <int S> BINBCSR_PHYS_HD double corner_inverted(const double *x)
+{
+  double d[3][3];
+  BINBCSR_PHYS_UNROLL
+  for (int k = 0; k < 3; ++k) BINBCSR_PHYS_UNROLL
+  for (int c = 0; c < 3; ++c) d[k][c] = x[(3 * (k + 1) + c) * S] - x[c * S];
+  const double det = d[0][0] * (d[1][1] * d[2][2] - d[1][2] * d[2][1]) -
+                     d[0][1] * (d[1][0] * d[2][2] - d[1][2] * d[2][0]) +
+                     d[0][2] * (d[1][0] * d[2][1] - d[1][1] * d[2][0]);
+  return det > 0 ? 0.0 : 1.0;
+}
+
+// u_b = R^T x_b - X_b for n nodes: the displacement in the element's rest frame.
+template <int S, int N>
+BINBCSR_PHYS_HD void rest_frame_displacement(const double *x, const double *X, const double *R,
+                                             double u[N][3])
+{
+  BINBCSR_PHYS_UNROLL
+  for (int b = 0; b < N; ++b) BINBCSR_PHYS_UNROLL
+  for (int i = 0; i < 3; ++i)
+    u[b][i] = R[(3 * i) * S] * x[(3 * b) * S] + R[(3 * i + 1) * S] * x[(3 * b + 1) * S] +
+              R[(3 * i + 2) * S] * x[(3 * b + 2) * S] - X[(3 * b + i) * S];
+}
+
+// lambda tr(A) tr(B) + 2 mu sym(A) : sym(B) = sigma(A) : B for displacement gradients A, B (row-major).
+BINBCSR_PHYS_HD double strain_product(const double A[9], const double B[9], double lambda, double mu)
+{
+  double s = 0;
+  BINBCSR_PHYS_UNROLL
+  for (int i = 0; i < 3; ++i) BINBCSR_PHYS_UNROLL
+  for (int j = 0; j < 3; ++j) s += (A[3 * i + j] + A[3 * j + i]) * (B[3 * i + j] + B[3 * j + i]);
+  const double ta = A[0] + A[4] + A[8], tb = B[0] + B[4] + B[8];
+  return lambda * ta * tb + 0.5 * mu * s;
+}
+
+// The elastic energy u^T K0 u / 2 of a linear tetrahedron: V sigma(G) : G / 2 with the constant
+// displacement gradient G = sum_b u_b g_b^T (K0 = V B^T D B, no stored K0 read).
+template <int S>
+BINBCSR_PHYS_HD double p1_elastic_energy(const double *x, const double *X, const double *Dinv,
+                                         const double *R, double vol, double lambda, double mu)
+{
+  double g[4][3], u[4][3], G[9];
+  barycentric_gradients<S>(Dinv, g);
+  rest_frame_displacement<S, 4>(x, X, R, u);
+  BINBCSR_PHYS_UNROLL
+  for (int i = 0; i < 3; ++i) BINBCSR_PHYS_UNROLL
+  for (int j = 0; j < 3; ++j)
+    G[3 * i + j] = u[0][i] * g[0][j] + u[1][i] * g[1][j] + u[2][i] * g[2][j] + u[3][i] * g[3][j];
+  return 0.5 * vol * strain_product(G, G, lambda, mu);
+}
+
+// v^T M_e v / 2 = rho V sum_ab Mref_ab v_a . v_b / 2 (Mref: N x N, row-major).
+template <int S, int N>
+BINBCSR_PHYS_HD double kinetic_energy(const double *v, const double *Mref, double vol, double density)
+{
+  double s = 0;
+  BINBCSR_PHYS_UNROLL
+  for (int a = 0; a < N; ++a) BINBCSR_PHYS_UNROLL
+  for (int b = 0; b < N; ++b)
+    s += Mref[N * a + b] * (v[(3 * a) * S] * v[(3 * b) * S] + v[(3 * a + 1) * S] * v[(3 * b + 1) * S] +
+                            v[(3 * a + 2) * S] * v[(3 * b + 2) * S]);
+  return 0.5 * density * vol * s;
+}
+
 } // namespace BINBCSR_ELEMENT_SET
 } // namespace kernels
 } // namespace physics

@@ -160,6 +160,37 @@ BINBCSR_PHYS_HD void p2_block(int p, const double *Q, double vol, const ElementC
   for (int e = 0; e < 9; ++e) block[e * S] = B[e] + (e % 4 == 0 ? mass : 0.0);
 }
 
+// Its elastic energy u^T K0 u / 2, u_b = R^T x_b - X_b: V E[sigma(G(L)) : G(L)] / 2 with the affine
+// displacement gradient G(L) = sum_k L_k G_k (G_k at corner k, as in p2_forces) and
+// E[L_i L_j] = (1 + [i = j]) / 20, i.e. V / 40 (sum_k sigma(G_k) : G_k + sigma(sum_k G_k) : sum_k G_k)
+// (the stored K0's 4-point rule is exact for this quadratic integrand, so both are the same sum).
+template <int S>
+BINBCSR_PHYS_HD double p2_elastic_energy(const double *x, const double *X, const double *Dinv,
+                                         const double *R, double vol, double lambda, double mu)
+{
+  double g[4][3], u[10][3];
+  barycentric_gradients<S>(Dinv, g);
+  rest_frame_displacement<S, 10>(x, X, R, u);
+  double Gsum[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, corners = 0;
+  BINBCSR_PHYS_UNROLL
+  for (int kk = 0; kk < 4; ++kk) {
+    double G[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+    BINBCSR_PHYS_UNROLL
+    for (int d = 0; d < 4; ++d) {
+      double w[3];
+      BINBCSR_PHYS_UNROLL
+      for (int i = 0; i < 3; ++i) w[i] = kk == d ? 3.0 * u[d][i] : 4.0 * u[4 + kP2EdgeOf[d][kk]][i] - u[d][i];
+      BINBCSR_PHYS_UNROLL
+      for (int i = 0; i < 3; ++i) BINBCSR_PHYS_UNROLL
+      for (int j = 0; j < 3; ++j) G[3 * i + j] += w[i] * g[d][j];
+    }
+    corners += strain_product(G, G, lambda, mu);
+    BINBCSR_PHYS_UNROLL
+    for (int j = 0; j < 9; ++j) Gsum[j] += G[j];
+  }
+  return vol / 40 * (corners + strain_product(Gsum, Gsum, lambda, mu));
+}
+
 // Both, for a caller that owns one element (S = 1, a GPU thread).
 template <int S, bool Blocks, bool MassDamping>
 BINBCSR_PHYS_HD void p2_element(const double *x, const double *v, const double *X, const double *Dinv,

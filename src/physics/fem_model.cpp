@@ -103,40 +103,49 @@ double total_mass(const FemModel &model)
   return s * model.settings.density * model.reference_mass.sum();
 }
 
+FemEnergy element_energy(const FemModel &model, const double *x, const double *v, int e)
+{
+  FemEnergy                    E;
+  const int                    npe = model.npe;
+  const auto                  &X   = model.mesh.nodes;
+  Eigen::Matrix<double, 30, 1> u, Ku; // up to 10 nodes
+  const int                   *n = &model.mesh.elements[static_cast<size_t>(e) * npe];
+  Eigen::Matrix3d              R = Eigen::Matrix3d::Identity();
+  if (model.settings.corotational) {
+    Eigen::Matrix3d Ds;
+    for (int k = 0; k < 3; ++k)
+      for (int d = 0; d < 3; ++d) Ds(d, k) = x[3 * n[k + 1] + d] - x[3 * n[0] + d];
+    R = rotation_from_deformation(Ds * model.rest_shape_inverse[e]);
+  }
+  for (int a = 0; a < npe; ++a)
+    u.segment<3>(3 * a) = R.transpose() * Eigen::Vector3d(x[3 * n[a]], x[3 * n[a] + 1], x[3 * n[a] + 2]) -
+                          Eigen::Vector3d(X[3 * n[a]], X[3 * n[a] + 1], X[3 * n[a] + 2]);
+  const double *K = &model.stiffness[static_cast<size_t>(e) * packed_block_count(npe) * 9];
+  Ku.setZero();
+  for (int a = 0; a < npe; ++a)
+    for (int b = a; b < npe; ++b) {
+      const Eigen::Map<const Eigen::Matrix3d> Kab(K + 9 * packed_block(a, b, npe));
+      Ku.segment<3>(3 * a) += Kab * u.segment<3>(3 * b);
+      if (b != a) Ku.segment<3>(3 * b) += Kab.transpose() * u.segment<3>(3 * a);
+    }
+  E.elastic      = 0.5 * u.head(3 * npe).dot(Ku.head(3 * npe));
+  const double m = model.settings.density * model.volume[e];
+  for (int a = 0; a < npe; ++a)
+    for (int b = 0; b < npe; ++b) {
+      const double mab = m * model.reference_mass(a, b);
+      if (mab == 0) continue;
+      for (int d = 0; d < 3; ++d) E.kinetic += 0.5 * mab * v[3 * n[a] + d] * v[3 * n[b] + d];
+    }
+  return E;
+}
+
 FemEnergy fem_energy(const FemModel &model, const double *x, const double *v)
 {
-  FemEnergy       E;
-  const int       npe = model.npe;
-  const auto     &X   = model.mesh.nodes;
-  Eigen::VectorXd u(3 * npe), Ku(3 * npe);
+  FemEnergy E;
   for (int e = 0; e < model.element_count(); ++e) {
-    const int      *n = &model.mesh.elements[static_cast<size_t>(e) * npe];
-    Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-    if (model.settings.corotational) {
-      Eigen::Matrix3d Ds;
-      for (int k = 0; k < 3; ++k)
-        for (int d = 0; d < 3; ++d) Ds(d, k) = x[3 * n[k + 1] + d] - x[3 * n[0] + d];
-      R = rotation_from_deformation(Ds * model.rest_shape_inverse[e]);
-    }
-    for (int a = 0; a < npe; ++a)
-      u.segment<3>(3 * a) = R.transpose() * Eigen::Vector3d(x[3 * n[a]], x[3 * n[a] + 1], x[3 * n[a] + 2]) -
-                            Eigen::Vector3d(X[3 * n[a]], X[3 * n[a] + 1], X[3 * n[a] + 2]);
-    const double *K = &model.stiffness[static_cast<size_t>(e) * packed_block_count(npe) * 9];
-    Ku.setZero();
-    for (int a = 0; a < npe; ++a)
-      for (int b = a; b < npe; ++b) {
-        const Eigen::Map<const Eigen::Matrix3d> Kab(K + 9 * packed_block(a, b, npe));
-        Ku.segment<3>(3 * a) += Kab * u.segment<3>(3 * b);
-        if (b != a) Ku.segment<3>(3 * b) += Kab.transpose() * u.segment<3>(3 * a);
-      }
-    E.elastic += 0.5 * u.dot(Ku);
-    const double m = model.settings.density * model.volume[e];
-    for (int a = 0; a < npe; ++a)
-      for (int b = 0; b < npe; ++b) {
-        const double mab = m * model.reference_mass(a, b);
-        if (mab == 0) continue;
-        for (int d = 0; d < 3; ++d) E.kinetic += 0.5 * mab * v[3 * n[a] + d] * v[3 * n[b] + d];
-      }
+    const FemEnergy t = element_energy(model, x, v, e);
+    E.elastic += t.elastic;
+    E.kinetic += t.kinetic;
   }
   return E;
 }

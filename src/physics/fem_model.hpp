@@ -58,5 +58,7 @@ struct FemEnergy {
   double elastic = 0; // sum over elements u^T K0 u / 2, u = R^T x - X (R = I when not corotational)
 };
 FemEnergy fem_energy(const FemModel &model, const double *x, const double *v);
+// Element e's terms of fem_energy (the definition the element loop's ElementEnergy is tested against).
+FemEnergy element_energy(const FemModel &model, const double *x, const double *v, int e);
 
 } // namespace physics

@@ -49,17 +49,33 @@ Run run(MPI_Comm comm, const FemScene &scene, const std::map<std::string, std::s
       if (!v0.empty()) sim.v[3 * sim.new_of_old[i] + d] = v0[3 * i + d];
     }
   r.guard.bounds = FemHealthBounds(sim);
-  RunGuardStart(&r.guard, FemTotalEnergy(sim), FemInvertedFraction(sim));
+  // The guard's figures as the driver gets them (the element pass of each state), each checked
+  // against the definitions (FemTotalEnergy: fem_energy's scalar walk; FemInvertedFraction).
+  auto same_figures = [&](const FemStepInfo &info) {
+    const double E = FemTotalEnergy(sim);
+    CHECK(std::fabs(info.energy - E) <= 1e-10 * r.guard.bounds.energy_scale);
+    CHECK(info.inverted_fraction == FemInvertedFraction(sim));
+  };
+  {
+    FemStepInfo start;
+    r.err = FemSimulationAssembleState(&sim, &start);
+    if (r.err) return r;
+    same_figures(start);
+    RunGuardStart(&r.guard, start.energy, start.inverted_fraction);
+  }
   for (int s = 0; s < steps && !r.err; ++s) {
     FemStepInfo info;
-    r.err          = FemSimulationStep(&sim, &info);
+    r.err = FemSimulationStep(&sim, &info);
+    if (!r.err) r.err = FemSimulationAssembleState(&sim, &info);
+    if (r.err) break;
+    if (info.finite) same_figures(info);
     r.finite       = r.finite && info.finite;
     r.worst_reason = std::min<int>(r.worst_reason, info.stats.reason);
     StepHealth h;
     h.solver_reason     = info.stats.reason;
-    h.energy            = FemTotalEnergy(sim);
+    h.energy            = info.energy;
     h.finite            = info.finite && std::isfinite(h.energy);
-    h.inverted_fraction = FemInvertedFraction(sim);
+    h.inverted_fraction = info.inverted_fraction;
     bool stop           = false;
     if (!r.err) r.err = RunGuardCheckStep(PETSC_COMM_SELF, &r.guard, s + 1, h, &stop);
     if (!info.finite) break;

@@ -165,6 +165,27 @@ Differences element_differences(const FemModel &m, const std::vector<int> &eleme
   return d;
 }
 
+// What fem_energy's u^T K0 u / 2 of element e can be off by in floating point, plus 1e-12 of it: the
+// rest-frame displacement u = R^T x - X holds the element's translation, which K0 annihilates only to
+// rounding (its rows sum to ~1e-16 |K0|), so a translated element of linear_38k's size carries ~1e-10
+// of round-off that the batched form (strains from the gradients, which sum to zero) does not.
+double energy_roundoff(const FemModel &m, const double *x, int e, double energy)
+{
+  const int      *nd = &m.mesh.elements[static_cast<size_t>(e) * m.npe];
+  Eigen::Matrix3d Ds, R = Eigen::Matrix3d::Identity();
+  for (int k = 0; k < 3; ++k)
+    for (int d = 0; d < 3; ++d) Ds(d, k) = x[3 * nd[k + 1] + d] - x[3 * nd[0] + d];
+  if (m.settings.corotational) R = rotation_from_deformation(Ds * m.rest_shape_inverse[e]);
+  double u2 = 0, k2 = 0;
+  for (int a = 0; a < m.npe; ++a)
+    u2 +=
+      (R.transpose() * Eigen::Vector3d::Map(x + 3 * nd[a]) - Eigen::Vector3d::Map(&m.mesh.nodes[3 * nd[a]]))
+        .squaredNorm();
+  const int nb = packed_block_count(m.npe);
+  for (int j = 0; j < 9 * nb; ++j) k2 += std::pow(m.stiffness[static_cast<size_t>(e) * nb * 9 + j], 2);
+  return 1e-14 * std::sqrt(k2) * u2 + 1e-12 * std::fabs(energy) + 1e-300;
+}
+
 // The body sets this CPU runs (the portable one first, the reference of the others).
 std::vector<binbcsr::BodySet> runnable_bodies()
 {
@@ -315,4 +336,88 @@ TEST_CASE("fixed-step polar kernel: the scalar rotation where it accepts, the fa
     CHECK(kernels::polar_rotation<1>(F.data(), R) == 0);
     CHECK((Eigen::Matrix3d::Map(R) - Eigen::Matrix3d::Identity()).norm() == 0);
   }
+}
+
+TEST_CASE("the element pass's energy equals fem_energy's element by element, in every body set",
+          "[fem][kernel][batch][energy]")
+{
+  const std::vector<binbcsr::BodySet> bodies = runnable_bodies();
+  for (int order : {1, 2})
+    for (bool corotational : {true, false})
+      for (bool lumped : {false, true}) {
+        INFO("order " << order << " corotational " << corotational << " lumped " << lumped);
+        const int      n = 203; // not a multiple of the lane count
+        const Elements s = make_elements(order, n, 29 + order);
+        FemSettings    settings;
+        settings.young        = 3e5;
+        settings.poisson      = 0.45;
+        settings.corotational = corotational;
+        settings.mass         = lumped ? MassLumping::Lumped : MassLumping::Consistent;
+        const FemModel   m    = make_fem_model(s.mesh, settings);
+        std::vector<int> elements(n);
+        for (int e = 0; e < n; ++e) elements[e] = (e * 37) % n;
+        std::vector<char>      fixed(m.node_count(), 0);
+        const BlockPattern     p   = make_block_pattern(m, elements, fixed, 0, m.node_count(), true);
+        const StepCoefficients c   = implicit_euler_coefficients(0.01, 0.5, 0.002);
+        auto                   run = [&](ElementKernel kernel, binbcsr::BodySet body, bool blocks) {
+          std::vector<double> values, rhs(s.x.size(), 0.0), per(3 * static_cast<size_t>(n), -1.0);
+          reset_block_values(p, values);
+          ElementEnergy E;
+          E.per_element = per.data();
+          assemble_elements(m, elements, s.x.data(), s.v.data(), c, blocks ? &p : nullptr,
+                            blocks ? values.data() : nullptr, rhs.data(), nullptr, kernel, body, &E);
+          return std::make_pair(E, per);
+        };
+        // The definition, element by element, and the scalar loop's figures, which are its sums.
+        std::vector<FemEnergy> ref(n);
+        std::vector<double>    roundoff(n);
+        double                 elastic = 0, kinetic = 0, inverted = 0, roundoff_sum = 0;
+        for (int i = 0; i < n; ++i) {
+          ref[i]      = element_energy(m, s.x.data(), s.v.data(), elements[i]);
+          roundoff[i] = energy_roundoff(m, s.x.data(), elements[i], ref[i].elastic);
+          roundoff_sum += roundoff[i];
+          elastic += ref[i].elastic;
+          kinetic += ref[i].kinetic;
+          inverted += element_signed_volume(m.mesh, s.x.data(), elements[i]) > 0 ? 0 : 1;
+        }
+        CHECK(inverted >= n / kKinds); // the inverted elements at least (flat ones go either way)
+        const auto scalar = run(ElementKernel::Scalar, binbcsr::BodySet::Auto, true);
+        CHECK(scalar.first.elastic == Approx(elastic).epsilon(1e-14));
+        CHECK(scalar.first.kinetic == Approx(kinetic).epsilon(1e-14));
+        CHECK(scalar.first.inverted == inverted);
+        for (binbcsr::BodySet body : bodies)
+          for (bool blocks : {true, false}) {
+            INFO("element body " << binbcsr::body_set_name(body) << " blocks " << blocks);
+            const auto batched = run(ElementKernel::Batched, body, blocks);
+            // Per element: the energy within the definition's round-off, the kinetic energy to rounding.
+            double worst_elastic = 0, worst_kinetic = 0, sum_elastic = 0, sum_kinetic = 0, sum_inverted = 0;
+            int    flag_differs = 0;
+            for (int i = 0; i < n; ++i) {
+              const int     e   = elements[i];
+              const double *out = &batched.second[3 * static_cast<size_t>(i)];
+              REQUIRE(std::isfinite(out[0]));
+              REQUIRE(std::isfinite(out[1]));
+              worst_elastic    = std::max(worst_elastic, std::fabs(out[0] - ref[i].elastic) / roundoff[i]);
+              worst_kinetic    = std::max(worst_kinetic, std::fabs(out[1] - ref[i].kinetic) /
+                                                           std::max(std::fabs(ref[i].kinetic), 1e-300));
+              const double inv = element_signed_volume(m.mesh, s.x.data(), e) > 0 ? 0 : 1;
+              // Without FMA the test is element_signed_volume's to the bit; with it only a flat
+              // element's (volume within rounding of zero) may fall on the other side.
+              if (body == binbcsr::BodySet::Portable || s.kind[e] != Flat) CHECK(out[2] == inv);
+              flag_differs += out[2] != inv;
+              sum_elastic += out[0];
+              sum_kinetic += out[1];
+              sum_inverted += out[2];
+            }
+            CHECK(worst_elastic < 1);
+            CHECK(worst_kinetic < 1e-13);
+            CHECK(flag_differs <= n / kKinds + 1);
+            // The sums are the per-element figures' (in element order, lane after lane).
+            CHECK(batched.first.elastic == Approx(sum_elastic).epsilon(1e-14));
+            CHECK(batched.first.kinetic == Approx(sum_kinetic).epsilon(1e-14));
+            CHECK(batched.first.inverted == sum_inverted);
+            CHECK(std::fabs(batched.first.elastic - elastic) <= roundoff_sum);
+            CHECK(batched.first.kinetic == Approx(kinetic).epsilon(1e-13));
+          }
+      }
 }
