@@ -40,10 +40,15 @@ struct BlockSystem {
   std::vector<PetscInt> coo_block_row, coo_block_col; // kept for the fallback path and for dumps
   const PetscScalar    *last_values = nullptr; // the caller's array from the last SetValues (for dumps)
   GAMGSmootherCopies    gamg_copies;           // -gamg_smoother_precision single (smoother_copy.h)
+  // -initial_guess_scaled: a nonzero initial guess x0 is replaced by a x0, a minimising ||b - a A x0||
+  // (0 where x0 is no better than zero), at the cost of one product. r: its work vector.
+  PetscBool guess_scaled = PETSC_FALSE;
+  Vec       r            = nullptr;
 };
 
 struct SolveStats {
   PetscInt           iterations    = 0;
+  PetscReal          guess_scale   = 1; // the factor -initial_guess_scaled put on the guess (1: none)
   PetscReal          residual_norm = 0; // as the KSP reports it (0 when the KSP computes none)
   KSPConvergedReason reason        = KSP_CONVERGED_ITERATING;
   double             ms            = 0; // wall-clock milliseconds of KSPSolve
@@ -76,7 +81,8 @@ PetscErrorCode BlockSystemSetRigidBodyModes(BlockSystem *sys, const PetscScalar 
 PetscErrorCode BlockSystemSetValues(BlockSystem *sys, const PetscScalar *block_values);
 
 // Solves A sol = rhs for this rank's rows (3 * n_block_rows_local scalars each). sol_local is also
-// the initial guess when the KSP was told -ksp_initial_guess_nonzero. A KSP that does not converge
+// the initial guess when the KSP was told -ksp_initial_guess_nonzero (scaled first with
+// -initial_guess_scaled, see BlockSystem). A KSP that does not converge
 // is not an error here: stats->reason says what happened; the caller decides.
 PetscErrorCode BlockSystemSolve(BlockSystem *sys, const PetscScalar *rhs_local, PetscScalar *sol_local,
                                 SolveStats *stats);
