@@ -61,6 +61,25 @@ struct P2BlockTerms {
 };
 constexpr P2BlockTerms kP2Blocks{};
 
+// The gradient of a quadratic field at corner kk of the tetrahedron, G (3 x 3, row-major) =
+// sum_d w_d g_d^T with w_d = 3 u_d at d = kk, else 4 u_(edge d-kk) - u_d (u: the 10 nodal values,
+// g: the barycentric gradients). The forces take it of the displacements with damping, the energy of
+// the displacements.
+BINBCSR_PHYS_HD void p2_corner_gradient(const double (*u)[3], const double (*g)[3], int kk, double *G)
+{
+  BINBCSR_PHYS_UNROLL
+  for (int j = 0; j < 9; ++j) G[j] = 0;
+  BINBCSR_PHYS_UNROLL
+  for (int d = 0; d < 4; ++d) {
+    double w[3];
+    BINBCSR_PHYS_UNROLL
+    for (int i = 0; i < 3; ++i) w[i] = kk == d ? 3.0 * u[d][i] : 4.0 * u[4 + kP2EdgeOf[d][kk]][i] - u[d][i];
+    BINBCSR_PHYS_UNROLL
+    for (int i = 0; i < 3; ++i) BINBCSR_PHYS_UNROLL
+    for (int j = 0; j < 3; ++j) G[3 * i + j] += w[i] * g[d][j];
+  }
+}
+
 // One quadratic tetrahedron's forces: rhs (30) = -R sum_b K0_ab z_b - a_M m sum_b Mref_ab v_b, m = rho V;
 // Mref: 10 x 10 reference mass.
 template <int S, bool MassDamping>
@@ -75,16 +94,8 @@ BINBCSR_PHYS_HD void p2_forces(const double *x, const double *v, const double *X
   double y[4][4][3];
   BINBCSR_PHYS_UNROLL
   for (int kk = 0; kk < 4; ++kk) {
-    double G[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-    BINBCSR_PHYS_UNROLL
-    for (int d = 0; d < 4; ++d) {
-      double w[3];
-      BINBCSR_PHYS_UNROLL
-      for (int i = 0; i < 3; ++i) w[i] = kk == d ? 3.0 * z[d][i] : 4.0 * z[4 + kP2EdgeOf[d][kk]][i] - z[d][i];
-      BINBCSR_PHYS_UNROLL
-      for (int i = 0; i < 3; ++i) BINBCSR_PHYS_UNROLL
-      for (int j = 0; j < 3; ++j) G[3 * i + j] += w[i] * g[d][j];
-    }
+    double G[9];
+    p2_corner_gradient(z, g, kk, G);
     double sigma[9];
     linear_stress(G, k.lambda, k.mu, sigma);
     BINBCSR_PHYS_UNROLL
@@ -174,16 +185,8 @@ BINBCSR_PHYS_HD double p2_elastic_energy(const double *x, const double *X, const
   double Gsum[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, corners = 0;
   BINBCSR_PHYS_UNROLL
   for (int kk = 0; kk < 4; ++kk) {
-    double G[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-    BINBCSR_PHYS_UNROLL
-    for (int d = 0; d < 4; ++d) {
-      double w[3];
-      BINBCSR_PHYS_UNROLL
-      for (int i = 0; i < 3; ++i) w[i] = kk == d ? 3.0 * u[d][i] : 4.0 * u[4 + kP2EdgeOf[d][kk]][i] - u[d][i];
-      BINBCSR_PHYS_UNROLL
-      for (int i = 0; i < 3; ++i) BINBCSR_PHYS_UNROLL
-      for (int j = 0; j < 3; ++j) G[3 * i + j] += w[i] * g[d][j];
-    }
+    double G[9];
+    p2_corner_gradient(u, g, kk, G);
     corners += strain_product(G, G, lambda, mu);
     BINBCSR_PHYS_UNROLL
     for (int j = 0; j < 9; ++j) Gsum[j] += G[j];
