@@ -186,6 +186,25 @@ double energy_roundoff(const FemModel &m, const double *x, int e, double energy)
   return 1e-14 * std::sqrt(k2) * u2 + 1e-12 * std::fabs(energy) + 1e-300;
 }
 
+// The model of the element tests: a stiff, nearly incompressible material on the elements of s.
+FemModel test_model(const Elements &s, bool corotational, bool lumped)
+{
+  FemSettings settings;
+  settings.young        = 3e5;
+  settings.poisson      = 0.45;
+  settings.corotational = corotational;
+  settings.mass         = lumped ? MassLumping::Lumped : MassLumping::Consistent;
+  return make_fem_model(s.mesh, settings);
+}
+
+// The element list 0..n-1 permuted (37 and n coprime for the n the tests use).
+std::vector<int> permuted_elements(int n)
+{
+  std::vector<int> elements(n);
+  for (int e = 0; e < n; ++e) elements[e] = (e * 37) % n;
+  return elements;
+}
+
 // The body sets this CPU runs (the portable one first, the reference of the others).
 std::vector<binbcsr::BodySet> runnable_bodies()
 {
@@ -225,16 +244,10 @@ TEST_CASE("batched element kernels equal the scalar ones element by element, in 
       for (int variant = 0; variant < 4; ++variant) {
         // 0: step with damping (a_M != 0), 1: step without, 2: static Newton step, 3: forces only
         INFO("order " << order << " corotational " << corotational << " variant " << variant);
-        const int      n = 203; // not a multiple of the lane count
-        const Elements s = make_elements(order, n, 17 + order);
-        FemSettings    settings;
-        settings.young        = 3e5;
-        settings.poisson      = 0.45;
-        settings.corotational = corotational;
-        settings.mass         = variant == 1 ? MassLumping::Lumped : MassLumping::Consistent;
-        const FemModel   m    = make_fem_model(s.mesh, settings);
-        std::vector<int> elements(n);
-        for (int e = 0; e < n; ++e) elements[e] = (e * 37) % n; // a permuted element list
+        const int         n        = 203; // not a multiple of the lane count
+        const Elements    s        = make_elements(order, n, 17 + order);
+        const FemModel    m        = test_model(s, corotational, variant == 1);
+        std::vector<int>  elements = permuted_elements(n);
         std::vector<char> fixed(m.node_count(), 0);
         fixed[3] = fixed[m.node_count() - 1] = 1; // some slots dropped
         const BlockPattern p =
@@ -271,7 +284,8 @@ TEST_CASE("batched element kernels equal the scalar ones element by element, in 
           } else {
             CHECK(batched.scalar_path == 0);
           }
-          const Differences d = element_differences(m, elements, p, blocks, settings.young, scalar, batched);
+          const Differences d =
+            element_differences(m, elements, p, blocks, m.settings.young, scalar, batched);
           CHECK(d.R < 1e-12);
           // The scalar reference stops its Newton iteration within ~1e-14 of the rotation; a nearly rigid
           // element's forces (a difference of two large terms) amplify that to ~1e-11 of the floor.
@@ -292,7 +306,7 @@ TEST_CASE("batched element kernels equal the scalar ones element by element, in 
           // forces, as against the scalar loop).
           CHECK(batched.scalar_path == portable.scalar_path);
           const Differences t =
-            element_differences(m, elements, p, blocks, settings.young, portable, batched);
+            element_differences(m, elements, p, blocks, m.settings.young, portable, batched);
           CHECK(t.R < 1e-13);
           CHECK(t.rhs < 1e-10);
           CHECK(t.block < 1e-13);
@@ -346,16 +360,10 @@ TEST_CASE("the element pass's energy equals fem_energy's element by element, in 
     for (bool corotational : {true, false})
       for (bool lumped : {false, true}) {
         INFO("order " << order << " corotational " << corotational << " lumped " << lumped);
-        const int      n = 203; // not a multiple of the lane count
-        const Elements s = make_elements(order, n, 29 + order);
-        FemSettings    settings;
-        settings.young        = 3e5;
-        settings.poisson      = 0.45;
-        settings.corotational = corotational;
-        settings.mass         = lumped ? MassLumping::Lumped : MassLumping::Consistent;
-        const FemModel   m    = make_fem_model(s.mesh, settings);
-        std::vector<int> elements(n);
-        for (int e = 0; e < n; ++e) elements[e] = (e * 37) % n;
+        const int              n        = 203; // not a multiple of the lane count
+        const Elements         s        = make_elements(order, n, 29 + order);
+        const FemModel         m        = test_model(s, corotational, lumped);
+        std::vector<int>       elements = permuted_elements(n);
         std::vector<char>      fixed(m.node_count(), 0);
         const BlockPattern     p   = make_block_pattern(m, elements, fixed, 0, m.node_count(), true);
         const StepCoefficients c   = implicit_euler_coefficients(0.01, 0.5, 0.002);
