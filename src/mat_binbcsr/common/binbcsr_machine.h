@@ -1,6 +1,6 @@
 /*
-   What the tuner and the benchmarks need to know about the machine they run on, read from Linux's
-   /proc and /sys: the CPU model string, the online cores and the last-level cache size. Plain C++,
+   What the tuner and the benchmarks need to know about the machine they run on, from CPUID and
+   Linux's /proc and /sys: the CPU model string, the online cores and the last-level cache size. Plain C++,
    no PETSc, header only, so the plug-in and the example programs read them the same way. Each
    answer is empty or 0 where the system does not say (another OS, a container hiding /sys).
 */
