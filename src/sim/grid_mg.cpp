@@ -131,6 +131,28 @@ PetscErrorCode LevelSmoothers(PC pc, PetscInt level, KSP sides[2])
   PetscFunctionReturn(0);
 }
 
+// Level `level`'s smoothers become slab Gauss-Seidel on the blocks `entries` (n block rows) when the
+// level's couplings allow it (slab_gs.h); otherwise they stay SOR, and -info says why.
+PetscErrorCode UseSlabs(GridMG *mg, PetscInt level, int n, std::vector<SlabGS::Entry> entries,
+                        bool column_major)
+{
+  PetscFunctionBegin;
+  const std::string why = SlabGSBuild(n, std::move(entries), column_major, &mg->slabs[level]);
+  if (!why.empty()) {
+    PetscCall(PetscInfo(mg->pc, "grid multigrid level %d keeps SOR: %s\n", (int)level, why.c_str()));
+    PetscFunctionReturn(0);
+  }
+  KSP sides[2];
+  PetscCall(LevelSmoothers(mg->pc, level, sides));
+  for (KSP smoother : sides) {
+    PC spc;
+    PetscCall(KSPGetPC(smoother, &spc));
+    PetscCall(SlabGSSetPC(spc, &mg->slabs[level]));
+  }
+  mg->slab_used[level] = 1;
+  PetscFunctionReturn(0);
+}
+
 } // namespace
 
 PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
@@ -233,6 +255,26 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
     }
   }
   {
+    const char *kinds[] = {"sor", "slab"};
+    PetscInt    kind    = mg->own_galerkin ? 1 : 0;
+    PetscCall(PetscOptionsGetEList(nullptr, nullptr, "-grid_mg_smoother", kinds, 2, &kind, nullptr));
+    PetscCheck(
+      kind == 0 || mg->own_galerkin, comm, PETSC_ERR_SUP,
+      "-grid_mg_smoother slab needs the block Galerkin products (one rank, -grid_mg_galerkin blocks)");
+    mg->smoother_slab = kind == 1;
+    mg->slabs.assign(nlev, SlabGS());
+    mg->slab_used.assign(nlev, 0);
+    if (mg->smoother_slab && nlev > 1) { // the fine level's blocks: the driver's COO list, solver numbering
+      std::vector<SlabGS::Entry> entries;
+      for (size_t k = 0; k < coo_row.size(); ++k) {
+        const int r = new_of_old[coo_row[k]], c = new_of_old[coo_col[k]];
+        entries.push_back({r, c, (long)k, false});
+        if (coo_mirrored && r != c) entries.push_back({c, r, (long)k, true});
+      }
+      PetscCall(UseSlabs(mg, nlev - 1, (int)(n * n), std::move(entries), false));
+    }
+  }
+  {
     const char *precisions[] = {"double", "single"};
     PetscInt    precision    = 0;
     PetscCall(PetscOptionsGetEList(nullptr, nullptr, "-grid_mg_smoother_precision", precisions, 2, &precision,
@@ -286,6 +328,8 @@ PetscErrorCode GridMGRefill(GridMG *mg, const PetscScalar *coo_values)
     PetscCall(SetLevelOperators(mg, (PetscInt)mg->smoother_mats.size() - 1, A));
   }
   if (!mg->own_galerkin) PetscFunctionReturn(0); // PCMG recomputes its products at its set-up
+  const PetscInt fine = (PetscInt)mg->galerkin.size();
+  if (mg->smoother_slab && mg->slab_used[fine]) PetscCall(SlabGSRefill(&mg->slabs[fine], coo_values));
   for (size_t l = 0; l < mg->galerkin.size(); ++l) {
     const PetscScalar *src = coo_values;
     PetscScalar       *a   = nullptr;
@@ -295,7 +339,28 @@ PetscErrorCode GridMGRefill(GridMG *mg, const PetscScalar *coo_values)
     }
     PetscCall(BlockGalerkinRefill(&mg->galerkin[l], src));
     if (l > 0) PetscCall(MatSeqBAIJRestoreArray(mg->galerkin[l - 1].Ac, &a));
-    PetscCall(SetLevelOperators(mg, (PetscInt)(mg->galerkin.size() - 1 - l), mg->galerkin[l].Ac));
+    const PetscInt level = (PetscInt)(mg->galerkin.size() - 1 - l);
+    if (mg->smoother_slab && level > 0) {
+      Mat          Ac = mg->galerkin[l].Ac;
+      PetscInt     nb;
+      PetscScalar *ac;
+      if (mg->slabs[level].n == 0 && !mg->slab_used[level]) { // first refill: the level's pattern
+        std::vector<PetscInt>      rows, cols;
+        std::vector<SlabGS::Entry> entries;
+        PetscCall(BlockGalerkinBlocksOf(Ac, &rows, &cols));
+        for (size_t k = 0; k < rows.size(); ++k)
+          entries.push_back({(int)rows[k], (int)cols[k], (long)k, false});
+        PetscCall(MatGetLocalSize(Ac, &nb, nullptr));
+        PetscCall(UseSlabs(mg, level, (int)(nb / 3), std::move(entries), true));
+        if (!mg->slab_used[level]) mg->slabs[level].n = -1; // tried
+      }
+      if (mg->slab_used[level]) {
+        PetscCall(MatSeqBAIJGetArray(Ac, &ac));
+        PetscCall(SlabGSRefill(&mg->slabs[level], ac));
+        PetscCall(MatSeqBAIJRestoreArray(Ac, &ac));
+      }
+    }
+    PetscCall(SetLevelOperators(mg, level, mg->galerkin[l].Ac));
   }
   PetscFunctionReturn(0);
 }

@@ -10,6 +10,9 @@
 // coarse levels, one rank), with -grid_mg_galerkin pcmg (the default on more ranks) by PCMG's MatPtAP (AIJ)
 // at its set-up. Smoothers: -grid_mg_levels_[N_]* (default one symmetric Gauss-Seidel sweep), coarse solve:
 // -grid_mg_coarse_* (default LU, redundant on more ranks); GAMG's -mg_levels_* do not reach them.
+// -grid_mg_smoother slab (the default on one rank with the block Galerkin products; sor: the SOR above):
+// each level whose couplings allow it smooths with slab Gauss-Seidel (slab_gs.h), the same symmetric
+// block Gauss-Seidel sweep with 8 rows relaxed side by side; the others keep SOR.
 // -grid_mg_smoother_precision single (with the block Galerkin products; ignored with PCMG's): the smoothers sweep single-precision binbcsr
 // copies of the level operators (the fine one duplicated, the coarse BAIJ ones in upper-triangle storage)
 // and the V-cycle's residuals are taken on them too, while interpolation, the Galerkin products and the
@@ -20,6 +23,7 @@
 // row_offsets[r + 1] on rank r); each coarse node belongs to the rank owning the fine node nearest to it.
 #pragma once
 #include "sim/block_galerkin.h"
+#include "sim/slab_gs.h"
 
 #include <petscksp.h>
 #include <vector>
@@ -34,6 +38,11 @@ struct GridMG {
   // operators
   bool             single_smoothers = false;
   std::vector<Mat> smoother_mats; // per PCMG level (0 unused): the copies, made at the first refill
+  // -grid_mg_smoother slab (one rank, block Galerkin products): per PCMG level (0 unused), the slab
+  // Gauss-Seidel smoother (slab_gs.h) where its couplings allow it; slab_used[l] says whether it does
+  bool                smoother_slab = false;
+  std::vector<SlabGS> slabs;
+  std::vector<char>   slab_used;
 };
 
 // ksp's PC must be PCMG (-pc_type mg). fixed: n * n flags (row-major, physics numbering). coo_row, coo_col:

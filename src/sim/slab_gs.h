@@ -1,0 +1,63 @@
+// Slab Gauss-Seidel: a symmetric block Gauss-Seidel smoother for multigrid levels whose couplings are
+// short-ranged in the row numbering (the cloth's grid levels), with 8 rows relaxed side by side.
+//
+// Why: a Gauss-Seidel sweep in the natural order is a chain, row r waits for row r - 1 (its neighbour),
+// so binbcsr's MatSOR walks one lane at a time and its symmetric sweep on the cloth's fine level cost
+// 5.5-7 products (docs/cloth.md). Here the block rows are cut into 8 slabs of S = ceil(n / 8) rows and
+// lane l of step j relaxes row l S + j. When no row is coupled to a row S or more away, the 8 rows of
+// one step are not coupled to each other, so relaxing them together is exactly a Gauss-Seidel sweep in
+// the order (j, l): every row reads the newest value of every neighbour, as the sequential sweep would,
+// and the 8 relaxations are independent (no chain between them). A symmetric sweep is the forward
+// sweep over j followed by the backward one, so the V-cycle stays symmetric for CG.
+//
+// The level's 3x3 blocks come as a list of (row, column, source block, transposed) entries, refilled
+// from the source values in place: the driver's COO blocks on the fine level, SeqBAIJ arrays on the
+// coarse ones. Off-diagonal blocks are stored in single precision (the smoother only damps the error,
+// see smoother_copy.h); the diagonal blocks are inverted in double.
+#pragma once
+#include <petscksp.h>
+
+#include <string>
+#include <vector>
+
+struct SlabGS {
+  static constexpr int lanes = 8;
+  int                  n     = 0; // block rows
+  int                  steps = 0; // S = ceil(n / lanes): rows per slab
+  // entries of the level: block row, block column, index of the source block, source block transposed
+  struct Entry {
+    int  row, col;
+    long source;
+    bool transposed;
+  };
+  // the refill's copies: source block -> val offset of its entry 0 (off-diagonal) or row (diagonal);
+  // [0] read row by row, [1] read transposed (column-major or transposed source, not both)
+  struct Copy {
+    long source, dest;
+  };
+  std::vector<Copy>   copies[2], diagonal_copies[2];
+  std::vector<int>    step_start; // slot groups of step j: step_start[j] .. step_start[j + 1]
+  std::vector<int>    col;        // [group * lanes + lane] block column (padding: column 0, zero block)
+  std::vector<float>  val;        // [group * 9 lanes + entry * lanes + lane], entries row-major
+  std::vector<double> diag;       // [row * 9], row-major
+  std::vector<double> dinv;       // [step * 9 lanes + entry * lanes + lane]: the inverses, lane by lane
+};
+
+// Builds the layout for n block rows from entries (every off-diagonal block the row has, each (row, col)
+// at most once, the diagonal ones possibly repeated: they are summed). Returns an empty string, or why the
+// rows cannot be relaxed side by side (a coupling S or more rows away).
+std::string SlabGSBuild(int n, std::vector<SlabGS::Entry> entries, bool column_major_source, SlabGS *gs);
+
+// New values: blocks of 9 (row-major, or column-major when the layout says so) indexed by the entries'
+// source. PETSC_ERR_MAT_LU_ZRPVT naming the block row for a singular diagonal block.
+PetscErrorCode SlabGSRefill(SlabGS *gs, const PetscScalar *blocks);
+
+// One forward (or backward) sweep of x over all rows with right-hand side b (3 n values each): the
+// portable loop (SlabGSSweep, the definition) and the best the CPU runs (SlabGSSweepBest: AVX-512
+// where it has it; the same sums, possibly contracted differently).
+void SlabGSSweep(const SlabGS &gs, const double *b, double *x, bool forward);
+void SlabGSSweepBest(const SlabGS &gs, const double *b, double *x, bool forward);
+
+// Makes pc a PCSHELL that applies `its` symmetric sweeps through KSPRICHARDSON (PCApplyRichardson, no
+// residual product): the smoother of a PCMG level. gs must outlive pc.
+PetscErrorCode SlabGSSetPC(PC pc, SlabGS *gs);
