@@ -49,7 +49,7 @@ add_test(NAME cloth_mg_slab_smoothers_named
 add_test(NAME cloth_mg_slab_smoothers_need_blocks
          COMMAND ${EXPECT_RUN} nonzero "needs the block Galerkin products" -- ${CLOTH} -cloth_n 8 -steps 1 -pc_type mg -grid_mg_coarse_nodes 10 -grid_mg_galerkin pcmg -grid_mg_smoother slab)
 add_test(NAME cloth_mg_single_smoothers_need_binbcsr
-         COMMAND ${EXPECT_RUN} nonzero "needs a binbcsr fine operator" -- ${CLOTH} -cloth_n 8 -steps 1 -mat_type aij -pc_type mg -grid_mg_coarse_nodes 10 -grid_mg_smoother_precision single)
+         COMMAND ${EXPECT_RUN} nonzero "needs a binbcsr fine operator" -- ${CLOTH} -cloth_n 8 -steps 1 -mat_type aij -pc_type mg -grid_mg_coarse_nodes 10 -grid_mg_smoother sor -grid_mg_smoother_precision single)
 add_test(NAME cloth_mg_single_smoothers_only_with_blocks
          COMMAND ${EXPECT_RUN} 0 "coarse operators by MatPtAP, smoothers on the operators" -- ${CLOTH} -cloth_n 8 -steps 1 -mat_type binbcsr -pc_type mg -grid_mg_coarse_nodes 10 -grid_mg_galerkin pcmg -grid_mg_smoother_precision single)
 add_test(NAME cloth_mg_bad_smoother_precision

@@ -298,6 +298,17 @@ static PetscErrorCode SetLevelOperators(GridMG *mg, PetscInt level, Mat A)
   KSP sides[2];
 
   PetscFunctionBegin;
+  PetscCall(LevelSmoothers(mg->pc, level, sides));
+  if (mg->smoother_slab && level > 0 && mg->slab_used[level]) {
+    // slab Gauss-Seidel holds the level's blocks itself (single precision off the diagonal) and takes the
+    // level's residual in the same layout: no copy of the operator
+    // PCMG hands its residual function the level's operator (not the Mat given here): the slabs go
+    // with that operator
+    PetscCall(SlabGSAttach(A, &mg->slabs[level]));
+    for (KSP smoother : sides) PetscCall(KSPSetOperators(smoother, A, A));
+    PetscCall(PCMGSetResidual(mg->pc, level, SlabGSResidualMat, A));
+    PetscFunctionReturn(0);
+  }
   if (mg->single_smoothers && level > 0) {
     if (level == (PetscInt)mg->smoother_mats.size() - 1) { // the fine operator: the driver's Mat type
       PetscBool binbcsr;
@@ -311,7 +322,6 @@ static PetscErrorCode SetLevelOperators(GridMG *mg, PetscInt level, Mat A)
     PetscCall(SmootherCopyRefill(A, &mg->smoother_mats[level]));
     sweep = mg->smoother_mats[level];
   }
-  PetscCall(LevelSmoothers(mg->pc, level, sides));
   for (KSP smoother : sides) PetscCall(KSPSetOperators(smoother, A, sweep));
   // The level's residual on the copy as well: BAIJ's product ran at about a third of binbcsr single's
   // (cloth 160 x 160: the 81 x 81 level's residuals took more than the fine level's)

@@ -1,6 +1,7 @@
 #include "sim/slab_gs.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 
@@ -23,46 +24,83 @@ bool Invert3(const double *m, double *inv)
 
 } // namespace
 
+namespace {
+
+inline int LaneIndex(int r, int S) { return SlabGS::lanes + (r % S) * 3 * SlabGS::lanes + r / S; }
+
+} // namespace
+
 std::string SlabGSBuild(int n, std::vector<SlabGS::Entry> entries, bool column_major_source, SlabGS *gs)
 {
   constexpr int L = SlabGS::lanes;
   SlabGS        g;
-  g.n     = n;
-  g.steps = (n + L - 1) / L;
-  // rows' off-diagonal entries, in the order given
-  std::vector<int> count(n, 0);
-  for (const SlabGS::Entry &e : entries) {
+  g.n         = n;
+  g.steps     = (n + L - 1) / L;
+  const int S = g.steps;
+  // each row's off-diagonal entries as (offset c - r, how many of that offset came before, entry)
+  std::vector<std::vector<std::array<long, 3>>> row_entries(n);
+  for (size_t k = 0; k < entries.size(); ++k) {
+    const SlabGS::Entry &e = entries[k];
     if (e.row < 0 || e.row >= n || e.col < 0 || e.col >= n) return "an entry outside the level";
-    if (e.row == e.col) continue;
-    if (std::abs(e.row - e.col) >= g.steps)
-      return "row " + std::to_string(e.row) + " is coupled to row " + std::to_string(e.col) +
-             ", a slab or more away";
-    count[e.row]++;
-  }
-  g.step_start.assign(g.steps + 1, 0);
-  for (int j = 0; j < g.steps; ++j) {
-    int len = 0;
-    for (int l = 0; l < L; ++l)
-      if (l * g.steps + j < n) len = std::max(len, count[l * g.steps + j]);
-    g.step_start[j + 1] = g.step_start[j] + len;
-  }
-  const long groups = g.step_start[g.steps];
-  g.col.assign(groups * L, 0);
-  g.val.assign(groups * 9 * L, 0.0f);
-  std::vector<int> next(n, 0);
-  for (const SlabGS::Entry &e : entries) {
     const int flip = e.transposed != column_major_source;
     if (e.row == e.col) {
       g.diagonal_copies[flip].push_back({e.source, e.row});
       continue;
     }
-    const int  step = e.row % g.steps, lane = e.row / g.steps;
-    const long s = (long)(g.step_start[step] + next[e.row]++) * L + lane;
-    g.col[s]     = e.col;
-    g.copies[flip].push_back({e.source, (s / L) * 9 * L + lane});
+    if (std::abs(e.row - e.col) >= S)
+      return "row " + std::to_string(e.row) + " is coupled to row " + std::to_string(e.col) +
+             ", a slab or more away";
+    row_entries[e.row].push_back({e.col - e.row, 0, (long)k});
   }
+  for (auto &list : row_entries) { // a repeated (row, col) gets a group of its own: (offset, repeat)
+    std::sort(list.begin(), list.end());
+    for (size_t q = 1; q < list.size(); ++q)
+      if (list[q][0] == list[q - 1][0]) list[q][1] = list[q - 1][1] + 1;
+  }
+  // Step j's groups: one per (offset, repeat) any of its lanes has, in that order, so that lanes whose
+  // rows have the same neighbours (the grid away from its edges) meet them in the same group.
+  g.step_start.assign(S + 1, 0);
+  for (int j = 0; j < S; ++j) {
+    std::vector<std::array<long, 2>> keys;
+    for (int l = 0; l < L && l * S + j < n; ++l)
+      for (const auto &e : row_entries[l * S + j]) keys.push_back({e[0], e[1]});
+    std::sort(keys.begin(), keys.end());
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+    g.step_start[j + 1] = g.step_start[j] + (int)keys.size();
+    for (const auto &key : keys) {
+      const long group = (long)g.xidx.size() / L;
+      int        shift = 0, shifts = 0;
+      bool       same  = true;
+      unsigned   lanes = 0;
+      for (int l = 0; l < L; ++l) {
+        const int r = l * S + j;
+        int       c = r < n ? r : 0; // padding: the lane's own row (or row 0), zero block
+        if (r < n) {
+          const auto &list = row_entries[r];
+          const auto  it = std::lower_bound(list.begin(), list.end(), std::array<long, 3>{key[0], key[1], 0});
+          if (it != list.end() && (*it)[0] == key[0] && (*it)[1] == key[1]) {
+            const SlabGS::Entry &e = entries[(*it)[2]];
+            c                      = e.col;
+            lanes |= 1u << l;
+            g.copies[e.transposed != column_major_source].push_back({e.source, group * 9 * L + l});
+            const int s = LaneIndex(c, S) - l;
+            if (shifts++ == 0) shift = s;
+            same &= s == shift;
+          }
+        }
+        g.xidx.push_back(LaneIndex(c, S));
+      }
+      g.base.push_back(same && shifts > 0 ? shift : -1);
+      g.real.push_back((unsigned char)lanes);
+    }
+  }
+  g.val.assign(g.xidx.size() * 9, 0.0f);
   g.diag.assign(9 * (size_t)n, 0.0);
-  g.dinv.assign(9 * (size_t)g.steps * L, 0.0);
+  g.dinv.assign(9 * (size_t)S * L, 0.0);
+  g.dl.assign(g.dinv.size(), 0.0);
+  g.xl.assign((size_t)(3 * S + 2) * L, 0.0);
+  g.bl.assign(g.xl.size(), 0.0);
+  g.rl.assign(g.xl.size(), 0.0);
   *gs = std::move(g);
   return "";
 }
@@ -90,118 +128,229 @@ PetscErrorCode SlabGSRefill(SlabGS *gs, const PetscScalar *blocks)
     PetscCheck(Invert3(&gs->diag[9 * (size_t)r], inv), PETSC_COMM_SELF, PETSC_ERR_MAT_LU_ZRPVT,
                "slab Gauss-Seidel: the diagonal block of block row %d is singular", r);
     const int step = r % gs->steps, lane = r / gs->steps;
-    for (int e = 0; e < 9; ++e) gs->dinv[((size_t)step * 9 + e) * L + lane] = inv[e];
+    for (int e = 0; e < 9; ++e) {
+      gs->dinv[((size_t)step * 9 + e) * L + lane] = inv[e];
+      gs->dl[((size_t)step * 9 + e) * L + lane]   = gs->diag[9 * (size_t)r + e];
+    }
   }
   PetscFunctionReturn(0);
 }
 
-// One build per instruction set, picked by the CPU at load time (GCC's target_clones): the lane loop
-// is a vector of 8 with gathers of x where the CPU has them; the library's baseline (x86-64-v2) has no
-// gathers, and there the lanes ran at a third of the speed of binbcsr's own SOR.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("default", "avx2", "avx512f")))
-#endif
-void SlabGSSweep(const SlabGS &gs, const double *b, double *x, bool forward)
+namespace {
+
+// v (3 n values, row by row) into / out of the lane layout lv (padding lanes stay zero): slab l of v is
+// a run of 3 S values, read or written as lane l of every step (no division per row)
+void ToLanes(const SlabGS &gs, const double *v, std::vector<double> &lv)
+{
+  constexpr int L = SlabGS::lanes;
+  const int     S = gs.steps;
+  for (int l = 0; l < L; ++l) {
+    const int rows = std::min(S, gs.n - l * S);
+    for (int j = 0; j < rows; ++j)
+      for (int i = 0; i < 3; ++i) lv[L + (3 * j + i) * L + l] = v[3 * (l * S + j) + i];
+  }
+}
+
+void FromLanes(const SlabGS &gs, const std::vector<double> &lv, double *v)
+{
+  constexpr int L = SlabGS::lanes;
+  const int     S = gs.steps;
+  for (int l = 0; l < L; ++l) {
+    const int rows = std::min(S, gs.n - l * S);
+    for (int j = 0; j < rows; ++j)
+      for (int i = 0; i < 3; ++i) v[3 * (l * S + j) + i] = lv[L + (3 * j + i) * L + l];
+  }
+}
+
+// One sweep in the lane layout, lane by lane: the definition. With r: no sweep, r = b - A x instead
+// (the same pass, the diagonal blocks times x in place of their inverses times the sums).
+void SweepLanes(const SlabGS &gs, const double *b, double *x, bool forward, double *r)
 {
   constexpr int L = SlabGS::lanes;
   const int     S = gs.steps;
   for (int q = 0; q < S; ++q) {
     const int j = forward ? q : S - 1 - q;
-    double    a0[L], a1[L], a2[L];
-#pragma omp simd
-    for (int l = 0; l < L; ++l) {
-      const int r = l * S + j;
-      a0[l]       = r < gs.n ? b[3 * r] : 0.0;
-      a1[l]       = r < gs.n ? b[3 * r + 1] : 0.0;
-      a2[l]       = r < gs.n ? b[3 * r + 2] : 0.0;
-    }
+    double    a[3][L];
+    for (int i = 0; i < 3; ++i)
+      for (int l = 0; l < L; ++l) a[i][l] = b[L + (3 * j + i) * L + l];
     // b_r minus the row's off-diagonal blocks times the newest x: the lanes' rows are not coupled to
     // each other, so none of them reads an x another lane writes in this step
     for (int g = gs.step_start[j]; g < gs.step_start[j + 1]; ++g) {
-      const int   *c = gs.col.data() + (size_t)g * L;
+      const int   *c = gs.xidx.data() + (size_t)g * L;
       const float *v = gs.val.data() + (size_t)g * 9 * L;
-#pragma omp simd
-      for (int l = 0; l < L; ++l) {
-        const double x0 = x[3 * c[l]], x1 = x[3 * c[l] + 1], x2 = x[3 * c[l] + 2];
-        a0[l] -= (double)v[0 * L + l] * x0 + (double)v[1 * L + l] * x1 + (double)v[2 * L + l] * x2;
-        a1[l] -= (double)v[3 * L + l] * x0 + (double)v[4 * L + l] * x1 + (double)v[5 * L + l] * x2;
-        a2[l] -= (double)v[6 * L + l] * x0 + (double)v[7 * L + l] * x1 + (double)v[8 * L + l] * x2;
-      }
+      for (int l = 0; l < L; ++l)
+        for (int i = 0; i < 3; ++i)
+          a[i][l] -= (double)v[(3 * i) * L + l] * x[c[l]] + (double)v[(3 * i + 1) * L + l] * x[c[l] + L] +
+                     (double)v[(3 * i + 2) * L + l] * x[c[l] + 2 * L];
+    }
+    if (r) {
+      const double *d = gs.dl.data() + (size_t)j * 9 * L, *xj = x + L + 3 * j * L;
+      for (int i = 0; i < 3; ++i)
+        for (int l = 0; l < L; ++l)
+          r[L + (3 * j + i) * L + l] =
+            a[i][l] - (d[(3 * i) * L + l] * xj[l] + d[(3 * i + 1) * L + l] * xj[L + l] +
+                       d[(3 * i + 2) * L + l] * xj[2 * L + l]);
+      continue;
     }
     const double *d = gs.dinv.data() + (size_t)j * 9 * L;
-    for (int l = 0; l < L; ++l) {
-      const int r = l * S + j;
-      if (r >= gs.n) continue;
-      for (int i = 0; i < 3; ++i)
-        x[3 * r + i] =
-          d[(3 * i) * L + l] * a0[l] + d[(3 * i + 1) * L + l] * a1[l] + d[(3 * i + 2) * L + l] * a2[l];
-    }
+    for (int i = 0; i < 3; ++i)
+      for (int l = 0; l < L; ++l)
+        x[L + (3 * j + i) * L + l] =
+          d[(3 * i) * L + l] * a[0][l] + d[(3 * i + 1) * L + l] * a[1][l] + d[(3 * i + 2) * L + l] * a[2][l];
   }
 }
+
+} // namespace
 
 #if defined(__GNUC__) && defined(__x86_64__)
   #include <immintrin.h>
-// The same sweep in AVX-512: one register of 8 lanes per component, x of the lanes' columns gathered,
-// the new x scattered (the lanes' rows are distinct), b gathered. GCC vectorised the portable loop
-// with 256-bit halves and no gathers (3 x 8 scalar loads per slot group).
-__attribute__((target("avx512f,avx512vl"))) static void SweepAVX512(const SlabGS &gs, const double *b,
-                                                                    double *x, bool forward)
+// The same sweep in AVX-512, one register of 8 lanes per component: x of a group by plain (masked) loads
+// where its lanes read the same offset (base), else gathered. Gathers of x in the rows' own order, and
+// the new x scattered back, took 1.4-1.9 ms per symmetric sweep of the cloth's fine level.
+__attribute__((target("avx512f,avx512vl"))) static void SweepLanesAVX512(const SlabGS &gs, const double *b,
+                                                                         double *x, bool forward, double *r)
 {
-  constexpr int L     = SlabGS::lanes;
-  const int     S     = gs.steps;
-  const __m256i iota  = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  const __m256i rows0 = _mm256_mullo_epi32(iota, _mm256_set1_epi32(S));
+  constexpr int L = SlabGS::lanes;
+  const int     S = gs.steps;
   for (int q = 0; q < S; ++q) {
-    const int      j    = forward ? q : S - 1 - q;
-    const __m256i  rows = _mm256_add_epi32(rows0, _mm256_set1_epi32(j));
-    const __mmask8 real = _mm256_cmplt_epi32_mask(rows, _mm256_set1_epi32(gs.n));
-    const __m256i  o    = _mm256_add_epi32(rows, _mm256_add_epi32(rows, rows)); /* 3 r */
-    __m512d        a0   = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), real, o, b, 8);
-    __m512d        a1   = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), real, o, b + 1, 8);
-    __m512d        a2   = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), real, o, b + 2, 8);
+    const int j  = forward ? q : S - 1 - q;
+    __m512d   a0 = _mm512_loadu_pd(b + L + (3 * j) * L), a1 = _mm512_loadu_pd(b + L + (3 * j + 1) * L),
+            a2 = _mm512_loadu_pd(b + L + (3 * j + 2) * L);
     for (int g = gs.step_start[j]; g < gs.step_start[j + 1]; ++g) {
-      const float  *v  = gs.val.data() + (size_t)g * 9 * L;
-      const __m256i c  = _mm256_loadu_si256((const __m256i *)(gs.col.data() + (size_t)g * L));
-      const __m256i oc = _mm256_add_epi32(c, _mm256_add_epi32(c, c));
-      const __m512d x0 = _mm512_i32gather_pd(oc, x, 8), x1 = _mm512_i32gather_pd(oc, x + 1, 8),
-                    x2 = _mm512_i32gather_pd(oc, x + 2, 8);
-      a0               = _mm512_fnmadd_pd(
-                      _mm512_cvtps_pd(_mm256_loadu_ps(v + 2 * L)), x2,
-                      _mm512_fnmadd_pd(_mm512_cvtps_pd(_mm256_loadu_ps(v + 1 * L)), x1,
-                                       _mm512_fnmadd_pd(_mm512_cvtps_pd(_mm256_loadu_ps(v + 0 * L)), x0, a0)));
-      a1 = _mm512_fnmadd_pd(
-        _mm512_cvtps_pd(_mm256_loadu_ps(v + 5 * L)), x2,
-        _mm512_fnmadd_pd(_mm512_cvtps_pd(_mm256_loadu_ps(v + 4 * L)), x1,
-                         _mm512_fnmadd_pd(_mm512_cvtps_pd(_mm256_loadu_ps(v + 3 * L)), x0, a1)));
-      a2 = _mm512_fnmadd_pd(
-        _mm512_cvtps_pd(_mm256_loadu_ps(v + 8 * L)), x2,
-        _mm512_fnmadd_pd(_mm512_cvtps_pd(_mm256_loadu_ps(v + 7 * L)), x1,
-                         _mm512_fnmadd_pd(_mm512_cvtps_pd(_mm256_loadu_ps(v + 6 * L)), x0, a2)));
+      const float   *v    = gs.val.data() + (size_t)g * 9 * L;
+      const __mmask8 real = gs.real[g];
+      __m512d        x0, x1, x2;
+      if (gs.base[g] >= 0) {
+        const double *xs = x + gs.base[g];
+        x0               = _mm512_maskz_loadu_pd(real, xs);
+        x1               = _mm512_maskz_loadu_pd(real, xs + L);
+        x2               = _mm512_maskz_loadu_pd(real, xs + 2 * L);
+      } else {
+        const __m256i c = _mm256_loadu_si256((const __m256i *)(gs.xidx.data() + (size_t)g * L));
+        x0              = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), real, c, x, 8);
+        x1              = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), real, c, x + L, 8);
+        x2              = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), real, c, x + 2 * L, 8);
+      }
+  #define SLAB_W(e) _mm512_cvtps_pd(_mm256_loadu_ps(v + (e)*L))
+      // a_i -= (block row i) x_c as one subtraction: the products of a group do not wait for the
+      // accumulator, which would make the step a chain of 3 dependent FMAs per group
+      a0 = _mm512_sub_pd(
+        a0, _mm512_fmadd_pd(SLAB_W(2), x2, _mm512_fmadd_pd(SLAB_W(1), x1, _mm512_mul_pd(SLAB_W(0), x0))));
+      a1 = _mm512_sub_pd(
+        a1, _mm512_fmadd_pd(SLAB_W(5), x2, _mm512_fmadd_pd(SLAB_W(4), x1, _mm512_mul_pd(SLAB_W(3), x0))));
+      a2 = _mm512_sub_pd(
+        a2, _mm512_fmadd_pd(SLAB_W(8), x2, _mm512_fmadd_pd(SLAB_W(7), x1, _mm512_mul_pd(SLAB_W(6), x0))));
+  #undef SLAB_W
     }
-    const double *d  = gs.dinv.data() + (size_t)j * 9 * L;
-    const __m512d y0 = _mm512_fmadd_pd(
-      _mm512_loadu_pd(d + 2 * L), a2,
-      _mm512_fmadd_pd(_mm512_loadu_pd(d + 1 * L), a1, _mm512_mul_pd(_mm512_loadu_pd(d + 0 * L), a0)));
-    const __m512d y1 = _mm512_fmadd_pd(
-      _mm512_loadu_pd(d + 5 * L), a2,
-      _mm512_fmadd_pd(_mm512_loadu_pd(d + 4 * L), a1, _mm512_mul_pd(_mm512_loadu_pd(d + 3 * L), a0)));
-    const __m512d y2 = _mm512_fmadd_pd(
-      _mm512_loadu_pd(d + 8 * L), a2,
-      _mm512_fmadd_pd(_mm512_loadu_pd(d + 7 * L), a1, _mm512_mul_pd(_mm512_loadu_pd(d + 6 * L), a0)));
-    _mm512_mask_i32scatter_pd(x, real, o, y0, 8);
-    _mm512_mask_i32scatter_pd(x + 1, real, o, y1, 8);
-    _mm512_mask_i32scatter_pd(x + 2, real, o, y2, 8);
+    if (r) {
+      const double *d = gs.dl.data() + (size_t)j * 9 * L, *xj = x + L + 3 * j * L;
+      const __m512d x0 = _mm512_loadu_pd(xj), x1 = _mm512_loadu_pd(xj + L), x2 = _mm512_loadu_pd(xj + 2 * L);
+  #define SLAB_D(e) _mm512_loadu_pd(d + (e)*L)
+      _mm512_storeu_pd(
+        r + L + (3 * j) * L,
+        _mm512_sub_pd(
+          a0, _mm512_fmadd_pd(SLAB_D(2), x2, _mm512_fmadd_pd(SLAB_D(1), x1, _mm512_mul_pd(SLAB_D(0), x0)))));
+      _mm512_storeu_pd(
+        r + L + (3 * j + 1) * L,
+        _mm512_sub_pd(
+          a1, _mm512_fmadd_pd(SLAB_D(5), x2, _mm512_fmadd_pd(SLAB_D(4), x1, _mm512_mul_pd(SLAB_D(3), x0)))));
+      _mm512_storeu_pd(
+        r + L + (3 * j + 2) * L,
+        _mm512_sub_pd(
+          a2, _mm512_fmadd_pd(SLAB_D(8), x2, _mm512_fmadd_pd(SLAB_D(7), x1, _mm512_mul_pd(SLAB_D(6), x0)))));
+  #undef SLAB_D
+      continue;
+    }
+    const double *d = gs.dinv.data() + (size_t)j * 9 * L;
+  #define SLAB_D(e) _mm512_loadu_pd(d + (e)*L)
+    _mm512_storeu_pd(
+      x + L + (3 * j) * L,
+      _mm512_fmadd_pd(SLAB_D(2), a2, _mm512_fmadd_pd(SLAB_D(1), a1, _mm512_mul_pd(SLAB_D(0), a0))));
+    _mm512_storeu_pd(
+      x + L + (3 * j + 1) * L,
+      _mm512_fmadd_pd(SLAB_D(5), a2, _mm512_fmadd_pd(SLAB_D(4), a1, _mm512_mul_pd(SLAB_D(3), a0))));
+    _mm512_storeu_pd(
+      x + L + (3 * j + 2) * L,
+      _mm512_fmadd_pd(SLAB_D(8), a2, _mm512_fmadd_pd(SLAB_D(7), a1, _mm512_mul_pd(SLAB_D(6), a0))));
+  #undef SLAB_D
   }
 }
 #endif
 
-void SlabGSSweepBest(const SlabGS &gs, const double *b, double *x, bool forward)
+namespace {
+
+using SweepBody = void (*)(const SlabGS &, const double *, double *, bool, double *);
+
+SweepBody BestBody()
 {
 #if defined(__GNUC__) && defined(__x86_64__)
   static const bool avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl");
-  if (avx512 && 3L * gs.n < (1L << 31)) return SweepAVX512(gs, b, x, forward);
+  if (avx512) return SweepLanesAVX512;
 #endif
-  SlabGSSweep(gs, b, x, forward);
+  return SweepLanes;
+}
+
+void SweepWith(SweepBody body, SlabGS &gs, const double *b, double *x, bool forward)
+{
+  ToLanes(gs, b, gs.bl);
+  ToLanes(gs, x, gs.xl);
+  body(gs, gs.bl.data(), gs.xl.data(), forward, nullptr);
+  FromLanes(gs, gs.xl, x);
+}
+
+} // namespace
+
+void SlabGSSweep(SlabGS &gs, const double *b, double *x, bool forward)
+{
+  SweepWith(SweepLanes, gs, b, x, forward);
+}
+
+void SlabGSSweepBest(SlabGS &gs, const double *b, double *x, bool forward)
+{
+  SweepWith(BestBody(), gs, b, x, forward);
+}
+
+void SlabGSResidual(SlabGS &gs, const double *b, const double *x, double *r, bool best)
+{
+  ToLanes(gs, b, gs.bl);
+  ToLanes(gs, x, gs.xl);
+  (best ? BestBody() : SweepLanes)(gs, gs.bl.data(), gs.xl.data(), true, gs.rl.data());
+  FromLanes(gs, gs.rl, r);
+}
+
+PetscErrorCode SlabGSAttach(Mat A, SlabGS *gs)
+{
+  PetscContainer c;
+
+  PetscFunctionBegin;
+  PetscCall(PetscContainerCreate(PetscObjectComm((PetscObject)A), &c));
+  PetscCall(PetscContainerSetPointer(c, gs));
+  PetscCall(PetscObjectCompose((PetscObject)A, "SlabGS", (PetscObject)c));
+  PetscCall(PetscContainerDestroy(&c));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode SlabGSResidualMat(Mat A, Vec b, Vec x, Vec r)
+{
+  PetscContainer     c;
+  SlabGS            *gs;
+  const PetscScalar *ba, *xa;
+  PetscScalar       *ra;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectQuery((PetscObject)A, "SlabGS", (PetscObject *)&c));
+  PetscCheck(c, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_WRONG,
+             "slab Gauss-Seidel residual: no SlabGS attached to the operator");
+  PetscCall(PetscContainerGetPointer(c, (void **)&gs));
+  PetscCall(VecGetArrayRead(b, &ba));
+  PetscCall(VecGetArrayRead(x, &xa));
+  PetscCall(VecGetArrayWrite(r, &ra));
+  SlabGSResidual(*gs, ba, xa, ra, true);
+  PetscCall(VecRestoreArrayWrite(r, &ra));
+  PetscCall(VecRestoreArrayRead(x, &xa));
+  PetscCall(VecRestoreArrayRead(b, &ba));
+  PetscCall(PetscLogFlops(18.0 * (double)gs->val.size() / 9 + 18.0 * gs->n));
+  PetscFunctionReturn(0);
 }
 
 namespace {
@@ -212,13 +361,17 @@ PetscErrorCode SymmetricSweeps(SlabGS *gs, Vec b, Vec x, PetscInt its, PetscBool
   PetscScalar       *xa;
 
   PetscFunctionBegin;
-  if (zero_guess) PetscCall(VecSet(x, 0.0));
+  const SweepBody body = BestBody();
   PetscCall(VecGetArrayRead(b, &ba));
   PetscCall(VecGetArray(x, &xa));
+  ToLanes(*gs, ba, gs->bl);
+  if (zero_guess) std::fill(gs->xl.begin(), gs->xl.end(), 0.0);
+  else ToLanes(*gs, xa, gs->xl);
   for (PetscInt k = 0; k < its; ++k) {
-    SlabGSSweepBest(*gs, ba, xa, true);
-    SlabGSSweepBest(*gs, ba, xa, false);
+    body(*gs, gs->bl.data(), gs->xl.data(), true, nullptr);
+    body(*gs, gs->bl.data(), gs->xl.data(), false, nullptr);
   }
+  FromLanes(*gs, gs->xl, xa);
   PetscCall(VecRestoreArray(x, &xa));
   PetscCall(VecRestoreArrayRead(b, &ba));
   // two passes over the off-diagonal blocks and the diagonal solves

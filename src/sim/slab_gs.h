@@ -35,12 +35,21 @@ struct SlabGS {
   struct Copy {
     long source, dest;
   };
-  std::vector<Copy>   copies[2], diagonal_copies[2];
-  std::vector<int>    step_start; // slot groups of step j: step_start[j] .. step_start[j + 1]
-  std::vector<int>    col;        // [group * lanes + lane] block column (padding: column 0, zero block)
-  std::vector<float>  val;        // [group * 9 lanes + entry * lanes + lane], entries row-major
-  std::vector<double> diag;       // [row * 9], row-major
-  std::vector<double> dinv;       // [step * 9 lanes + entry * lanes + lane]: the inverses, lane by lane
+  std::vector<Copy> copies[2], diagonal_copies[2];
+  // The sweeps keep x and b lane by lane: component i of row r at lane_index(r) + i * lanes, with
+  // lane_index(r) = lanes + (r % S) * 3 * lanes + r / S (one padding register before and after). Step j's
+  // rows are then one register per component, and a slot group whose lanes all read the neighbour at
+  // the same offset (a grid level away from its edges) reads x with plain loads.
+  std::vector<int> step_start;           // slot groups of step j: step_start[j] .. step_start[j + 1]
+  std::vector<int> xidx;                 // [group * lanes + lane] lane_index of the lane's column
+  std::vector<int> base;                 // [group] xidx - lane where that is one number for the group's real
+                                         // lanes (plain loads), -1: the group gathers
+  std::vector<unsigned char> real;       // [group] the lanes with a block in the group (bit per lane)
+  std::vector<float>         val;        // [group * 9 lanes + entry * lanes + lane], entries row-major
+  std::vector<double>        diag;       // [row * 9], row-major
+  std::vector<double>        dinv;       // [step * 9 lanes + entry * lanes + lane]: the inverses
+  std::vector<double>        dl;         // the diagonal blocks, laid out as dinv (residuals)
+  std::vector<double>        xl, bl, rl; // x, b and a residual lane by lane during an application
 };
 
 // Builds the layout for n block rows from entries (every off-diagonal block the row has, each (row, col)
@@ -52,11 +61,19 @@ std::string SlabGSBuild(int n, std::vector<SlabGS::Entry> entries, bool column_m
 // source. PETSC_ERR_MAT_LU_ZRPVT naming the block row for a singular diagonal block.
 PetscErrorCode SlabGSRefill(SlabGS *gs, const PetscScalar *blocks);
 
-// One forward (or backward) sweep of x over all rows with right-hand side b (3 n values each): the
-// portable loop (SlabGSSweep, the definition) and the best the CPU runs (SlabGSSweepBest: AVX-512
-// where it has it; the same sums, possibly contracted differently).
-void SlabGSSweep(const SlabGS &gs, const double *b, double *x, bool forward);
-void SlabGSSweepBest(const SlabGS &gs, const double *b, double *x, bool forward);
+// One forward (or backward) sweep of x over all rows with right-hand side b (3 n values each, row by
+// row): the portable sweep (SlabGSSweep, the definition) and the best the CPU runs (SlabGSSweepBest:
+// AVX-512 where it has it; the same sums, possibly contracted differently). gs's lane vectors are the
+// work space.
+void SlabGSSweep(SlabGS &gs, const double *b, double *x, bool forward);
+void SlabGSSweepBest(SlabGS &gs, const double *b, double *x, bool forward);
+
+// r = b - A x (row by row), in one pass over the layout as a sweep makes (best: the CPU's best body).
+void SlabGSResidual(SlabGS &gs, const double *b, const double *x, double *r, bool best);
+// The same as PCMG's residual for a level (PCMGSetResidual), A the level's operator with its SlabGS
+// attached (SlabGSAttach: composed as "SlabGS"; gs must outlive that use of A).
+PetscErrorCode SlabGSAttach(Mat A, SlabGS *gs);
+PetscErrorCode SlabGSResidualMat(Mat A, Vec b, Vec x, Vec r);
 
 // Makes pc a PCSHELL that applies `its` symmetric sweeps through KSPRICHARDSON (PCApplyRichardson, no
 // residual product): the smoother of a PCMG level. gs must outlive pc.

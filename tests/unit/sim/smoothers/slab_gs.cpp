@@ -116,6 +116,27 @@ TEST_CASE("slab Gauss-Seidel sweeps are the sequential sweeps in slab order", "[
   }
 }
 
+TEST_CASE("slab Gauss-Seidel residuals are b - A x", "[slab_gs]")
+{
+  for (int n : {45, 203}) {
+    const Banded m = make_banded(n, 2, 11u + n);
+    SlabGS       gs;
+    REQUIRE(SlabGSBuild(n, m.entries, false, &gs).empty());
+    REQUIRE(SlabGSRefill(&gs, m.blocks.data()) == 0);
+    std::vector<double> b(3 * n), x(3 * n), r(3 * n), rbest(3 * n);
+    for (int i = 0; i < 3 * n; ++i) b[i] = std::sin(0.21 * i), x[i] = std::cos(0.53 * i);
+    SlabGSResidual(gs, b.data(), x.data(), r.data(), false);
+    SlabGSResidual(gs, b.data(), x.data(), rbest.data(), true);
+    for (int i = 0; i < 3 * n; ++i) {
+      double ref = b[i];
+      for (int c = 0; c < 3 * n; ++c) ref -= m.dense[i][c] * x[c];
+      INFO("n " << n << " entry " << i);
+      CHECK(r[i] == Approx(ref).epsilon(1e-12).margin(1e-12));
+      CHECK(rbest[i] == Approx(r[i]).epsilon(1e-13).margin(1e-13));
+    }
+  }
+}
+
 TEST_CASE("slab Gauss-Seidel reads column-major transposed sources", "[slab_gs]")
 {
   const int    n = 40;
