@@ -43,6 +43,7 @@ ClothSystem make_cloth_system(const Cloth &cloth, const std::vector<char> &own,
   s.block_values.assign(9 * s.block_row.size(), 0.0);
   s.rhs.assign(3 * s.n_particles, 0.0);
   s.dv.assign(3 * s.n_particles, 0.0);
+  s.strain_limiter = make_strain_limiter(cloth);
   return s;
 }
 
@@ -196,8 +197,13 @@ ClothStepReport cloth_step(Cloth &cloth, ClothSystem &sys, const ClothParams &pa
       }
     }
   }
-  report.strain_sweeps = limit_strain(cloth, params.strain_limit, h).sweeps;
-  report.max_stretch   = max_stretch_ratio(cloth, sys.stretch_springs);
+  const StrainLimitReport limited = limit_strain(cloth, sys.strain_limiter, params.strain_limit, h);
+  report.strain_sweeps            = limited.sweeps;
+  // the limit's report holds the same maximum over every stretch spring: where this process assembles
+  // them all (one process), that is the answer
+  const bool all_stretch = sys.stretch_springs.size() == sys.strain_limiter.stretch_all.size();
+  report.max_stretch =
+    limited.sweeps > 0 && all_stretch ? limited.max_ratio : max_stretch_ratio(cloth, sys.stretch_springs);
   return report;
 }
 

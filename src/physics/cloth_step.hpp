@@ -34,6 +34,7 @@ struct ClothSystem {
   std::vector<int> stretch_springs; // those of them along grid edges (for the stretch check)
   std::vector<int> block_ab, block_ba; // per listed spring: block of (a, b) and of (b, a), -1 when not listed
   std::vector<double> block_values, rhs, dv; // rhs: 3 per particle, meaningful in assembled rows only
+  StrainLimiter       strain_limiter;        // over every stretch spring: each process limits the whole state
 };
 struct ClothStepReport {
   int    iterations    = 0;

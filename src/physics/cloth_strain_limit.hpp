@@ -11,7 +11,9 @@
 #pragma once
 #include "physics/cloth_model.hpp"
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 namespace physics {
 
@@ -28,7 +30,44 @@ struct StrainLimitReport {
 
 std::string validate_strain_limit(const StrainLimit &limit);
 
+// One stretch spring as the sweeps read it: a visit reads a, b and trigger, a correction the rest.
+struct LimitedSpring {
+  int    a = 0, b = 0;
+  double rest_length = 0;
+  double lmax        = 0; // the bound on its length, (1 + max_strain) rest_length
+  double trigger     = 0; // squared length above which it is corrected: (lmax (1 + slack))^2
+  double wa = 0, wb = 0;  // inverse masses, 0 for a pinned end
+  double w = 0;           // wa + wb
+};
+
+// What the limiting of one cloth needs besides its state, made once: the stretch springs that can move
+// (both ends pinned: left out) with their inverse masses, the stretch springs each particle ends, and
+// the work space of the sweeps, so that a step's limiting allocates and gathers nothing. Made from the
+// cloth's springs, masses and pins, which must not change after (as for make_cloth_system); the bounds
+// follow the StrainLimit of each call.
+struct StrainLimiter {
+  int                        particles = 0; // of the cloth it was made for
+  size_t                     springs   = 0; // all springs of that cloth (a check it is the same cloth)
+  std::vector<LimitedSpring> stretch;       // in the cloth's order
+  std::vector<Spring>        stretch_all;   // every stretch spring, pinned or not, for max_ratio
+  // the stretch springs particle p ends, as bits of the sweeps' visiting sets (bit k of word k / 64 for
+  // spring k of `stretch`): mark_bits[e] to OR into word mark_word[e], e in first[p] .. first[p + 1)
+  std::vector<int>           first, mark_word;
+  std::vector<std::uint64_t> mark_bits;
+  double                     bounds_for = 0; // the max_strain the springs' lmax and trigger hold
+  // work space
+  std::vector<Eigen::Vector3d> before;
+  std::vector<std::uint64_t>   visit, next;
+  std::vector<int>             moved, projected, candidates, moved_in;
+};
+
+StrainLimiter make_strain_limiter(const Cloth &cloth);
+
 // Limits the stretch springs of `cloth` after a step of length dt (velocities corrected by dx / dt).
 StrainLimitReport limit_strain(Cloth &cloth, const StrainLimit &limit, double dt);
+
+// The same with a limiter made for this cloth earlier (remade if it was made for a cloth of another
+// size): the same corrections in the same order, bit for bit.
+StrainLimitReport limit_strain(Cloth &cloth, StrainLimiter &limiter, const StrainLimit &limit, double dt);
 
 } // namespace physics

@@ -183,3 +183,39 @@ TEST_CASE("strain limiting makes the corrections of full sweeps over every sprin
   }
   CHECK(capped > 0); // the case the visiting sets are for
 }
+
+TEST_CASE("a strain limiter made once limits step after step as limit_strain does", "[cloth][strain]")
+{
+  // the limiter keeps its springs, bounds and work space between calls: each call must still make the
+  // corrections of a fresh limit_strain, also when the strain limit changes between calls
+  Cloth         cloth = corner_pinned_cloth(24, true, -0.3);
+  ClothSystem   sys   = make_cloth_system(cloth);
+  auto          ref   = sparse_solver_for(sys);
+  auto          lin   = ref.adapter();
+  ClothParams   free_params;
+  StrainLimiter limiter = make_strain_limiter(cloth);
+  StrainLimiter unmade; // made for no cloth: remade on its first call
+  Cloth         other = cloth;
+  for (int s = 0; s < 30; ++s) {
+    REQUIRE(cloth_step(cloth, sys, free_params, lin).converged);
+    other.position = cloth.position, other.velocity = cloth.velocity;
+    StrainLimit limit;
+    limit.max_strain                 = s < 15 ? 0.03 : 0.05;
+    limit.max_sweeps                 = 60;
+    Cloth                   fresh    = cloth;
+    const StrainLimitReport expected = limit_strain(fresh, limit, free_params.dt);
+    const StrainLimitReport got      = limit_strain(cloth, limiter, limit, free_params.dt);
+    const StrainLimitReport remade   = limit_strain(other, unmade, limit, free_params.dt);
+    INFO("step " << s);
+    CHECK(got.sweeps == expected.sweeps);
+    CHECK(got.corrected == expected.corrected);
+    CHECK(got.max_ratio == expected.max_ratio);
+    CHECK(remade.corrected == expected.corrected);
+    size_t differ = 0;
+    for (int p = 0; p < cloth.particle_count(); ++p)
+      differ += cloth.position[p] != fresh.position[p] || cloth.velocity[p] != fresh.velocity[p] ||
+                other.position[p] != fresh.position[p];
+    REQUIRE(differ == 0);
+  }
+  CHECK(unmade.particles == cloth.particle_count());
+}
