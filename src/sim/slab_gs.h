@@ -30,12 +30,13 @@ struct SlabGS {
     long source;
     bool transposed;
   };
-  // the refill's copies: source block -> val offset of its entry 0 (off-diagonal) or row (diagonal);
-  // [0] read row by row, [1] read transposed (column-major or transposed source, not both)
+  // the refill's copies: source block -> val offset of its entry 0 (off-diagonal) or row (diagonal),
+  // the block read row by row or transposed (flip: a column-major or a transposed source, not both)
   struct Copy {
     long source, dest;
+    bool flip;
   };
-  std::vector<Copy> copies[2], diagonal_copies[2];
+  std::vector<Copy> copies, diagonal_copies;
   // The sweeps keep x and b lane by lane: component i of row r at lane_index(r) + i * lanes, with
   // lane_index(r) = lanes + (r % S) * 3 * lanes + r / S (one padding register before and after). Step j's
   // rows are then one register per component, and a slot group whose lanes all read the neighbour at
