@@ -7,7 +7,7 @@
 
 namespace {
 
-// x = M^-1 b for a 3x3 row-major M; false when M is singular (or not finite)
+// inv = M^-1 for a 3x3 row-major M; false when M is singular (or not finite)
 bool Invert3(const double *m, double *inv)
 {
   const double c00 = m[4] * m[8] - m[5] * m[7], c01 = m[5] * m[6] - m[3] * m[8],
@@ -152,7 +152,7 @@ PetscErrorCode SlabGSRefill(SlabGS *gs, const PetscScalar *blocks)
   for (int r = 0; r < gs->n; ++r) {
     double inv[9];
     PetscCheck(Invert3(&gs->diag[9 * (size_t)r], inv), PETSC_COMM_SELF, PETSC_ERR_MAT_LU_ZRPVT,
-               "slab Gauss-Seidel: the diagonal block of block row %d is singular", r);
+               "slab Gauss-Seidel: the diagonal block of block row %d is singular or not finite", r);
     const int step = r % gs->steps, lane = r / gs->steps;
     for (int e = 0; e < 9; ++e) {
       gs->dinv[((size_t)step * 9 + e) * L + lane] = inv[e];

@@ -187,4 +187,16 @@ TEST_CASE("slab Gauss-Seidel refuses what it cannot sweep", "[slab_gs]")
     PetscPopErrorHandler();
     CHECK(ierr == PETSC_ERR_MAT_LU_ZRPVT);
   }
+  SECTION("a NaN in a diagonal block is refused the same way")
+  {
+    Banded m = make_banded(24, 1, 6u);
+    for (size_t k = 0; k < m.entries.size(); ++k)
+      if (m.entries[k].row == 5 && m.entries[k].col == 5) m.blocks[9 * m.entries[k].source + 4] = NAN;
+    SlabGS gs;
+    REQUIRE(SlabGSBuild(24, m.entries, false, &gs).empty());
+    PetscPushErrorHandler(PetscReturnErrorHandler, nullptr);
+    const PetscErrorCode ierr = SlabGSRefill(&gs, m.blocks.data());
+    PetscPopErrorHandler();
+    CHECK(ierr == PETSC_ERR_MAT_LU_ZRPVT);
+  }
 }
