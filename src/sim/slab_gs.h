@@ -12,8 +12,11 @@
 //
 // The level's 3x3 blocks come as a list of (row, column, source block, transposed) entries, refilled
 // from the source values in place: the driver's COO blocks on the fine level, SeqBAIJ arrays on the
-// coarse ones. Off-diagonal blocks are stored in single precision (the smoother only damps the error,
-// see smoother_copy.h); the diagonal blocks are inverted in double.
+// coarse ones. The level must be symmetric (a Galerkin product of a symmetric operator is): each row
+// keeps only its blocks toward rows of later steps, the others are their transposes, pushed from the rows
+// that keep them (slab_gs.cpp), so a sweep reads half the bytes. Off-diagonal blocks are stored in single
+// precision (the smoother only damps the error, see smoother_copy.h); the diagonal blocks are inverted
+// in double.
 #pragma once
 #include <petscksp.h>
 
@@ -51,11 +54,12 @@ struct SlabGS {
   std::vector<double>        dinv;       // [step * 9 lanes + entry * lanes + lane]: the inverses
   std::vector<double>        dl;         // the diagonal blocks, laid out as dinv (residuals)
   std::vector<double>        xl, bl, rl; // x, b and a residual lane by lane during an application
+  std::vector<double>        ll;         // the lower part L x of the rows, lane by lane (see slab_gs.cpp)
 };
 
-// Builds the layout for n block rows from entries (every off-diagonal block the row has, each (row, col)
-// at most once, the diagonal ones possibly repeated: they are summed). Returns an empty string, or why the
-// rows cannot be relaxed side by side (a coupling S or more rows away).
+// Builds the layout for n block rows from entries (every off-diagonal block the row has, of a symmetric
+// matrix; the diagonal ones possibly repeated: they are summed). Returns an empty string, or why the rows
+// cannot be relaxed side by side (a coupling S or more rows away).
 std::string SlabGSBuild(int n, std::vector<SlabGS::Entry> entries, bool column_major_source, SlabGS *gs);
 
 // New values: blocks of 9 (row-major, or column-major when the layout says so) indexed by the entries'
