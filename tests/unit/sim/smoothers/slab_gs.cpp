@@ -174,29 +174,26 @@ TEST_CASE("slab Gauss-Seidel refuses what it cannot sweep", "[slab_gs]")
     SlabGS gs;
     CHECK(!SlabGSBuild(4, {{0, 7, 0, false}}, false, &gs).empty());
   }
-  SECTION("a singular diagonal block names its row")
-  {
+  // the refill's error for a 24-row matrix whose diagonal block of row `row` is spoiled by `spoil`
+  const auto refill_error = [](int row, void (*spoil)(double *)) {
     Banded m = make_banded(24, 1, 5u);
     for (size_t k = 0; k < m.entries.size(); ++k)
-      if (m.entries[k].row == 13 && m.entries[k].col == 13)
-        for (int e = 0; e < 9; ++e) m.blocks[9 * m.entries[k].source + e] = 0.0;
+      if (m.entries[k].row == row && m.entries[k].col == row) spoil(&m.blocks[9 * m.entries[k].source]);
     SlabGS gs;
     REQUIRE(SlabGSBuild(24, m.entries, false, &gs).empty());
     PetscPushErrorHandler(PetscReturnErrorHandler, nullptr);
     const PetscErrorCode ierr = SlabGSRefill(&gs, m.blocks.data());
     PetscPopErrorHandler();
-    CHECK(ierr == PETSC_ERR_MAT_LU_ZRPVT);
+    return ierr;
+  };
+  SECTION("a singular diagonal block names its row")
+  {
+    CHECK(refill_error(13, [](double *b) {
+            for (int e = 0; e < 9; ++e) b[e] = 0.0;
+          }) == PETSC_ERR_MAT_LU_ZRPVT);
   }
   SECTION("a NaN in a diagonal block is refused the same way")
   {
-    Banded m = make_banded(24, 1, 6u);
-    for (size_t k = 0; k < m.entries.size(); ++k)
-      if (m.entries[k].row == 5 && m.entries[k].col == 5) m.blocks[9 * m.entries[k].source + 4] = NAN;
-    SlabGS gs;
-    REQUIRE(SlabGSBuild(24, m.entries, false, &gs).empty());
-    PetscPushErrorHandler(PetscReturnErrorHandler, nullptr);
-    const PetscErrorCode ierr = SlabGSRefill(&gs, m.blocks.data());
-    PetscPopErrorHandler();
-    CHECK(ierr == PETSC_ERR_MAT_LU_ZRPVT);
+    CHECK(refill_error(5, [](double *b) { b[4] = NAN; }) == PETSC_ERR_MAT_LU_ZRPVT);
   }
 }
