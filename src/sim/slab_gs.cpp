@@ -1,28 +1,11 @@
 #include "sim/slab_gs.h"
 
+#include <petsc/private/kernels/blockinvert.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
-
-namespace {
-
-// inv = M^-1 for a 3x3 row-major M; false when M is singular (or not finite)
-bool Invert3(const double *m, double *inv)
-{
-  const double c00 = m[4] * m[8] - m[5] * m[7], c01 = m[5] * m[6] - m[3] * m[8],
-               c02   = m[3] * m[7] - m[4] * m[6];
-  const double det   = m[0] * c00 + m[1] * c01 + m[2] * c02;
-  const double scale = std::max({std::abs(m[0]), std::abs(m[4]), std::abs(m[8])});
-  if (!(std::abs(det) > 1e-14 * scale * scale * scale) || !std::isfinite(det)) return false;
-  const double r = 1.0 / det;
-  inv[0] = c00 * r, inv[1] = (m[2] * m[7] - m[1] * m[8]) * r, inv[2] = (m[1] * m[5] - m[2] * m[4]) * r;
-  inv[3] = c01 * r, inv[4] = (m[0] * m[8] - m[2] * m[6]) * r, inv[5] = (m[2] * m[3] - m[0] * m[5]) * r;
-  inv[6] = c02 * r, inv[7] = (m[1] * m[6] - m[0] * m[7]) * r, inv[8] = (m[0] * m[4] - m[1] * m[3]) * r;
-  return true;
-}
-
-} // namespace
 
 namespace {
 
@@ -60,7 +43,7 @@ std::string SlabGSBuild(int n, std::vector<SlabGS::Entry> entries, bool column_m
     if (e.row < 0 || e.row >= n || e.col < 0 || e.col >= n) return "an entry outside the level";
     const int flip = e.transposed != column_major_source;
     if (e.row == e.col) {
-      g.diagonal_copies.push_back({e.source, e.row, flip == 1});
+      g.diagonal_copies.push_back({e.source, (long)(e.row % S) * 9 * L + e.row / S, flip == 1});
       continue;
     }
     if (std::abs(e.row - e.col) >= S)
@@ -119,7 +102,6 @@ std::string SlabGSBuild(int n, std::vector<SlabGS::Entry> entries, bool column_m
     return a.source != b.source ? a.source < b.source : a.flip < b.flip;
   });
   g.val.assign(g.xidx.size() * 9, 0.0f);
-  g.diag.assign(9 * (size_t)n, 0.0);
   g.dinv.assign(9 * (size_t)S * L, 0.0);
   g.dl.assign(g.dinv.size(), 0.0);
   g.xl.assign((size_t)(3 * S + 2) * L, 0.0);
@@ -137,7 +119,7 @@ PetscErrorCode SlabGSRefill(SlabGS *gs, const PetscScalar *blocks)
   PetscFunctionBegin;
   PetscCall(SlabGSRegisterEvents());
   PetscCall(PetscLogEventBegin(SLAB_Refill, 0, 0, 0, 0));
-  std::fill(gs->diag.begin(), gs->diag.end(), 0.0);
+  std::fill(gs->dl.begin(), gs->dl.end(), 0.0);
   // entry e = 3 i + j of a block, read at e or (flip) at 3 j + i
   for (const SlabGS::Copy &c : gs->copies) {
     const PetscScalar *b = blocks + 9 * c.source;
@@ -149,18 +131,21 @@ PetscErrorCode SlabGSRefill(SlabGS *gs, const PetscScalar *blocks)
   }
   for (const SlabGS::Copy &c : gs->diagonal_copies) {
     const PetscScalar *b = blocks + 9 * c.source;
-    double            *d = gs->diag.data() + 9 * c.dest;
-    for (int e = 0; e < 9; ++e) d[e] += b[c.flip ? 3 * (e % 3) + e / 3 : e];
+    double            *d = gs->dl.data() + c.dest;
+    for (int e = 0; e < 9; ++e) d[e * L] += b[c.flip ? 3 * (e % 3) + e / 3 : e];
   }
+  // the inverses as MatSOR's diagonal and KSPMCG's point-block Jacobi take them (PETSc's 3x3 kernel);
+  // a block with a zero pivot, or whose inverse is not finite (a NaN or Inf in it), is refused
   for (int r = 0; r < gs->n; ++r) {
-    double inv[9];
-    PetscCheck(Invert3(&gs->diag[9 * (size_t)r], inv), PETSC_COMM_SELF, PETSC_ERR_MAT_LU_ZRPVT,
+    const size_t at = (size_t)(r % gs->steps) * 9 * L + r / gs->steps;
+    MatScalar    inv[9];
+    PetscBool    zero_pivot = PETSC_FALSE, finite = PETSC_TRUE;
+    for (int e = 0; e < 9; ++e) inv[e] = gs->dl[at + e * L];
+    PetscCall(PetscKernel_A_gets_inverse_A_3(inv, 0.0, PETSC_TRUE, &zero_pivot));
+    for (int e = 0; e < 9; ++e) finite = (PetscBool)(finite && std::isfinite(inv[e]));
+    PetscCheck(!zero_pivot && finite, PETSC_COMM_SELF, PETSC_ERR_MAT_LU_ZRPVT,
                "slab Gauss-Seidel: the diagonal block of block row %d is singular or not finite", r);
-    const int step = r % gs->steps, lane = r / gs->steps;
-    for (int e = 0; e < 9; ++e) {
-      gs->dinv[((size_t)step * 9 + e) * L + lane] = inv[e];
-      gs->dl[((size_t)step * 9 + e) * L + lane]   = gs->diag[9 * (size_t)r + e];
-    }
+    for (int e = 0; e < 9; ++e) gs->dinv[at + e * L] = inv[e];
   }
   PetscCall(PetscLogEventEnd(SLAB_Refill, 0, 0, 0, 0));
   PetscFunctionReturn(0);

@@ -33,7 +33,7 @@ struct SlabGS {
     long source;
     bool transposed;
   };
-  // the refill's copies: source block -> val offset of its entry 0 (off-diagonal) or row (diagonal),
+  // the refill's copies: source block -> val (off-diagonal) or dl (diagonal) offset of its entry 0,
   // the block read row by row or transposed (flip: a column-major or a transposed source, not both)
   struct Copy {
     long source, dest;
@@ -50,9 +50,8 @@ struct SlabGS {
                                          // lanes (plain loads), -1: the group gathers
   std::vector<unsigned char> real;       // [group] the lanes with a block in the group (bit per lane)
   std::vector<float>         val;        // [group * 9 lanes + entry * lanes + lane], entries row-major
-  std::vector<double>        diag;       // [row * 9], row-major
   std::vector<double>        dinv;       // [step * 9 lanes + entry * lanes + lane]: the inverses
-  std::vector<double>        dl;         // the diagonal blocks, laid out as dinv (residuals)
+  std::vector<double>        dl;         // the diagonal blocks (repeats summed), laid out as dinv
   std::vector<double>        xl, bl, rl; // x, b and a residual lane by lane during an application
   std::vector<double>        ll;         // the lower part L x of the rows, lane by lane (see slab_gs.cpp)
 };
