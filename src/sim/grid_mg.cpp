@@ -139,6 +139,7 @@ PetscErrorCode UseSlabs(GridMG *mg, PetscInt level, int n, std::vector<SlabGS::E
   PetscFunctionBegin;
   const std::string why = SlabGSBuild(n, std::move(entries), column_major, &mg->slabs[level]);
   if (!why.empty()) {
+    mg->slab_used[level] = GridMG::kSor;
     PetscCall(PetscInfo(mg->pc, "grid multigrid level %d keeps SOR: %s\n", (int)level, why.c_str()));
     PetscFunctionReturn(0);
   }
@@ -149,7 +150,7 @@ PetscErrorCode UseSlabs(GridMG *mg, PetscInt level, int n, std::vector<SlabGS::E
     PetscCall(KSPGetPC(smoother, &spc));
     PetscCall(SlabGSSetPC(spc, &mg->slabs[level]));
   }
-  mg->slab_used[level] = 1;
+  mg->slab_used[level] = GridMG::kSlab;
   PetscFunctionReturn(0);
 }
 
@@ -263,7 +264,7 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
       "-grid_mg_smoother slab needs the block Galerkin products (one rank, -grid_mg_galerkin blocks)");
     mg->smoother_slab = kind == 1;
     mg->slabs.assign(nlev, SlabGS());
-    mg->slab_used.assign(nlev, 0);
+    mg->slab_used.assign(nlev, GridMG::kUndecided);
     if (mg->smoother_slab && nlev > 1) { // the fine level's blocks: the driver's COO list, solver numbering
       std::vector<SlabGS::Entry> entries;
       for (size_t k = 0; k < coo_row.size(); ++k) {
@@ -299,11 +300,10 @@ static PetscErrorCode SetLevelOperators(GridMG *mg, PetscInt level, Mat A)
 
   PetscFunctionBegin;
   PetscCall(LevelSmoothers(mg->pc, level, sides));
-  if (mg->smoother_slab && level > 0 && mg->slab_used[level]) {
+  if (mg->smoother_slab && level > 0 && mg->slab_used[level] == GridMG::kSlab) {
     // slab Gauss-Seidel holds the level's blocks itself (single precision off the diagonal) and takes the
-    // level's residual in the same layout: no copy of the operator
-    // PCMG hands its residual function the level's operator (not the Mat given here): the slabs go
-    // with that operator
+    // level's residual in the same layout: no copy of the operator. PCMG hands its residual function the
+    // level's operator (not the Mat given here), so the slabs go with that operator
     PetscCall(SlabGSAttach(A, &mg->slabs[level]));
     for (KSP smoother : sides) PetscCall(KSPSetOperators(smoother, A, A));
     PetscCall(PCMGSetResidual(mg->pc, level, SlabGSResidualMat, A));
@@ -339,7 +339,8 @@ PetscErrorCode GridMGRefill(GridMG *mg, const PetscScalar *coo_values)
   }
   if (!mg->own_galerkin) PetscFunctionReturn(0); // PCMG recomputes its products at its set-up
   const PetscInt fine = (PetscInt)mg->galerkin.size();
-  if (mg->smoother_slab && mg->slab_used[fine]) PetscCall(SlabGSRefill(&mg->slabs[fine], coo_values));
+  if (mg->smoother_slab && mg->slab_used[fine] == GridMG::kSlab)
+    PetscCall(SlabGSRefill(&mg->slabs[fine], coo_values));
   for (size_t l = 0; l < mg->galerkin.size(); ++l) {
     const PetscScalar *src = coo_values;
     PetscScalar       *a   = nullptr;
@@ -354,7 +355,7 @@ PetscErrorCode GridMGRefill(GridMG *mg, const PetscScalar *coo_values)
       Mat          Ac = mg->galerkin[l].Ac;
       PetscInt     nb;
       PetscScalar *ac;
-      if (mg->slabs[level].n == 0 && !mg->slab_used[level]) { // first refill: the level's pattern
+      if (mg->slab_used[level] == GridMG::kUndecided) { // first refill: the level's pattern
         std::vector<PetscInt>      rows, cols;
         std::vector<SlabGS::Entry> entries;
         PetscCall(BlockGalerkinBlocksOf(Ac, &rows, &cols));
@@ -362,9 +363,8 @@ PetscErrorCode GridMGRefill(GridMG *mg, const PetscScalar *coo_values)
           entries.push_back({(int)rows[k], (int)cols[k], (long)k, false});
         PetscCall(MatGetLocalSize(Ac, &nb, nullptr));
         PetscCall(UseSlabs(mg, level, (int)(nb / 3), std::move(entries), true));
-        if (!mg->slab_used[level]) mg->slabs[level].n = -1; // tried
       }
-      if (mg->slab_used[level]) {
+      if (mg->slab_used[level] == GridMG::kSlab) {
         PetscCall(MatSeqBAIJGetArray(Ac, &ac));
         PetscCall(SlabGSRefill(&mg->slabs[level], ac));
         PetscCall(MatSeqBAIJRestoreArray(Ac, &ac));

@@ -40,9 +40,15 @@ struct GridMG {
   std::vector<Mat> smoother_mats; // per PCMG level (0 unused): the copies, made at the first refill
   // -grid_mg_smoother slab (one rank, block Galerkin products): per PCMG level (0 unused), the slab
   // Gauss-Seidel smoother (slab_gs.h) where its couplings allow it; slab_used[l] says whether it does
-  bool                smoother_slab = false;
-  std::vector<SlabGS> slabs;
-  std::vector<char>   slab_used;
+  // (decided at the set-up for the fine level, at the first refill for the coarse ones)
+  enum SlabUse : char {
+    kUndecided,
+    kSlab,
+    kSor
+  };
+  bool                 smoother_slab = false;
+  std::vector<SlabGS>  slabs;
+  std::vector<SlabUse> slab_used;
 };
 
 // ksp's PC must be PCMG (-pc_type mg). fixed: n * n flags (row-major, physics numbering). coo_row, coo_col:
