@@ -49,7 +49,7 @@ StrainLimiter make_strain_limiter(const Cloth &cloth)
   for (size_t k = 0; k < cloth.springs.size(); ++k) {
     const Spring &sp = cloth.springs[k];
     if (sp.kind != SpringKind::Stretch) continue;
-    l.stretch_all.push_back(sp);
+    l.stretch_all.push_back((int)k);
     const double wa = cloth.fixed[sp.a] ? 0.0 : 1.0 / cloth.mass[sp.a],
                  wb = cloth.fixed[sp.b] ? 0.0 : 1.0 / cloth.mass[sp.b];
     if (wa + wb == 0) continue; // both ends pinned: nothing can move
@@ -190,10 +190,7 @@ StrainLimitReport limit_strain(Cloth &cloth, StrainLimiter &limiter, const Strai
       if (vn < 0) cloth.velocity[p] -= vn / dist * d;
     }
   }
-  for (const Spring &sp : limiter.stretch_all) {
-    report.max_ratio =
-      std::max(report.max_ratio, (cloth.position[sp.b] - cloth.position[sp.a]).norm() / sp.rest_length);
-  }
+  report.max_ratio = max_stretch_ratio(cloth, limiter.stretch_all);
   return report;
 }
 

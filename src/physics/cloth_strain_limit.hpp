@@ -49,7 +49,7 @@ struct StrainLimiter {
   int                        particles = 0; // of the cloth it was made for
   size_t                     springs   = 0; // all springs of that cloth (a check it is the same cloth)
   std::vector<LimitedSpring> stretch;       // in the cloth's order
-  std::vector<Spring>        stretch_all;   // every stretch spring, pinned or not, for max_ratio
+  std::vector<int>           stretch_all;   // every stretch spring (index), pinned or not, for max_ratio
   // the stretch springs particle p ends, as bits of the sweeps' visiting sets (bit k of word k / 64 for
   // spring k of `stretch`): mark_bits[e] to OR into word mark_word[e], e in first[p] .. first[p + 1)
   std::vector<int>           first, mark_word;
