@@ -1,6 +1,7 @@
 #include "sim/slab_gs.h"
 
 #include <petsc/private/kernels/blockinvert.h>
+#include <petsc/private/petscimpl.h> // PetscObjectStateGet
 
 #include <algorithm>
 #include <array>
@@ -153,28 +154,35 @@ PetscErrorCode SlabGSRefill(SlabGS *gs, const PetscScalar *blocks)
 
 namespace {
 
-// v (3 n values, row by row) into / out of the lane layout lv (padding lanes stay zero): slab l of v is
-// a run of 3 S values, read or written as lane l of every step (no division per row)
+// v (3 n values, row by row) into / out of the lane layout lv (padding lanes stay zero): lane l of step j
+// is row l S + j. The layout is written (read) in its order, from (into) the 8 slabs as 8 streams: a
+// slab at a time, every write of one slab lands on its own cache line, 8 times over the whole layout.
 void ToLanes(const SlabGS &gs, const double *v, std::vector<double> &lv)
 {
   constexpr int L = SlabGS::lanes;
   const int     S = gs.steps;
-  for (int l = 0; l < L; ++l) {
-    const int rows = std::min(S, gs.n - l * S);
-    for (int j = 0; j < rows; ++j)
-      for (int i = 0; i < 3; ++i) lv[L + (3 * j + i) * L + l] = v[3 * (l * S + j) + i];
-  }
+  double       *o = lv.data() + L;
+  for (int j = 0; j < S; ++j, o += 3 * L)
+    for (int l = 0; l < L; ++l) {
+      const int     r  = l * S + j;
+      const double *s  = v + 3 * (size_t)r;
+      const bool    in = r < gs.n;
+      o[l]             = in ? s[0] : 0.0;
+      o[L + l]         = in ? s[1] : 0.0;
+      o[2 * L + l]     = in ? s[2] : 0.0;
+    }
 }
 
 void FromLanes(const SlabGS &gs, const std::vector<double> &lv, double *v)
 {
   constexpr int L = SlabGS::lanes;
   const int     S = gs.steps;
-  for (int l = 0; l < L; ++l) {
-    const int rows = std::min(S, gs.n - l * S);
-    for (int j = 0; j < rows; ++j)
-      for (int i = 0; i < 3; ++i) v[3 * (l * S + j) + i] = lv[L + (3 * j + i) * L + l];
-  }
+  const double *o = lv.data() + L;
+  for (int j = 0; j < S; ++j, o += 3 * L)
+    for (int l = 0; l < L && l * S + j < gs.n; ++l) {
+      double *d = v + 3 * (size_t)(l * S + j);
+      d[0] = o[l], d[1] = o[L + l], d[2] = o[2 * L + l];
+    }
 }
 
 // What a pass over the layout does. The layout keeps each row's blocks toward rows of later steps (U);
@@ -372,6 +380,7 @@ PassBody BestBody()
 // one sweep from x, row by row in and out (a backward one first takes L x for the x it starts from)
 void SweepWith(PassBody body, SlabGS &gs, const double *b, double *x, bool forward)
 {
+  gs.held_b = gs.held_x = SlabGS::Held();
   ToLanes(gs, b, gs.bl);
   ToLanes(gs, x, gs.xl);
   if (!forward) body(gs, gs.bl.data(), gs.xl.data(), gs.ll.data(), nullptr, kLower);
@@ -393,11 +402,34 @@ void SlabGSSweepBest(SlabGS &gs, const double *b, double *x, bool forward)
 
 void SlabGSResidual(SlabGS &gs, const double *b, const double *x, double *r, bool best)
 {
+  gs.held_b = gs.held_x = SlabGS::Held();
   ToLanes(gs, b, gs.bl);
   ToLanes(gs, x, gs.xl);
   (best ? BestBody() : PassLanes)(gs, gs.bl.data(), gs.xl.data(), gs.ll.data(), gs.rl.data(), kResidual);
   FromLanes(gs, gs.rl, r);
 }
+
+namespace {
+
+// lv holds v's values in the lane layout, converted unless held says lv already holds v as it is now
+PetscErrorCode LanesOf(SlabGS *gs, Vec v, SlabGS::Held *held, std::vector<double> &lv)
+{
+  SlabGS::Held now;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectGetId((PetscObject)v, &now.id));
+  PetscCall(PetscObjectStateGet((PetscObject)v, &now.state));
+  if (held->id != now.id || held->state != now.state) {
+    const PetscScalar *a;
+    PetscCall(VecGetArrayRead(v, &a));
+    ToLanes(*gs, a, lv);
+    PetscCall(VecRestoreArrayRead(v, &a));
+    *held = now;
+  }
+  PetscFunctionReturn(0);
+}
+
+} // namespace
 
 PetscErrorCode SlabGSAttach(Mat A, SlabGS *gs)
 {
@@ -413,10 +445,9 @@ PetscErrorCode SlabGSAttach(Mat A, SlabGS *gs)
 
 PetscErrorCode SlabGSResidualMat(Mat A, Vec b, Vec x, Vec r)
 {
-  PetscContainer     c;
-  SlabGS            *gs;
-  const PetscScalar *ba, *xa;
-  PetscScalar       *ra;
+  PetscContainer c;
+  SlabGS        *gs;
+  PetscScalar   *ra;
 
   PetscFunctionBegin;
   PetscCall(PetscObjectQuery((PetscObject)A, "SlabGS", (PetscObject *)&c));
@@ -424,13 +455,12 @@ PetscErrorCode SlabGSResidualMat(Mat A, Vec b, Vec x, Vec r)
              "slab Gauss-Seidel residual: no SlabGS attached to the operator");
   PetscCall(PetscContainerGetPointer(c, (void **)&gs));
   PetscCall(PetscLogEventBegin(SLAB_Residual, A, b, x, r));
-  PetscCall(VecGetArrayRead(b, &ba));
-  PetscCall(VecGetArrayRead(x, &xa));
+  PetscCall(LanesOf(gs, b, &gs->held_b, gs->bl));
+  PetscCall(LanesOf(gs, x, &gs->held_x, gs->xl));
+  BestBody()(*gs, gs->bl.data(), gs->xl.data(), gs->ll.data(), gs->rl.data(), kResidual);
   PetscCall(VecGetArrayWrite(r, &ra));
-  SlabGSResidual(*gs, ba, xa, ra, true);
+  FromLanes(*gs, gs->rl, ra);
   PetscCall(VecRestoreArrayWrite(r, &ra));
-  PetscCall(VecRestoreArrayRead(x, &xa));
-  PetscCall(VecRestoreArrayRead(b, &ba));
   PetscCall(PetscLogFlops(2 * 18.0 * (double)gs->val.size() / 9 + 18.0 * gs->n));
   PetscCall(PetscLogEventEnd(SLAB_Residual, A, b, x, r));
   PetscFunctionReturn(0);
@@ -440,25 +470,24 @@ namespace {
 
 PetscErrorCode SymmetricSweeps(SlabGS *gs, Vec b, Vec x, PetscInt its, PetscBool zero_guess)
 {
-  const PetscScalar *ba;
-  PetscScalar       *xa;
+  PetscScalar *xa;
 
   PetscFunctionBegin;
   const PassBody body = BestBody();
   PetscCall(PetscLogEventBegin(SLAB_Smooth, 0, 0, 0, 0));
-  PetscCall(VecGetArrayRead(b, &ba));
-  PetscCall(VecGetArray(x, &xa));
-  ToLanes(*gs, ba, gs->bl);
+  PetscCall(LanesOf(gs, b, &gs->held_b, gs->bl));
   if (zero_guess) std::fill(gs->xl.begin(), gs->xl.end(), 0.0);
-  else ToLanes(*gs, xa, gs->xl);
+  else PetscCall(LanesOf(gs, x, &gs->held_x, gs->xl));
   for (PetscInt k = 0; k < its; ++k) { // forward from zero: no U products (x of later rows is zero)
     body(*gs, gs->bl.data(), gs->xl.data(), gs->ll.data(), nullptr,
          zero_guess && k == 0 ? kForwardZero : kForward);
     body(*gs, gs->bl.data(), gs->xl.data(), gs->ll.data(), nullptr, kBackward);
   }
+  PetscCall(VecGetArrayWrite(x, &xa));
   FromLanes(*gs, gs->xl, xa);
-  PetscCall(VecRestoreArray(x, &xa));
-  PetscCall(VecRestoreArrayRead(b, &ba));
+  PetscCall(VecRestoreArrayWrite(x, &xa));
+  PetscCall(PetscObjectGetId((PetscObject)x, &gs->held_x.id)); // xl holds x as it is now
+  PetscCall(PetscObjectStateGet((PetscObject)x, &gs->held_x.state));
   // per symmetric sweep: U products twice, the pushes once (each 18 flops per stored block), the solves
   PetscCall(PetscLogFlops(its * (3 * 18.0 * (double)gs->val.size() / 9 + 2 * 15.0 * gs->n)));
   PetscCall(PetscLogEventEnd(SLAB_Smooth, 0, 0, 0, 0));

@@ -54,6 +54,14 @@ struct SlabGS {
   std::vector<double>        dl;         // the diagonal blocks (repeats summed), laid out as dinv
   std::vector<double>        xl, bl, rl; // x, b and a residual lane by lane during an application
   std::vector<double>        ll;         // the lower part L x of the rows, lane by lane (see slab_gs.cpp)
+  // The Vec (id and state) bl and xl were last converted from or to, for the PETSc-facing applications:
+  // in a V-cycle the residual reads the b and x the pre-smoothing just left, and the post-smoothing the
+  // same b, so those conversions are skipped while the Vec is unchanged (id 0: nothing held).
+  struct Held {
+    PetscObjectId    id    = 0;
+    PetscObjectState state = 0;
+  };
+  Held held_b, held_x;
 };
 
 // Builds the layout for n block rows from entries (every off-diagonal block the row has, of a symmetric

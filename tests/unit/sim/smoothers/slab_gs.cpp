@@ -1,8 +1,9 @@
 // Slab Gauss-Seidel (src/sim/slab_gs.h): a sweep is the sequential block Gauss-Seidel sweep in the
 // order (step, lane), for row-major and column-major (transposed) sources; the AVX-512 sweep agrees
-// with the portable one; couplings a slab or more away and singular diagonal blocks are refused.
+// with the portable one; the PC and residual applications follow every change of their vectors (they
+// keep lane copies of b and x between calls); couplings a slab or more away and singular diagonal blocks are refused.
 #include <catch2/catch.hpp>
-#include <petscsys.h>
+#include <petscksp.h>
 
 #include "sim/slab_gs.h"
 
@@ -196,4 +197,90 @@ TEST_CASE("slab Gauss-Seidel refuses what it cannot sweep", "[slab_gs]")
   {
     CHECK(refill_error(5, [](double *b) { b[4] = NAN; }) == PETSC_ERR_MAT_LU_ZRPVT);
   }
+}
+
+TEST_CASE("slab Gauss-Seidel as a PC and a residual follows its vectors", "[slab_gs]")
+{
+  // A V-cycle's level: pre-smoothing, the residual of what it left, x changed (the coarse correction),
+  // post-smoothing with the same b; the lane copies kept between the calls must follow every change
+  const int    n = 45;
+  const Banded m = make_banded(n, 2, 17u);
+  SlabGS       gs;
+  REQUIRE(SlabGSBuild(n, m.entries, false, &gs).empty());
+  REQUIRE(SlabGSRefill(&gs, m.blocks.data()) == 0);
+  Mat A; // any operator: the residual takes the attached layout
+  PC  pc;
+  Vec b, x, r, w;
+  REQUIRE(MatCreateSeqDense(PETSC_COMM_SELF, 3 * n, 3 * n, nullptr, &A) == 0);
+  REQUIRE(SlabGSAttach(A, &gs) == 0);
+  REQUIRE(PCCreate(PETSC_COMM_SELF, &pc) == 0);
+  REQUIRE(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY) == 0);
+  REQUIRE(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY) == 0);
+  REQUIRE(PCSetOperators(pc, A, A) == 0);
+  REQUIRE(SlabGSSetPC(pc, &gs) == 0);
+  REQUIRE(VecCreateSeq(PETSC_COMM_SELF, 3 * n, &b) == 0);
+  REQUIRE(VecDuplicate(b, &x) == 0);
+  REQUIRE(VecDuplicate(b, &r) == 0);
+  REQUIRE(VecDuplicate(b, &w) == 0);
+  std::vector<double> bv(3 * n), xv(3 * n, 0.0);
+  for (int i = 0; i < 3 * n; ++i) bv[i] = std::sin(0.29 * i);
+  PetscScalar *a;
+  REQUIRE(VecGetArray(b, &a) == 0);
+  for (int i = 0; i < 3 * n; ++i) a[i] = bv[i];
+  REQUIRE(VecRestoreArray(b, &a) == 0);
+  const auto check_x = [&](const char *when) {
+    const PetscScalar *xa;
+    REQUIRE(VecGetArrayRead(x, &xa) == 0);
+    for (int i = 0; i < 3 * n; ++i) {
+      INFO(when << ", entry " << i);
+      CHECK(xa[i] == Approx(xv[i]).epsilon(1e-12).margin(1e-13));
+    }
+    REQUIRE(VecRestoreArrayRead(x, &xa) == 0);
+  };
+  const auto check_residual = [&](const char *when) {
+    REQUIRE(SlabGSResidualMat(A, b, x, r) == 0);
+    const PetscScalar *ra;
+    REQUIRE(VecGetArrayRead(r, &ra) == 0);
+    for (int i = 0; i < 3 * n; ++i) {
+      double ref = bv[i];
+      for (int c = 0; c < 3 * n; ++c) ref -= m.dense[i][c] * xv[c];
+      INFO(when << ", entry " << i);
+      CHECK(ra[i] == Approx(ref).epsilon(1e-12).margin(1e-12));
+    }
+    REQUIRE(VecRestoreArrayRead(r, &ra) == 0);
+  };
+  const auto smooth = [&](PetscBool zero_guess) {
+    PetscInt                    its;
+    PCRichardsonConvergedReason reason;
+    REQUIRE(PCApplyRichardson(pc, b, x, w, 0, 0, 0, 1, zero_guess, &its, &reason) == 0);
+    if (zero_guess) std::fill(xv.begin(), xv.end(), 0.0);
+    reference_sweep(m, slab_order(n, true), bv, xv);
+    reference_sweep(m, slab_order(n, false), bv, xv);
+  };
+  smooth(PETSC_TRUE);
+  check_x("pre-smoothing from zero");
+  check_residual("the residual after it");
+  REQUIRE(VecScale(x, 0.5) == 0); // x changed in place
+  for (double &v : xv) v *= 0.5;
+  check_residual("the residual of x changed in place");
+  smooth(PETSC_FALSE);
+  check_x("post-smoothing from the changed x");
+  REQUIRE(VecGetArray(b, &a) == 0); // b changed in place
+  a[7] += 1.0;
+  REQUIRE(VecRestoreArray(b, &a) == 0);
+  bv[7] += 1.0;
+  check_residual("the residual of b changed in place");
+  std::vector<double> raw(3 * n, 0.0); // the raw sweep uses the same lane vectors
+  SlabGSSweep(gs, bv.data(), raw.data(), true);
+  smooth(PETSC_FALSE);
+  check_x("smoothing after a raw sweep");
+  REQUIRE(VecSet(x, 0.25) == 0);
+  std::fill(xv.begin(), xv.end(), 0.25);
+  check_residual("the residual after VecSet");
+  REQUIRE(VecDestroy(&w) == 0);
+  REQUIRE(VecDestroy(&r) == 0);
+  REQUIRE(VecDestroy(&x) == 0);
+  REQUIRE(VecDestroy(&b) == 0);
+  REQUIRE(PCDestroy(&pc) == 0);
+  REQUIRE(MatDestroy(&A) == 0);
 }
