@@ -3,6 +3,23 @@
 
 #include <algorithm>
 
+namespace {
+
+PetscLogEvent BG_Refill = 0;
+
+// -log_view event: a refill of the coarse operator (the product's terms summed into its blocks)
+PetscErrorCode BlockGalerkinRegisterEvents()
+{
+  static PetscClassId classid = 0;
+  PetscFunctionBegin;
+  if (classid) PetscFunctionReturn(0);
+  PetscCall(PetscClassIdRegister("BlockGalerkin", &classid));
+  PetscCall(PetscLogEventRegister("BlockGalerkinRefill", classid, &BG_Refill));
+  PetscFunctionReturn(0);
+}
+
+} // namespace
+
 PetscErrorCode BlockGalerkinCreate(const std::vector<PetscInt> &row, const std::vector<PetscInt> &col,
                                    bool row_major, bool mirrored,
                                    const std::vector<std::vector<BlockWeight>> &weights, PetscInt n_coarse,
@@ -102,6 +119,8 @@ PetscErrorCode BlockGalerkinRefill(BlockGalerkin *g, const PetscScalar *values)
   PetscScalar *a;
 
   PetscFunctionBegin;
+  PetscCall(BlockGalerkinRegisterEvents());
+  PetscCall(PetscLogEventBegin(BG_Refill, 0, 0, 0, 0));
   PetscCall(MatSeqBAIJGetArray(g->Ac, &a));
   const BlockGalerkin::Term *term = g->terms.data();
   for (size_t b = 0; b + 1 < g->start.size(); ++b) {
@@ -129,6 +148,7 @@ PetscErrorCode BlockGalerkinRefill(BlockGalerkin *g, const PetscScalar *values)
   PetscCall(MatAssemblyBegin(g->Ac, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(g->Ac, MAT_FINAL_ASSEMBLY));
   PetscCall(PetscLogFlops(18.0 * g->terms.size()));
+  PetscCall(PetscLogEventEnd(BG_Refill, 0, 0, 0, 0));
   PetscFunctionReturn(0);
 }
 
