@@ -3,8 +3,8 @@
 //
 // Levels: every coarsening keeps every other node per side (n -> n / 2 + 1), until a level has at most
 // -grid_mg_coarse_nodes nodes (default 150; the 160 x 160 cloth gets 160, 81, 41, 21, 11). Interpolation:
-// bilinear, the same weights for each of the 3 components, one AIJ matrix per level, built once (the grid
-// does not change). Rows of fixed (Dirichlet) fine nodes are zero: their equations hold only the mass, the
+// bilinear, the same weights for each of the 3 components, one matrix per level, built once (the grid
+// does not change; MAIJ with the block Galerkin products, AIJ for PCMG's). Rows of fixed (Dirichlet) fine nodes are zero: their equations hold only the mass, the
 // smoother solves them exactly, and a coarse correction must not move them. Coarse operators: Galerkin,
 // P^T A P for every new set of values, by default from the driver's COO blocks (block_galerkin.h, SeqBAIJ
 // coarse levels, one rank), with -grid_mg_galerkin pcmg (the default on more ranks) by PCMG's MatPtAP (AIJ)
