@@ -3,21 +3,23 @@
 //
 // Levels: every coarsening keeps every other node per side (n -> n / 2 + 1), until a level has at most
 // -grid_mg_coarse_nodes nodes (default 150; the 160 x 160 cloth gets 160, 81, 41, 21, 11). Interpolation:
-// bilinear, the same weights for each of the 3 components, one matrix per level, built once (the grid
-// does not change; MAIJ with the block Galerkin products, AIJ for PCMG's). Rows of fixed (Dirichlet) fine nodes are zero: their equations hold only the mass, the
-// smoother solves them exactly, and a coarse correction must not move them. Coarse operators: Galerkin,
-// P^T A P for every new set of values, by default from the driver's COO blocks (block_galerkin.h, SeqBAIJ
-// coarse levels, one rank), with -grid_mg_galerkin pcmg (the default on more ranks) by PCMG's MatPtAP (AIJ)
-// at its set-up. Smoothers: -grid_mg_levels_[N_]* (default one symmetric Gauss-Seidel sweep), coarse solve:
-// -grid_mg_coarse_* (default LU, redundant on more ranks); GAMG's -mg_levels_* do not reach them.
-// -grid_mg_smoother slab (the default on one rank with the block Galerkin products; sor: the SOR above):
-// each level whose couplings allow it smooths with slab Gauss-Seidel (slab_gs.h), the same symmetric
-// block Gauss-Seidel sweep with 8 rows relaxed side by side; the others keep SOR.
-// -grid_mg_smoother_precision single (with the block Galerkin products; ignored with PCMG's): the smoothers sweep single-precision binbcsr
-// copies of the level operators (the fine one duplicated, the coarse BAIJ ones in upper-triangle storage)
-// and the V-cycle's residuals are taken on them too, while interpolation, the Galerkin products and the
-// outer Krylov method stay on the operators themselves. The V-cycle only has to reduce the error, so its
-// rounding does not reach the solution; the sweeps read a half (fine) or a quarter (coarse) of the bytes.
+// bilinear, the same weights for each of the 3 components, one matrix per level, built once (the grid does
+// not change; MAIJ with the block Galerkin products, AIJ for PCMG's). Rows of fixed (Dirichlet) fine nodes
+// are zero: their equations hold only the mass, the smoother solves them exactly, and a coarse correction
+// must not move them. Coarse operators: Galerkin, P^T A P for every new set of values, by default from the
+// driver's COO blocks (block_galerkin.h, SeqBAIJ coarse levels, one rank), with -grid_mg_galerkin pcmg (the
+// default on more ranks) by PCMG's MatPtAP (AIJ) at its set-up. Smoothers: -grid_mg_levels_[N_]* (default one
+// symmetric Gauss-Seidel sweep), coarse solve: -grid_mg_coarse_* (default LU, redundant on more ranks);
+// GAMG's -mg_levels_* do not reach them.
+// -grid_mg_smoother slab (the default on one rank with the block Galerkin products; sor: the SOR above): each
+// level whose couplings allow it smooths with slab Gauss-Seidel (slab_gs.h), the same symmetric block
+// Gauss-Seidel sweep with 8 rows relaxed side by side; the others keep SOR.
+// -grid_mg_smoother_precision single (with the block Galerkin products; ignored with PCMG's): the smoothers
+// sweep single-precision binbcsr copies of the level operators (the fine one duplicated, the coarse BAIJ ones
+// in upper-triangle storage) and the V-cycle's residuals are taken on them too, while interpolation, the
+// Galerkin products and the outer Krylov method stay on the operators themselves. The V-cycle only has to
+// reduce the error, so its rounding does not reach the solution; the sweeps read a half (fine) or a quarter
+// (coarse) of the bytes.
 //
 // On P ranks the fine rows are those of the solver's numbering (new_of_old, rows row_offsets[r] ..
 // row_offsets[r + 1] on rank r); each coarse node belongs to the rank owning the fine node nearest to it.
