@@ -21,7 +21,7 @@ PetscErrorCode BlockGalerkinRegisterEvents()
 } // namespace
 
 PetscErrorCode BlockGalerkinCreate(const std::vector<PetscInt> &row, const std::vector<PetscInt> &col,
-                                   bool row_major, bool mirrored,
+                                   bool row_major, bool mirrored, bool symmetric,
                                    const std::vector<std::vector<BlockWeight>> &weights, PetscInt n_coarse,
                                    BlockGalerkin *g)
 {
@@ -79,12 +79,22 @@ PetscErrorCode BlockGalerkinCreate(const std::vector<PetscInt> &row, const std::
     PetscCall(MatGetRowIJ(g->Ac, 0, PETSC_FALSE, PETSC_TRUE, &nr, &ia, &ja, &done));
     PetscCheck(done && nr == n_coarse, PETSC_COMM_SELF, PETSC_ERR_PLIB,
                "no block structure of the coarse matrix");
-    g->terms.resize(pending.size());
-    for (size_t t = 0; t < pending.size(); ++t) {
-      const Pending  &p  = pending[t];
+    g->terms.clear();
+    g->mirror.clear();
+    for (const Pending &p : pending) {
+      if (symmetric && p.I > p.J) continue; // the transpose of block (J, I)
       const PetscInt *at = std::lower_bound(ja + ia[p.I], ja + ia[p.I + 1], p.J);
-      g->terms[t]        = {p.src, (PetscInt)(at - ja), p.w};
+      g->terms.push_back({p.src, (PetscInt)(at - ja), p.w});
     }
+    if (symmetric) // the pattern is symmetric: it came from the terms, with (J, I) for every (I, J)
+      for (PetscInt I = 0; I < nr; ++I)
+        for (PetscInt k = ia[I]; k < ia[I + 1] && ja[k] < I; ++k) {
+          const PetscInt  J  = ja[k];
+          const PetscInt *at = std::lower_bound(ja + ia[J], ja + ia[J + 1], I);
+          PetscCheck(at < ja + ia[J + 1] && *at == I, PETSC_COMM_SELF, PETSC_ERR_PLIB,
+                     "coarse block (%" PetscInt_FMT ", %" PetscInt_FMT ") has no transpose", I, J);
+          g->mirror.push_back({k, (PetscInt)(at - ja)});
+        }
     // Grouped by destination, a refill sums each block of Ac in registers and stores it once (the
     // source blocks it reads are a few MB, cache-resident; Ac's are written in order).
     std::stable_sort(
@@ -137,6 +147,11 @@ PetscErrorCode BlockGalerkinRefill(BlockGalerkin *g, const PetscScalar *values)
       }
     }
     for (int k = 0; k < 9; ++k) a[9 * b + k] = acc[k];
+  }
+  for (const auto &m : g->mirror) {
+    PetscScalar *lower = a + 9 * m.first, *upper = a + 9 * m.second;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) lower[3 * i + j] = upper[3 * j + i];
   }
   PetscCall(MatSeqBAIJRestoreArray(g->Ac, &a));
   // A new state, so that the level's smoother and factorisation see the new values. Assembled as a

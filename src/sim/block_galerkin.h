@@ -5,6 +5,7 @@
 // binbcsr operator through an AIJ copy of it refreshed every time).
 #pragma once
 #include <petscmat.h>
+#include <utility>
 #include <vector>
 
 struct BlockWeight {
@@ -21,13 +22,18 @@ struct BlockGalerkin {
   };
   std::vector<Term>     terms; // sorted by dst
   std::vector<PetscInt> start; // terms of Ac's block b: [start[b], start[b + 1])
+  // symmetric products: (block below the diagonal, the block above it whose transpose it is)
+  std::vector<std::pair<PetscInt, PetscInt>> mirror;
 };
 
 // The source: nblocks 3x3 blocks (row[k], col[k]) in fine node numbering, 9 values each, row-major when
 // row_major (a COO list), else column-major (PETSc's BAIJ). mirrored: every block off the diagonal also
 // stands for its transpose at (col, row) (upper-triangle storage). weights[i]: fine node i's row of W.
+// symmetric: the source matrix is symmetric (mirrored, or each block listed with its transpose), so Ac is
+// too: only its blocks on and above the diagonal are summed and the others copied from them transposed
+// (about half the terms; the blocks off the diagonal are then exact transposes of each other).
 PetscErrorCode BlockGalerkinCreate(const std::vector<PetscInt> &row, const std::vector<PetscInt> &col,
-                                   bool row_major, bool mirrored,
+                                   bool row_major, bool mirrored, bool symmetric,
                                    const std::vector<std::vector<BlockWeight>> &weights, PetscInt n_coarse,
                                    BlockGalerkin *g);
 // The source blocks of a SeqBAIJ matrix (block size 3), in its value array's order, for BlockGalerkinCreate.

@@ -236,7 +236,8 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
     std::vector<PetscInt> rows, cols;
     if (l == 0) rows.assign(coo_row.begin(), coo_row.end()), cols.assign(coo_col.begin(), coo_col.end());
     else PetscCall(BlockGalerkinBlocksOf(mg->galerkin[l - 1].Ac, &rows, &cols));
-    PetscCall(BlockGalerkinCreate(rows, cols, l == 0, l == 0 && coo_mirrored, w,
+    // the fine operator is symmetric (the driver assembles a symmetric system), so is every product
+    PetscCall(BlockGalerkinCreate(rows, cols, l == 0, l == 0 && coo_mirrored, true, w,
                                   levels[l + 1].side * levels[l + 1].side, &mg->galerkin[l]));
     PetscCall(PCMGSetOperators(pc, nlev - 2 - l, mg->galerkin[l].Ac, mg->galerkin[l].Ac));
   }

@@ -1,5 +1,7 @@
 // Geometric multigrid (PCMG) for a square n x n grid of nodes with 3 unknowns each (the cloth), whatever
 // the fine operator's Mat type: the driver knows the grid, PETSc does not.
+// The fine operator must be symmetric (CG's): the block Galerkin products sum only the coarse blocks on
+// and above the diagonal.
 //
 // Levels: every coarsening keeps every other node per side (n -> n / 2 + 1), until a level has at most
 // -grid_mg_coarse_nodes nodes (default 150; the 160 x 160 cloth gets 160, 81, 41, 21, 11). Interpolation:
