@@ -149,11 +149,12 @@ int main(int argc, char **argv)
                           sys.block_col, rs.upper_only, &mg));
     PetscCall(PetscPrintf(comm, "cloth: grid multigrid, %zu level(s):", mg.sides.size()));
     for (PetscInt side : mg.sides) PetscCall(PetscPrintf(comm, " %" PetscInt_FMT "^2", side));
-    PetscCall(PetscPrintf(comm, " nodes, coarse operators by %s, smoothers on %s, %s\n",
-                          mg.own_galerkin ? "blocks" : "MatPtAP",
-                          mg.single_smoothers ? "single-precision copies" : "the operators",
-                          mg.smoother_slab ? "slab Gauss-Seidel sweeps where the couplings allow"
-                                           : "SOR sweeps"));
+    PetscCall(PetscPrintf(
+      comm, " nodes, coarse operators by %s, smoothers on %s, %s\n", mg.own_galerkin ? "blocks" : "MatPtAP",
+      mg.single_smoothers ? "single-precision copies" : "the operators",
+      !mg.smoother_slab ? "SOR sweeps"
+      : mg.own_galerkin ? "slab Gauss-Seidel sweeps where the couplings allow"
+                        : "slab Gauss-Seidel sweeps on each rank's fine rows, SOR below"));
     // The coarse operators follow every refill of the fine matrix (timed with it: setvalues_ms).
     linear.set_matrix = [&rs, &mg, fine = linear.set_matrix](const std::vector<double> &values) {
       fine(values);

@@ -155,7 +155,7 @@ PetscErrorCode LevelSmoothers(PC pc, PetscInt level, KSP sides[2])
 // Level `level`'s smoothers become slab Gauss-Seidel on the blocks `entries` (n block rows) when the
 // level's couplings allow it (slab_gs.h); otherwise they stay SOR, and -info says why.
 PetscErrorCode UseSlabs(GridMG *mg, PetscInt level, int n, std::vector<SlabGS::Entry> entries,
-                        bool column_major)
+                        bool column_major, PetscBool whole)
 {
   PetscFunctionBegin;
   const std::string why = SlabGSBuild(n, std::move(entries), column_major, &mg->slabs[level]);
@@ -169,7 +169,7 @@ PetscErrorCode UseSlabs(GridMG *mg, PetscInt level, int n, std::vector<SlabGS::E
   for (KSP smoother : sides) {
     PC spc;
     PetscCall(KSPGetPC(smoother, &spc));
-    PetscCall(SlabGSSetPC(spc, &mg->slabs[level]));
+    PetscCall(SlabGSSetPC(spc, &mg->slabs[level], whole));
   }
   mg->slab_used[level] = GridMG::kSlab;
   PetscFunctionReturn(0);
@@ -279,22 +279,30 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
   }
   {
     const char *kinds[] = {"sor", "slab"};
-    PetscInt    kind    = mg->own_galerkin ? 1 : 0;
+    PetscInt    kind    = 1;
     PetscCall(PetscOptionsGetEList(nullptr, nullptr, "-grid_mg_smoother", kinds, 2, &kind, nullptr));
-    PetscCheck(
-      kind == 0 || mg->own_galerkin, comm, PETSC_ERR_SUP,
-      "-grid_mg_smoother slab needs the block Galerkin products (one rank, -grid_mg_galerkin blocks)");
     mg->smoother_slab = kind == 1;
     mg->slabs.assign(nlev, SlabGS());
     mg->slab_used.assign(nlev, GridMG::kUndecided);
-    if (mg->smoother_slab && nlev > 1) { // the fine level's blocks: the driver's COO list, solver numbering
+    // The fine level's blocks: the driver's COO list (this rank's rows), in the solver's numbering local
+    // to the rank. With PCMG's products (more ranks) only the fine level sweeps slabs, each rank its own
+    // rows with their couplings to other ranks left out (block Jacobi between the ranks, as SOR's local
+    // sweeps do), and its residual stays PCMG's on the whole operator.
+    if (mg->smoother_slab && nlev > 1) {
+      PetscMPIInt rank;
+      PetscCallMPI(MPI_Comm_rank(comm, &rank));
+      const int                  begin = row_offsets[rank], local = row_offsets[rank + 1] - begin;
       std::vector<SlabGS::Entry> entries;
       for (size_t k = 0; k < coo_row.size(); ++k) {
-        const int r = new_of_old[coo_row[k]], c = new_of_old[coo_col[k]];
+        const int r = new_of_old[coo_row[k]] - begin, c = new_of_old[coo_col[k]] - begin;
+        PetscCheck(r >= 0 && r < local, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+                   "grid multigrid: COO block %zu is in row %d, not one of this rank's", k, r + begin);
+        if (c < 0 || c >= local) continue;
         entries.push_back({r, c, (long)k, false});
         if (coo_mirrored && r != c) entries.push_back({c, r, (long)k, true});
       }
-      PetscCall(UseSlabs(mg, nlev - 1, (int)(n * n), std::move(entries), false));
+      PetscCall(
+        UseSlabs(mg, nlev - 1, local, std::move(entries), false, size == 1 ? PETSC_TRUE : PETSC_FALSE));
     }
   }
   {
@@ -359,10 +367,10 @@ PetscErrorCode GridMGRefill(GridMG *mg, const PetscScalar *coo_values)
     PetscCall(PCGetOperators(mg->pc, &A, nullptr));
     PetscCall(SetLevelOperators(mg, (PetscInt)mg->smoother_mats.size() - 1, A));
   }
-  if (!mg->own_galerkin) PetscFunctionReturn(0); // PCMG recomputes its products at its set-up
   const PetscInt fine = (PetscInt)mg->galerkin.size();
-  if (mg->smoother_slab && mg->slab_used[fine] == GridMG::kSlab)
+  if (mg->smoother_slab && fine > 0 && mg->slab_used[fine] == GridMG::kSlab)
     PetscCall(SlabGSRefill(&mg->slabs[fine], coo_values));
+  if (!mg->own_galerkin) PetscFunctionReturn(0); // PCMG recomputes its products at its set-up
   for (size_t l = 0; l < mg->galerkin.size(); ++l) {
     const PetscScalar *src = coo_values;
     PetscScalar       *a   = nullptr;
@@ -384,7 +392,7 @@ PetscErrorCode GridMGRefill(GridMG *mg, const PetscScalar *coo_values)
         for (size_t k = 0; k < rows.size(); ++k)
           entries.push_back({(int)rows[k], (int)cols[k], (long)k, false});
         PetscCall(MatGetLocalSize(Ac, &nb, nullptr));
-        PetscCall(UseSlabs(mg, level, (int)(nb / 3), std::move(entries), true));
+        PetscCall(UseSlabs(mg, level, (int)(nb / 3), std::move(entries), true, PETSC_TRUE));
       }
       if (mg->slab_used[level] == GridMG::kSlab) {
         PetscCall(MatSeqBAIJGetArray(Ac, &ac));

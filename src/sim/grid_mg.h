@@ -13,9 +13,11 @@
 // default on more ranks) by PCMG's MatPtAP (AIJ) at its set-up. Smoothers: -grid_mg_levels_[N_]* (default one
 // symmetric Gauss-Seidel sweep), coarse solve: -grid_mg_coarse_* (default LU, redundant on more ranks);
 // GAMG's -mg_levels_* do not reach them.
-// -grid_mg_smoother slab (the default on one rank with the block Galerkin products; sor: the SOR above): each
-// level whose couplings allow it smooths with slab Gauss-Seidel (slab_gs.h), the same symmetric block
-// Gauss-Seidel sweep with 8 rows relaxed side by side; the others keep SOR.
+// -grid_mg_smoother slab (the default; sor: the SOR above): with the block Galerkin products each level
+// whose couplings allow it smooths with slab Gauss-Seidel (slab_gs.h), the same symmetric block
+// Gauss-Seidel sweep with 8 rows relaxed side by side, the others keep SOR; with PCMG's products (more
+// ranks) the fine level does, each rank on its own rows (block Jacobi between the ranks, as SOR's local
+// sweeps), and the coarse levels keep SOR.
 // -grid_mg_smoother_precision single (with the block Galerkin products; ignored with PCMG's): the smoothers
 // sweep single-precision binbcsr copies of the level operators (the fine one duplicated, the coarse BAIJ ones
 // in upper-triangle storage) and the V-cycle's residuals are taken on them too, while interpolation, the
@@ -42,9 +44,10 @@ struct GridMG {
   // operators
   bool             single_smoothers = false;
   std::vector<Mat> smoother_mats; // per PCMG level (0 unused): the copies, made at the first refill
-  // -grid_mg_smoother slab (one rank, block Galerkin products): per PCMG level (0 unused), the slab
-  // Gauss-Seidel smoother (slab_gs.h) where its couplings allow it; slab_used[l] says whether it does
-  // (decided at the set-up for the fine level, at the first refill for the coarse ones)
+  // -grid_mg_smoother slab: per PCMG level (0 unused), the slab Gauss-Seidel smoother (slab_gs.h) where
+  // its couplings allow it (with PCMG's products the fine level only, this rank's rows); slab_used[l]
+  // says whether it does (decided at the set-up for the fine level, at the first refill for the coarse
+  // ones)
   enum SlabUse : char {
     kUndecided,
     kSlab,

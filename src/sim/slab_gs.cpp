@@ -519,14 +519,14 @@ PetscErrorCode Apply(PC pc, Vec b, Vec x)
 
 } // namespace
 
-PetscErrorCode SlabGSSetPC(PC pc, SlabGS *gs)
+PetscErrorCode SlabGSSetPC(PC pc, SlabGS *gs, PetscBool whole)
 {
   PetscFunctionBegin;
   PetscCall(SlabGSRegisterEvents());
   PetscCall(PCSetType(pc, PCSHELL));
   PetscCall(PCShellSetContext(pc, gs));
   PetscCall(PCShellSetApply(pc, Apply));
-  PetscCall(PCShellSetApplyRichardson(pc, ApplyRichardson));
+  if (whole) PetscCall(PCShellSetApplyRichardson(pc, ApplyRichardson));
   PetscCall(PCShellSetName(pc, "slab Gauss-Seidel (symmetric sweep, 8 rows side by side)"));
   PetscFunctionReturn(0);
 }

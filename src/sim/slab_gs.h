@@ -87,6 +87,10 @@ void SlabGSResidual(SlabGS &gs, const double *b, const double *x, double *r, boo
 PetscErrorCode SlabGSAttach(Mat A, SlabGS *gs);
 PetscErrorCode SlabGSResidualMat(Mat A, Vec b, Vec x, Vec r);
 
-// Makes pc a PCSHELL that applies `its` symmetric sweeps through KSPRICHARDSON (PCApplyRichardson, no
-// residual product): the smoother of a PCMG level. gs must outlive pc.
-PetscErrorCode SlabGSSetPC(PC pc, SlabGS *gs);
+// Makes pc a PCSHELL for the smoother of a PCMG level (KSPRICHARDSON, one application). whole: gs holds
+// every coupling of the operator's rows, and the sweeps run from the smoother's guess (PCApplyRichardson,
+// no residual product). Else (a rank's rows of a distributed operator, their couplings to other ranks
+// left out) the PC applies one symmetric sweep from zero to the residual KSPRICHARDSON forms with the
+// whole operator: x + M^-1 (b - A x), the same as sweeping the rank's rows from x with the other ranks'
+// part moved to the right-hand side (SOR's local sweeps). gs must outlive pc.
+PetscErrorCode SlabGSSetPC(PC pc, SlabGS *gs, PetscBool whole);

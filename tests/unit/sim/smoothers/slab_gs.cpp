@@ -217,7 +217,7 @@ TEST_CASE("slab Gauss-Seidel as a PC and a residual follows its vectors", "[slab
   REQUIRE(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY) == 0);
   REQUIRE(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY) == 0);
   REQUIRE(PCSetOperators(pc, A, A) == 0);
-  REQUIRE(SlabGSSetPC(pc, &gs) == 0);
+  REQUIRE(SlabGSSetPC(pc, &gs, PETSC_TRUE) == 0);
   REQUIRE(VecCreateSeq(PETSC_COMM_SELF, 3 * n, &b) == 0);
   REQUIRE(VecDuplicate(b, &x) == 0);
   REQUIRE(VecDuplicate(b, &r) == 0);
