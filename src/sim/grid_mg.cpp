@@ -152,16 +152,21 @@ PetscErrorCode LevelSmoothers(PC pc, PetscInt level, KSP sides[2])
   PetscFunctionReturn(0);
 }
 
-// Level `level`'s smoothers become slab Gauss-Seidel on the blocks `entries` (n block rows) when the
-// level's couplings allow it (slab_gs.h); otherwise they stay SOR, and -info says why.
+// Level `level`'s smoothers become slab Gauss-Seidel on the blocks `entries` (this rank's n block rows)
+// when the level's couplings allow it (slab_gs.h) on every rank; otherwise they stay SOR on all of them
+// (a level's smoother is one collective object: the ranks must agree), and -info says why.
 PetscErrorCode UseSlabs(GridMG *mg, PetscInt level, int n, std::vector<SlabGS::Entry> entries,
                         bool column_major, PetscBool whole)
 {
   PetscFunctionBegin;
-  const std::string why = SlabGSBuild(n, std::move(entries), column_major, &mg->slabs[level]);
-  if (!why.empty()) {
+  const std::string why     = SlabGSBuild(n, std::move(entries), column_major, &mg->slabs[level]);
+  int               here_ok = why.empty(), all_ok;
+  PetscCallMPI(MPI_Allreduce(&here_ok, &all_ok, 1, MPI_INT, MPI_LAND, PetscObjectComm((PetscObject)mg->pc)));
+  if (!all_ok) {
     mg->slab_used[level] = GridMG::kSor;
-    PetscCall(PetscInfo(mg->pc, "grid multigrid level %d keeps SOR: %s\n", (int)level, why.c_str()));
+    mg->slabs[level]     = SlabGS();
+    PetscCall(PetscInfo(mg->pc, "grid multigrid level %d keeps SOR: %s\n", (int)level,
+                        here_ok ? "another rank's rows cannot be swept in slabs" : why.c_str()));
     PetscFunctionReturn(0);
   }
   KSP sides[2];
