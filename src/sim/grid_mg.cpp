@@ -89,55 +89,42 @@ std::vector<std::vector<BlockWeight>> Weights(const GridLevel &f, const GridLeve
   return rows;
 }
 
-// The interpolation as PCMG applies it: AIJ, rows and columns in the levels' (solver) numbering. maij: the
+// The interpolation as PCMG applies it, rows and columns in the levels' (solver) numbering. maij: the
 // scalar weights once, as MAIJ with 3 components (PCMG's transfers then read a third of the bytes); else
-// the weight repeated for each component (an AIJ matrix MatPtAP takes, for PCMG's own products).
+// AIJ with the weight repeated for each component (what MatPtAP takes, for PCMG's own products).
 PetscErrorCode Interpolation(MPI_Comm comm, const GridLevel &f, const GridLevel &c,
                              const std::vector<std::vector<BlockWeight>> &rows, bool maij, Mat *P)
 {
-  PetscMPIInt rank;
+  PetscMPIInt    rank;
+  Mat            W;
+  const PetscInt dof = maij ? 1 : 3, nf = f.side * f.side; // the components W itself carries
 
   PetscFunctionBegin;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  if (maij) {
-    const PetscInt nf = f.side * f.side;
-    Mat            W;
-    PetscCall(MatCreateAIJ(comm, f.offsets[rank + 1] - f.offsets[rank], c.offsets[rank + 1] - c.offsets[rank],
-                           nf, c.side * c.side, 4, nullptr, 4, nullptr, &W));
-    for (PetscInt node = 0; node < nf; ++node) {
-      if (OwnerOf(f.offsets, f.num[node]) != rank) continue;
-      for (const BlockWeight &w : rows[node]) {
-        const PetscInt    row = f.num[node], col = c.num[w.coarse];
-        const PetscScalar v = w.w;
-        PetscCall(MatSetValues(W, 1, &row, 1, &col, &v, INSERT_VALUES));
-      }
-    }
-    PetscCall(MatAssemblyBegin(W, MAT_FINAL_ASSEMBLY));
-    PetscCall(MatAssemblyEnd(W, MAT_FINAL_ASSEMBLY));
-    PetscCall(MatCreateMAIJ(W, 3, P));
-    PetscCall(MatDestroy(&W));
-    PetscFunctionReturn(0);
-  }
-  const PetscInt nf   = f.side * f.side;
-  const PetscInt mloc = 3 * (f.offsets[rank + 1] - f.offsets[rank]);
-  const PetscInt nloc = 3 * (c.offsets[rank + 1] - c.offsets[rank]);
-  PetscCall(MatCreate(comm, P));
-  PetscCall(MatSetSizes(*P, mloc, nloc, 3 * nf, 3 * c.side * c.side));
-  PetscCall(MatSetBlockSizes(*P, 3, 3));
-  PetscCall(MatSetType(*P, MATAIJ));
-  PetscCall(MatSeqAIJSetPreallocation(*P, 4, nullptr));
-  PetscCall(MatMPIAIJSetPreallocation(*P, 4, nullptr, 4, nullptr));
+  PetscCall(MatCreate(comm, &W));
+  PetscCall(MatSetSizes(W, dof * (f.offsets[rank + 1] - f.offsets[rank]),
+                        dof * (c.offsets[rank + 1] - c.offsets[rank]), dof * nf, dof * c.side * c.side));
+  PetscCall(MatSetBlockSizes(W, dof, dof));
+  PetscCall(MatSetType(W, MATAIJ));
+  PetscCall(MatSeqAIJSetPreallocation(W, 4, nullptr));
+  PetscCall(MatMPIAIJSetPreallocation(W, 4, nullptr, 4, nullptr));
   for (PetscInt node = 0; node < nf; ++node) {
     if (OwnerOf(f.offsets, f.num[node]) != rank) continue;
     for (const BlockWeight &w : rows[node])
-      for (PetscInt k = 0; k < 3; ++k) {
-        const PetscInt    row = 3 * f.num[node] + k, col = 3 * c.num[w.coarse] + k;
+      for (PetscInt k = 0; k < dof; ++k) {
+        const PetscInt    row = dof * f.num[node] + k, col = dof * c.num[w.coarse] + k;
         const PetscScalar v = w.w;
-        PetscCall(MatSetValues(*P, 1, &row, 1, &col, &v, INSERT_VALUES));
+        PetscCall(MatSetValues(W, 1, &row, 1, &col, &v, INSERT_VALUES));
       }
   }
-  PetscCall(MatAssemblyBegin(*P, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(*P, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyBegin(W, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(W, MAT_FINAL_ASSEMBLY));
+  if (!maij) {
+    *P = W;
+    PetscFunctionReturn(0);
+  }
+  PetscCall(MatCreateMAIJ(W, 3, P));
+  PetscCall(MatDestroy(&W));
   PetscFunctionReturn(0);
 }
 

@@ -411,14 +411,22 @@ void SlabGSResidual(SlabGS &gs, const double *b, const double *x, double *r, boo
 
 namespace {
 
+// v's identity and state: which Vec, as it is now
+PetscErrorCode HeldOf(Vec v, SlabGS::Held *held)
+{
+  PetscFunctionBegin;
+  PetscCall(PetscObjectGetId((PetscObject)v, &held->id));
+  PetscCall(PetscObjectStateGet((PetscObject)v, &held->state));
+  PetscFunctionReturn(0);
+}
+
 // lv holds v's values in the lane layout, converted unless held says lv already holds v as it is now
 PetscErrorCode LanesOf(SlabGS *gs, Vec v, SlabGS::Held *held, std::vector<double> &lv)
 {
   SlabGS::Held now;
 
   PetscFunctionBegin;
-  PetscCall(PetscObjectGetId((PetscObject)v, &now.id));
-  PetscCall(PetscObjectStateGet((PetscObject)v, &now.state));
+  PetscCall(HeldOf(v, &now));
   if (held->id != now.id || held->state != now.state) {
     const PetscScalar *a;
     PetscCall(VecGetArrayRead(v, &a));
@@ -486,8 +494,7 @@ PetscErrorCode SymmetricSweeps(SlabGS *gs, Vec b, Vec x, PetscInt its, PetscBool
   PetscCall(VecGetArrayWrite(x, &xa));
   FromLanes(*gs, gs->xl, xa);
   PetscCall(VecRestoreArrayWrite(x, &xa));
-  PetscCall(PetscObjectGetId((PetscObject)x, &gs->held_x.id)); // xl holds x as it is now
-  PetscCall(PetscObjectStateGet((PetscObject)x, &gs->held_x.state));
+  PetscCall(HeldOf(x, &gs->held_x)); // xl holds x as it is now
   // per symmetric sweep: U products twice, the pushes once (each 18 flops per stored block), the solves
   PetscCall(PetscLogFlops(its * (3 * 18.0 * (double)gs->val.size() / 9 + 2 * 15.0 * gs->n)));
   PetscCall(PetscLogEventEnd(SLAB_Smooth, 0, 0, 0, 0));
