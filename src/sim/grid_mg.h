@@ -16,8 +16,8 @@
 // -grid_mg_smoother slab (the default; sor: the SOR above): with the block Galerkin products each level
 // whose couplings allow it smooths with slab Gauss-Seidel (slab_gs.h), the same symmetric block
 // Gauss-Seidel sweep with 8 rows relaxed side by side, the others keep SOR; with PCMG's products (more
-// ranks) the fine level does, each rank on its own rows (block Jacobi between the ranks, as SOR's local
-// sweeps), and the coarse levels keep SOR.
+// ranks) every level but the coarsest does, each rank on its own rows (block Jacobi between the ranks, as
+// SOR's local sweeps; the coarse levels' blocks from the rank's diagonal part of PCMG's AIJ products).
 // -grid_mg_smoother_precision single (with the block Galerkin products; ignored with PCMG's): the smoothers
 // sweep single-precision binbcsr copies of the level operators (the fine one duplicated, the coarse BAIJ ones
 // in upper-triangle storage) and the V-cycle's residuals are taken on them too, while interpolation, the
@@ -56,6 +56,20 @@ struct GridMG {
   bool                 smoother_slab = false;
   std::vector<SlabGS>  slabs;
   std::vector<SlabUse> slab_used;
+  // With PCMG's products the coarse levels' operators are AIJ, made at PCMG's set-up: their smoothers
+  // are PCSHELLs whose own set-up takes the level's 3x3 blocks from this rank's diagonal part of the
+  // operator (slabs[level] then sweeps them as on the fine level: block Jacobi between the ranks), or
+  // keeps SOR where the ranks cannot all sweep slabs. One per PCMG level (0 and the fine one unused).
+  struct AijSlab {
+    GridMG  *mg    = nullptr;
+    PetscInt level = 0;
+    std::vector<PetscInt>
+      gather; // per block entry (9 per block, row-major): index into the AIJ values, -1: none
+    std::vector<PetscScalar> blocks;        // the gathered blocks SlabGSRefill reads
+    SlabGS::Held             held;          // the operator (and its state) the slabs hold
+    PC                       sor = nullptr; // the level keeps SOR: this PC does it
+  };
+  std::vector<AijSlab> aij_slabs;
 };
 
 // ksp's PC must be PCMG (-pc_type mg). fixed: n * n flags (row-major, physics numbering). coo_row, coo_col:

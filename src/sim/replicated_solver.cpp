@@ -31,13 +31,21 @@ PetscErrorCode ReplicatedSolverNumber(MPI_Comm comm, PetscInt n_blocks, const st
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-rows_group_window", &window, nullptr));
   PetscCheck(window >= 0, comm, PETSC_ERR_ARG_OUTOFRANGE,
              "-rows_group_window must be >= 0 (0 = off), got %" PetscInt_FMT, window);
+  const char *partitions[] = {"metis", "contiguous"};
+  PetscInt    parts        = rs->contiguous_parts ? 1 : 0;
+  PetscCall(PetscOptionsGetEList(nullptr, nullptr, "-rows_partition", partitions, 2, &parts, nullptr));
   std::vector<std::pair<int, int>> edges;
   for (size_t k = 0; k < block_row.size(); ++k)
     if (block_row[k] < block_col[k]) edges.push_back({block_row[k], block_col[k]});
   try {
     const physics::AdjacencyGraph g = physics::graph_from_edges((int)n_blocks, edges);
     physics::Renumbering          r;
-    if (rs->size > 1) {
+    if (rs->size > 1 && parts == 1) { // equal contiguous ranges of the physics order
+      r.new_of_old.resize(n_blocks);
+      std::iota(r.new_of_old.begin(), r.new_of_old.end(), 0);
+      r.old_of_new = r.new_of_old;
+      for (int p = 0; p <= rs->size; ++p) r.part_offsets.push_back((int)((long long)n_blocks * p / rs->size));
+    } else if (rs->size > 1) {
       r = physics::partition_graph(g, rs->size);
     } else {
       r.new_of_old.resize(n_blocks);

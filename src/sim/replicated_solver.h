@@ -7,6 +7,10 @@
 // (physics/row_order.hpp; default 256 for -mat_type binbcsr or sell, else 0 = off), so that the bins hold
 // rows of similar length and carry little padding; the physics never sees the new numbering (right-hand sides and solutions are
 // permuted here, the COO values keep their order).
+// -rows_partition metis|contiguous: how the rows are split between the ranks, METIS (the default) or
+// equal contiguous ranges of the physics order, for a physics order that is already local (the cloth's
+// row-major particle grid: strips of whole grid rows, what its grid multigrid coarsens and sweeps best;
+// the caller sets contiguous_parts before ReplicatedSolverNumber to make that its default).
 // The solution vector passed to the solve is the initial guess when the KSP uses one
 // (KSPSetInitialGuessNonzero / -ksp_initial_guess_nonzero).
 //
@@ -23,15 +27,16 @@
 #include <vector>
 
 struct ReplicatedSolver {
-  BlockSystem         sys;
-  MPI_Comm            comm = MPI_COMM_NULL;
-  int                 size = 1, rank = 0;
-  PetscInt            n_blocks = 0;           // block rows
-  std::vector<int>    new_of_old, old_of_new; // physics block row -> solver block row and back
-  bool                renumbered = false;     // new_of_old is not the identity
-  std::vector<int>    row_offsets;            // block rows per rank, size + 1 entries
-  std::vector<size_t> local_blocks;           // indices into the physics COO list, this rank's rows
-  bool                copy_local = false;     // set_matrix gets the whole list and copies out local_blocks
+  BlockSystem      sys;
+  MPI_Comm         comm = MPI_COMM_NULL;
+  int              size = 1, rank = 0;
+  PetscInt         n_blocks = 0;           // block rows
+  std::vector<int> new_of_old, old_of_new; // physics block row -> solver block row and back
+  bool             renumbered = false;     // new_of_old is not the identity
+  bool contiguous_parts = false;    // ReplicatedSolverNumber's default split: contiguous ranges (else METIS)
+  std::vector<int>    row_offsets;  // block rows per rank, size + 1 entries
+  std::vector<size_t> local_blocks; // indices into the physics COO list, this rank's rows
+  bool                copy_local = false; // set_matrix gets the whole list and copies out local_blocks
   PetscBool           upper_only = PETSC_FALSE,
             offrank_full         = PETSC_FALSE; // what the Mat type stores (BlockSystemStoredTriangle)
   std::vector<PetscScalar> local_values, rhs_local, sol_local, sol_all;

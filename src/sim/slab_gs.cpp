@@ -409,16 +409,18 @@ void SlabGSResidual(SlabGS &gs, const double *b, const double *x, double *r, boo
   FromLanes(gs, gs.rl, r);
 }
 
+PetscErrorCode SlabGSHeldOf(PetscObject obj, SlabGS::Held *held)
+{
+  PetscFunctionBegin;
+  PetscCall(PetscObjectGetId(obj, &held->id));
+  PetscCall(PetscObjectStateGet(obj, &held->state));
+  PetscFunctionReturn(0);
+}
+
 namespace {
 
 // v's identity and state: which Vec, as it is now
-PetscErrorCode HeldOf(Vec v, SlabGS::Held *held)
-{
-  PetscFunctionBegin;
-  PetscCall(PetscObjectGetId((PetscObject)v, &held->id));
-  PetscCall(PetscObjectStateGet((PetscObject)v, &held->state));
-  PetscFunctionReturn(0);
-}
+PetscErrorCode HeldOf(Vec v, SlabGS::Held *held) { return SlabGSHeldOf((PetscObject)v, held); }
 
 // lv holds v's values in the lane layout, converted unless held says lv already holds v as it is now
 PetscErrorCode LanesOf(SlabGS *gs, Vec v, SlabGS::Held *held, std::vector<double> &lv)
@@ -525,6 +527,14 @@ PetscErrorCode Apply(PC pc, Vec b, Vec x)
 }
 
 } // namespace
+
+PetscErrorCode SlabGSApplySweep(SlabGS *gs, Vec b, Vec x)
+{
+  PetscFunctionBegin;
+  PetscCall(SlabGSRegisterEvents());
+  PetscCall(SymmetricSweeps(gs, b, x, 1, PETSC_TRUE));
+  PetscFunctionReturn(0);
+}
 
 PetscErrorCode SlabGSSetPC(PC pc, SlabGS *gs, PetscBool whole)
 {

@@ -64,6 +64,9 @@ struct SlabGS {
   Held held_b, held_x;
 };
 
+// Which object obj is and its state now (PetscObjectStateGet is PETSc's private API): a Held to compare.
+PetscErrorCode SlabGSHeldOf(PetscObject obj, SlabGS::Held *held);
+
 // Builds the layout for n block rows from entries (every off-diagonal block the row has, of a symmetric
 // matrix; the diagonal ones possibly repeated: they are summed). Returns an empty string, or why the rows
 // cannot be relaxed side by side (a coupling S or more rows away).
@@ -86,6 +89,9 @@ void SlabGSResidual(SlabGS &gs, const double *b, const double *x, double *r, boo
 // attached (SlabGSAttach: composed as "SlabGS"; gs must outlive that use of A).
 PetscErrorCode SlabGSAttach(Mat A, SlabGS *gs);
 PetscErrorCode SlabGSResidualMat(Mat A, Vec b, Vec x, Vec r);
+
+// x = one symmetric sweep from zero with right-hand side b (the PC of SlabGSSetPC without whole).
+PetscErrorCode SlabGSApplySweep(SlabGS *gs, Vec b, Vec x);
 
 // Makes pc a PCSHELL for the smoother of a PCMG level (KSPRICHARDSON, one application). whole: gs holds
 // every coupling of the operator's rows, and the sweeps run from the smoother's guess (PCApplyRichardson,
