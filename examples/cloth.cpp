@@ -154,15 +154,16 @@ int main(int argc, char **argv)
   }
   if (is_mg) {
     PetscCall(GridMGSetUp(rs.sys.ksp, cloth.n, cloth.fixed, rs.new_of_old, rs.row_offsets, sys.block_row,
-                          sys.block_col, rs.upper_only, &mg));
+                          sys.block_col, rs.upper_only, rs.offrank_full, &mg));
     PetscCall(PetscPrintf(comm, "cloth: grid multigrid, %zu level(s):", mg.sides.size()));
     for (PetscInt side : mg.sides) PetscCall(PetscPrintf(comm, " %" PetscInt_FMT "^2", side));
-    PetscCall(PetscPrintf(
-      comm, " nodes, coarse operators by %s, smoothers on %s, %s\n", mg.own_galerkin ? "blocks" : "MatPtAP",
-      mg.single_smoothers ? "single-precision copies" : "the operators",
-      !mg.smoother_slab ? "SOR sweeps"
-      : mg.own_galerkin ? "slab Gauss-Seidel sweeps where the couplings allow"
-                        : "slab Gauss-Seidel sweeps on each rank's rows where the couplings allow"));
+    PetscCall(
+      PetscPrintf(comm, " nodes, coarse operators by %s, smoothers on %s, %s\n",
+                  mg.distributed ? "blocks (each rank's share)" : (mg.own_galerkin ? "blocks" : "MatPtAP"),
+                  mg.single_smoothers ? "single-precision copies" : "the operators",
+                  !mg.smoother_slab ? "SOR sweeps"
+                  : size == 1       ? "slab Gauss-Seidel sweeps where the couplings allow"
+                              : "slab Gauss-Seidel sweeps on each rank's rows where the couplings allow"));
     // The coarse operators follow every refill of the fine matrix (timed with it: setvalues_ms).
     linear.set_matrix = [&rs, &mg, fine = linear.set_matrix](const std::vector<double> &values) {
       fine(values);

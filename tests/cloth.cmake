@@ -53,10 +53,17 @@ add_test(NAME cloth_mg_slab_smoothers_named
 # converged.
 add_test(NAME cloth_mg_slab_smoothers_np2_converge_like_tight
          COMMAND sh -c "${CLOTH_MG} -cloth_n 48 -pc_type pbjacobi -ksp_rtol 1e-10 -write_positions cloth_mg_ref_np2.txt >/dev/null && ${SUMMARY_CHECK} 'cg_its<=10 && unconverged_steps==0 && diverged_solves==0 && rms_position_diff<5e-4' -- ${MPIEXEC_LINE} -n 2 ${CLOTH_MG} -cloth_n 48 -reference_positions cloth_mg_ref_np2.txt")
-# With PCMG's products the coarse levels (but the coarsest) sweep slabs too, from each rank's diagonal
-# part of the AIJ products; the PC view names them.
-add_test(NAME cloth_mg_slab_smoothers_each_rank_with_pcmg
+# On more ranks the coarse levels (but the coarsest) sweep slabs too, from each rank's diagonal part of
+# the AIJ levels, with the distributed block products (the default) or PCMG's; the PC view names them.
+add_test(NAME cloth_mg_slab_smoothers_each_rank
          COMMAND ${EXPECT_RUN} 0 "slab Gauss-Seidel on this rank's rows of the level's AIJ operator" -- ${MPIEXEC_CMD} -n 2 ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 96 -steps 1 -progress_every 1000 -ksp_view)
+add_test(NAME cloth_mg_slab_smoothers_each_rank_with_pcmg
+         COMMAND ${EXPECT_RUN} 0 "slab Gauss-Seidel on this rank's rows of the level's AIJ operator" -- ${MPIEXEC_CMD} -n 2 ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 96 -steps 1 -progress_every 1000 -ksp_view -grid_mg_galerkin pcmg)
+# The distributed block products (each rank's share of W^T A W from its own rows, summed by COO) are
+# PCMG's MatPtAP in other rounding: the same CG iterations and energy (96 x 96, 10 steps: 4.5 and
+# -0.0777096 both, measured), on the cut of METIS as on the strips.
+add_test(NAME cloth_mg_distributed_blocks_as_matptap
+         COMMAND ${SUMMARY_SAME} "cg_its:0 energy_final:0" 1e-5 "${MPIEXEC_LINE} -n 2 ${CLOTH_MG} -cloth_n 96 -steps 10 -grid_mg_galerkin pcmg" "${MPIEXEC_LINE} -n 2 ${CLOTH_MG} -cloth_n 96 -steps 10" "${MPIEXEC_LINE} -n 2 ${CLOTH_MG} -cloth_n 96 -steps 10 -rows_partition metis")
 # ... and the V-cycle with them still gives the motion of a tight solve (96 x 96, 10 steps: 4.5 CG iterations
 # per step, rms position difference 1.1e-6 m measured).
 add_test(NAME cloth_mg_coarse_slabs_np2_converge_like_tight
@@ -66,6 +73,7 @@ add_test(NAME cloth_mg_coarse_slabs_np2_converge_like_tight
 add_test(NAME cloth_mg_coarse_slabs_fall_back_to_sor
          COMMAND ${EXPECT_RUN} 0 "keeps SOR" -- ${MPIEXEC_CMD} -n 2 ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 32 -steps 2 -progress_every 1000 -info :pc)
 set_tests_properties(cloth_mg_slab_smoothers_np2_converge_like_tight cloth_mg_slab_smoothers_each_rank_with_pcmg
+                     cloth_mg_slab_smoothers_each_rank cloth_mg_distributed_blocks_as_matptap
                      cloth_mg_coarse_slabs_np2_converge_like_tight cloth_mg_coarse_slabs_fall_back_to_sor
                      PROPERTIES LABELS "cloth;mpi" PROCESSORS 2 TIMEOUT 90)
 add_test(NAME cloth_mg_single_smoothers_need_binbcsr
@@ -78,13 +86,15 @@ add_test(NAME cloth_mg_single_level_direct
          COMMAND ${SUMMARY_CHECK} "cg_its<=1.01 && unconverged_steps==0" -- ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 8 -steps 5 -progress_every 1000)
 add_test(NAME cloth_mg_bad_coarse_nodes
          COMMAND ${EXPECT_RUN} nonzero "grid_mg_coarse_nodes must be at least 4" -- ${CLOTH} -cloth_n 8 -pc_type mg -grid_mg_coarse_nodes 2)
-add_test(NAME cloth_mg_blocks_one_rank
-         COMMAND ${EXPECT_RUN} nonzero "runs on one rank only" -- ${MPIEXEC_CMD} -n 2 ${CLOTH} -cloth_n 8 -pc_type mg -grid_mg_galerkin blocks)
-set_tests_properties(cloth_mg_converges_like_tight cloth_mg_energy_as_tight cloth_mg_single_level_direct cloth_mg_bad_coarse_nodes
+add_test(NAME cloth_mg_distributed_blocks_named
+         COMMAND ${EXPECT_RUN} 0 "coarse operators by blocks" -- ${MPIEXEC_CMD} -n 2 ${CLOTH} -cloth_n 8 -pc_type mg -steps 1)
+add_test(NAME cloth_bad_rows_partition
+         COMMAND ${EXPECT_RUN} nonzero "rows_partition" -- ${CLOTH} -cloth_n 8 -pc_type mg -steps 1 -rows_partition stripes)
+set_tests_properties(cloth_mg_converges_like_tight cloth_mg_energy_as_tight cloth_mg_single_level_direct cloth_mg_bad_coarse_nodes cloth_bad_rows_partition
                      cloth_mg_double_smoothers_converge_like_tight cloth_mg_single_smoothers_need_binbcsr
                      cloth_mg_single_smoothers_only_with_blocks cloth_mg_bad_smoother_precision
                      PROPERTIES LABELS "cloth" TIMEOUT 60)
-set_tests_properties(cloth_mg_blocks_one_rank PROPERTIES LABELS "cloth;mpi" PROCESSORS 2 TIMEOUT 60)
+set_tests_properties(cloth_mg_distributed_blocks_named PROPERTIES LABELS "cloth;mpi" PROCESSORS 2 TIMEOUT 60)
 add_test(NAME cloth_bad_dt COMMAND ${EXPECT_RUN} nonzero "time step must be positive" -- ${CLOTH} -cloth_n 4 -dt 0)
 add_test(NAME cloth_bad_n COMMAND ${EXPECT_RUN} nonzero "at least 2 x 2" -- ${CLOTH} -cloth_n 1)
 add_test(NAME cloth_bad_pins COMMAND ${EXPECT_RUN} nonzero "unknown -cloth_pins elbows" -- ${CLOTH} -cloth_n 4 -cloth_pins elbows)

@@ -23,11 +23,13 @@ PetscErrorCode BlockGalerkinRegisterEvents()
 PetscErrorCode BlockGalerkinCreate(const std::vector<PetscInt> &row, const std::vector<PetscInt> &col,
                                    bool row_major, bool mirrored, bool symmetric,
                                    const std::vector<std::vector<BlockWeight>> &weights, PetscInt n_coarse,
-                                   BlockGalerkin *g)
+                                   BlockGalerkin *g, const std::vector<char> *mirror_block)
 {
   PetscFunctionBegin;
   PetscCheck(row.size() == col.size(), PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "%zu block rows but %zu columns",
              row.size(), col.size());
+  PetscCheck(!mirror_block || mirror_block->size() == row.size(), PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+             "%zu blocks but %zu mirror flags", row.size(), mirror_block ? mirror_block->size() : 0);
   // Terms with the destination as (I, J) first; Ac's block index replaces it once the pattern is known.
   struct Pending {
     PetscInt src, I, J;
@@ -48,7 +50,7 @@ PetscErrorCode BlockGalerkinCreate(const std::vector<PetscInt> &row, const std::
         const PetscInt src = (PetscInt)k;
         pending.push_back({row_major ? ~src : src, a.coarse, b.coarse, a.w * b.w});
         cols[a.coarse].push_back(b.coarse);
-        if (mirrored && r != c) {
+        if (mirrored && r != c && (!mirror_block || (*mirror_block)[k])) {
           pending.push_back({row_major ? src : ~src, b.coarse, a.coarse, a.w * b.w});
           cols[b.coarse].push_back(a.coarse);
         }

@@ -32,10 +32,12 @@ struct BlockGalerkin {
 // symmetric: the source matrix is symmetric (mirrored, or each block listed with its transpose), so Ac is
 // too: only its blocks on and above the diagonal are summed and the others copied from them transposed
 // (about half the terms; the blocks off the diagonal are then exact transposes of each other).
+// mirror_block (optional, one flag per block): with mirrored, only the blocks flagged stand for their
+// transposes.
 PetscErrorCode BlockGalerkinCreate(const std::vector<PetscInt> &row, const std::vector<PetscInt> &col,
                                    bool row_major, bool mirrored, bool symmetric,
                                    const std::vector<std::vector<BlockWeight>> &weights, PetscInt n_coarse,
-                                   BlockGalerkin *g);
+                                   BlockGalerkin *g, const std::vector<char> *mirror_block = nullptr);
 // The source blocks of a SeqBAIJ matrix (block size 3), in its value array's order, for BlockGalerkinCreate.
 PetscErrorCode BlockGalerkinBlocksOf(Mat A, std::vector<PetscInt> *row, std::vector<PetscInt> *col);
 // Ac = W^T A W for new source values (9 per block, the layout given at creation).

@@ -170,6 +170,91 @@ PetscErrorCode UseSlabs(GridMG *mg, PetscInt level, int n, std::vector<SlabGS::E
 // The blocks of A's rows on this rank among themselves (A AIJ with 3 unknowns per node: MPIAIJ's diagonal
 // part, or SeqAIJ): where each block entry sits in the part's value array (a->gather, row-major) and the
 // slab entries; returns why the rows cannot be swept in slabs, or an empty string.
+// A coarse level with distributed block products: an AIJ matrix in the level's numbering whose COO list is
+// every rank's share Ac (SeqBAIJ, the level's physics numbering, all its nodes) entry by entry in Ac's
+// value order (column-major blocks), so that MatSetValuesCOO with Ac's values sums the shares.
+PetscErrorCode PartialProductTarget(MPI_Comm comm, Mat Ac, const GridMG::DistributedLevel &c, Mat *target)
+{
+  PetscMPIInt           rank;
+  std::vector<PetscInt> rows, cols, ci, cj;
+  Mat                   A;
+
+  PetscFunctionBegin;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCall(BlockGalerkinBlocksOf(Ac, &rows, &cols));
+  for (size_t k = 0; k < rows.size(); ++k)
+    for (int e = 0; e < 9; ++e) {
+      ci.push_back(3 * (PetscInt)c.num[rows[k]] + e % 3);
+      cj.push_back(3 * (PetscInt)c.num[cols[k]] + e / 3);
+    }
+  const PetscInt local = 3 * (c.offsets[rank + 1] - c.offsets[rank]), global = 3 * c.side * c.side;
+  PetscCall(MatCreate(comm, &A));
+  PetscCall(MatSetSizes(A, local, local, global, global));
+  PetscCall(MatSetBlockSize(A, 3));
+  PetscCall(MatSetType(A, MATAIJ));
+  PetscCall(MatSetPreallocationCOO(A, (PetscCount)ci.size(), ci.data(), cj.data()));
+  *target = A;
+  PetscFunctionReturn(0);
+}
+
+// The 3x3 blocks of this rank's rows of an AIJ level (MPIAIJ: diagonal and off-diagonal part) in the
+// level's physics numbering (rows, cols), and where each of their entries sits: d->gather (9 per block,
+// row-major) indexes the diagonal part's values, or the off-diagonal part's past d->diagonal_count.
+PetscErrorCode AijRowBlocks(Mat A, const GridMG::DistributedLevel &level, GridMG::DistributedLevel *d,
+                            std::vector<PetscInt> *rows, std::vector<PetscInt> *cols)
+{
+  Mat             Ad = A, Ao = nullptr;
+  const PetscInt *garray = nullptr, *ia, *ja;
+  PetscInt        rstart, cstart, nr;
+  PetscBool       mpi, done;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIAIJ, &mpi));
+  if (mpi) PetscCall(MatMPIAIJGetSeqAIJ(A, &Ad, &Ao, &garray));
+  PetscCall(MatGetOwnershipRange(A, &rstart, nullptr));
+  PetscCall(MatGetOwnershipRangeColumn(A, &cstart, nullptr));
+  std::vector<int> phys(level.num.size()); // solver -> physics numbering of the level's nodes
+  for (size_t k = 0; k < level.num.size(); ++k) phys[level.num[k]] = (int)k;
+  std::vector<std::pair<long, long>> keys; // (global block row * N + global block column, entry)
+  const long                         N  = (long)level.num.size();
+  PetscInt                           nd = 0;
+  for (int part = 0; part < (mpi ? 2 : 1); ++part) {
+    Mat M = part ? Ao : Ad;
+    PetscCall(MatGetRowIJ(M, 0, PETSC_FALSE, PETSC_FALSE, &nr, &ia, &ja, &done));
+    PetscCheck(done, PETSC_COMM_SELF, PETSC_ERR_SUP,
+               "grid multigrid: no row structure of a level's operator");
+    for (PetscInt i = 0; i < nr; ++i)
+      for (PetscInt k = ia[i]; k < ia[i + 1]; ++k) {
+        const PetscInt col = part ? garray[ja[k]] : cstart + ja[k];
+        keys.push_back({(long)((rstart + i) / 3) * N + col / 3, (long)(part ? nd + k : k)});
+      }
+    if (!part) nd = ia[nr];
+    PetscCall(MatRestoreRowIJ(M, 0, PETSC_FALSE, PETSC_FALSE, &nr, &ia, &ja, &done));
+  }
+  d->diagonal_count = nd;
+  std::sort(keys.begin(), keys.end());
+  d->gather.clear();
+  rows->clear();
+  cols->clear();
+  for (size_t q = 0; q < keys.size(); ++q) {
+    const long R = keys[q].first / N, C = keys[q].first % N;
+    if (q == 0 || keys[q].first != keys[q - 1].first) {
+      rows->push_back(phys[R]);
+      cols->push_back(phys[C]);
+      d->gather.insert(d->gather.end(), 9, -1);
+    }
+    // the entry's scalar row and column within the block, from its place in the part it came from
+    const long k = keys[q].second;
+    PetscCall(MatGetRowIJ(k < nd ? Ad : Ao, 0, PETSC_FALSE, PETSC_FALSE, &nr, &ia, &ja, &done));
+    const PetscInt kk = k < nd ? k : k - nd, i = std::upper_bound(ia, ia + nr + 1, kk) - ia - 1;
+    const PetscInt col = k < nd ? cstart + ja[kk] : garray[ja[kk]];
+    d->gather[d->gather.size() - 9 + 3 * ((rstart + i) % 3) + col % 3] = (PetscInt)k;
+    PetscCall(MatRestoreRowIJ(k < nd ? Ad : Ao, 0, PETSC_FALSE, PETSC_FALSE, &nr, &ia, &ja, &done));
+  }
+  d->blocks.assign(d->gather.size(), 0.0);
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode AijBlocks(Mat A, GridMG::AijSlab *a, int *nb, std::vector<SlabGS::Entry> *entries,
                          std::string *why)
 {
@@ -311,7 +396,7 @@ PetscErrorCode AijSlabView(PC pc, PetscViewer viewer)
 PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
                            const std::vector<int> &new_of_old, const std::vector<int> &row_offsets,
                            const std::vector<int> &coo_row, const std::vector<int> &coo_col,
-                           PetscBool coo_mirrored, GridMG *mg)
+                           PetscBool coo_mirrored, PetscBool offrank_full, GridMG *mg)
 {
   MPI_Comm    comm;
   PC          pc;
@@ -333,12 +418,9 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-grid_mg_coarse_nodes", &coarse_nodes, nullptr));
   PetscCheck(coarse_nodes >= 4, comm, PETSC_ERR_ARG_OUTOFRANGE,
              "-grid_mg_coarse_nodes must be at least 4 (a 2 x 2 grid), got %" PetscInt_FMT, coarse_nodes);
-  if (size > 1) galerkin = 1;
   PetscCall(PetscOptionsGetEList(nullptr, nullptr, "-grid_mg_galerkin", galerkins, 2, &galerkin, nullptr));
-  PetscCheck(size == 1 || galerkin == 1, comm, PETSC_ERR_SUP,
-             "-grid_mg_galerkin blocks runs on one rank only (%d ranks): use -grid_mg_galerkin pcmg",
-             (int)size);
   mg->own_galerkin = galerkin == 0;
+  mg->distributed  = mg->own_galerkin && size > 1;
   mg->pc           = pc;
 
   std::vector<GridLevel> levels(1);
@@ -358,8 +440,39 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
   for (PetscInt l = 0; l + 1 < nlev; ++l) {
     Mat        P;
     const auto w = Weights(levels[l], levels[l + 1], l == 0 ? fixed : std::vector<char>());
-    PetscCall(Interpolation(comm, levels[l], levels[l + 1], w, galerkin == 0, &P));
+    PetscCall(Interpolation(comm, levels[l], levels[l + 1], w, galerkin == 0 && !mg->distributed, &P));
     PetscCall(PCMGSetInterpolation(pc, nlev - 1 - l, P));
+    if (mg->distributed) {
+      // the first product from this rank's COO blocks, the others from its rows of the AIJ level above
+      // (at the first refill, when that level has its structure: GridMGRefill)
+      mg->aij_interp.push_back(P);
+      GridMG::DistributedLevel d;
+      d.num     = levels[l + 1].num;
+      d.offsets = levels[l + 1].offsets;
+      d.side    = levels[l + 1].side;
+      d.weights = w;
+      mg->dist_levels.push_back(d);
+      if (l == 0) {
+        // A block coupling two ranks stands for its transpose only where the other rank does not list
+        // that itself (offrank_full: both list their own rows' blocks whole); then this rank's share is
+        // not symmetric, so every coarse block is summed.
+        PetscMPIInt       rank;
+        std::vector<char> mirror(coo_row.size(), coo_mirrored ? 1 : 0);
+        PetscCallMPI(MPI_Comm_rank(comm, &rank));
+        if (coo_mirrored && offrank_full)
+          for (size_t k = 0; k < coo_row.size(); ++k) {
+            const int c = new_of_old[coo_col[k]];
+            if (c < row_offsets[rank] || c >= row_offsets[rank + 1]) mirror[k] = 0;
+          }
+        PetscCall(BlockGalerkinCreate(std::vector<PetscInt>(coo_row.begin(), coo_row.end()),
+                                      std::vector<PetscInt>(coo_col.begin(), coo_col.end()), true,
+                                      coo_mirrored, coo_mirrored && !offrank_full, w,
+                                      levels[1].side * levels[1].side, &mg->galerkin[0], &mirror));
+        mg->aij_levels.assign(nlev - 1, nullptr);
+        PetscCall(PartialProductTarget(comm, mg->galerkin[0].Ac, mg->dist_levels[0], &mg->aij_levels[0]));
+      }
+      continue;
+    }
     PetscCall(MatDestroy(&P)); // PCMG holds a reference
     if (!mg->own_galerkin) continue;
     // The first product reads the driver's COO blocks (physics numbering, as the weights), the others
@@ -439,7 +552,7 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
     // (AijSlabSetUp). Their SOR on MPIAIJ took more time than the fine level's slabs (cloth.opts, 2 ranks,
     // the 81 x 81 level: 22 against 16 ms per step, docs/cloth.md).
     mg->aij_slabs.assign(nlev, GridMG::AijSlab());
-    if (mg->smoother_slab && !mg->own_galerkin)
+    if (mg->smoother_slab && (!mg->own_galerkin || mg->distributed))
       for (PetscInt l = 1; l + 1 < nlev; ++l) {
         mg->aij_slabs[l].mg    = mg;
         mg->aij_slabs[l].level = l;
@@ -464,7 +577,7 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
                                    nullptr));
     // PCMG's own products (-grid_mg_galerkin pcmg, more ranks) would be taken from the copies: there the
     // smoothers stay on the operators (the driver's set-up line says which)
-    mg->single_smoothers = precision == 1 && mg->own_galerkin;
+    mg->single_smoothers = precision == 1 && mg->own_galerkin && !mg->distributed;
     mg->smoother_mats.assign(nlev, nullptr);
   }
   PetscCall(KSPSetFromOptions(ksp)); // the new levels' smoothers and coarse solve take their options
@@ -523,6 +636,56 @@ PetscErrorCode GridMGRefill(GridMG *mg, const PetscScalar *coo_values)
   if (mg->smoother_slab && fine > 0 && mg->slab_used[fine] == GridMG::kSlab)
     PetscCall(SlabGSRefill(&mg->slabs[fine], coo_values));
   if (!mg->own_galerkin) PetscFunctionReturn(0); // PCMG recomputes its products at its set-up
+  if (mg->distributed && mg->aij_levels.empty()) PetscFunctionReturn(0); // a lone level is solved directly
+  if (mg->distributed) {
+    // this rank's share of the first product, summed into the AIJ level by COO (the other ranks' shares
+    // of its rows come from them); the coarser levels by MatPtAP
+    PetscScalar *a;
+    PetscCall(BlockGalerkinRefill(&mg->galerkin[0], coo_values));
+    PetscCall(MatSeqBAIJGetArray(mg->galerkin[0].Ac, &a));
+    PetscCall(MatSetValuesCOO(mg->aij_levels[0], a, INSERT_VALUES));
+    PetscCall(MatSeqBAIJRestoreArray(mg->galerkin[0].Ac, &a));
+    for (size_t l = 1; l < mg->aij_levels.size(); ++l) {
+      GridMG::DistributedLevel &d = mg->dist_levels[l - 1]; // the source level's gather (its rows)
+      if (!mg->aij_levels[l]) {                             // first refill: the level's pattern
+        std::vector<PetscInt> rows, cols;
+        MPI_Comm              comm;
+        PetscCall(PetscObjectGetComm((PetscObject)mg->pc, &comm));
+        PetscCall(AijRowBlocks(mg->aij_levels[l - 1], d, &d, &rows, &cols));
+        const GridMG::DistributedLevel &c = mg->dist_levels[l];
+        PetscCall(
+          BlockGalerkinCreate(rows, cols, true, false, false, c.weights, c.side * c.side, &mg->galerkin[l]));
+        PetscCall(PartialProductTarget(comm, mg->galerkin[l].Ac, c, &mg->aij_levels[l]));
+      }
+      Mat                Ad = mg->aij_levels[l - 1], Ao = nullptr;
+      const PetscScalar *va, *vo                        = nullptr;
+      PetscBool          mpi;
+      PetscCall(PetscObjectTypeCompare((PetscObject)Ad, MATMPIAIJ, &mpi));
+      if (mpi) PetscCall(MatMPIAIJGetSeqAIJ(mg->aij_levels[l - 1], &Ad, &Ao, nullptr));
+      PetscCall(MatSeqAIJGetArrayRead(Ad, &va));
+      if (Ao) PetscCall(MatSeqAIJGetArrayRead(Ao, &vo));
+      for (size_t q = 0; q < d.gather.size(); ++q) {
+        const PetscInt g = d.gather[q];
+        d.blocks[q]      = g < 0 ? 0.0 : (g < d.diagonal_count ? va[g] : vo[g - d.diagonal_count]);
+      }
+      PetscCall(MatSeqAIJRestoreArrayRead(Ad, &va));
+      if (Ao) PetscCall(MatSeqAIJRestoreArrayRead(Ao, &vo));
+      PetscCall(BlockGalerkinRefill(&mg->galerkin[l], d.blocks.data()));
+      PetscCall(MatSeqBAIJGetArray(mg->galerkin[l].Ac, &a));
+      PetscCall(MatSetValuesCOO(mg->aij_levels[l], a, INSERT_VALUES));
+      PetscCall(MatSeqBAIJRestoreArray(mg->galerkin[l].Ac, &a));
+    }
+    for (size_t l = 0; l < mg->aij_levels.size(); ++l) {
+      const PetscInt level = (PetscInt)(mg->aij_levels.size() - 1 - l);
+      PetscCall(PCMGSetOperators(mg->pc, level, mg->aij_levels[l], mg->aij_levels[l]));
+      if (level > 0) { // PCMG sets the pre-smoother's; the post-smoother is another KSP
+        KSP sides[2];
+        PetscCall(LevelSmoothers(mg->pc, level, sides));
+        PetscCall(KSPSetOperators(sides[1], mg->aij_levels[l], mg->aij_levels[l]));
+      }
+    }
+    PetscFunctionReturn(0);
+  }
   for (size_t l = 0; l < mg->galerkin.size(); ++l) {
     const PetscScalar *src = coo_values;
     PetscScalar       *a   = nullptr;
@@ -563,6 +726,11 @@ PetscErrorCode GridMGDestroy(GridMG *mg)
   for (BlockGalerkin &g : mg->galerkin) PetscCall(BlockGalerkinDestroy(&g));
   for (Mat &m : mg->smoother_mats) PetscCall(MatDestroy(&m));
   for (GridMG::AijSlab &a : mg->aij_slabs) PetscCall(PCDestroy(&a.sor));
+  for (Mat &m : mg->aij_levels) PetscCall(MatDestroy(&m));
+  for (Mat &m : mg->aij_interp) PetscCall(MatDestroy(&m));
+  mg->aij_levels.clear();
+  mg->aij_interp.clear();
+  mg->dist_levels.clear();
   mg->aij_slabs.clear();
   mg->smoother_mats.clear();
   mg->galerkin.clear();

@@ -37,8 +37,23 @@
 struct GridMG {
   std::vector<PetscInt> sides;                // nodes per side, finest first
   bool                  own_galerkin = false; // coarse operators from block_galerkin.h, else PCMG's MatPtAP
-  std::vector<BlockGalerkin> galerkin;        // level l + 1 from level l
-  PC                         pc = nullptr;
+  // own_galerkin on more ranks: each rank's share of the first product from its own blocks (galerkin[0],
+  // all the level's nodes), summed into the AIJ aij_levels[0] by COO; the coarser levels by MatPtAP
+  bool             distributed = false;
+  std::vector<Mat> aij_levels; // finest coarse level first
+  std::vector<Mat> aij_interp; // AIJ interpolation to level l from level l + 1 (ours, finest first)
+  struct DistributedLevel {    // coarse level l + 1 of the distributed products (dist_levels[l])
+    std::vector<int>                      num, offsets; // its nodes' solver numbers, the ranks' ranges
+    PetscInt                              side = 0;
+    std::vector<std::vector<BlockWeight>> weights; // the interpolation to level l from it (physics numbering)
+    // as the source of the next product: this rank's blocks of the level, gathered from the AIJ values
+    std::vector<PetscInt>    gather;
+    PetscInt                 diagonal_count = 0;
+    std::vector<PetscScalar> blocks;
+  };
+  std::vector<DistributedLevel> dist_levels;
+  std::vector<BlockGalerkin>    galerkin; // level l + 1 from level l
+  PC                            pc = nullptr;
   // -grid_mg_smoother_precision single: every level smooths on a single-precision binbcsr copy of its
   // operator (upper triangle on the coarse levels) and takes its residual there; the outer CG keeps the
   // operators
@@ -74,11 +89,12 @@ struct GridMG {
 
 // ksp's PC must be PCMG (-pc_type mg). fixed: n * n flags (row-major, physics numbering). coo_row, coo_col:
 // the driver's COO list of 3x3 blocks (physics numbering; coo_mirrored: blocks off the diagonal stand for
-// their transposes too), whose values GridMGRefill takes.
+// their transposes too, but with offrank_full not those coupling two ranks: each rank lists its own rows'
+// blocks toward other ranks whole, ReplicatedSolverStoresBlock), whose values GridMGRefill takes.
 PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
                            const std::vector<int> &new_of_old, const std::vector<int> &row_offsets,
                            const std::vector<int> &coo_row, const std::vector<int> &coo_col,
-                           PetscBool coo_mirrored, GridMG *mg);
+                           PetscBool coo_mirrored, PetscBool offrank_full, GridMG *mg);
 // The coarse operators for new fine values (9 per COO block, row-major), after the fine matrix's refill.
 PetscErrorCode GridMGRefill(GridMG *mg, const PetscScalar *coo_values);
 PetscErrorCode GridMGDestroy(GridMG *mg);
