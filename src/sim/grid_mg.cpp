@@ -1,9 +1,11 @@
 #include "sim/grid_mg.h"
+#include "sim/grid_mg_aij.h"
 #include "sim/smoother_copy.h"
 
 #include <petscbinbcsr.h>
 
 #include <algorithm>
+#include <unordered_map>
 
 namespace {
 
@@ -142,12 +144,19 @@ PetscErrorCode LevelSmoothers(PC pc, PetscInt level, KSP sides[2])
 // Level `level`'s smoothers become slab Gauss-Seidel on the blocks `entries` (this rank's n block rows)
 // when the level's couplings allow it (slab_gs.h) on every rank; otherwise they stay SOR on all of them
 // (a level's smoother is one collective object: the ranks must agree), and -info says why.
+// halo (a rank's rows of a distributed level, with ghosts: the rows they couple to on other ranks): the
+// level's couplings toward other ranks, so that the sweeps run from the smoother's guess (SlabGSSetHalo).
 PetscErrorCode UseSlabs(GridMG *mg, PetscInt level, int n, std::vector<SlabGS::Entry> entries,
-                        bool column_major, PetscBool whole)
+                        bool column_major, PetscBool whole, std::vector<SlabGS::HaloEntry> *halo = nullptr,
+                        std::vector<PetscInt> *ghosts = nullptr)
 {
   PetscFunctionBegin;
-  const std::string why     = SlabGSBuild(n, std::move(entries), column_major, &mg->slabs[level]);
-  int               here_ok = why.empty(), all_ok;
+  const std::string why = SlabGSBuild(n, std::move(entries), column_major, &mg->slabs[level]);
+  if (why.empty() && halo) {
+    SlabGSSetHalo(&mg->slabs[level], std::move(*halo), std::move(*ghosts));
+    whole = PETSC_TRUE;
+  }
+  int here_ok = why.empty(), all_ok;
   PetscCallMPI(MPI_Allreduce(&here_ok, &all_ok, 1, MPI_INT, MPI_LAND, PetscObjectComm((PetscObject)mg->pc)));
   if (!all_ok) {
     mg->slab_used[level] = GridMG::kSor;
@@ -164,230 +173,6 @@ PetscErrorCode UseSlabs(GridMG *mg, PetscInt level, int n, std::vector<SlabGS::E
     PetscCall(SlabGSSetPC(spc, &mg->slabs[level], whole));
   }
   mg->slab_used[level] = GridMG::kSlab;
-  PetscFunctionReturn(0);
-}
-
-// The blocks of A's rows on this rank among themselves (A AIJ with 3 unknowns per node: MPIAIJ's diagonal
-// part, or SeqAIJ): where each block entry sits in the part's value array (a->gather, row-major) and the
-// slab entries; returns why the rows cannot be swept in slabs, or an empty string.
-// A coarse level with distributed block products: an AIJ matrix in the level's numbering whose COO list is
-// every rank's share Ac (SeqBAIJ, the level's physics numbering, all its nodes) entry by entry in Ac's
-// value order (column-major blocks), so that MatSetValuesCOO with Ac's values sums the shares.
-PetscErrorCode PartialProductTarget(MPI_Comm comm, Mat Ac, const GridMG::DistributedLevel &c, Mat *target)
-{
-  PetscMPIInt           rank;
-  std::vector<PetscInt> rows, cols, ci, cj;
-  Mat                   A;
-
-  PetscFunctionBegin;
-  PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  PetscCall(BlockGalerkinBlocksOf(Ac, &rows, &cols));
-  for (size_t k = 0; k < rows.size(); ++k)
-    for (int e = 0; e < 9; ++e) {
-      ci.push_back(3 * (PetscInt)c.num[rows[k]] + e % 3);
-      cj.push_back(3 * (PetscInt)c.num[cols[k]] + e / 3);
-    }
-  const PetscInt local = 3 * (c.offsets[rank + 1] - c.offsets[rank]), global = 3 * c.side * c.side;
-  PetscCall(MatCreate(comm, &A));
-  PetscCall(MatSetSizes(A, local, local, global, global));
-  PetscCall(MatSetBlockSize(A, 3));
-  PetscCall(MatSetType(A, MATAIJ));
-  PetscCall(MatSetPreallocationCOO(A, (PetscCount)ci.size(), ci.data(), cj.data()));
-  *target = A;
-  PetscFunctionReturn(0);
-}
-
-// The 3x3 blocks of this rank's rows of an AIJ level (MPIAIJ: diagonal and off-diagonal part) in the
-// level's physics numbering (rows, cols), and where each of their entries sits: d->gather (9 per block,
-// row-major) indexes the diagonal part's values, or the off-diagonal part's past d->diagonal_count.
-PetscErrorCode AijRowBlocks(Mat A, const GridMG::DistributedLevel &level, GridMG::DistributedLevel *d,
-                            std::vector<PetscInt> *rows, std::vector<PetscInt> *cols)
-{
-  Mat             Ad = A, Ao = nullptr;
-  const PetscInt *garray = nullptr, *ia, *ja;
-  PetscInt        rstart, cstart, nr;
-  PetscBool       mpi, done;
-
-  PetscFunctionBegin;
-  PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIAIJ, &mpi));
-  if (mpi) PetscCall(MatMPIAIJGetSeqAIJ(A, &Ad, &Ao, &garray));
-  PetscCall(MatGetOwnershipRange(A, &rstart, nullptr));
-  PetscCall(MatGetOwnershipRangeColumn(A, &cstart, nullptr));
-  std::vector<int> phys(level.num.size()); // solver -> physics numbering of the level's nodes
-  for (size_t k = 0; k < level.num.size(); ++k) phys[level.num[k]] = (int)k;
-  std::vector<std::pair<long, long>> keys; // (global block row * N + global block column, entry)
-  const long                         N  = (long)level.num.size();
-  PetscInt                           nd = 0;
-  for (int part = 0; part < (mpi ? 2 : 1); ++part) {
-    Mat M = part ? Ao : Ad;
-    PetscCall(MatGetRowIJ(M, 0, PETSC_FALSE, PETSC_FALSE, &nr, &ia, &ja, &done));
-    PetscCheck(done, PETSC_COMM_SELF, PETSC_ERR_SUP,
-               "grid multigrid: no row structure of a level's operator");
-    for (PetscInt i = 0; i < nr; ++i)
-      for (PetscInt k = ia[i]; k < ia[i + 1]; ++k) {
-        const PetscInt col = part ? garray[ja[k]] : cstart + ja[k];
-        keys.push_back({(long)((rstart + i) / 3) * N + col / 3, (long)(part ? nd + k : k)});
-      }
-    if (!part) nd = ia[nr];
-    PetscCall(MatRestoreRowIJ(M, 0, PETSC_FALSE, PETSC_FALSE, &nr, &ia, &ja, &done));
-  }
-  d->diagonal_count = nd;
-  std::sort(keys.begin(), keys.end());
-  d->gather.clear();
-  rows->clear();
-  cols->clear();
-  for (size_t q = 0; q < keys.size(); ++q) {
-    const long R = keys[q].first / N, C = keys[q].first % N;
-    if (q == 0 || keys[q].first != keys[q - 1].first) {
-      rows->push_back(phys[R]);
-      cols->push_back(phys[C]);
-      d->gather.insert(d->gather.end(), 9, -1);
-    }
-    // the entry's scalar row and column within the block, from its place in the part it came from
-    const long k = keys[q].second;
-    PetscCall(MatGetRowIJ(k < nd ? Ad : Ao, 0, PETSC_FALSE, PETSC_FALSE, &nr, &ia, &ja, &done));
-    const PetscInt kk = k < nd ? k : k - nd, i = std::upper_bound(ia, ia + nr + 1, kk) - ia - 1;
-    const PetscInt col = k < nd ? cstart + ja[kk] : garray[ja[kk]];
-    d->gather[d->gather.size() - 9 + 3 * ((rstart + i) % 3) + col % 3] = (PetscInt)k;
-    PetscCall(MatRestoreRowIJ(k < nd ? Ad : Ao, 0, PETSC_FALSE, PETSC_FALSE, &nr, &ia, &ja, &done));
-  }
-  d->blocks.assign(d->gather.size(), 0.0);
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode AijBlocks(Mat A, GridMG::AijSlab *a, int *nb, std::vector<SlabGS::Entry> *entries,
-                         std::string *why)
-{
-  PetscBool       mpi, seq, done;
-  Mat             Ad = A;
-  PetscInt        nr;
-  const PetscInt *ia, *ja;
-
-  PetscFunctionBegin;
-  PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIAIJ, &mpi));
-  PetscCall(PetscObjectTypeCompare((PetscObject)A, MATSEQAIJ, &seq));
-  if (!mpi && !seq) {
-    *why = "the level's operator is not AIJ";
-    PetscFunctionReturn(0);
-  }
-  if (mpi) PetscCall(MatMPIAIJGetSeqAIJ(A, &Ad, nullptr, nullptr));
-  PetscCall(MatGetRowIJ(Ad, 0, PETSC_FALSE, PETSC_FALSE, &nr, &ia, &ja, &done));
-  PetscCheck(done, PETSC_COMM_SELF, PETSC_ERR_SUP,
-             "grid multigrid: no row structure of the level's operator");
-  if (nr % 3) {
-    *why = "the level's rows are not in nodes of 3";
-  } else {
-    *nb = (int)(nr / 3);
-    std::vector<std::pair<long, long>> keys; // (block row * nb + block column, entry index)
-    for (PetscInt i = 0; i < nr; ++i)
-      for (PetscInt k = ia[i]; k < ia[i + 1]; ++k) keys.push_back({(long)(i / 3) * *nb + ja[k] / 3, (long)k});
-    std::sort(keys.begin(), keys.end());
-    a->gather.clear();
-    entries->clear();
-    for (size_t q = 0; q < keys.size(); ++q) {
-      if (q == 0 || keys[q].first != keys[q - 1].first) {
-        entries->push_back(
-          {(int)(keys[q].first / *nb), (int)(keys[q].first % *nb), (long)entries->size(), false});
-        a->gather.insert(a->gather.end(), 9, -1);
-      }
-      const long     k = keys[q].second;
-      const PetscInt i = std::upper_bound(ia, ia + nr + 1, (PetscInt)k) - ia - 1; // k's row
-      a->gather[a->gather.size() - 9 + 3 * (i % 3) + ja[k] % 3] = (PetscInt)k;
-    }
-    a->blocks.assign(a->gather.size(), 0.0);
-  }
-  PetscCall(MatRestoreRowIJ(Ad, 0, PETSC_FALSE, PETSC_FALSE, &nr, &ia, &ja, &done));
-  PetscFunctionReturn(0);
-}
-
-// The PCSHELL set-up of a coarse level's smoother with PCMG's products: at the first, the ranks decide
-// together on slabs or SOR; then the slabs take the operator's new values (once per new set: the pre- and
-// post-smoother share them).
-PetscErrorCode AijSlabSetUp(PC pc)
-{
-  GridMG::AijSlab *a;
-  Mat              A;
-  SlabGS::Held     now;
-
-  PetscFunctionBegin;
-  PetscCall(PCShellGetContext(pc, &a));
-  GridMG *mg = a->mg;
-  PetscCall(PCGetOperators(pc, nullptr, &A));
-  if (mg->slab_used[a->level] == GridMG::kUndecided) {
-    std::string                why;
-    std::vector<SlabGS::Entry> entries;
-    int                        nb = 0;
-    PetscCall(AijBlocks(A, a, &nb, &entries, &why));
-    if (why.empty()) why = SlabGSBuild(nb, std::move(entries), false, &mg->slabs[a->level]);
-    int here_ok = why.empty(), all_ok;
-    PetscCallMPI(MPI_Allreduce(&here_ok, &all_ok, 1, MPI_INT, MPI_LAND, PetscObjectComm((PetscObject)pc)));
-    mg->slab_used[a->level] = all_ok ? GridMG::kSlab : GridMG::kSor;
-    if (!all_ok) {
-      mg->slabs[a->level] = SlabGS();
-      PetscCall(PetscInfo(mg->pc, "grid multigrid level %d keeps SOR: %s\n", (int)a->level,
-                          here_ok ? "another rank's rows cannot be swept in slabs" : why.c_str()));
-    }
-  }
-  if (mg->slab_used[a->level] == GridMG::kSor) {
-    if (!a->sor) {
-      PetscCall(PCCreate(PetscObjectComm((PetscObject)pc), &a->sor));
-      PetscCall(PCSetType(a->sor, PCSOR));
-      PetscCall(PCSORSetSymmetric(a->sor, SOR_LOCAL_SYMMETRIC_SWEEP));
-    }
-    PetscCall(PCSetOperators(a->sor, A, A));
-    PetscCall(PCSetUp(a->sor));
-    PetscFunctionReturn(0);
-  }
-  PetscCall(SlabGSHeldOf((PetscObject)A, &now));
-  if (now.id == a->held.id && now.state == a->held.state) PetscFunctionReturn(0);
-  Mat                Ad = A;
-  PetscBool          mpi;
-  const PetscScalar *v;
-  PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIAIJ, &mpi));
-  if (mpi) PetscCall(MatMPIAIJGetSeqAIJ(A, &Ad, nullptr, nullptr));
-  PetscCall(MatSeqAIJGetArrayRead(Ad, &v));
-  for (size_t q = 0; q < a->gather.size(); ++q) a->blocks[q] = a->gather[q] < 0 ? 0.0 : v[a->gather[q]];
-  PetscCall(MatSeqAIJRestoreArrayRead(Ad, &v));
-  PetscCall(SlabGSRefill(&mg->slabs[a->level], a->blocks.data()));
-  a->held = now;
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode AijSlabApply(PC pc, Vec b, Vec x)
-{
-  GridMG::AijSlab *a;
-
-  PetscFunctionBegin;
-  PetscCall(PCShellGetContext(pc, &a));
-  if (a->mg->slab_used[a->level] == GridMG::kSlab) PetscCall(SlabGSApplySweep(&a->mg->slabs[a->level], b, x));
-  else PetscCall(PCApply(a->sor, b, x));
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode AijSlabView(PC pc, PetscViewer viewer)
-{
-  GridMG::AijSlab *a;
-  PetscBool        ascii;
-
-  PetscFunctionBegin;
-  PetscCall(PCShellGetContext(pc, &a));
-  PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &ascii));
-  if (!ascii) PetscFunctionReturn(0);
-  switch (a->mg->slab_used[a->level]) {
-  case GridMG::kSlab:
-    PetscCall(PetscViewerASCIIPrintf(viewer,
-                                     "slab Gauss-Seidel on this rank's rows of the level's AIJ operator "
-                                     "(symmetric sweep from zero, 8 rows side by side)\n"));
-    break;
-  case GridMG::kSor:
-    PetscCall(PetscViewerASCIIPrintf(viewer,
-                                     "SOR, local symmetric sweeps (the level's rows cannot all be swept "
-                                     "in slabs)\n"));
-    break;
-  default:
-    PetscCall(
-      PetscViewerASCIIPrintf(viewer, "slab Gauss-Seidel or SOR, decided at the level's first set-up\n"));
-  }
   PetscFunctionReturn(0);
 }
 
@@ -469,7 +254,7 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
                                       coo_mirrored, coo_mirrored && !offrank_full, w,
                                       levels[1].side * levels[1].side, &mg->galerkin[0], &mirror));
         mg->aij_levels.assign(nlev - 1, nullptr);
-        PetscCall(PartialProductTarget(comm, mg->galerkin[0].Ac, mg->dist_levels[0], &mg->aij_levels[0]));
+        PetscCall(GridMGShareTarget(comm, mg->galerkin[0].Ac, mg->dist_levels[0], &mg->aij_levels[0]));
       }
       continue;
     }
@@ -529,27 +314,39 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
     mg->slabs.assign(nlev, SlabGS());
     mg->slab_used.assign(nlev, GridMG::kUndecided);
     // The fine level's blocks: the driver's COO list (this rank's rows), in the solver's numbering local
-    // to the rank. With PCMG's products (more ranks) only the fine level sweeps slabs, each rank its own
-    // rows with their couplings to other ranks left out (block Jacobi between the ranks, as SOR's local
-    // sweeps do), and its residual stays PCMG's on the whole operator.
+    // to the rank. On more ranks each rank sweeps its own rows (block Jacobi between the ranks, as SOR's
+    // local sweeps do): where each rank lists its rows' blocks toward the others itself (not mirrored
+    // from the other side) they form the halo, and the sweeps run from the guess with the other ranks'
+    // part on the right-hand side; else the couplings are left out and the smoother sweeps from zero
+    // on the residual Richardson forms with the whole operator (a product more per smoothing).
     if (mg->smoother_slab && nlev > 1) {
       PetscMPIInt rank;
       PetscCallMPI(MPI_Comm_rank(comm, &rank));
-      const int                  begin = row_offsets[rank], local = row_offsets[rank + 1] - begin;
-      std::vector<SlabGS::Entry> entries;
+      const int                      begin = row_offsets[rank], local = row_offsets[rank + 1] - begin;
+      const bool                     with_halo = size > 1 && (!coo_mirrored || offrank_full);
+      std::vector<SlabGS::Entry>     entries;
+      std::vector<SlabGS::HaloEntry> halo;
+      std::vector<PetscInt>          ghosts;
+      std::unordered_map<int, int>   ghost_of;
       for (size_t k = 0; k < coo_row.size(); ++k) {
         const int r = new_of_old[coo_row[k]] - begin, c = new_of_old[coo_col[k]] - begin;
         PetscCheck(r >= 0 && r < local, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
                    "grid multigrid: COO block %zu is in row %d, not one of this rank's", k, r + begin);
-        if (c < 0 || c >= local) continue;
+        if (c < 0 || c >= local) {
+          if (!with_halo) continue;
+          const auto g = ghost_of.emplace(c + begin, (int)ghosts.size());
+          if (g.second) ghosts.push_back(c + begin);
+          halo.push_back({r, g.first->second, (long)k, false});
+          continue;
+        }
         entries.push_back({r, c, (long)k, false});
         if (coo_mirrored && r != c) entries.push_back({c, r, (long)k, true});
       }
-      PetscCall(
-        UseSlabs(mg, nlev - 1, local, std::move(entries), false, size == 1 ? PETSC_TRUE : PETSC_FALSE));
+      PetscCall(UseSlabs(mg, nlev - 1, local, std::move(entries), false, size == 1 ? PETSC_TRUE : PETSC_FALSE,
+                         with_halo ? &halo : nullptr, with_halo ? &ghosts : nullptr));
     }
     // The coarse levels with PCMG's products: their operators come at PCMG's set-up, so do their slabs
-    // (AijSlabSetUp). Their SOR on MPIAIJ took more time than the fine level's slabs (cloth.opts, 2 ranks,
+    // (grid_mg_aij.h). Their SOR on MPIAIJ took more time than the fine level's slabs (cloth.opts, 2 ranks,
     // the 81 x 81 level: 22 against 16 ms per step, docs/cloth.md).
     mg->aij_slabs.assign(nlev, GridMG::AijSlab());
     if (mg->smoother_slab && (!mg->own_galerkin || mg->distributed))
@@ -561,12 +358,7 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
         for (KSP smoother : sides) {
           PC spc;
           PetscCall(KSPGetPC(smoother, &spc));
-          PetscCall(PCSetType(spc, PCSHELL));
-          PetscCall(PCShellSetContext(spc, &mg->aij_slabs[l]));
-          PetscCall(PCShellSetSetUp(spc, AijSlabSetUp));
-          PetscCall(PCShellSetApply(spc, AijSlabApply));
-          PetscCall(PCShellSetView(spc, AijSlabView));
-          PetscCall(PCShellSetName(spc, "grid multigrid coarse-level smoother"));
+          PetscCall(GridMGAijSmoother(spc, &mg->aij_slabs[l]));
         }
       }
   }
@@ -637,55 +429,7 @@ PetscErrorCode GridMGRefill(GridMG *mg, const PetscScalar *coo_values)
     PetscCall(SlabGSRefill(&mg->slabs[fine], coo_values));
   if (!mg->own_galerkin) PetscFunctionReturn(0); // PCMG recomputes its products at its set-up
   if (mg->distributed && mg->aij_levels.empty()) PetscFunctionReturn(0); // a lone level is solved directly
-  if (mg->distributed) {
-    // this rank's share of the first product, summed into the AIJ level by COO (the other ranks' shares
-    // of its rows come from them); the coarser levels by MatPtAP
-    PetscScalar *a;
-    PetscCall(BlockGalerkinRefill(&mg->galerkin[0], coo_values));
-    PetscCall(MatSeqBAIJGetArray(mg->galerkin[0].Ac, &a));
-    PetscCall(MatSetValuesCOO(mg->aij_levels[0], a, INSERT_VALUES));
-    PetscCall(MatSeqBAIJRestoreArray(mg->galerkin[0].Ac, &a));
-    for (size_t l = 1; l < mg->aij_levels.size(); ++l) {
-      GridMG::DistributedLevel &d = mg->dist_levels[l - 1]; // the source level's gather (its rows)
-      if (!mg->aij_levels[l]) {                             // first refill: the level's pattern
-        std::vector<PetscInt> rows, cols;
-        MPI_Comm              comm;
-        PetscCall(PetscObjectGetComm((PetscObject)mg->pc, &comm));
-        PetscCall(AijRowBlocks(mg->aij_levels[l - 1], d, &d, &rows, &cols));
-        const GridMG::DistributedLevel &c = mg->dist_levels[l];
-        PetscCall(
-          BlockGalerkinCreate(rows, cols, true, false, false, c.weights, c.side * c.side, &mg->galerkin[l]));
-        PetscCall(PartialProductTarget(comm, mg->galerkin[l].Ac, c, &mg->aij_levels[l]));
-      }
-      Mat                Ad = mg->aij_levels[l - 1], Ao = nullptr;
-      const PetscScalar *va, *vo                        = nullptr;
-      PetscBool          mpi;
-      PetscCall(PetscObjectTypeCompare((PetscObject)Ad, MATMPIAIJ, &mpi));
-      if (mpi) PetscCall(MatMPIAIJGetSeqAIJ(mg->aij_levels[l - 1], &Ad, &Ao, nullptr));
-      PetscCall(MatSeqAIJGetArrayRead(Ad, &va));
-      if (Ao) PetscCall(MatSeqAIJGetArrayRead(Ao, &vo));
-      for (size_t q = 0; q < d.gather.size(); ++q) {
-        const PetscInt g = d.gather[q];
-        d.blocks[q]      = g < 0 ? 0.0 : (g < d.diagonal_count ? va[g] : vo[g - d.diagonal_count]);
-      }
-      PetscCall(MatSeqAIJRestoreArrayRead(Ad, &va));
-      if (Ao) PetscCall(MatSeqAIJRestoreArrayRead(Ao, &vo));
-      PetscCall(BlockGalerkinRefill(&mg->galerkin[l], d.blocks.data()));
-      PetscCall(MatSeqBAIJGetArray(mg->galerkin[l].Ac, &a));
-      PetscCall(MatSetValuesCOO(mg->aij_levels[l], a, INSERT_VALUES));
-      PetscCall(MatSeqBAIJRestoreArray(mg->galerkin[l].Ac, &a));
-    }
-    for (size_t l = 0; l < mg->aij_levels.size(); ++l) {
-      const PetscInt level = (PetscInt)(mg->aij_levels.size() - 1 - l);
-      PetscCall(PCMGSetOperators(mg->pc, level, mg->aij_levels[l], mg->aij_levels[l]));
-      if (level > 0) { // PCMG sets the pre-smoother's; the post-smoother is another KSP
-        KSP sides[2];
-        PetscCall(LevelSmoothers(mg->pc, level, sides));
-        PetscCall(KSPSetOperators(sides[1], mg->aij_levels[l], mg->aij_levels[l]));
-      }
-    }
-    PetscFunctionReturn(0);
-  }
+  if (mg->distributed) PetscFunctionReturn(GridMGDistributedRefill(mg, coo_values));
   for (size_t l = 0; l < mg->galerkin.size(); ++l) {
     const PetscScalar *src = coo_values;
     PetscScalar       *a   = nullptr;
@@ -726,12 +470,13 @@ PetscErrorCode GridMGDestroy(GridMG *mg)
   for (BlockGalerkin &g : mg->galerkin) PetscCall(BlockGalerkinDestroy(&g));
   for (Mat &m : mg->smoother_mats) PetscCall(MatDestroy(&m));
   for (GridMG::AijSlab &a : mg->aij_slabs) PetscCall(PCDestroy(&a.sor));
+  mg->aij_slabs.clear();
+  mg->slabs.clear(); // their halos' scatters: PETSc objects, gone before PetscFinalize
   for (Mat &m : mg->aij_levels) PetscCall(MatDestroy(&m));
   for (Mat &m : mg->aij_interp) PetscCall(MatDestroy(&m));
   mg->aij_levels.clear();
   mg->aij_interp.clear();
   mg->dist_levels.clear();
-  mg->aij_slabs.clear();
   mg->smoother_mats.clear();
   mg->galerkin.clear();
   PetscFunctionReturn(0);

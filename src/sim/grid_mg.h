@@ -78,9 +78,10 @@ struct GridMG {
   struct AijSlab {
     GridMG  *mg    = nullptr;
     PetscInt level = 0;
-    std::vector<PetscInt>
-      gather; // per block entry (9 per block, row-major): index into the AIJ values, -1: none
-    std::vector<PetscScalar> blocks;        // the gathered blocks SlabGSRefill reads
+    // this rank's blocks of the level (grid_mg_aij.h's GridMGAijBlocks) and their values for SlabGSRefill
+    std::vector<PetscInt>    gather;
+    PetscInt                 diagonal_count = 0;
+    std::vector<PetscScalar> blocks;
     SlabGS::Held             held;          // the operator (and its state) the slabs hold
     PC                       sor = nullptr; // the level keeps SOR: this PC does it
   };

@@ -109,8 +109,20 @@ std::string SlabGSBuild(int n, std::vector<SlabGS::Entry> entries, bool column_m
   g.bl.assign(g.xl.size(), 0.0);
   g.rl.assign(g.xl.size(), 0.0);
   g.ll.assign(g.xl.size(), 0.0);
-  *gs = std::move(g);
+  g.column_major = column_major_source;
+  *gs            = std::move(g);
   return "";
+}
+
+void SlabGSSetHalo(SlabGS *gs, std::vector<SlabGS::HaloEntry> halo, std::vector<PetscInt> ghost_nodes)
+{
+  std::sort(halo.begin(), halo.end(),
+            [](const SlabGS::HaloEntry &a, const SlabGS::HaloEntry &b) { return a.source < b.source; });
+  gs->distributed = true;
+  gs->halo        = std::move(halo);
+  gs->ghost_nodes = std::move(ghost_nodes);
+  gs->halo_val.assign(9 * gs->halo.size(), 0.0);
+  gs->halo_scatter.reset();
 }
 
 PetscErrorCode SlabGSRefill(SlabGS *gs, const PetscScalar *blocks)
@@ -121,6 +133,11 @@ PetscErrorCode SlabGSRefill(SlabGS *gs, const PetscScalar *blocks)
   PetscCall(SlabGSRegisterEvents());
   PetscCall(PetscLogEventBegin(SLAB_Refill, 0, 0, 0, 0));
   std::fill(gs->dl.begin(), gs->dl.end(), 0.0);
+  for (size_t k = 0; k < gs->halo.size(); ++k) { // row-major
+    const PetscScalar *b    = blocks + 9 * gs->halo[k].source;
+    const bool         flip = gs->halo[k].transposed != gs->column_major;
+    for (int e = 0; e < 9; ++e) gs->halo_val[9 * k + e] = flip ? b[3 * (e % 3) + e / 3] : b[e];
+  }
   // entry e = 3 i + j of a block, read at e or (flip) at 3 j + i
   for (const SlabGS::Copy &c : gs->copies) {
     const PetscScalar *b = blocks + 9 * c.source;
@@ -478,6 +495,51 @@ PetscErrorCode SlabGSResidualMat(Mat A, Vec b, Vec x, Vec r)
 
 namespace {
 
+// The ghosts' scatter and Vec of a distributed level, made at its first sweep from a guess.
+struct HaloScatter {
+  VecScatter scatter = nullptr;
+  Vec        ghosts  = nullptr;
+  ~HaloScatter()
+  {
+    (void)VecScatterDestroy(&scatter);
+    (void)VecDestroy(&ghosts);
+  }
+};
+
+// bl -= A_halo x_ghost (x's entries of the other ranks' rows the halo couples to)
+PetscErrorCode SubtractHalo(SlabGS *gs, Vec x)
+{
+  constexpr int      L = SlabGS::lanes;
+  const PetscScalar *xg;
+
+  PetscFunctionBegin;
+  if (!gs->halo_scatter) {
+    auto                  h = std::make_shared<HaloScatter>();
+    std::vector<PetscInt> dofs;
+    IS                    is;
+    for (PetscInt node : gs->ghost_nodes)
+      for (int i = 0; i < 3; ++i) dofs.push_back(3 * node + i);
+    PetscCall(ISCreateGeneral(PETSC_COMM_SELF, (PetscInt)dofs.size(), dofs.data(), PETSC_COPY_VALUES, &is));
+    PetscCall(VecCreateSeq(PETSC_COMM_SELF, (PetscInt)dofs.size(), &h->ghosts));
+    PetscCall(VecScatterCreate(x, is, h->ghosts, nullptr, &h->scatter));
+    PetscCall(ISDestroy(&is));
+    gs->halo_scatter = h;
+  }
+  HaloScatter *h = static_cast<HaloScatter *>(gs->halo_scatter.get());
+  PetscCall(VecScatterBegin(h->scatter, x, h->ghosts, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecScatterEnd(h->scatter, x, h->ghosts, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecGetArrayRead(h->ghosts, &xg));
+  for (size_t k = 0; k < gs->halo.size(); ++k) {
+    const double *a = gs->halo_val.data() + 9 * k, *v = xg + 3 * gs->halo[k].ghost;
+    double       *t = gs->bl.data() + LaneIndex(gs->halo[k].row, gs->steps);
+    for (int i = 0; i < 3; ++i) t[i * L] -= a[3 * i] * v[0] + a[3 * i + 1] * v[1] + a[3 * i + 2] * v[2];
+  }
+  PetscCall(VecRestoreArrayRead(h->ghosts, &xg));
+  gs->held_b = SlabGS::Held(); // bl is no longer b
+  PetscCall(PetscLogFlops(18.0 * (double)gs->halo.size()));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode SymmetricSweeps(SlabGS *gs, Vec b, Vec x, PetscInt its, PetscBool zero_guess)
 {
   PetscScalar *xa;
@@ -485,10 +547,20 @@ PetscErrorCode SymmetricSweeps(SlabGS *gs, Vec b, Vec x, PetscInt its, PetscBool
   PetscFunctionBegin;
   const PassBody body = BestBody();
   PetscCall(PetscLogEventBegin(SLAB_Smooth, 0, 0, 0, 0));
-  PetscCall(LanesOf(gs, b, &gs->held_b, gs->bl));
   if (zero_guess) std::fill(gs->xl.begin(), gs->xl.end(), 0.0);
   else PetscCall(LanesOf(gs, x, &gs->held_x, gs->xl));
   for (PetscInt k = 0; k < its; ++k) { // forward from zero: no U products (x of later rows is zero)
+    PetscCall(LanesOf(gs, b, &gs->held_b, gs->bl));
+    // from a guess on a distributed level, the other ranks' part to the right-hand side (from zero it
+    // is zero, on every rank alike: the exchange is collective); x's ghosts as they are now
+    if (gs->distributed && (k > 0 || !zero_guess)) {
+      if (k > 0) {
+        PetscCall(VecGetArrayWrite(x, &xa));
+        FromLanes(*gs, gs->xl, xa);
+        PetscCall(VecRestoreArrayWrite(x, &xa));
+      }
+      PetscCall(SubtractHalo(gs, x));
+    }
     body(*gs, gs->bl.data(), gs->xl.data(), gs->ll.data(), nullptr,
          zero_guess && k == 0 ? kForwardZero : kForward);
     body(*gs, gs->bl.data(), gs->xl.data(), gs->ll.data(), nullptr, kBackward);
@@ -533,6 +605,14 @@ PetscErrorCode SlabGSApplySweep(SlabGS *gs, Vec b, Vec x)
   PetscFunctionBegin;
   PetscCall(SlabGSRegisterEvents());
   PetscCall(SymmetricSweeps(gs, b, x, 1, PETSC_TRUE));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode SlabGSApplySweeps(SlabGS *gs, Vec b, Vec x, PetscInt its, PetscBool zero_guess)
+{
+  PetscFunctionBegin;
+  PetscCall(SlabGSRegisterEvents());
+  PetscCall(SymmetricSweeps(gs, b, x, its, zero_guess));
   PetscFunctionReturn(0);
 }
 

@@ -20,6 +20,7 @@
 #pragma once
 #include <petscksp.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,21 @@ struct SlabGS {
     PetscObjectState state = 0;
   };
   Held held_b, held_x;
+  // A rank's rows of a distributed level (SlabGSSetHalo): their blocks toward other ranks' rows, so that
+  // a sweep from a guess moves the other ranks' part to the right-hand side, b - A_halo x_ghost (x_ghost
+  // gathered from the level's Vec), and sweeps this rank's rows: block Jacobi between the ranks, as
+  // SOR's local sweeps, with no residual product of the whole operator.
+  struct HaloEntry {
+    int  row, ghost; // this rank's block row, index into ghost_nodes
+    long source;     // source block
+    bool transposed;
+  };
+  bool                   distributed  = false;
+  bool                   column_major = false; // the source blocks' layout (SlabGSBuild)
+  std::vector<PetscInt>  ghost_nodes;          // their global block rows in the level's numbering
+  std::vector<HaloEntry> halo;
+  std::vector<double>    halo_val;     // 9 per halo entry, row-major
+  std::shared_ptr<void>  halo_scatter; // the scatter of x's ghost entries and their Vec (slab_gs.cpp)
 };
 
 // Which object obj is and its state now (PetscObjectStateGet is PETSc's private API): a Held to compare.
@@ -71,6 +87,10 @@ PetscErrorCode SlabGSHeldOf(PetscObject obj, SlabGS::Held *held);
 // matrix; the diagonal ones possibly repeated: they are summed). Returns an empty string, or why the rows
 // cannot be relaxed side by side (a coupling S or more rows away).
 std::string SlabGSBuild(int n, std::vector<SlabGS::Entry> entries, bool column_major_source, SlabGS *gs);
+
+// Makes gs a distributed level's (on every rank of it): halo, the blocks of its rows toward other ranks'
+// rows (ghost_nodes: those rows' global block numbers in the level's Vec), refilled with the others.
+void SlabGSSetHalo(SlabGS *gs, std::vector<SlabGS::HaloEntry> halo, std::vector<PetscInt> ghost_nodes);
 
 // New values: blocks of 9 (row-major, or column-major when the layout says so) indexed by the entries'
 // source. PETSC_ERR_MAT_LU_ZRPVT naming the block row for a singular diagonal block.
@@ -92,10 +112,13 @@ PetscErrorCode SlabGSResidualMat(Mat A, Vec b, Vec x, Vec r);
 
 // x = one symmetric sweep from zero with right-hand side b (the PC of SlabGSSetPC without whole).
 PetscErrorCode SlabGSApplySweep(SlabGS *gs, Vec b, Vec x);
+// its symmetric sweeps of x from x (or from zero) with right-hand side b: the PCApplyRichardson of
+// SlabGSSetPC with whole (collective on a distributed level: the ghosts' exchange).
+PetscErrorCode SlabGSApplySweeps(SlabGS *gs, Vec b, Vec x, PetscInt its, PetscBool zero_guess);
 
 // Makes pc a PCSHELL for the smoother of a PCMG level (KSPRICHARDSON, one application). whole: gs holds
-// every coupling of the operator's rows, and the sweeps run from the smoother's guess (PCApplyRichardson,
-// no residual product). Else (a rank's rows of a distributed operator, their couplings to other ranks
+// every coupling of the operator's rows (in its layout, or toward other ranks in its halo), and the sweeps
+// run from the smoother's guess (PCApplyRichardson, no residual product). Else (a rank's rows of a distributed operator, their couplings to other ranks
 // left out) the PC applies one symmetric sweep from zero to the residual KSPRICHARDSON forms with the
 // whole operator: x + M^-1 (b - A x), the same as sweeping the rank's rows from x with the other ranks'
 // part moved to the right-hand side (SOR's local sweeps). gs must outlive pc.
