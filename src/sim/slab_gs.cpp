@@ -458,6 +458,56 @@ PetscErrorCode LanesOf(SlabGS *gs, Vec v, SlabGS::Held *held, std::vector<double
 
 } // namespace
 
+namespace {
+
+// The ghosts' scatter and Vec of a distributed level, made at its first use.
+struct HaloScatter {
+  VecScatter scatter = nullptr;
+  Vec        ghosts  = nullptr;
+  ~HaloScatter()
+  {
+    (void)VecScatterDestroy(&scatter);
+    (void)VecDestroy(&ghosts);
+  }
+};
+
+// lanes -= A_halo x_ghost (x's entries of the other ranks' rows the halo couples to); lanes is gs->bl (the
+// sweeps' right-hand side, then no longer b) or gs->rl (a residual)
+PetscErrorCode SubtractHalo(SlabGS *gs, Vec x, std::vector<double> &lanes)
+{
+  constexpr int      L = SlabGS::lanes;
+  const PetscScalar *xg;
+
+  PetscFunctionBegin;
+  if (!gs->halo_scatter) {
+    auto                  h = std::make_shared<HaloScatter>();
+    std::vector<PetscInt> dofs;
+    IS                    is;
+    for (PetscInt node : gs->ghost_nodes)
+      for (int i = 0; i < 3; ++i) dofs.push_back(3 * node + i);
+    PetscCall(ISCreateGeneral(PETSC_COMM_SELF, (PetscInt)dofs.size(), dofs.data(), PETSC_COPY_VALUES, &is));
+    PetscCall(VecCreateSeq(PETSC_COMM_SELF, (PetscInt)dofs.size(), &h->ghosts));
+    PetscCall(VecScatterCreate(x, is, h->ghosts, nullptr, &h->scatter));
+    PetscCall(ISDestroy(&is));
+    gs->halo_scatter = h;
+  }
+  HaloScatter *h = static_cast<HaloScatter *>(gs->halo_scatter.get());
+  PetscCall(VecScatterBegin(h->scatter, x, h->ghosts, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecScatterEnd(h->scatter, x, h->ghosts, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecGetArrayRead(h->ghosts, &xg));
+  for (size_t k = 0; k < gs->halo.size(); ++k) {
+    const double *a = gs->halo_val.data() + 9 * k, *v = xg + 3 * gs->halo[k].ghost;
+    double       *t = lanes.data() + LaneIndex(gs->halo[k].row, gs->steps);
+    for (int i = 0; i < 3; ++i) t[i * L] -= a[3 * i] * v[0] + a[3 * i + 1] * v[1] + a[3 * i + 2] * v[2];
+  }
+  PetscCall(VecRestoreArrayRead(h->ghosts, &xg));
+  if (&lanes == &gs->bl) gs->held_b = SlabGS::Held(); // bl is no longer b
+  PetscCall(PetscLogFlops(18.0 * (double)gs->halo.size()));
+  PetscFunctionReturn(0);
+}
+
+} // namespace
+
 PetscErrorCode SlabGSAttach(Mat A, SlabGS *gs)
 {
   PetscContainer c;
@@ -485,6 +535,7 @@ PetscErrorCode SlabGSResidualMat(Mat A, Vec b, Vec x, Vec r)
   PetscCall(LanesOf(gs, b, &gs->held_b, gs->bl));
   PetscCall(LanesOf(gs, x, &gs->held_x, gs->xl));
   BestBody()(*gs, gs->bl.data(), gs->xl.data(), gs->ll.data(), gs->rl.data(), kResidual);
+  if (gs->distributed) PetscCall(SubtractHalo(gs, x, gs->rl)); // the couplings to other ranks' rows
   PetscCall(VecGetArrayWrite(r, &ra));
   FromLanes(*gs, gs->rl, ra);
   PetscCall(VecRestoreArrayWrite(r, &ra));
@@ -494,51 +545,6 @@ PetscErrorCode SlabGSResidualMat(Mat A, Vec b, Vec x, Vec r)
 }
 
 namespace {
-
-// The ghosts' scatter and Vec of a distributed level, made at its first sweep from a guess.
-struct HaloScatter {
-  VecScatter scatter = nullptr;
-  Vec        ghosts  = nullptr;
-  ~HaloScatter()
-  {
-    (void)VecScatterDestroy(&scatter);
-    (void)VecDestroy(&ghosts);
-  }
-};
-
-// bl -= A_halo x_ghost (x's entries of the other ranks' rows the halo couples to)
-PetscErrorCode SubtractHalo(SlabGS *gs, Vec x)
-{
-  constexpr int      L = SlabGS::lanes;
-  const PetscScalar *xg;
-
-  PetscFunctionBegin;
-  if (!gs->halo_scatter) {
-    auto                  h = std::make_shared<HaloScatter>();
-    std::vector<PetscInt> dofs;
-    IS                    is;
-    for (PetscInt node : gs->ghost_nodes)
-      for (int i = 0; i < 3; ++i) dofs.push_back(3 * node + i);
-    PetscCall(ISCreateGeneral(PETSC_COMM_SELF, (PetscInt)dofs.size(), dofs.data(), PETSC_COPY_VALUES, &is));
-    PetscCall(VecCreateSeq(PETSC_COMM_SELF, (PetscInt)dofs.size(), &h->ghosts));
-    PetscCall(VecScatterCreate(x, is, h->ghosts, nullptr, &h->scatter));
-    PetscCall(ISDestroy(&is));
-    gs->halo_scatter = h;
-  }
-  HaloScatter *h = static_cast<HaloScatter *>(gs->halo_scatter.get());
-  PetscCall(VecScatterBegin(h->scatter, x, h->ghosts, INSERT_VALUES, SCATTER_FORWARD));
-  PetscCall(VecScatterEnd(h->scatter, x, h->ghosts, INSERT_VALUES, SCATTER_FORWARD));
-  PetscCall(VecGetArrayRead(h->ghosts, &xg));
-  for (size_t k = 0; k < gs->halo.size(); ++k) {
-    const double *a = gs->halo_val.data() + 9 * k, *v = xg + 3 * gs->halo[k].ghost;
-    double       *t = gs->bl.data() + LaneIndex(gs->halo[k].row, gs->steps);
-    for (int i = 0; i < 3; ++i) t[i * L] -= a[3 * i] * v[0] + a[3 * i + 1] * v[1] + a[3 * i + 2] * v[2];
-  }
-  PetscCall(VecRestoreArrayRead(h->ghosts, &xg));
-  gs->held_b = SlabGS::Held(); // bl is no longer b
-  PetscCall(PetscLogFlops(18.0 * (double)gs->halo.size()));
-  PetscFunctionReturn(0);
-}
 
 PetscErrorCode SymmetricSweeps(SlabGS *gs, Vec b, Vec x, PetscInt its, PetscBool zero_guess)
 {
@@ -559,7 +565,7 @@ PetscErrorCode SymmetricSweeps(SlabGS *gs, Vec b, Vec x, PetscInt its, PetscBool
         FromLanes(*gs, gs->xl, xa);
         PetscCall(VecRestoreArrayWrite(x, &xa));
       }
-      PetscCall(SubtractHalo(gs, x));
+      PetscCall(SubtractHalo(gs, x, gs->bl));
     }
     body(*gs, gs->bl.data(), gs->xl.data(), gs->ll.data(), nullptr,
          zero_guess && k == 0 ? kForwardZero : kForward);

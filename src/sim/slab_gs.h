@@ -106,7 +106,8 @@ void SlabGSSweepBest(SlabGS &gs, const double *b, double *x, bool forward);
 // r = b - A x (row by row), in one pass over the layout as a sweep makes (best: the CPU's best body).
 void SlabGSResidual(SlabGS &gs, const double *b, const double *x, double *r, bool best);
 // The same as PCMG's residual for a level (PCMGSetResidual), A the level's operator with its SlabGS
-// attached (SlabGSAttach: composed as "SlabGS"; gs must outlive that use of A).
+// attached (SlabGSAttach: composed as "SlabGS"; gs must outlive that use of A). gs must hold every
+// coupling of its rows: a whole level, or a rank's rows with their halo (then collective: x's ghosts).
 PetscErrorCode SlabGSAttach(Mat A, SlabGS *gs);
 PetscErrorCode SlabGSResidualMat(Mat A, Vec b, Vec x, Vec r);
 
