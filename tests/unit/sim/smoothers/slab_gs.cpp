@@ -284,3 +284,99 @@ TEST_CASE("slab Gauss-Seidel as a PC and a residual follows its vectors", "[slab
   REQUIRE(PCDestroy(&pc) == 0);
   REQUIRE(MatDestroy(&A) == 0);
 }
+
+TEST_CASE("slab Gauss-Seidel on a rank's rows: the halo takes the other ranks' part", "[slab_gs][mpi]")
+{
+  // The banded matrix split into contiguous row ranges, one per rank: each rank's slabs hold its rows'
+  // blocks among themselves and, in the halo, those toward other ranks' rows. A sweep from a guess is the
+  // sequential sweep of the rank's rows with the other ranks' x fixed (block Jacobi between the ranks);
+  // from zero it ignores them; the residual is b - A x of the whole matrix. On one rank: no halo.
+  PetscMPIInt rank, size;
+  REQUIRE(MPI_Comm_rank(PETSC_COMM_WORLD, &rank) == 0);
+  REQUIRE(MPI_Comm_size(PETSC_COMM_WORLD, &size) == 0);
+  const int    n = 45 * size, reach = 2, r0 = 45 * rank, nl = 45;
+  const Banded m = make_banded(n, reach, 23u);
+  // the rank's rows as a level of their own (their blocks among them), and the halo
+  Banded local{nl, {}, {}, std::vector<std::vector<double>>(3 * nl, std::vector<double>(3 * nl))};
+  std::vector<SlabGS::HaloEntry> halo;
+  std::vector<PetscInt>          ghosts;
+  for (size_t k = 0; k < m.entries.size(); ++k) {
+    const SlabGS::Entry &e = m.entries[k];
+    if (e.row < r0 || e.row >= r0 + nl) continue;
+    if (e.col >= r0 && e.col < r0 + nl) {
+      local.entries.push_back({e.row - r0, e.col - r0, e.source, false});
+      continue;
+    }
+    int g = 0;
+    while (g < (int)ghosts.size() && ghosts[g] != e.col) ++g;
+    if (g == (int)ghosts.size()) ghosts.push_back(e.col);
+    halo.push_back({e.row - r0, g, e.source, false});
+  }
+  for (int i = 0; i < 3 * nl; ++i)
+    for (int j = 0; j < 3 * nl; ++j) local.dense[i][j] = m.dense[3 * r0 + i][3 * r0 + j];
+  SlabGS gs;
+  REQUIRE(SlabGSBuild(nl, local.entries, false, &gs).empty());
+  if (size > 1) SlabGSSetHalo(&gs, halo, ghosts);
+  REQUIRE(SlabGSRefill(&gs, m.blocks.data()) == 0);
+  CHECK(gs.distributed == (size > 1));
+  CHECK(gs.halo.size() == halo.size());
+
+  Mat A; // any operator of the level's layout: the residual takes the attached slabs
+  Vec b, x, r;
+  REQUIRE(MatCreateDense(PETSC_COMM_WORLD, 3 * nl, 3 * nl, 3 * n, 3 * n, nullptr, &A) == 0);
+  REQUIRE(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY) == 0);
+  REQUIRE(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY) == 0);
+  REQUIRE(SlabGSAttach(A, &gs) == 0);
+  REQUIRE(MatCreateVecs(A, &x, &b) == 0);
+  REQUIRE(VecDuplicate(b, &r) == 0);
+  std::vector<double> bv(3 * n), xv(3 * n);
+  for (int i = 0; i < 3 * n; ++i) bv[i] = std::sin(0.31 * i), xv[i] = std::cos(0.17 * i);
+  const auto set = [&](Vec v, const std::vector<double> &from) {
+    PetscScalar *a;
+    REQUIRE(VecGetArray(v, &a) == 0);
+    for (int i = 0; i < 3 * nl; ++i) a[i] = from[3 * r0 + i];
+    REQUIRE(VecRestoreArray(v, &a) == 0);
+  };
+  set(b, bv);
+  set(x, xv);
+
+  // the residual of the whole matrix
+  REQUIRE(SlabGSResidualMat(A, b, x, r) == 0);
+  const PetscScalar *ra;
+  REQUIRE(VecGetArrayRead(r, &ra) == 0);
+  for (int i = 0; i < 3 * nl; ++i) {
+    double ref = bv[3 * r0 + i];
+    for (int c = 0; c < 3 * n; ++c) ref -= m.dense[3 * r0 + i][c] * xv[c];
+    INFO("rank " << rank << " residual entry " << i);
+    CHECK(ra[i] == Approx(ref).epsilon(1e-12).margin(1e-12));
+  }
+  REQUIRE(VecRestoreArrayRead(r, &ra) == 0);
+
+  // a symmetric sweep from the guess: the other ranks' part on the right-hand side
+  for (PetscBool zero_guess : {PETSC_FALSE, PETSC_TRUE}) {
+    std::vector<double> bl(3 * nl), xl(3 * nl);
+    for (int i = 0; i < 3 * nl; ++i) {
+      bl[i] = bv[3 * r0 + i];
+      xl[i] = zero_guess ? 0.0 : xv[3 * r0 + i];
+      if (!zero_guess)
+        for (int c = 0; c < 3 * n; ++c)
+          if (c / 3 < r0 || c / 3 >= r0 + nl) bl[i] -= m.dense[3 * r0 + i][c] * xv[c];
+    }
+    reference_sweep(local, slab_order(nl, true), bl, xl);
+    reference_sweep(local, slab_order(nl, false), bl, xl);
+    set(x, xv);
+    REQUIRE(SlabGSApplySweeps(&gs, b, x, 1, zero_guess) == 0);
+    const PetscScalar *xa;
+    REQUIRE(VecGetArrayRead(x, &xa) == 0);
+    for (int i = 0; i < 3 * nl; ++i) {
+      INFO("rank " << rank << (zero_guess ? " from zero" : " from the guess") << ", entry " << i);
+      CHECK(xa[i] == Approx(xl[i]).epsilon(1e-12).margin(1e-13));
+    }
+    REQUIRE(VecRestoreArrayRead(x, &xa) == 0);
+  }
+  gs = SlabGS(); // its halo's scatter before the Vecs it was made for
+  REQUIRE(VecDestroy(&r) == 0);
+  REQUIRE(VecDestroy(&x) == 0);
+  REQUIRE(VecDestroy(&b) == 0);
+  REQUIRE(MatDestroy(&A) == 0);
+}
