@@ -50,6 +50,7 @@ struct GridMG {
     std::vector<PetscInt>    gather;
     PetscInt                 diagonal_count = 0;
     std::vector<PetscScalar> blocks;
+    SlabGS::Held             held; // the AIJ level (and its values) blocks holds: its slabs take them too
   };
   std::vector<DistributedLevel> dist_levels;
   std::vector<BlockGalerkin>    galerkin; // level l + 1 from level l

@@ -141,6 +141,7 @@ PetscErrorCode GridMGDistributedRefill(GridMG *mg, const PetscScalar *coo_values
       PetscCall(GridMGShareTarget(comm, mg->galerkin[l].Ac, c, &mg->aij_levels[l]));
     }
     PetscCall(GridMGAijGather(mg->aij_levels[l - 1], d.gather, d.diagonal_count, &d.blocks));
+    PetscCall(SlabGSHeldOf((PetscObject)mg->aij_levels[l - 1], &d.held));
     PetscCall(BlockGalerkinRefill(&mg->galerkin[l], d.blocks.data()));
     PetscCall(MatSeqBAIJGetArray(mg->galerkin[l].Ac, &a));
     PetscCall(MatSetValuesCOO(mg->aij_levels[l], a, INSERT_VALUES));
@@ -237,8 +238,19 @@ PetscErrorCode AijSlabSetUp(PC pc)
   }
   PetscCall(SlabGSHeldOf((PetscObject)A, &now));
   if (now.id == a->held.id && now.state == a->held.state) PetscFunctionReturn(0);
-  PetscCall(GridMGAijGather(A, a->gather, a->diagonal_count, &a->blocks));
-  PetscCall(SlabGSRefill(&mg->slabs[a->level], a->blocks.data()));
+  // the same blocks in the same order (GridMGAijBlocks of the same operator) where the distributed
+  // products just gathered them as the next product's source; else gathered here
+  const PetscScalar *blocks = nullptr;
+  const size_t       l      = mg->aij_levels.size() - 1 - (size_t)a->level; // A is aij_levels[l]?
+  if (mg->distributed && a->level < (PetscInt)mg->aij_levels.size() && l < mg->dist_levels.size() &&
+      mg->aij_levels[l] == A && mg->dist_levels[l].held.id == now.id &&
+      mg->dist_levels[l].held.state == now.state)
+    blocks = mg->dist_levels[l].blocks.data();
+  else {
+    PetscCall(GridMGAijGather(A, a->gather, a->diagonal_count, &a->blocks));
+    blocks = a->blocks.data();
+  }
+  PetscCall(SlabGSRefill(&mg->slabs[a->level], blocks));
   a->held = now;
   // the level's residual in the slabs' layout too (with the halo on more ranks): MPIAIJ's took more time
   // than the level's smoothing (cloth.opts, 2 ranks, the 81 x 81 level: 5.4 against 2.9 ms per step)
