@@ -6,24 +6,25 @@
 // Levels: every coarsening keeps every other node per side (n -> n / 2 + 1), until a level has at most
 // -grid_mg_coarse_nodes nodes (default 150; the 160 x 160 cloth gets 160, 81, 41, 21, 11). Interpolation:
 // bilinear, the same weights for each of the 3 components, one matrix per level, built once (the grid does
-// not change; MAIJ with the block Galerkin products, AIJ for PCMG's). Rows of fixed (Dirichlet) fine nodes
-// are zero: their equations hold only the mass, the smoother solves them exactly, and a coarse correction
-// must not move them. Coarse operators: Galerkin, P^T A P for every new set of values, by default from the
-// driver's COO blocks (block_galerkin.h, SeqBAIJ coarse levels, one rank), with -grid_mg_galerkin pcmg (the
-// default on more ranks) by PCMG's MatPtAP (AIJ) at its set-up. Smoothers: -grid_mg_levels_[N_]* (default one
-// symmetric Gauss-Seidel sweep), coarse solve: -grid_mg_coarse_* (default LU, redundant on more ranks);
-// GAMG's -mg_levels_* do not reach them.
-// -grid_mg_smoother slab (the default; sor: the SOR above): with the block Galerkin products each level
-// whose couplings allow it smooths with slab Gauss-Seidel (slab_gs.h), the same symmetric block
-// Gauss-Seidel sweep with 8 rows relaxed side by side, the others keep SOR; with PCMG's products (more
-// ranks) every level but the coarsest does, each rank on its own rows (block Jacobi between the ranks, as
-// SOR's local sweeps; the coarse levels' blocks from the rank's diagonal part of PCMG's AIJ products).
-// -grid_mg_smoother_precision single (with the block Galerkin products; ignored with PCMG's): the smoothers
-// sweep single-precision binbcsr copies of the level operators (the fine one duplicated, the coarse BAIJ ones
-// in upper-triangle storage) and the V-cycle's residuals are taken on them too, while interpolation, the
-// Galerkin products and the outer Krylov method stay on the operators themselves. The V-cycle only has to
-// reduce the error, so its rounding does not reach the solution; the sweeps read a half (fine) or a quarter
-// (coarse) of the bytes.
+// not change; MAIJ with the block Galerkin products on one rank, AIJ otherwise). Rows of fixed (Dirichlet)
+// fine nodes are zero: their equations hold only the mass, the smoother solves them exactly, and a coarse
+// correction must not move them. Coarse operators: Galerkin, P^T A P for every new set of values, by default
+// from the driver's COO blocks (block_galerkin.h): on one rank SeqBAIJ coarse levels, on more each rank's
+// share from its own rows summed by COO into AIJ levels (grid_mg_aij.h); with -grid_mg_galerkin pcmg by
+// PCMG's MatPtAP (AIJ) at its set-up. Smoothers: -grid_mg_levels_[N_]* (default one symmetric Gauss-Seidel
+// sweep), coarse solve: -grid_mg_coarse_* (default LU, redundant on more ranks); GAMG's -mg_levels_* do not
+// reach them.
+// -grid_mg_smoother slab (the default; sor: the SOR above): each level whose couplings allow it smooths with
+// slab Gauss-Seidel (slab_gs.h), the same symmetric block Gauss-Seidel sweep with 8 rows relaxed side by
+// side, the others keep SOR. On more ranks every level but the coarsest does, each rank on its own rows
+// (block Jacobi between the ranks, as SOR's local sweeps) with their couplings to other ranks as the slabs'
+// halo: the sweeps run from the smoother's guess and the levels' residuals are taken in the slabs' layout.
+// -grid_mg_smoother_precision single (one rank with the block Galerkin products; ignored otherwise): the
+// smoothers sweep single-precision binbcsr copies of the level operators (the fine one duplicated, the coarse
+// BAIJ ones in upper-triangle storage) and the V-cycle's residuals are taken on them too, while
+// interpolation, the Galerkin products and the outer Krylov method stay on the operators themselves. The
+// V-cycle only has to reduce the error, so its rounding does not reach the solution; the sweeps read a half
+// (fine) or a quarter (coarse) of the bytes.
 //
 // On P ranks the fine rows are those of the solver's numbering (new_of_old, rows row_offsets[r] ..
 // row_offsets[r + 1] on rank r); each coarse node belongs to the rank owning the fine node nearest to it.
@@ -61,9 +62,9 @@ struct GridMG {
   bool             single_smoothers = false;
   std::vector<Mat> smoother_mats; // per PCMG level (0 unused): the copies, made at the first refill
   // -grid_mg_smoother slab: per PCMG level (0 unused), the slab Gauss-Seidel smoother (slab_gs.h) where
-  // its couplings allow it (with PCMG's products the fine level only, this rank's rows); slab_used[l]
-  // says whether it does (decided at the set-up for the fine level, at the first refill for the coarse
-  // ones)
+  // its couplings allow it (on more ranks this rank's rows, with their halo); slab_used[l] says whether it
+  // does (decided at the set-up for the fine level, at the first refill or the smoother's first set-up
+  // for the coarse ones)
   enum SlabUse : char {
     kUndecided,
     kSlab,
@@ -72,9 +73,9 @@ struct GridMG {
   bool                 smoother_slab = false;
   std::vector<SlabGS>  slabs;
   std::vector<SlabUse> slab_used;
-  // With PCMG's products the coarse levels' operators are AIJ, made at PCMG's set-up: their smoothers
-  // are PCSHELLs whose own set-up takes the level's 3x3 blocks from this rank's diagonal part of the
-  // operator (slabs[level] then sweeps them as on the fine level: block Jacobi between the ranks), or
+  // On more ranks (and with PCMG's products) the coarse levels' operators are AIJ: their smoothers are
+  // PCSHELLs whose own set-up takes the level's 3x3 blocks from this rank's rows of the operator
+  // (slabs[level] then sweeps them as on the fine level, the blocks toward other ranks as the halo), or
   // keeps SOR where the ranks cannot all sweep slabs. One per PCMG level (0 and the fine one unused).
   struct AijSlab {
     GridMG  *mg    = nullptr;

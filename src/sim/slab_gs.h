@@ -117,10 +117,11 @@ PetscErrorCode SlabGSApplySweep(SlabGS *gs, Vec b, Vec x);
 // SlabGSSetPC with whole (collective on a distributed level: the ghosts' exchange).
 PetscErrorCode SlabGSApplySweeps(SlabGS *gs, Vec b, Vec x, PetscInt its, PetscBool zero_guess);
 
-// Makes pc a PCSHELL for the smoother of a PCMG level (KSPRICHARDSON, one application). whole: gs holds
-// every coupling of the operator's rows (in its layout, or toward other ranks in its halo), and the sweeps
-// run from the smoother's guess (PCApplyRichardson, no residual product). Else (a rank's rows of a distributed operator, their couplings to other ranks
-// left out) the PC applies one symmetric sweep from zero to the residual KSPRICHARDSON forms with the
-// whole operator: x + M^-1 (b - A x), the same as sweeping the rank's rows from x with the other ranks'
-// part moved to the right-hand side (SOR's local sweeps). gs must outlive pc.
+// Makes pc a PCSHELL for the smoother of a PCMG level (KSPRICHARDSON, one application). whole: gs holds every
+// coupling of the operator's rows (in its layout, or toward other ranks in its halo), and the sweeps run from
+// the smoother's guess (PCApplyRichardson, no residual product). Else (a rank's rows of a distributed
+// operator, their couplings to other ranks left out) the PC applies one symmetric sweep from zero to the
+// residual KSPRICHARDSON forms with the whole operator: x + M^-1 (b - A x), the same as sweeping the rank's
+// rows from x with the other ranks' part moved to the right-hand side (SOR's local sweeps). gs must outlive
+// pc.
 PetscErrorCode SlabGSSetPC(PC pc, SlabGS *gs, PetscBool whole);
