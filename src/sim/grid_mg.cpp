@@ -345,9 +345,9 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
       PetscCall(UseSlabs(mg, nlev - 1, local, std::move(entries), false, size == 1 ? PETSC_TRUE : PETSC_FALSE,
                          with_halo ? &halo : nullptr, with_halo ? &ghosts : nullptr));
     }
-    // The coarse levels with PCMG's products: their operators come at PCMG's set-up, so do their slabs
-    // (grid_mg_aij.h). Their SOR on MPIAIJ took more time than the fine level's slabs (cloth.opts, 2 ranks,
-    // the 81 x 81 level: 22 against 16 ms per step, docs/cloth.md).
+    // The AIJ coarse levels (more ranks, or PCMG's products): their operators come with the refills or at
+    // PCMG's set-up, so do their slabs (grid_mg_aij.h). Their SOR on MPIAIJ took more time than the fine
+    // level's slabs (cloth.opts, 2 ranks, the 81 x 81 level: 22 against 16 ms per step, docs/cloth.md).
     mg->aij_slabs.assign(nlev, GridMG::AijSlab());
     if (mg->smoother_slab && (!mg->own_galerkin || mg->distributed))
       for (PetscInt l = 1; l + 1 < nlev; ++l) {
@@ -428,8 +428,10 @@ PetscErrorCode GridMGRefill(GridMG *mg, const PetscScalar *coo_values)
   if (mg->smoother_slab && fine > 0 && mg->slab_used[fine] == GridMG::kSlab)
     PetscCall(SlabGSRefill(&mg->slabs[fine], coo_values));
   if (!mg->own_galerkin) PetscFunctionReturn(0); // PCMG recomputes its products at its set-up
-  if (mg->distributed && mg->aij_levels.empty()) PetscFunctionReturn(0); // a lone level is solved directly
-  if (mg->distributed) PetscFunctionReturn(GridMGDistributedRefill(mg, coo_values));
+  if (mg->distributed) {
+    if (!mg->aij_levels.empty()) PetscCall(GridMGDistributedRefill(mg, coo_values)); // else one level: LU
+    PetscFunctionReturn(0);
+  }
   for (size_t l = 0; l < mg->galerkin.size(); ++l) {
     const PetscScalar *src = coo_values;
     PetscScalar       *a   = nullptr;

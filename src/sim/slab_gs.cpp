@@ -456,10 +456,6 @@ PetscErrorCode LanesOf(SlabGS *gs, Vec v, SlabGS::Held *held, std::vector<double
   PetscFunctionReturn(0);
 }
 
-} // namespace
-
-namespace {
-
 // The ghosts' scatter and Vec of a distributed level, made at its first use.
 struct HaloScatter {
   VecScatter scatter = nullptr;
