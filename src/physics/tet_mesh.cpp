@@ -80,6 +80,51 @@ void sort_elements_by_lowest_node(TetMesh &mesh)
   mesh.elements.swap(sorted);
 }
 
+void cluster_elements(TetMesh &mesh, int group)
+{
+  const int npe = mesh.nodes_per_element(), ne = mesh.element_count(), nn = mesh.node_count();
+  if (group < 2 || ne <= group) return;
+  std::vector<std::vector<int>> of_node(nn);
+  for (int e = 0; e < ne; ++e)
+    for (int c = 0; c < npe; ++c) of_node[mesh.elements[(size_t)e * npe + c]].push_back(e);
+  std::vector<char> taken(ne, 0), in_group(nn, 0);
+  std::vector<int>  score(ne, 0), order, touched, nodes;
+  order.reserve(ne);
+  int next = 0; // the first element (in the current order) not yet taken
+  while ((int)order.size() < ne) {
+    while (taken[next]) ++next;
+    int pick = next;
+    touched.clear();
+    nodes.clear();
+    for (int k = 0; k < group && pick >= 0; ++k) {
+      taken[pick] = 1;
+      order.push_back(pick);
+      // the group's new nodes raise the score of the elements around them: the next element is the
+      // one sharing the most nodes with the group (ties: the earliest in the current order)
+      for (int c = 0; c < npe; ++c) {
+        const int n = mesh.elements[(size_t)pick * npe + c];
+        if (in_group[n]) continue;
+        in_group[n] = 1;
+        nodes.push_back(n);
+        for (int e : of_node[n])
+          if (!taken[e]) {
+            if (score[e]++ == 0) touched.push_back(e);
+          }
+      }
+      pick     = -1;
+      int best = 0;
+      for (int e : touched)
+        if (!taken[e] && (score[e] > best || (score[e] == best && e < pick))) best = score[e], pick = e;
+    }
+    for (int e : touched) score[e] = 0;
+    for (int n : nodes) in_group[n] = 0;
+  }
+  std::vector<int> sorted(mesh.elements.size());
+  for (int k = 0; k < ne; ++k)
+    std::copy_n(mesh.elements.begin() + (size_t)order[k] * npe, npe, sorted.begin() + (size_t)k * npe);
+  mesh.elements.swap(sorted);
+}
+
 void validate_mesh(const TetMesh &mesh, const std::string &what, const std::vector<long long> &element_tags)
 {
   const int n = mesh.node_count(), npe = mesh.nodes_per_element();

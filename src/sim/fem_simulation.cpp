@@ -65,6 +65,8 @@ PetscErrorCode FemSimulationCreate(MPI_Comm comm, const FemScene &scene, FemSimu
       }
       physics::renumber_nodes(mesh, r.new_of_old);
       physics::sort_elements_by_lowest_node(mesh);
+      physics::cluster_elements(mesh, physics::kElementLanes *
+                                        physics::write_group_batches(mesh.nodes_per_element()));
       std::vector<char> f(sim->fixed.size());
       for (size_t i = 0; i < f.size(); ++i) f[r.new_of_old[i]] = sim->fixed[i];
       sim->fixed        = f;

@@ -225,12 +225,12 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
   for (PetscInt l = 0; l + 1 < nlev; ++l) {
     Mat        P;
     const auto w = Weights(levels[l], levels[l + 1], l == 0 ? fixed : std::vector<char>());
-    PetscCall(Interpolation(comm, levels[l], levels[l + 1], w, galerkin == 0 && !mg->distributed, &P));
+    PetscCall(Interpolation(comm, levels[l], levels[l + 1], w, galerkin == 0, &P));
     PetscCall(PCMGSetInterpolation(pc, nlev - 1 - l, P));
+    PetscCall(MatDestroy(&P)); // PCMG holds a reference
     if (mg->distributed) {
       // the first product from this rank's COO blocks, the others from its rows of the AIJ level above
       // (at the first refill, when that level has its structure: GridMGRefill)
-      mg->aij_interp.push_back(P);
       GridMG::DistributedLevel d;
       d.num     = levels[l + 1].num;
       d.offsets = levels[l + 1].offsets;
@@ -258,7 +258,6 @@ PetscErrorCode GridMGSetUp(KSP ksp, PetscInt n, const std::vector<char> &fixed,
       }
       continue;
     }
-    PetscCall(MatDestroy(&P)); // PCMG holds a reference
     if (!mg->own_galerkin) continue;
     // The first product reads the driver's COO blocks (physics numbering, as the weights), the others
     // the level above's BAIJ values.
@@ -475,9 +474,7 @@ PetscErrorCode GridMGDestroy(GridMG *mg)
   mg->aij_slabs.clear();
   mg->slabs.clear(); // their halos' scatters: PETSc objects, gone before PetscFinalize
   for (Mat &m : mg->aij_levels) PetscCall(MatDestroy(&m));
-  for (Mat &m : mg->aij_interp) PetscCall(MatDestroy(&m));
   mg->aij_levels.clear();
-  mg->aij_interp.clear();
   mg->dist_levels.clear();
   mg->smoother_mats.clear();
   mg->galerkin.clear();

@@ -6,7 +6,7 @@
 // Levels: every coarsening keeps every other node per side (n -> n / 2 + 1), until a level has at most
 // -grid_mg_coarse_nodes nodes (default 150; the 160 x 160 cloth gets 160, 81, 41, 21, 11). Interpolation:
 // bilinear, the same weights for each of the 3 components, one matrix per level, built once (the grid does
-// not change; MAIJ with the block Galerkin products on one rank, AIJ otherwise). Rows of fixed (Dirichlet)
+// not change; MAIJ with the block Galerkin products, AIJ for PCMG's). Rows of fixed (Dirichlet)
 // fine nodes are zero: their equations hold only the mass, the smoother solves them exactly, and a coarse
 // correction must not move them. Coarse operators: Galerkin, P^T A P for every new set of values, by default
 // from the driver's COO blocks (block_galerkin.h): on one rank SeqBAIJ coarse levels, on more each rank's
@@ -42,7 +42,6 @@ struct GridMG {
   // all the level's nodes), summed into the AIJ aij_levels[0] by COO; the coarser levels by MatPtAP
   bool             distributed = false;
   std::vector<Mat> aij_levels; // finest coarse level first
-  std::vector<Mat> aij_interp; // AIJ interpolation to level l from level l + 1 (ours, finest first)
   struct DistributedLevel {    // coarse level l + 1 of the distributed products (dist_levels[l])
     std::vector<int>                      num, offsets; // its nodes' solver numbers, the ranks' ranges
     PetscInt                              side = 0;

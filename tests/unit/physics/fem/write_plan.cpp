@@ -82,3 +82,46 @@ TEST_CASE("grouped write-out: one term per element block, one first write per CO
         }
       }
 }
+
+TEST_CASE("clustered element order: the same elements, fewer block writes per write group", "[fem][batch]")
+{
+  for (int order : {1, 2}) {
+    INFO("order " << order);
+    TetMesh mesh = make_box_mesh(1.0, 0.8, 0.6, 12, 10, 8);
+    if (order == 2) mesh = promote_to_quadratic(mesh);
+    sort_elements_by_lowest_node(mesh);
+    const int              npe = mesh.nodes_per_element(), group = kElementLanes * write_group_batches(npe);
+    const std::vector<int> before = mesh.elements;
+    cluster_elements(mesh, group);
+    // a permutation of whole elements (each keeps its node order: its orientation)
+    std::vector<std::vector<int>> a, b;
+    for (size_t e = 0; e < before.size(); e += npe) {
+      a.emplace_back(before.begin() + e, before.begin() + e + npe);
+      b.emplace_back(mesh.elements.begin() + e, mesh.elements.begin() + e + npe);
+    }
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    CHECK(a == b);
+    // the write groups of the clustered order touch fewer blocks (linear_38k: 19% fewer writes)
+    const auto writes = [&](const std::vector<int> &elements) {
+      TetMesh m              = mesh;
+      m.elements             = elements;
+      const FemModel   model = make_fem_model(m, FemSettings{});
+      std::vector<int> list(model.element_count());
+      std::iota(list.begin(), list.end(), 0);
+      const BlockPattern p = make_block_pattern(model, list, std::vector<char>(m.node_count(), 0), 0,
+                                                m.node_count(), true, LowerTriangle{});
+      return p.plan.write_slots.size();
+    };
+    const size_t sorted = writes(before), clustered = writes(mesh.elements);
+    INFO("block writes: sorted " << sorted << ", clustered " << clustered);
+    CHECK(clustered < 0.97 * sorted);
+  }
+  // a group of one, or a mesh of at most one group, keeps the order
+  TetMesh                mesh   = make_box_mesh(1, 1, 1, 2, 2, 2);
+  const std::vector<int> before = mesh.elements;
+  cluster_elements(mesh, 1);
+  CHECK(mesh.elements == before);
+  cluster_elements(mesh, mesh.element_count());
+  CHECK(mesh.elements == before);
+}
