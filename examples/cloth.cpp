@@ -10,8 +10,9 @@
 // Provot; 0: off) and -cloth_strain_limit_sweeps N. Time: -dt, -steps, -cloth_exact_jacobian (drop Choi-Ko). Output:
 // a progress line every -progress_every steps, -vtk PREFIX (triangle surface per -vtk_every steps),
 // -dump_matrix FILE (first step's matrix), -write_positions / -reference_positions FILE (rms and largest
-// position difference against another run, sim/position_file.h), and a final `summary key=value ...` line; -cloth_timer cpu times
-// in process CPU time instead of wall time (a shared machine).
+// position difference against another run, sim/position_file.h), and a final `summary key=value ...` line;
+// -cloth_timer cpu times in process CPU time instead of wall time (a shared machine). More ranks:
+// -rows_partition metis|contiguous (with -pc_type mg contiguous by default: strips of the grid).
 #include "sim/run_guard.h"
 #include "sim/grid_mg.h"
 #include "sim/position_file.h"
