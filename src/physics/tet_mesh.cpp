@@ -63,6 +63,20 @@ void renumber_nodes(TetMesh &mesh, const std::vector<int> &new_of_old)
   for (int &v : mesh.elements) v = new_of_old[v];
 }
 
+namespace {
+
+// The elements in the given order (order[k]: the element that becomes element k), each node list whole.
+void reorder_elements(TetMesh &mesh, const std::vector<int> &order)
+{
+  const int        npe = mesh.nodes_per_element();
+  std::vector<int> sorted(mesh.elements.size());
+  for (size_t k = 0; k < order.size(); ++k)
+    std::copy_n(mesh.elements.begin() + static_cast<size_t>(order[k]) * npe, npe, sorted.begin() + k * npe);
+  mesh.elements.swap(sorted);
+}
+
+} // namespace
+
 void sort_elements_by_lowest_node(TetMesh &mesh)
 {
   const int        npe = mesh.nodes_per_element(), ne = mesh.element_count();
@@ -73,11 +87,7 @@ void sort_elements_by_lowest_node(TetMesh &mesh)
     order[e]  = e;
   }
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return lowest[a] < lowest[b]; });
-  std::vector<int> sorted(mesh.elements.size());
-  for (int k = 0; k < ne; ++k)
-    std::copy_n(mesh.elements.begin() + static_cast<size_t>(order[k]) * npe, npe,
-                sorted.begin() + static_cast<size_t>(k) * npe);
-  mesh.elements.swap(sorted);
+  reorder_elements(mesh, order);
 }
 
 void cluster_elements(TetMesh &mesh, int group)
@@ -119,10 +129,7 @@ void cluster_elements(TetMesh &mesh, int group)
     for (int e : touched) score[e] = 0;
     for (int n : nodes) in_group[n] = 0;
   }
-  std::vector<int> sorted(mesh.elements.size());
-  for (int k = 0; k < ne; ++k)
-    std::copy_n(mesh.elements.begin() + (size_t)order[k] * npe, npe, sorted.begin() + (size_t)k * npe);
-  mesh.elements.swap(sorted);
+  reorder_elements(mesh, order);
 }
 
 void validate_mesh(const TetMesh &mesh, const std::string &what, const std::vector<long long> &element_tags)

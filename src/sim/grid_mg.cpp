@@ -143,7 +143,7 @@ PetscErrorCode LevelSmoothers(PC pc, PetscInt level, KSP sides[2])
 
 // Level `level`'s smoothers become slab Gauss-Seidel on the blocks `entries` (this rank's n block rows)
 // when the level's couplings allow it (slab_gs.h) on every rank; otherwise they stay SOR on all of them
-// (a level's smoother is one collective object: the ranks must agree), and -info says why.
+// (GridMGAgreeOnSlabs).
 // halo (a rank's rows of a distributed level, with ghosts: the rows they couple to on other ranks): the
 // level's couplings toward other ranks, so that the sweeps run from the smoother's guess (SlabGSSetHalo).
 PetscErrorCode UseSlabs(GridMG *mg, PetscInt level, int n, std::vector<SlabGS::Entry> entries,
@@ -152,19 +152,13 @@ PetscErrorCode UseSlabs(GridMG *mg, PetscInt level, int n, std::vector<SlabGS::E
 {
   PetscFunctionBegin;
   const std::string why = SlabGSBuild(n, std::move(entries), column_major, &mg->slabs[level]);
+  GridMG::SlabUse   use;
   if (why.empty() && halo) {
     SlabGSSetHalo(&mg->slabs[level], std::move(*halo), std::move(*ghosts));
     whole = PETSC_TRUE;
   }
-  int here_ok = why.empty(), all_ok;
-  PetscCallMPI(MPI_Allreduce(&here_ok, &all_ok, 1, MPI_INT, MPI_LAND, PetscObjectComm((PetscObject)mg->pc)));
-  if (!all_ok) {
-    mg->slab_used[level] = GridMG::kSor;
-    mg->slabs[level]     = SlabGS();
-    PetscCall(PetscInfo(mg->pc, "grid multigrid level %d keeps SOR: %s\n", (int)level,
-                        here_ok ? "another rank's rows cannot be swept in slabs" : why.c_str()));
-    PetscFunctionReturn(0);
-  }
+  PetscCall(GridMGAgreeOnSlabs(mg, level, why, &use));
+  if (use != GridMG::kSlab) PetscFunctionReturn(0);
   KSP sides[2];
   PetscCall(LevelSmoothers(mg->pc, level, sides));
   for (KSP smoother : sides) {
@@ -172,7 +166,6 @@ PetscErrorCode UseSlabs(GridMG *mg, PetscInt level, int n, std::vector<SlabGS::E
     PetscCall(KSPGetPC(smoother, &spc));
     PetscCall(SlabGSSetPC(spc, &mg->slabs[level], whole));
   }
-  mg->slab_used[level] = GridMG::kSlab;
   PetscFunctionReturn(0);
 }
 

@@ -167,6 +167,22 @@ PetscErrorCode GridMGDistributedRefill(GridMG *mg, const PetscScalar *coo_values
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode GridMGAgreeOnSlabs(GridMG *mg, PetscInt level, const std::string &why, GridMG::SlabUse *use)
+{
+  int here_ok = why.empty(), all_ok;
+
+  PetscFunctionBegin;
+  PetscCallMPI(MPI_Allreduce(&here_ok, &all_ok, 1, MPI_INT, MPI_LAND, PetscObjectComm((PetscObject)mg->pc)));
+  mg->slab_used[level] = all_ok ? GridMG::kSlab : GridMG::kSor;
+  if (!all_ok) {
+    mg->slabs[level] = SlabGS();
+    PetscCall(PetscInfo(mg->pc, "grid multigrid level %d keeps SOR: %s\n", (int)level,
+                        here_ok ? "another rank's rows cannot be swept in slabs" : why.c_str()));
+  }
+  *use = mg->slab_used[level];
+  PetscFunctionReturn(0);
+}
+
 namespace {
 
 // The slabs of this rank's rows of A: the blocks among them, and (distributed) the halo toward the other
@@ -215,16 +231,10 @@ PetscErrorCode AijSlabSetUp(PC pc)
   GridMG *mg = a->mg;
   PetscCall(PCGetOperators(pc, nullptr, &A));
   if (mg->slab_used[a->level] == GridMG::kUndecided) {
-    std::string why;
+    std::string     why;
+    GridMG::SlabUse use;
     PetscCall(BuildAijSlabs(A, a, &mg->slabs[a->level], &why));
-    int here_ok = why.empty(), all_ok;
-    PetscCallMPI(MPI_Allreduce(&here_ok, &all_ok, 1, MPI_INT, MPI_LAND, PetscObjectComm((PetscObject)pc)));
-    mg->slab_used[a->level] = all_ok ? GridMG::kSlab : GridMG::kSor;
-    if (!all_ok) {
-      mg->slabs[a->level] = SlabGS();
-      PetscCall(PetscInfo(mg->pc, "grid multigrid level %d keeps SOR: %s\n", (int)a->level,
-                          here_ok ? "another rank's rows cannot be swept in slabs" : why.c_str()));
-    }
+    PetscCall(GridMGAgreeOnSlabs(mg, a->level, why, &use));
   }
   if (mg->slab_used[a->level] == GridMG::kSor) {
     if (!a->sor) {
@@ -251,11 +261,14 @@ PetscErrorCode AijSlabSetUp(PC pc)
     blocks = a->blocks.data();
   }
   PetscCall(SlabGSRefill(&mg->slabs[a->level], blocks));
-  a->held = now;
   // the level's residual in the slabs' layout too (with the halo on more ranks): MPIAIJ's took more time
-  // than the level's smoothing (cloth.opts, 2 ranks, the 81 x 81 level: 5.4 against 2.9 ms per step)
-  PetscCall(SlabGSAttach(A, &mg->slabs[a->level]));
-  PetscCall(PCMGSetResidual(mg->pc, a->level, SlabGSResidualMat, A));
+  // than the level's smoothing (cloth.opts, 2 ranks, the 81 x 81 level: 5.4 against 2.9 ms per step);
+  // once per operator, which keeps its identity from refill to refill
+  if (now.id != a->held.id) {
+    PetscCall(SlabGSAttach(A, &mg->slabs[a->level]));
+    PetscCall(PCMGSetResidual(mg->pc, a->level, SlabGSResidualMat, A));
+  }
+  a->held = now;
   PetscFunctionReturn(0);
 }
 

@@ -20,6 +20,11 @@ PetscErrorCode GridMGShareTarget(MPI_Comm comm, Mat Ac, const GridMG::Distribute
 // The distributed products for new fine values (GridMGRefill with mg->distributed).
 PetscErrorCode GridMGDistributedRefill(GridMG *mg, const PetscScalar *coo_values);
 
+// Level `level` sweeps slabs only where every rank's rows can be (why: this rank's reason they cannot, or
+// empty); else all ranks keep SOR there (a level's smoother is one collective object), mg->slabs[level]
+// is cleared and -info says why. Sets and returns mg->slab_used[level]. Collective on mg->pc.
+PetscErrorCode GridMGAgreeOnSlabs(GridMG *mg, PetscInt level, const std::string &why, GridMG::SlabUse *use);
+
 // Makes spc (a coarse level's pre- or post-smoother PC, KSPRICHARDSON) the PCSHELL that sweeps slabs of
 // this rank's rows of the level's AIJ operator, decided at its first set-up with the other ranks (SOR
 // where they cannot all sweep slabs).

@@ -456,16 +456,13 @@ PetscErrorCode SlabGSHeldOf(PetscObject obj, SlabGS::Held *held)
 
 namespace {
 
-// v's identity and state: which Vec, as it is now
-PetscErrorCode HeldOf(Vec v, SlabGS::Held *held) { return SlabGSHeldOf((PetscObject)v, held); }
-
 // lv holds v's values in the lane layout, converted unless held says lv already holds v as it is now
 PetscErrorCode LanesOf(SlabGS *gs, Vec v, SlabGS::Held *held, std::vector<double> &lv)
 {
   SlabGS::Held now;
 
   PetscFunctionBegin;
-  PetscCall(HeldOf(v, &now));
+  PetscCall(SlabGSHeldOf((PetscObject)v, &now));
   if (held->id != now.id || held->state != now.state) {
     const PetscScalar *a;
     PetscCall(VecGetArrayRead(v, &a));
@@ -590,7 +587,7 @@ PetscErrorCode SymmetricSweeps(SlabGS *gs, Vec b, Vec x, PetscInt its, PetscBool
   PetscCall(VecGetArrayWrite(x, &xa));
   FromLanes(*gs, gs->xl, xa);
   PetscCall(VecRestoreArrayWrite(x, &xa));
-  PetscCall(HeldOf(x, &gs->held_x)); // xl holds x as it is now
+  PetscCall(SlabGSHeldOf((PetscObject)x, &gs->held_x)); // xl holds x as it is now
   // per symmetric sweep: U products twice, the pushes once (each 18 flops per stored block), the solves
   PetscCall(PetscLogFlops(its * (3 * 18.0 * (double)gs->val.size() / 9 + 2 * 15.0 * gs->n)));
   PetscCall(PetscLogEventEnd(SLAB_Smooth, 0, 0, 0, 0));
@@ -621,14 +618,6 @@ PetscErrorCode Apply(PC pc, Vec b, Vec x)
 }
 
 } // namespace
-
-PetscErrorCode SlabGSApplySweep(SlabGS *gs, Vec b, Vec x)
-{
-  PetscFunctionBegin;
-  PetscCall(SlabGSRegisterEvents());
-  PetscCall(SymmetricSweeps(gs, b, x, 1, PETSC_TRUE));
-  PetscFunctionReturn(0);
-}
 
 PetscErrorCode SlabGSApplySweeps(SlabGS *gs, Vec b, Vec x, PetscInt its, PetscBool zero_guess)
 {

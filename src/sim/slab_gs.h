@@ -111,8 +111,6 @@ void SlabGSResidual(SlabGS &gs, const double *b, const double *x, double *r, boo
 PetscErrorCode SlabGSAttach(Mat A, SlabGS *gs);
 PetscErrorCode SlabGSResidualMat(Mat A, Vec b, Vec x, Vec r);
 
-// x = one symmetric sweep from zero with right-hand side b (the PC of SlabGSSetPC without whole).
-PetscErrorCode SlabGSApplySweep(SlabGS *gs, Vec b, Vec x);
 // its symmetric sweeps of x from x (or from zero) with right-hand side b: the PCApplyRichardson of
 // SlabGSSetPC with whole (collective on a distributed level: the ghosts' exchange).
 PetscErrorCode SlabGSApplySweeps(SlabGS *gs, Vec b, Vec x, PetscInt its, PetscBool zero_guess);
