@@ -7,7 +7,7 @@
 // Scene: -cloth_n, -cloth_size (m), -cloth_mass (kg), -cloth_k_stretch, -cloth_k_shear, -cloth_k_bend (N/m),
 // -cloth_damping (N s/m), -cloth_pins corners|four|top|none, -cloth_hanging, -sphere (drape over a sphere;
 // -sphere_radius, -sphere_centre x,y,z), -cloth_strain_limit S (stretch springs kept within (1 + S) x rest length,
-// Provot; 0: off) and -cloth_strain_limit_sweeps N. Time: -dt, -steps, -cloth_exact_jacobian (drop Choi-Ko). Output:
+// Provot; 0: off), -cloth_strain_limit_sweeps N and -cloth_strain_limit_omega W (over-relaxation in [1, 2)). Time: -dt, -steps, -cloth_exact_jacobian (drop Choi-Ko). Output:
 // a progress line every -progress_every steps, -vtk PREFIX (triangle surface per -vtk_every steps),
 // -dump_matrix FILE (first step's matrix), -write_positions / -reference_positions FILE (rms and largest
 // position difference against another run, sim/position_file.h), and a final `summary key=value ...` line;
@@ -84,6 +84,8 @@ int main(int argc, char **argv)
     PetscCall(
       PetscOptionsGetReal(nullptr, nullptr, "-cloth_strain_limit", &params.strain_limit.max_strain, nullptr));
     PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-cloth_strain_limit_sweeps", &sweeps, nullptr));
+    PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-cloth_strain_limit_omega", &params.strain_limit.omega,
+                                  nullptr));
     params.strain_limit.max_sweeps = (int)sweeps;
   }
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-dt", &params.dt, nullptr));
@@ -103,9 +105,11 @@ int main(int argc, char **argv)
   else if (!std::strcmp(pins, "none")) opt.pins = physics::ClothPins::None;
   else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "unknown -cloth_pins %s (corners, four, top, none)", pins);
   const std::string bad = physics::validate_params(params);
-  PetscCheck(bad.empty(), comm, PETSC_ERR_ARG_OUTOFRANGE,
-             "%s (-dt %g, -cloth_strain_limit %g, -cloth_strain_limit_sweeps %d)", bad.c_str(),
-             (double)params.dt, (double)params.strain_limit.max_strain, params.strain_limit.max_sweeps);
+  PetscCheck(
+    bad.empty(), comm, PETSC_ERR_ARG_OUTOFRANGE,
+    "%s (-dt %g, -cloth_strain_limit %g, -cloth_strain_limit_sweeps %d, -cloth_strain_limit_omega %g)",
+    bad.c_str(), (double)params.dt, (double)params.strain_limit.max_strain, params.strain_limit.max_sweeps,
+    (double)params.strain_limit.omega);
   PetscCheck(!sphere || radius > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-sphere_radius must be positive, got %g",
              (double)radius);
 

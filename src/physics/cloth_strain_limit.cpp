@@ -12,6 +12,7 @@ std::string validate_strain_limit(const StrainLimit &limit)
   if (!(limit.max_strain >= 0) || !std::isfinite(limit.max_strain))
     return "strain limit must be non-negative and finite (0: off)";
   if (limit.max_sweeps < 1) return "strain limiting needs at least one sweep";
+  if (!(limit.omega >= 1 && limit.omega < 2)) return "strain limiting's over-relaxation must be in [1, 2)";
   return "";
 }
 
@@ -96,6 +97,7 @@ StrainLimitReport limit_strain(Cloth &cloth, StrainLimiter &limiter, const Strai
   if (limiter.particles != np || limiter.springs != cloth.springs.size())
     limiter = make_strain_limiter(cloth);
   std::vector<LimitedSpring> &stretch = limiter.stretch;
+  const double                omega   = limit.omega;
   if (limiter.bounds_for != limit.max_strain) {
     const double bound = 1 + limit.max_strain;
     // a sweep stops the limiting once no spring exceeds the bound by more than this (relative): the
@@ -152,8 +154,11 @@ StrainLimitReport limit_strain(Cloth &cloth, StrainLimiter &limiter, const Strai
         const LimitedSpring &sp = stretch[64 * w + bit];
         Eigen::Vector3d      d  = cloth.position[sp.b] - cloth.position[sp.a];
         if (!(d.squaredNorm() > sp.trigger)) continue;
-        const double          l    = d.norm();
-        const Eigen::Vector3d corr = (l - sp.lmax) / (l * sp.w) * d;
+        const double l = d.norm();
+        // omega times the excess (with omega = 1: the excess, exactly); over-relaxed, never below half
+        // the rest length: a spring stretched past omega / (omega - 1) lmax would be turned inside out
+        const double          shorten = std::min(omega * (l - sp.lmax), l - 0.5 * sp.rest_length);
+        const Eigen::Vector3d corr    = shorten / (l * sp.w) * d;
         cloth.position[sp.a] += sp.wa * corr;
         cloth.position[sp.b] -= sp.wb * corr;
         for (int p : {sp.a, sp.b})

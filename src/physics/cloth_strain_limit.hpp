@@ -7,7 +7,9 @@
 // concentrates its whole weight on the springs at the pins. The sweeps read and write the full state in a
 // fixed order, so processes that hold the same replicated state stay identical. With the sphere collider on,
 // each sweep ends by projecting particles out of it again, and particles left on it lose their velocity
-// into it: the collider wins over the springs.
+// into it: the collider wins over the springs. The sweeps are Gauss-Seidel on the springs, and like
+// Gauss-Seidel they move an excess spread over a large region (where a falling cloth lands on the
+// sphere and stops) one spring at a time: StrainLimit::omega over-relaxes them.
 #pragma once
 #include "physics/cloth_model.hpp"
 
@@ -20,6 +22,11 @@ namespace physics {
 struct StrainLimit {
   double max_strain = 0;   // 0: off; else the largest relative elongation a stretch spring keeps
   int    max_sweeps = 200; // Gauss-Seidel sweeps over the stretch springs at most (they stop when within)
+  // Over-relaxation of each correction, in [1, 2): a spring over its bound is shortened omega times its
+  // excess, to below the bound (never below half its rest length). 1 is Provot's projection; where a
+  // large region is over the bound (the cloth landing on the sphere) the sweeps pass the excess on to
+  // the region's edge in far fewer sweeps with omega near 2, as SOR does for linear systems.
+  double omega = 1;
 };
 
 struct StrainLimitReport {

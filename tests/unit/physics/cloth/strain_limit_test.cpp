@@ -45,7 +45,7 @@ double worst_stretch(int n, double max_strain, int steps, bool sphere)
 // direction) and ends by projecting every particle out of the sphere; then the velocities take the
 // change. limit_strain visits only the springs and particles that can change, and must make exactly
 // the same corrections.
-int reference_limit(Cloth &cloth, double max_strain, int max_sweeps, double dt)
+int reference_limit(Cloth &cloth, double max_strain, int max_sweeps, double dt, double omega = 1)
 {
   const std::vector<Eigen::Vector3d> before = cloth.position;
   std::vector<const Spring *>        stretch;
@@ -64,7 +64,8 @@ int reference_limit(Cloth &cloth, double max_strain, int max_sweeps, double dt)
       const double wa = cloth.fixed[sp.a] ? 0.0 : 1.0 / cloth.mass[sp.a],
                    wb = cloth.fixed[sp.b] ? 0.0 : 1.0 / cloth.mass[sp.b];
       if (wa + wb == 0) continue;
-      const Eigen::Vector3d corr = (l - lmax) / (l * (wa + wb)) * d;
+      const double          shorten = std::min(omega * (l - lmax), l - 0.5 * sp.rest_length);
+      const Eigen::Vector3d corr    = shorten / (l * (wa + wb)) * d;
       cloth.position[sp.a] += wa * corr;
       cloth.position[sp.b] -= wb * corr;
       over = true;
@@ -142,6 +143,41 @@ TEST_CASE("strain limiting moves the free end of an overstretched spring and its
   CHECK(r.max_ratio == Approx(1.1));
 }
 
+TEST_CASE("over-relaxed strain limiting brings a stretched chain within the bound in fewer sweeps",
+          "[cloth][strain]")
+{
+  // a chain pinned at one end, every spring 20% over its rest length: the excess has to leave through
+  // the free end, which Gauss-Seidel sweeps do a spring at a time
+  const auto sweeps_to_bound = [](double omega, double &max_ratio, double &shortest) {
+    const int n = 30;
+    Cloth     c;
+    for (int p = 0; p < n; ++p) c.position.emplace_back(1.2 * p, 0.3 * (p % 2), 0);
+    c.velocity.assign(n, Eigen::Vector3d::Zero());
+    c.mass.assign(n, 1.0);
+    c.fixed.assign(n, 0);
+    c.fixed[0] = 1;
+    for (int p = 0; p + 1 < n; ++p)
+      c.springs.push_back(
+        Spring{p, p + 1, (c.position[p + 1] - c.position[p]).norm() / 1.2, 1.0, SpringKind::Stretch});
+    StrainLimit limit;
+    limit.max_strain = 0.05, limit.max_sweeps = 5000, limit.omega = omega;
+    const StrainLimitReport r = limit_strain(c, limit, 0.01);
+    max_ratio                 = r.max_ratio;
+    shortest                  = 1e300;
+    for (const Spring &sp : c.springs)
+      shortest = std::min(shortest, (c.position[sp.b] - c.position[sp.a]).norm() / sp.rest_length);
+    return r.sweeps;
+  };
+  double    ratio1, ratio19, shortest1, shortest19;
+  const int plain = sweeps_to_bound(1.0, ratio1, shortest1), sor = sweeps_to_bound(1.9, ratio19, shortest19);
+  INFO("sweeps " << plain << " (omega 1), " << sor << " (omega 1.9)");
+  CHECK(plain < 5000);
+  CHECK(sor * 4 < plain);
+  for (double r : {ratio1, ratio19}) CHECK(r <= 1.05 * (1 + 1e-4));
+  CHECK(shortest1 >= 1.0 - 1e-12); // Provot's projection never shortens below the bound... nor the rest
+  CHECK(shortest19 >= 0.5);        // over-relaxed: below the bound, never below half the rest length
+}
+
 TEST_CASE("bad strain limits are refused", "[cloth][strain]")
 {
   ClothParams p;
@@ -152,10 +188,17 @@ TEST_CASE("bad strain limits are refused", "[cloth][strain]")
   p.strain_limit.max_strain = 0.1;
   p.strain_limit.max_sweeps = 0;
   CHECK(validate_params(p).find("sweep") != std::string::npos);
+  p.strain_limit.max_sweeps = 10;
+  for (double omega : {0.9, 2.0, std::nan("")}) {
+    p.strain_limit.omega = omega;
+    CHECK(validate_params(p).find("over-relaxation") != std::string::npos);
+  }
 }
 
 TEST_CASE("strain limiting makes the corrections of full sweeps over every spring", "[cloth][strain]")
 {
+  const double omega = GENERATE(1.0, 1.9);
+  INFO("omega " << omega);
   // a cloth that hangs from its pins onto the sphere: many sweeps per step (up to the cap), the
   // sphere's projection fighting the springs, so the visited sets change from sweep to sweep
   Cloth        cloth = corner_pinned_cloth(24, true, -0.3);
@@ -166,12 +209,13 @@ TEST_CASE("strain limiting makes the corrections of full sweeps over every sprin
   const double dt = free_params.dt, max_strain = 0.03;
   StrainLimit  limit;
   limit.max_strain = max_strain;
-  limit.max_sweeps = 60;
+  limit.max_sweeps = omega == 1 ? 60 : 12; // over-relaxed sweeps reach the bound sooner: cap them sooner
+  limit.omega      = omega;
   int capped       = 0;
   for (int s = 0; s < 40; ++s) {
     REQUIRE(cloth_step(cloth, sys, free_params, lin).converged);
     Cloth                   expected = cloth;
-    const int               sweeps   = reference_limit(expected, max_strain, limit.max_sweeps, dt);
+    const int               sweeps   = reference_limit(expected, max_strain, limit.max_sweeps, dt, omega);
     const StrainLimitReport got      = limit_strain(cloth, limit, dt);
     INFO("step " << s);
     CHECK(got.sweeps == sweeps);
