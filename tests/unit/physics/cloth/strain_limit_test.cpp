@@ -170,11 +170,12 @@ TEST_CASE("over-relaxed strain limiting brings a stretched chain within the boun
   };
   double    ratio1, ratio19, shortest1, shortest19;
   const int plain = sweeps_to_bound(1.0, ratio1, shortest1), sor = sweeps_to_bound(1.9, ratio19, shortest19);
-  INFO("sweeps " << plain << " (omega 1), " << sor << " (omega 1.9)");
+  INFO("sweeps " << plain << " (omega 1), " << sor << " (omega 1.9); shortest " << shortest1 << ", "
+                 << shortest19);
   CHECK(plain < 5000);
   CHECK(sor * 4 < plain);
   for (double r : {ratio1, ratio19}) CHECK(r <= 1.05 * (1 + 1e-4));
-  CHECK(shortest1 >= 1.0 - 1e-12); // Provot's projection never shortens below the bound... nor the rest
+  CHECK(shortest1 >= 1.0 - 1e-12); // plain: a corrected spring ends at its bound, above its rest length
   CHECK(shortest19 >= 0.5);        // over-relaxed: below the bound, never below half the rest length
 }
 
