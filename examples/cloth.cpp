@@ -6,9 +6,10 @@
 //
 // Scene: -cloth_n, -cloth_size (m), -cloth_mass (kg), -cloth_k_stretch, -cloth_k_shear, -cloth_k_bend (N/m),
 // -cloth_damping (N s/m), -cloth_pins corners|four|top|none, -cloth_hanging, -sphere (drape over a sphere;
-// -sphere_radius, -sphere_centre x,y,z), -cloth_strain_limit S (stretch springs kept within (1 + S) x rest length,
-// Provot; 0: off), -cloth_strain_limit_sweeps N and -cloth_strain_limit_omega W (over-relaxation in [1, 2)). Time: -dt, -steps, -cloth_exact_jacobian (drop Choi-Ko). Output:
-// a progress line every -progress_every steps, -vtk PREFIX (triangle surface per -vtk_every steps),
+// -sphere_radius, -sphere_centre x,y,z), -cloth_strain_limit S (stretch springs kept within (1 + S) x rest
+// length, Provot; 0: off), -cloth_strain_limit_sweeps N and -cloth_strain_limit_omega W (its sweeps
+// over-relaxed, W in [1, 2)). Time: -dt, -steps, -cloth_exact_jacobian (drop Choi-Ko). Output: a progress
+// line every -progress_every steps, -vtk PREFIX (triangle surface per -vtk_every steps),
 // -dump_matrix FILE (first step's matrix), -write_positions / -reference_positions FILE (rms and largest
 // position difference against another run, sim/position_file.h), and a final `summary key=value ...` line;
 // -cloth_timer cpu times in process CPU time instead of wall time (a shared machine). More ranks:
