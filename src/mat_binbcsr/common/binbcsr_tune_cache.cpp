@@ -10,15 +10,22 @@
    that ran 2.3x slower with it) holds choices this one would not make, so it is dropped quietly and
    measured again. The version also moves when bodies change what is fastest: v3 came with the
    hand-written AVX2 bodies, after which a Zen 3 core ran the 48^3 stencil's whole single product
-   fastest at bin width 4, where v2 files held 16 (measured with the compiler-vectorised ones). */
+   fastest at bin width 4, where v2 files held 16 (measured with the compiler-vectorised ones).
+   Since then the machine key ends with the kernel id (BINBCSR_KERNEL_ID, a hash of the bodies', the
+   layout build's and the tuner's sources made by the build): a library whose kernels changed takes none
+   of the choices an earlier one made, and its first store drops them. Without it a choice stayed in the
+   file for good: on a Zen 5 VM the 32^3 stencil kept bin width 4 with the AVX2 body, chosen by an earlier
+   build, 1.2-1.4x slower than the width 8 AVX-512 body that every new tuning chose. */
 #include "binbcsr_tune.h"
 #include "binbcsr_machine.h"
 #include "../kernels/binbcsr_dispatch.h"
+#include "binbcsr_kernel_id.h" /* generated: BINBCSR_KERNEL_ID */
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <sys/stat.h>
@@ -27,13 +34,29 @@
 static const char *const cache_header      = "# petscbinbcsr tune cache v3";
 static const char *const cache_header_stem = "# petscbinbcsr tune cache v"; /* of every version */
 
-const std::string &BinBCSRTuneMachineKey(void)
+/* The machine without the kernel id: CPU, cores and the best body set. */
+static const std::string &MachineStem(void)
 {
   static const char       *bodies = binbcsr::body_set_name(binbcsr::best_body_set());
   const std::string       &model  = binbcsr::cpu_model();
-  static const std::string key    = (model.empty() ? std::string("unknown cpu") : model) + " | " +
-                                 std::to_string(binbcsr::online_cpus()) + " cores | " + bodies;
+  static const std::string stem   = (model.empty() ? std::string("unknown cpu") : model) + " | " +
+                                  std::to_string(binbcsr::online_cpus()) + " cores | " + bodies;
+  return stem;
+}
+
+const std::string &BinBCSRTuneMachineKey(void)
+{
+  static const std::string key = MachineStem() + " | kernels " + BINBCSR_KERNEL_ID;
   return key;
+}
+
+/* Whether an entry (machine TAB class) is this machine's from another kernel id, or from before the
+   id was in the key. */
+static bool StaleForThisMachine(const std::string &entry)
+{
+  const std::string machine = entry.substr(0, entry.find('\t')), &stem = MachineStem();
+  if (machine == BinBCSRTuneMachineKey()) return false;
+  return machine == stem || machine.rfind(stem + " | kernels ", 0) == 0;
 }
 
 std::string BinBCSRTuneCachePath(void)
@@ -184,6 +207,8 @@ PetscErrorCode BinBCSRTuneCacheStore(const std::string &key, const BinBCSRTuneCh
   PetscFunctionBegin;
   if (path.empty()) PetscFunctionReturn(0);
   if (!ReadCache(path, entries, why)) entries.clear(); /* a corrupt file is replaced (the lookup warned) */
+  for (auto it = entries.begin(); it != entries.end();) /* other kernels' choices for this machine */
+    it = StaleForThisMachine(it->first) ? entries.erase(it) : std::next(it);
   entries[key] = c;
   if (!MakeParents(path)) {
     PetscCall(PetscInfo(nullptr, "Cannot create the folder of the tuning cache %s: %s\n", path.c_str(),

@@ -338,6 +338,32 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
     std::getline(in, first);
     CHECK(first == "# petscbinbcsr tune cache v3");
   }
+  // this machine's entries written by a library with other kernels (another kernel id), or by one from
+  // before the id was in the key: not taken (measured again), and dropped by the store that follows
+  const size_t kid = key.find(" | kernels ");
+  REQUIRE(kid != std::string::npos);
+  const size_t      tab      = key.find('\t');
+  const std::string other_id = key.substr(0, kid) + " | kernels 000000000000" + key.substr(tab);
+  const std::string no_id    = key.substr(0, kid) + key.substr(tab);
+  for (const std::string &stale : {other_id, no_id}) {
+    CAPTURE(stale);
+    {
+      std::ofstream out(file, std::ios::trunc);
+      out << "# petscbinbcsr tune cache v3\n" << stale << "\t16 1 portable\n"
+          << "Another CPU (family 1 model 2) | 64 cores | avx2 | kernels 000000000000\tbs 3 double whole size "
+             "2^20 rowlen 2^4 spread 0\t16 2 portable\n";
+    }
+    Mat C = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
+    CHECK(info_view(C).find("measured on block rows") != std::string::npos);
+    check_same(C, A, p);
+    MatDestroy(&C);
+    std::ifstream     in(file);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    CHECK(ss.str().find(stale + "\t") == std::string::npos); // dropped
+    CHECK(ss.str().find(key + "\t") != std::string::npos);   // the new choice
+    CHECK(ss.str().find("Another CPU") != std::string::npos); // other machines' entries kept
+  }
   // an unreadable cache folder: no file written, no error
   setenv("XDG_CACHE_HOME", "/proc/no/such/folder", 1);
   Mat C = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
