@@ -358,11 +358,15 @@ PetscErrorCode SetValuesCOO(Mat A, const PetscInt *perm, const PetscScalar v[], 
   PetscCheck(imode == INSERT_VALUES || imode == ADD_VALUES, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
              "MatSetValuesCOO supports INSERT_VALUES and ADD_VALUES only");
   PetscCall(PetscLogEventBegin(MAT_BinBCSR_SetValuesCOO, A, 0, 0, 0));
+  /* Values come from v, and on an MPI part also from recv (the entries other ranks send). A rank with
+     no entries of its own has v null (n = 0) and may still receive some: only with neither source are
+     the values zeros. (Testing v alone zeroed such a rank's rows, received entries and all.) */
+  const bool values = v || recv;
   /* the map is built at preallocation; again if this refill reads another map or split (a copy, a part refilled on its own) */
-  if (v && (a->coo_slot_state == 0 ||
-            (a->coo_slot_state == 1 && (a->coo_slot_n != n || a->coo_slot_perm != perm))))
+  if (values && (a->coo_slot_state == 0 ||
+                 (a->coo_slot_state == 1 && (a->coo_slot_n != n || a->coo_slot_perm != perm))))
     PetscCall(BuildSlotMap(A, perm, n));
-  if (!v) { /* no values: zeros */
+  if (!values) { /* no values: zeros */
     if (imode == INSERT_VALUES) {
       if (a->val) PetscCall(PetscArrayzero(a->val, nv));
       else PetscCall(PetscArrayzero(a->valf, nv));

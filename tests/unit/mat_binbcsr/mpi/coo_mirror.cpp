@@ -173,6 +173,53 @@ TEST_CASE("COO mirror: binbcsr equals aij given the list and its transposes (bs 
         }
 }
 
+TEST_CASE("COO: a rank that lists no entries still gets those other ranks send it (bs 1 and 3)", "[mpi][coo_mirror]")
+{
+  // Only rank 0 lists entries, every block row's diagonal block among them; the other ranks call with
+  // no entries and no values (a null array, as an empty std::vector's data()). Their rows must hold
+  // what rank 0 sent: they were zeros, the received entries dropped with the missing local values.
+  PetscMPIInt rank;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  for (PetscInt bs : {1, 3})
+    for (bool mirror : {false, true})
+      for (bool sym : {false, true}) {
+        INFO("bs " << bs << " mirror " << mirror << " sym " << sym);
+        const PetscInt nblocks = 13;
+        CooList        l;
+        if (rank == 0) {
+          CooList r = random_list(nblocks, bs, 200, 99u + (unsigned)bs);
+          for (size_t k = 0; k < r.i.size(); ++k)
+            if (r.i[k] >= 0 && (!sym || r.i[k] / bs < r.j[k] / bs)) {
+              l.i.push_back(r.i[k]);
+              l.j.push_back(r.j[k]);
+              l.v.push_back(r.v[k]);
+            }
+          for (PetscInt b = 0; b < nblocks; ++b) // SPD-like diagonal blocks, symmetric
+            for (PetscInt p = 0; p < bs; ++p)
+              for (PetscInt q = 0; q < bs; ++q) {
+                l.i.push_back(b * bs + p);
+                l.j.push_back(b * bs + q);
+                l.v.push_back(p == q ? 10.0 + b : 0.5);
+              }
+        }
+        CooList full = mirror || sym ? with_transposes(l, bs) : l;
+        // symmetric storage without the mirror takes both triangles (the off-diagonal part is whole)
+        if (sym && !mirror) l = full;
+        Mat A, R;
+        PCHK(create(PETSC_COMM_WORLD, MATBINBCSR, nblocks, bs, mirror, sym, nullptr, &A));
+        PCHK(MatSetPreallocationCOO(A, (PetscCount)l.i.size(), l.i.data(), l.j.data()));
+        PCHK(create(PETSC_COMM_WORLD, MATAIJ, nblocks, bs, false, false, nullptr, &R));
+        PCHK(MatSetPreallocationCOO(R, (PetscCount)full.i.size(), full.i.data(), full.j.data()));
+        for (InsertMode mode : {INSERT_VALUES, ADD_VALUES}) {
+          PCHK(MatSetValuesCOO(A, l.v.empty() ? nullptr : l.v.data(), mode));
+          PCHK(MatSetValuesCOO(R, full.v.empty() ? nullptr : full.v.data(), mode));
+          CHECK(all_ranks(relative_difference(A, R) < 1e-14, PETSC_COMM_WORLD));
+        }
+        PCHK(MatDestroy(&A));
+        PCHK(MatDestroy(&R));
+      }
+}
+
 TEST_CASE("COO mirror: off by default, option, other types unaffected, non-square refused",
           "[mpi][coo_mirror]")
 {
