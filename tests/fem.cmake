@@ -37,6 +37,14 @@ set_tests_properties(fem_mpi2_aij PROPERTIES LABELS "fem;mpi")
 fem_test(fem_mpi2_binbcsr_mirror 0 "mat_type=mpibinbcsr .*ranks=2 .*status=ok" ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_SMALL} -fem_order 2
          -mat_type binbcsr -mat_binbcsr_coo_mirror -ksp_type mcg -dump_matrix ${CMAKE_CURRENT_BINARY_DIR}/fem_mirror_dump.bin)
 set_tests_properties(fem_mpi2_binbcsr_mirror PROPERTIES LABELS "fem;mpi")
+# More ranks than elements (a unit cube of 6 tetrahedra on 7 ranks): a rank with no elements lists no
+# COO entries and must still get the blocks other ranks send it (its rows were zeros: indefinite), and
+# the dump must not stop on it. The tip against one rank's run of the same cube.
+fem_test(fem_mpi7_rank_without_elements 0 "ranks=7 .*tip_dz=-0.00124079 .*ksp_reason=CONVERGED_RTOL .*status=ok"
+         ${MPIEXEC_CMD} -n 7 ${FEM} -mesh_box 1,1,1,1,1,1 -fem_order 1 -fix xmin:0.001 -young 1e7 -poisson 0.3
+         -density 1000 -dt 0.01 -steps 2 -gravity 0,0,-9.81 -rayleigh 0.5,0 -mat_type binbcsr -ksp_type mcg
+         -ksp_rtol 1e-6 -ksp_initial_guess_nonzero -fem_quiet -dump_matrix ${CMAKE_CURRENT_BINARY_DIR}/fem_np7_dump.bin)
+set_tests_properties(fem_mpi7_rank_without_elements PROPERTIES LABELS "fem;mpi")
 add_test(NAME unit_fem_mpi2 COMMAND ${MPIEXEC_CMD} -n 2 $<TARGET_FILE:test_fem> "[mpi]")
 set_tests_properties(unit_fem_mpi2 PROPERTIES LABELS "fem;mpi;unit" TIMEOUT 60)
 # GAMG with the rest shape's rigid body modes as near null space (the driver's default): a slender beam

@@ -282,6 +282,7 @@ PetscErrorCode BlockSystemSetValues(BlockSystem *sys, const PetscScalar *block_v
   PetscFunctionBegin;
   PetscCheck(sys && sys->A, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "BlockSystem not created");
   sys->last_values = block_values;
+  sys->values_set  = PETSC_TRUE;
   if (sys->native_coo) {
     PetscCall(MatSetValuesCOO(sys->A, block_values, INSERT_VALUES));
   } else {
@@ -363,7 +364,9 @@ PetscErrorCode BlockSystemDumpMatrix(BlockSystem *sys, const char *path)
 
   PetscFunctionBegin;
   PetscCall(PetscObjectGetComm((PetscObject)sys->A, &comm));
-  PetscCheck(sys->last_values, comm, PETSC_ERR_ARG_WRONGSTATE, "BlockSystemDumpMatrix: no values set yet");
+  // Checked on every rank alike: a rank with no blocks of its own has no value array (the check was on
+  // that array, and such a rank stopped alone, without a message from the others).
+  PetscCheck(sys->values_set, comm, PETSC_ERR_ARG_WRONGSTATE, "BlockSystemDumpMatrix: no values set yet");
   // Rebuilt as aij from the same COO list, so the dump works for every type (binbcsr has no MatView
   // to binary of its own) and loads anywhere.
   PetscCall(MatCreate(comm, &aij));

@@ -39,6 +39,7 @@ struct BlockSystem {
                  // symmetric storage or COO mirror): the caller lists the upper triangle
   std::vector<PetscInt> coo_block_row, coo_block_col; // kept for the fallback path and for dumps
   const PetscScalar    *last_values = nullptr; // the caller's array from the last SetValues (for dumps)
+  PetscBool             values_set  = PETSC_FALSE; // SetValues was called (a rank without blocks has no array)
   GAMGSmootherCopies    gamg_copies;           // -gamg_smoother_precision single (smoother_copy.h)
   // -initial_guess_scaled: a nonzero initial guess x0 is replaced by a x0, a minimising ||b - a A x0||
   // (0 where x0 is no better than zero), at the cost of one product. r: its work vector.
