@@ -177,9 +177,13 @@ ArticulatedStepReport articulated_step(ArticulatedScene &scene, ArticulatedSolve
   s.arm_a.resize(nj), s.arm_b.resize(nj);
   s.rhs.resize(3 * nj), s.impulses.resize(3 * nj), s.errors.resize(3 * nj);
   s.correction_sum.assign(3 * nj, 0.0);
-  if (s.split.active_bodies.empty() && s.whole_scene.body_active.size() != nb)
+  // A split that was made has a flag per body; a process whose share holds no body (more processes
+  // than joints) still takes part in every max over the processes (it was taken for "no split" and
+  // did the whole scene without them: the other processes waited in their reductions for good).
+  const bool split = !s.split.body_active.empty();
+  if (!split && s.whole_scene.body_active.size() != nb)
     s.whole_scene = split_articulated_work(scene, std::vector<int>(nj, 0), 0);
-  const ArticulatedWorkSplit &w = s.split.active_bodies.empty() ? s.whole_scene : s.split;
+  const ArticulatedWorkSplit &w = split ? s.split : s.whole_scene;
   update_frames(scene, s, w, nullptr);
 
   // With the physics replicated over processes, each fills only the block rows its solver part takes.

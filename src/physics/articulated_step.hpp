@@ -72,7 +72,7 @@ ArticulatedWorkSplit split_articulated_work(const ArticulatedScene &scene,
 
 struct ArticulatedSolver {
   JointMatrixPattern   pattern;
-  ArticulatedWorkSplit split;       // empty: this process does the whole scene
+  ArticulatedWorkSplit split;       // never made (no body flags): this process does the whole scene
   ArticulatedWorkSplit whole_scene; // the lists for that case, built at the first step
   std::vector<double>  block_values;
   bool                 regularised = false;
