@@ -93,6 +93,21 @@ add_test(NAME articulated_mpi_np2_chain
                  "${MPIEXEC_LINE} -n 2 ${ART_SAME} -mat_type binbcsr -ksp_type mcg -vtk art_np2_chain -vtk_every 50 -vtk_points")
 set_tests_properties(articulated_mpi_np2_chain PROPERTIES LABELS "articulated;mpi" PROCESSORS 2 TIMEOUT 60)
 
+# More ranks than joints: a rank that owns no joint must still take part in every reduction of the
+# step (it used to take itself for an unsplit run and skip them: the others waited for good), and its
+# empty block of PCBJACOBI must factor (PETSc's SBAIJ ICC crashed on the empty block of binbcsr's shadow).
+add_test(NAME articulated_more_ranks_than_joints
+         COMMAND ${SUMMARY_SAME} "energy_final:1e-9 joint_error_final:1e-12 corrections_per_step:0" 1e-6
+                 "${ART} -options_file ${OPTS}/chain.opts -chain_links 2 -steps 20 -mat_type aij"
+                 "${MPIEXEC_LINE} -n 3 ${ART} -options_file ${OPTS}/chain.opts -chain_links 2 -steps 20 -mat_type aij"
+                 "${MPIEXEC_LINE} -n 3 ${ART} -options_file ${OPTS}/chain.opts -chain_links 2 -steps 20 -mat_type binbcsr -ksp_type mcg")
+set_tests_properties(articulated_more_ranks_than_joints PROPERTIES LABELS "articulated;mpi" TIMEOUT 60)
+add_test(NAME articulated_bridge_rank_without_rows
+         COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && joint_error_max<1e-6 && ranks==5"
+                 -- ${MPIEXEC_CMD} -n 5 ${ART} -options_file ${OPTS}/bridge.opts -bridge_chains 1 -bridge_links 2
+                    -bridge_tie_every 1 -steps 3 -mat_type binbcsr -ksp_type mcg)
+set_tests_properties(articulated_bridge_rank_without_rows PROPERTIES LABELS "articulated;mpi" TIMEOUT 60)
+
 # -vtk writes one .vtu per frame and a .pvd collection; -dump_matrix writes a PETSc binary matrix.
 add_test(NAME articulated_vtk_dump
          COMMAND sh -c "rm -rf art_out && mkdir art_out && ${ART} -options_file ${OPTS}/loop.opts -steps 4 -vtk art_out/loop -vtk_every 2 -dump_matrix art_out/A.bin -progress_every 10 && test -s art_out/loop_00004.vtu && grep -q 'NumberOfCells=\"3\"' art_out/loop_00004.vtu && grep -q loop_00002.vtu art_out/loop.pvd && test -s art_out/A.bin")

@@ -344,6 +344,36 @@ PetscErrorCode FactorShadow::Routed(Mat F)
   PetscFunctionReturn(0);
 }
 
+/* The factor of a matrix without rows: nothing to compute or solve. PETSc 3.18's BAIJ and SBAIJ
+   factorisations of an empty matrix with block size 3 read past their arrays (SEGV in the numeric
+   ICC), and such matrices come with every rank that holds no rows (the sub-matrix of PCBJACOBI). */
+PetscErrorCode EmptyNumeric(Mat F, Mat, const MatFactorInfo *)
+{
+  PetscFunctionBegin;
+  F->assembled    = PETSC_TRUE;
+  F->preallocated = PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode EmptySolve(Mat, Vec, Vec)
+{
+  return 0;
+}
+
+PetscErrorCode EmptyFactor(Mat F)
+{
+  PetscFunctionBegin;
+  F->ops->lufactornumeric       = EmptyNumeric;
+  F->ops->choleskyfactornumeric = EmptyNumeric;
+  F->ops->solve                 = EmptySolve;
+  F->ops->solvetranspose        = EmptySolve;
+  F->ops->forwardsolve          = EmptySolve;
+  F->ops->backwardsolve         = EmptySolve;
+  F->ops->matsolve              = nullptr;
+  F->ops->matsolvetranspose     = nullptr;
+  PetscFunctionReturn(0);
+}
+
 /* The four symbolic factorisations: refill the shadow, translate the ordering to it, run PETSc's
    routine on it (the routing keeps the numeric kernel that routine chose on the shadow). */
 template <class Symbolic> PetscErrorCode ShadowSymbolic(Mat F, Mat A, IS row, IS col, Symbolic &&symbolic)
@@ -352,6 +382,10 @@ template <class Symbolic> PetscErrorCode ShadowSymbolic(Mat F, Mat A, IS row, IS
   FactorShadow   *f;
 
   PetscFunctionBegin;
+  if (A->rmap->n == 0) {
+    PetscCall(EmptyFactor(F));
+    PetscFunctionReturn(0);
+  }
   /* a new pattern (or the first one: the factor was asked for before the matrix was assembled) */
   PetscCall(binbcsr_factor::Get(F, &f));
   if (f->nzstate != A->nonzerostate) {
