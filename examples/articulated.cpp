@@ -243,6 +243,11 @@ int main(int argc, char **argv)
     HealthBounds hb;
     hb.energy_scale  = m * scene.gravity.norm() * (hi - lo).norm() + ke0;
     hb.energy_growth = 0.1;
+    // A joint still open by 5% of the smallest body after a step is an articulation that came
+    // apart (a step far too long, masses the projection cannot balance), not a tolerance missed.
+    double smallest = INFINITY;
+    for (const Eigen::Vector3d &size : scene.body_sizes) smallest = std::min(smallest, size.norm());
+    hb.joint_error = std::isfinite(smallest) && smallest > 0 ? 0.05 * smallest : NAN;
     PetscCall(RunGuardFromOptions(comm, hb, &guard));
     RunGuardStart(&guard, e0, NAN);
   }
@@ -286,8 +291,9 @@ int main(int argc, char **argv)
     // other failed solve leaves the impulses it produced (or zeros) in the step.
     if (rs.diverged_solves - diverged0 > (r.singular_detected ? 1 : 0))
       health.solver_reason = rs.worst_reason;
-    health.energy = energy;
-    health.finite = finite && std::isfinite(energy);
+    health.energy      = energy;
+    health.joint_error = r.joint_error;
+    health.finite      = finite && std::isfinite(energy);
     bool stop;
     PetscCall(RunGuardCheckStep(comm, &guard, n, health, &stop));
     if (stop) break;

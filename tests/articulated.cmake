@@ -124,6 +124,19 @@ foreach(mass 1e300 1e-300)
     set_tests_properties(articulated_link_mass_${mass}_np${np} PROPERTIES LABELS "articulated;mpi" PROCESSORS ${np} TIMEOUT 60)
   endforeach()
 endforeach()
+# A step far too long (1e10 s) leaves the joints 1e21 m apart, and link masses of 1e30 and 1e-30 kg
+# leave one 5 cm open: every step UNCONVERGED, and the run claimed status=ok. A joint open by more than
+# 5% of the smallest body is the articulation coming apart (-health_joint_error): a warning and
+# status=unstable, or a stop with -on_unstable stop.
+add_test(NAME articulated_joints_apart_unstable
+         COMMAND ${EXPECT_RUN} 0 "warning: unstable at step 1: a joint is .* m open .*status=unstable"
+                 -- ${ART} -options_file ${OPTS}/chain.opts -dt 1e10 -steps 5 -progress_every 1000)
+add_test(NAME articulated_joints_apart_stop
+         COMMAND ${EXPECT_RUN} 4 "error: unstable at step 5: a joint is 0.05.* m open .*ended=unstable@step5 status=unstable"
+                 -- ${ART} -options_file ${OPTS}/chain.opts -chain_mass_first 1e30 -chain_mass_last 1e-30 -steps 5
+                    -on_unstable stop -progress_every 1000)
+set_tests_properties(articulated_joints_apart_unstable articulated_joints_apart_stop PROPERTIES LABELS "articulated"
+                     TIMEOUT 60)
 # A healthy chain runs to the end and says so.
 add_test(NAME articulated_chain_completes
          COMMAND ${EXPECT_RUN} 0 "ended=completed status=ok" -- ${ART} -options_file ${OPTS}/chain.opts -steps 20 -progress_every 1000)

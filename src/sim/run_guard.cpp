@@ -38,6 +38,7 @@ PetscErrorCode RunGuardFromOptions(MPI_Comm comm, const HealthBounds &scene, Run
   PetscCall(GetChoice(comm, "-on_unstable", "stop", "warn", &g->stop_on_unstable));
   PetscCall(OverrideBound("-health_energy_growth", &g->bounds.energy_growth));
   PetscCall(OverrideBound("-health_inverted_fraction", &g->bounds.inverted_fraction));
+  PetscCall(OverrideBound("-health_joint_error", &g->bounds.joint_error));
   PetscCall(OverrideBound("-health_max_stretch", &g->bounds.max_stretch));
   PetscFunctionReturn(0);
 }
@@ -97,6 +98,9 @@ PetscErrorCode RunGuardCheckStep(MPI_Comm comm, RunGuard *g, long long step, con
   else if (std::isfinite(b.max_stretch) && std::isfinite(h.max_stretch) && h.max_stretch > b.max_stretch)
     std::snprintf(msg, sizeof msg, "a spring is stretched to %.4g x its rest length (bound %.3g)",
                   h.max_stretch, b.max_stretch);
+  else if (std::isfinite(b.joint_error) && !(h.joint_error <= b.joint_error) && !std::isnan(h.joint_error))
+    std::snprintf(msg, sizeof msg, "a joint is %.4g m open after the step (bound %.3g m)", h.joint_error,
+                  b.joint_error);
   if (msg[0]) {
     ++g->unstable_steps;
     if (g->status == "ok") g->status = "unstable";

@@ -8,9 +8,10 @@
 //   - A nonfinite state always stops the run (status=nonfinite, exit code 3).
 //   - The health check: energy growth beyond a bound the scene states (relative to the scene's energy
 //     scale), more inverted elements than at the start (fem), a spring stretched beyond a bound
-//     (cloth). A step that fails it turns status into `unstable` with a one-line warning (the first
-//     time); -on_unstable stop also stops the run there (exit code 4). The bounds can be set with
-//     -health_energy_growth, -health_inverted_fraction, -health_max_stretch (a negative value turns
+//     (cloth), a joint left open by more than a bound (articulated). A step that fails it turns
+//     status into `unstable` with a one-line warning (the first time); -on_unstable stop also stops
+//     the run there (exit code 4). The bounds can be set with -health_energy_growth,
+//     -health_inverted_fraction, -health_max_stretch, -health_joint_error (a negative value turns
 //     that check off).
 //
 // The summary line gets status= (ok, unstable, solver_failed, nonfinite), ended= (completed or what
@@ -29,6 +30,7 @@ struct HealthBounds {
   double energy_growth     = NAN; // largest E - E0 allowed, as a multiple of energy_scale
   double inverted_fraction = NAN; // largest rise of the inverted element fraction over the initial one
   double max_stretch       = NAN; // largest length / rest length of a spring
+  double joint_error       = NAN; // m: largest gap a joint may keep at the end of a step
 };
 
 // What a driver saw in one step (NaN: not measured).
@@ -39,6 +41,7 @@ struct StepHealth {
   double energy            = NAN;
   double inverted_fraction = NAN;
   double max_stretch       = NAN;
+  double joint_error       = NAN;
 };
 
 struct RunGuard {
