@@ -159,18 +159,25 @@ static PetscErrorCode KSPSetFromOptions_MCG(KSP ksp, PetscOptionItems *PetscOpti
   PetscCall(PetscOptionsBool("-ksp_mcg_verify_residual",
                              "Confirm convergence on the true residual b - A x, restarting if it fails", "",
                              mcg->verify, &mcg->verify, nullptr));
+  /* read into locals and kept only when valid: a refused value must not stay in the KSP */
+  PetscReal stagnation = mcg->stagnation, floor_set = mcg->floor_set;
   PetscCall(PetscOptionsReal("-ksp_mcg_stagnation",
-                             "Each restart must shrink the true residual by this factor", "", mcg->stagnation,
-                             &mcg->stagnation, nullptr));
+                             "Each restart must shrink the true residual by this factor", "", stagnation,
+                             &stagnation, nullptr));
+  /* 0 or NaN stopped at the first restart, above 1 let a restart grow the residual: neither is a factor */
+  PetscCheck(stagnation > 0 && stagnation <= 1, PetscObjectComm((PetscObject)ksp), PETSC_ERR_ARG_OUTOFRANGE,
+             "-ksp_mcg_stagnation must be a factor in (0, 1], not %g", (double)stagnation);
+  mcg->stagnation = stagnation;
   PetscCall(PetscOptionsReal(
     "-ksp_mcg_precision_floor",
     "Relative rounding u of the operator's products: stop at u ||A|| ||x|| instead of claiming a tolerance below it (-1: from the matrix, 0: off)",
-    "", mcg->floor_set, &mcg->floor_set, nullptr));
+    "", floor_set, &floor_set, nullptr));
   PetscCheck(
-    mcg->floor_set == MCG_FLOOR_AUTO || (mcg->floor_set >= 0 && mcg->floor_set < 1),
-    PetscObjectComm((PetscObject)ksp), PETSC_ERR_ARG_OUTOFRANGE,
+    floor_set == MCG_FLOOR_AUTO || (floor_set >= 0 && floor_set < 1), PetscObjectComm((PetscObject)ksp),
+    PETSC_ERR_ARG_OUTOFRANGE,
     "-ksp_mcg_precision_floor must be -1 (from the matrix), 0 (off) or a relative rounding in (0, 1), not %g",
-    (double)mcg->floor_set);
+    (double)floor_set);
+  mcg->floor_set = floor_set;
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }

@@ -65,6 +65,17 @@ TEST_CASE("precision floor: double products have none, any operator can be given
     PetscOptionsInsertString(nullptr, "-ksp_mcg_precision_floor 2");
     CHECK(KSPSetFromOptions(ksp) == PETSC_ERR_ARG_OUTOFRANGE);
     PetscOptionsClear(nullptr);
+    // and the restarts' stagnation factor (0 and NaN stopped at the first restart, 2 never)
+    for (const char *bad : {"-ksp_mcg_stagnation 0", "-ksp_mcg_stagnation -1", "-ksp_mcg_stagnation 2",
+                            "-ksp_mcg_stagnation nan"}) {
+      CAPTURE(bad);
+      PetscOptionsInsertString(nullptr, bad);
+      CHECK(KSPSetFromOptions(ksp) == PETSC_ERR_ARG_OUTOFRANGE);
+      PetscOptionsClear(nullptr);
+    }
+    PetscOptionsInsertString(nullptr, "-ksp_mcg_stagnation 1"); // a refused value is not kept
+    CHECK(KSPSetFromOptions(ksp) == 0);
+    PetscOptionsClear(nullptr);
     KSPDestroy(&ksp);
   }
   MatDestroy(&S);
