@@ -114,11 +114,19 @@ int main(int argc, char **argv)
   PetscCheck(!sphere || radius > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-sphere_radius must be positive, got %g",
              (double)radius);
 
+  // The matrix holds about 13 blocks of 9 entries per particle, and PETSc's indices here are 32-bit:
+  // past that n the allocation failed (std::bad_alloc) or the counts overflowed.
+  PetscCheck((long long)n * n * 117 <= (long long)PETSC_MAX_INT, comm, PETSC_ERR_ARG_OUTOFRANGE,
+             "-cloth_n %" PetscInt_FMT ": the system's %lld entries exceed PETSc's index range (%d)", n,
+             (long long)n * n * 117, PETSC_MAX_INT);
+
   physics::Cloth cloth;
   try {
     cloth = physics::make_cloth(opt);
   } catch (const std::invalid_argument &e) {
     SETERRQ(comm, PETSC_ERR_ARG_OUTOFRANGE, "cloth: %s", e.what());
+  } catch (const std::bad_alloc &) {
+    SETERRQ(comm, PETSC_ERR_MEM, "cloth: not enough memory for a %" PetscInt_FMT " x %" PetscInt_FMT " cloth", n, n);
   }
   cloth.sphere.enabled      = sphere;
   cloth.sphere.radius       = radius;

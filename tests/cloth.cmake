@@ -112,8 +112,17 @@ add_test(NAME cloth_bad_pins COMMAND ${EXPECT_RUN} nonzero "unknown -cloth_pins 
 add_test(NAME cloth_bad_stiffness COMMAND ${EXPECT_RUN} nonzero "non-negative" -- ${CLOTH} -cloth_n 4 -cloth_k_bend -5)
 add_test(NAME cloth_bad_strain_limit_omega COMMAND ${EXPECT_RUN} nonzero "over-relaxation must be in"
                                                   -- ${CLOTH} -cloth_n 4 -cloth_strain_limit 0.05 -cloth_strain_limit_omega 2)
+# Sizes past PETSc's 32-bit indices (the allocation used to abort with std::bad_alloc), an infinite
+# stiffness, a sphere with a NaN centre (it switched the sphere off): refused with a reason.
+add_test(NAME cloth_bad_huge_n COMMAND ${EXPECT_RUN} nonzero "-cloth_n 100000: .*exceed PETSc's index range"
+                                      -- ${CLOTH} -cloth_n 100000 -steps 1)
+add_test(NAME cloth_bad_infinite_stiffness COMMAND ${EXPECT_RUN} nonzero "stiffness non-negative, both finite"
+                                                  -- ${CLOTH} -cloth_n 4 -cloth_k_stretch inf)
+add_test(NAME cloth_bad_sphere_centre COMMAND ${EXPECT_RUN} nonzero "sphere needs a finite centre"
+                                             -- ${CLOTH} -cloth_n 4 -sphere -sphere_centre nan,0,0)
 set_tests_properties(cloth_drape_sphere cloth_scene_stretch_bounded cloth_scene_stretch_bounded_80 cloth_stiff_dt30 cloth_same_result_mat_types cloth_bad_dt cloth_bad_n cloth_bad_pins
-                     cloth_bad_stiffness cloth_bad_strain_limit_omega PROPERTIES LABELS "cloth" TIMEOUT 60)
+                     cloth_bad_stiffness cloth_bad_strain_limit_omega cloth_bad_huge_n cloth_bad_infinite_stiffness
+                     cloth_bad_sphere_centre PROPERTIES LABELS "cloth" TIMEOUT 60)
 
 add_test(NAME cloth_mpi_np2
          COMMAND ${SUMMARY_SAME} "energy_final:1e-9 max_stretch:1e-9 contacts:0" 1e-6

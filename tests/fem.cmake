@@ -30,6 +30,8 @@ fem_test(fem_aijcusparse_error nonzero "needs a PETSc configured with CUDA" ${FE
 fem_test(fem_bad_mesh_error nonzero "cannot open mesh file" ${FEM} -mesh /nonexistent/mesh.msh)
 fem_test(fem_bad_option_error nonzero "-fix .*expected none" ${FEM} ${FEM_SMALL} -fix middle)
 fem_test(fem_bad_material_error nonzero "Poisson" ${FEM} ${FEM_SMALL} -poisson 0.5)
+fem_test(fem_bad_infinite_young nonzero "need a finite Young's modulus" ${FEM} ${FEM_SMALL} -young inf)
+fem_test(fem_bad_infinite_density nonzero "density must be > 0 and finite" ${FEM} ${FEM_SMALL} -density inf)
 fem_test(fem_mpi2_aij 0 "ranks=2 .*status=ok" ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_SMALL} -fem_order 2 -mat_type aij)
 set_tests_properties(fem_mpi2_aij PROPERTIES LABELS "fem;mpi")
 # The COO mirror on 2 ranks (upper blocks only, lower ones filled by the Mat, also across ranks) and

@@ -73,10 +73,14 @@ std::string validate_cloth(const Cloth &c)
     const Spring &sp = c.springs[s];
     if (sp.a < 0 || sp.a >= np || sp.b < 0 || sp.b >= np || sp.a == sp.b)
       return "spring " + std::to_string(s) + ": particle index out of range or repeated";
-    if (!(sp.rest_length > 0) || !(sp.stiffness >= 0))
-      return "spring " + std::to_string(s) + ": rest length must be positive, stiffness non-negative";
+    if (!(sp.rest_length > 0) || !(sp.stiffness >= 0) || !std::isfinite(sp.rest_length) ||
+        !std::isfinite(sp.stiffness))
+      return "spring " + std::to_string(s) +
+             ": rest length must be positive, stiffness non-negative, both finite";
   }
-  if (!(c.damping >= 0)) return "damping must be non-negative";
+  if (!(c.damping >= 0) || !std::isfinite(c.damping)) return "damping must be non-negative and finite";
+  if (c.sphere.enabled && (!c.sphere.centre.allFinite() || !(c.sphere.radius > 0) || !std::isfinite(c.sphere.radius)))
+    return "the sphere needs a finite centre and a positive finite radius";
   return "";
 }
 

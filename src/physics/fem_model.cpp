@@ -24,7 +24,8 @@ FemModel make_fem_model(const TetMesh &mesh, const FemSettings &settings)
 {
   validate_mesh(mesh, "mesh");
   const LameParameters lame = lame_from_young_poisson(settings.young, settings.poisson);
-  if (!(settings.density > 0)) throw std::invalid_argument("material: density must be > 0");
+  if (!(settings.density > 0) || !std::isfinite(settings.density))
+    throw std::invalid_argument("material: density must be > 0 and finite");
   FemModel m;
   m.mesh       = mesh;
   m.settings   = settings;

@@ -1,4 +1,6 @@
 #include "physics/tet_element.hpp"
+
+#include <cmath>
 #include "physics/tet_mesh.hpp"
 
 #include <Eigen/LU>
@@ -10,8 +12,8 @@ namespace physics {
 
 LameParameters lame_from_young_poisson(double young, double poisson)
 {
-  if (!(young > 0) || !(poisson > -1.0 && poisson < 0.5))
-    throw std::invalid_argument("material: need Young's modulus > 0 and -1 < Poisson's ratio < 0.5");
+  if (!(young > 0) || !std::isfinite(young) || !(poisson > -1.0 && poisson < 0.5))
+    throw std::invalid_argument("material: need a finite Young's modulus > 0 and -1 < Poisson's ratio < 0.5");
   return {young * poisson / ((1 + poisson) * (1 - 2 * poisson)), young / (2 * (1 + poisson))};
 }
 
