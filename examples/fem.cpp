@@ -93,6 +93,10 @@ PetscErrorCode GetOptions(Options &o)
                                   &o.box_set));
   PetscCheck(!o.box_set || n == 6, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG,
              "-mesh_box needs lx,ly,lz,nx,ny,nz");
+  for (int k = 3; o.box_set && k < 6; ++k) // counts become ints: a value past their range is no count
+    PetscCheck(o.box[k] >= 1 && o.box[k] <= 1e6 && o.box[k] == std::floor(o.box[k]), PETSC_COMM_WORLD,
+               PETSC_ERR_ARG_OUTOFRANGE, "-mesh_box: the cell counts nx,ny,nz must be whole numbers in [1, 1e6], got %g",
+               (double)o.box[k]);
   PetscCall(
     PetscOptionsInt("-fem_order", "1 (4-node) or 2 (10-node) tetrahedra", "", o.order, &o.order, nullptr));
   PetscCheck(o.order == 1 || o.order == 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
@@ -277,8 +281,15 @@ std::vector<char> SelectFixed(const physics::TetMesh &mesh, const Options &o)
     double     fraction = 0.01;
     const auto colon    = fix.find(':');
     if (colon != std::string::npos) {
-      fraction = std::atof(fix.c_str() + colon + 1);
-      fix      = fix.substr(0, colon);
+      // the whole rest must be a number in [0, 1]: atof took "abc", "" and "nan" for 0 (no node fixed
+      // past the plane's 1e-9) and 5 fixed every node
+      const char *text = fix.c_str() + colon + 1;
+      char       *end  = nullptr;
+      fraction         = std::strtod(text, &end);
+      if (end == text || *end || !(fraction >= 0 && fraction <= 1))
+        throw std::invalid_argument("-fix " + std::string(o.fix) +
+                                    ": the fraction after ':' must be a number in [0, 1] (of the extent)");
+      fix = fix.substr(0, colon);
     }
     if (fix.size() != 4 || fix[0] < 'x' || fix[0] > 'z' || (fix.substr(1) != "min" && fix.substr(1) != "max"))
       throw std::invalid_argument("-fix " + std::string(o.fix) +
