@@ -131,6 +131,16 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-batch", &batch, nullptr));
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-bs", &bs, nullptr));
   PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-coo", &coo, nullptr));
+  /* -bs 0 divided by zero in MatSetBlockSize, -repeats 0 printed the unset minimum (1e300) */
+  PetscCheck(bs == 1 || bs == 3, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-bs must be 1 or 3, not %" PetscInt_FMT, bs);
+  PetscCheck(repeats >= 1 && batch >= 1, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+             "-repeats and -batch must be >= 1 (got %" PetscInt_FMT " and %" PetscInt_FMT ")", repeats, batch);
+  for (PetscInt i = 0; i < nw; i++)
+    PetscCheck(widths[i] >= 1, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+               "-bin_widths must be >= 1, not %" PetscInt_FMT, widths[i]);
+  for (PetscInt i = 0; i < ns; i++)
+    PetscCheck(streams[i] == 1 || streams[i] == 2 || streams[i] == 4 || streams[i] == 8, PETSC_COMM_WORLD,
+               PETSC_ERR_ARG_OUTOFRANGE, "-streams must be 1, 2, 4 or 8, not %" PetscInt_FMT, streams[i]);
   {
     char      timer[16] = "cpu";
     PetscBool flg;
@@ -149,6 +159,8 @@ int main(int argc, char **argv)
       s.now = Now;
       PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-repeats", &s.repeats, nullptr));
       PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-batch", &s.batch, nullptr));
+      PetscCheck(s.repeats >= 1 && s.batch >= 1, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+                 "-repeats and -batch must be >= 1");
       PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-tune_cache", &s.tune_cache, nullptr));
       PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-sweep_verbose", &s.verbose, nullptr));
       PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-stencil_sizes", sizes, &nsizes, &flg));

@@ -248,6 +248,10 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-rtol", &rtol, nullptr));
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-repeats", &repeats, nullptr));
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-timed_its", &timed_its, nullptr));
+  /* 0 printed NaN speed-ups, or times per iteration with no iteration behind them */
+  PetscCheck(repeats >= 1 && timed_its >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE,
+             "-repeats and -timed_its must be >= 1 (got %" PetscInt_FMT " and %" PetscInt_FMT ")", repeats,
+             timed_its);
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-history_its", &history_its, nullptr));
   PetscCall(MPI_Comm_size(comm, &size));
 

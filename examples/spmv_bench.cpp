@@ -499,6 +499,12 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-save_dir", buf, sizeof buf, &flg));
   if (flg) set.save_dir = buf;
   PetscCheck(set.repeats > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-repeats must be positive");
+  { /* -bs: the files' block size, or not given (0: the file's own); 0 and negatives were taken silently */
+    PetscBool bs_set;
+    PetscCall(PetscOptionsHasName(nullptr, nullptr, "-bs", &bs_set));
+    PetscCheck(!bs_set || set.file_bs >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-bs must be >= 1, not %" PetscInt_FMT,
+               set.file_bs);
+  }
 
   std::vector<MatrixSource> sources;
   PetscInt                  sizes[16], nsizes = 16;
@@ -510,7 +516,9 @@ int main(int argc, char **argv)
     sizes[2] = 48;
   }
   for (PetscInt i = 0; i < nsizes; ++i) {
-    if (sizes[i] <= 0) continue;
+    PetscCheck(sizes[i] >= 0, comm, PETSC_ERR_ARG_OUTOFRANGE,
+               "-stencil_sizes: %" PetscInt_FMT " is no grid size (0: no stencil)", sizes[i]);
+    if (sizes[i] == 0) continue;
     MatrixSource s;
     s.grid.nx = s.grid.ny = s.grid.nz = sizes[i];
     s.name                            = "stencil" + std::to_string(sizes[i]);

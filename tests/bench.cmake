@@ -17,3 +17,25 @@ add_test(NAME bench_spmv_smoke_mpi
          COMMAND ${BENCH_CHECK} ${CMAKE_CURRENT_BINARY_DIR}/bench_spmv_smoke_mpi.csv
                  ${MPIEXEC_CMD} -n 2 $<TARGET_FILE:spmv_bench> -stencil_sizes 4 -repeats 2 -min_batch_ms 1 -stream_elements 200000)
 set_tests_properties(bench_spmv_smoke_mpi PROPERTIES LABELS "bench;mpi" TIMEOUT 60)
+
+# The benchmark programs refuse settings they cannot measure with (each one divided by zero, printed
+# NaN or an unset minimum, or ran out of memory before).
+foreach(case
+    "tune_bs0|-bs must be 1 or 3|binbcsr_tune|-stencil_n 8 -bs 0"
+    "tune_repeats0|-repeats and -batch must be >= 1|binbcsr_tune|-stencil_n 8 -repeats 0"
+    "tune_streams3|-streams must be 1, 2, 4 or 8|binbcsr_tune|-stencil_n 8 -streams 3"
+    "tune_huge|entries exceed PETSc's index range|binbcsr_tune|-stencil_n 1300"
+    "solve_repeats0|-repeats and -timed_its must be >= 1|solve_bench|-stencil_n 6 -repeats 0"
+    "solve_timed_its0|-repeats and -timed_its must be >= 1|solve_bench|-stencil_n 6 -timed_its 0"
+    "spmv_huge|entries exceed PETSc's index range|spmv_bench|-stencil_sizes 2000"
+    "spmv_negative|is no grid size|spmv_bench|-stencil_sizes -5"
+    "spmv_bs0|-bs must be >= 1|spmv_bench|-stencil_sizes 0 -bs 0")
+  string(REPLACE "|" ";" parts "${case}")
+  list(GET parts 0 name)
+  list(GET parts 1 regex)
+  list(GET parts 2 prog)
+  list(GET parts 3 args)
+  separate_arguments(args)
+  add_test(NAME bench_bad_${name} COMMAND ${EXPECT_RUN} nonzero "${regex}" -- $<TARGET_FILE:${prog}> ${args})
+  set_tests_properties(bench_bad_${name} PROPERTIES LABELS "bench" TIMEOUT 60)
+endforeach()

@@ -62,19 +62,25 @@ void StencilBlockRow(const StencilGrid &g, PetscInt node, PetscInt *ncols, Petsc
 PetscErrorCode CreateStencilMatrix(MPI_Comm comm, const StencilGrid &grid, MatType type, const char *prefix,
                                    Mat *A)
 {
-  const PetscInt bs = 3, nodes = grid.nodes();
-  PetscInt       rstart, rend, cols[27], ncols;
-  PetscScalar    vals[27 * 9];
-  PetscBool      is_sbaij = PETSC_FALSE;
-  MatType        actual;
+  PetscInt    rstart, rend, cols[27], ncols;
+  PetscScalar vals[27 * 9];
+  PetscBool   is_sbaij = PETSC_FALSE;
+  MatType     actual;
 
   PetscFunctionBegin;
   PetscCheck(grid.nx > 0 && grid.ny > 0 && grid.nz > 0, comm, PETSC_ERR_ARG_OUTOFRANGE,
              "Stencil grid must have at least one node per direction, got %" PetscInt_FMT " x %" PetscInt_FMT
              " x %" PetscInt_FMT,
              grid.nx, grid.ny, grid.nz);
-  PetscCheck(grid.shift > 0, comm, PETSC_ERR_ARG_OUTOFRANGE,
-             "Stencil shift must be positive for an SPD matrix");
+  /* before grid.nodes() is formed: a 2000^3 grid overflowed it and the vectors' sizes */
+  PetscCheck(243.0 * grid.nx * grid.ny * grid.nz <= (double)PETSC_MAX_INT, comm, PETSC_ERR_ARG_OUTOFRANGE,
+             "Stencil grid %" PetscInt_FMT " x %" PetscInt_FMT " x %" PetscInt_FMT
+             ": its %.3g entries exceed PETSc's index range",
+             grid.nx, grid.ny, grid.nz, 243.0 * grid.nx * grid.ny * grid.nz);
+  PetscCheck(grid.shift > 0 && std::isfinite((double)grid.shift), comm, PETSC_ERR_ARG_OUTOFRANGE,
+             "Stencil shift must be positive and finite for an SPD matrix, got %g", (double)grid.shift);
+  const PetscInt bs = 3, nodes = grid.nodes();
+
   // PETSc's default row layout (whole blocks per rank), computed up front to count the preallocation.
   PetscLayout map;
   PetscInt    nlocal;
