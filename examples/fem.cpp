@@ -88,6 +88,8 @@ PetscErrorCode GetOptions(Options &o)
                                "", o.mesh, o.mesh, sizeof o.mesh, nullptr));
   PetscCall(PetscOptionsReal("-mesh_size", "gmsh characteristic length for .geo input", "", o.mesh_size,
                              &o.mesh_size, nullptr));
+  PetscCheck(o.mesh_size >= 0 && std::isfinite(o.mesh_size), PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+             "-mesh_size must be positive and finite (0: the .geo file's own), not %g", (double)o.mesh_size);
   n = 6;
   PetscCall(PetscOptionsRealArray("-mesh_box", "lx,ly,lz,nx,ny,nz: box of 6 tets per cell", "", o.box, &n,
                                   &o.box_set));
@@ -111,9 +113,13 @@ PetscErrorCode GetOptions(Options &o)
   PetscCall(PetscOptionsReal("-dt", "time step (s)", "", o.dt, &o.dt, nullptr));
   PetscCall(
     PetscOptionsInt("-steps", "time steps (Newton iterations with -static)", "", o.steps, &o.steps, nullptr));
-  n = 3;
-  PetscCall(PetscOptionsRealArray("-gravity", "gx,gy,gz", "", o.gravity, &n, &set));
-  PetscCheck(!set || n == 3, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "-gravity needs gx,gy,gz");
+  { // read into one more place than it takes, so that a fourth number is seen (it was dropped)
+    PetscReal g[4] = {o.gravity[0], o.gravity[1], o.gravity[2], 0};
+    n              = 4;
+    PetscCall(PetscOptionsRealArray("-gravity", "gx,gy,gz", "", g, &n, &set));
+    PetscCheck(!set || n == 3, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "-gravity needs gx,gy,gz (3 numbers)");
+    for (int k = 0; k < 3; ++k) o.gravity[k] = g[k];
+  }
   n = 2;
   PetscCall(
     PetscOptionsRealArray("-rayleigh", "alpha,beta: damping D = alpha M + beta K", "", o.rayleigh, &n, &set));
@@ -264,6 +270,7 @@ PetscErrorCode MeshGeo(MPI_Comm comm, const std::string geo, double size, std::s
     const std::string tmp = *msh + ".tmp." + std::to_string(getpid()) + ".msh";
     std::string       cmd = "gmsh " + options + "'" + geo + "' -o '" + tmp + "' > /dev/null 2>&1";
     failed                = std::system(cmd.c_str()) != 0 || std::rename(tmp.c_str(), msh->c_str()) != 0;
+    if (failed) std::remove(tmp.c_str()); // what gmsh left of a failed mesh stays out of the cache
   }
   PetscCallMPI(MPI_Bcast(&failed, 1, MPI_INT, 0, comm));
   PetscCheck(!failed, comm, PETSC_ERR_LIB,

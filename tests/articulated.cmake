@@ -142,4 +142,9 @@ add_test(NAME articulated_chain_completes
          COMMAND ${EXPECT_RUN} 0 "ended=completed status=ok" -- ${ART} -options_file ${OPTS}/chain.opts -steps 20 -progress_every 1000)
 add_test(NAME articulated_bad_chain_length
          COMMAND ${EXPECT_RUN} nonzero "link length and width must be positive" -- ${ART} -options_file ${OPTS}/chain.opts -chain_length 0)
-set_tests_properties(articulated_chain_completes articulated_bad_chain_length PROPERTIES LABELS "articulated" TIMEOUT 60)
+add_test(NAME articulated_bad_chain_links
+         COMMAND ${EXPECT_RUN} nonzero "at most 1,000,000 links" -- ${ART} -options_file ${OPTS}/chain.opts -chain_links 100000000)
+add_test(NAME articulated_bad_bridge_sag
+         COMMAND ${EXPECT_RUN} nonzero "sag must be positive and finite" -- ${ART} -options_file ${OPTS}/bridge.opts -bridge_sag 0)
+set_tests_properties(articulated_chain_completes articulated_bad_chain_length articulated_bad_chain_links
+                     articulated_bad_bridge_sag PROPERTIES LABELS "articulated" TIMEOUT 60)

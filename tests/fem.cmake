@@ -34,6 +34,8 @@ fem_test(fem_bad_infinite_young nonzero "need a finite Young's modulus" ${FEM} $
 fem_test(fem_bad_fix_fraction nonzero "-fix xmin:nan: the fraction after ':' must be a number in" ${FEM} ${FEM_SMALL} -fix xmin:nan)
 fem_test(fem_bad_box_counts nonzero "cell counts nx,ny,nz must be whole numbers" ${FEM} -mesh_box 1,1,1,1e300,2,2 -steps 1)
 fem_test(fem_bad_box_too_many nonzero "6e\\+15 tetrahedra, more than 32-bit" ${FEM} -mesh_box 1,1,1,100000,100000,100000 -steps 1)
+fem_test(fem_bad_gravity_count nonzero "-gravity needs gx,gy,gz \\(3 numbers\\)" ${FEM} ${FEM_SMALL} -gravity 0,0,1,2)
+fem_test(fem_bad_mesh_size nonzero "-mesh_size must be positive and finite" ${FEM} ${FEM_SMALL} -mesh_size -1)
 fem_test(fem_bad_infinite_density nonzero "density must be > 0 and finite" ${FEM} ${FEM_SMALL} -density inf)
 fem_test(fem_mpi2_aij 0 "ranks=2 .*status=ok" ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_SMALL} -fem_order 2 -mat_type aij)
 set_tests_properties(fem_mpi2_aij PROPERTIES LABELS "fem;mpi")

@@ -22,6 +22,8 @@ static RigidBody bar_between(const Eigen::Vector3d &p, const Eigen::Vector3d &q,
 ArticulatedScene make_chain(const ChainOptions &opt)
 {
   if (opt.links < 1) throw std::invalid_argument("a chain needs at least one link");
+  // a body and a joint per link, each with its dense 3x3 blocks: 1e8 links ran on filling memory
+  if (opt.links > 1000000) throw std::invalid_argument("a chain has at most 1,000,000 links");
   // checked here, where the option is named: a zero-length bar would surface later as a degenerate body
   if (!(opt.link_length > 0) || !std::isfinite(opt.link_length) || !(opt.link_width > 0) ||
       !std::isfinite(opt.link_width))
@@ -52,6 +54,11 @@ ArticulatedScene make_bridge(const BridgeOptions &opt)
 {
   if (opt.chains < 1 || opt.links < 2 || opt.tie_every < 1)
     throw std::invalid_argument("a bridge needs chains >= 1, links >= 2, tie_every >= 1");
+  if ((double)opt.chains * opt.links > 1000000) throw std::invalid_argument("a bridge has at most 1,000,000 planks");
+  // the arc's sag (0, negative or NaN gave a singular joint matrix and a failed solve, with no word
+  // about the sag); a sag past the arc's half circle is reached at its bound
+  if (!(opt.sag > 0) || !std::isfinite(opt.sag))
+    throw std::invalid_argument("the bridge's sag must be positive and finite");
   ArticulatedScene scene;
   // Circular arc through the nodes with equal chords plank_length, lowest point `sag` below the anchors.
   const int n          = opt.links;
