@@ -39,3 +39,9 @@ foreach(case
   add_test(NAME bench_bad_${name} COMMAND ${EXPECT_RUN} nonzero "${regex}" -- $<TARGET_FILE:${prog}> ${args})
   set_tests_properties(bench_bad_${name} PROPERTIES LABELS "bench" TIMEOUT 60)
 endforeach()
+# A matrix file whose first row length is -3 (PETSc's MatLoad took it and the matrix then crashed
+# MatIsSymmetric): spmv_bench checks the file and names the row.
+add_test(NAME bench_bad_matrix_file
+         COMMAND ${EXPECT_RUN} nonzero "corrupt_matrix.bin: row 0 has length -3"
+                 -- sh -c "cp ${PETSC_DATAFILES_DIR}/matrices/spd-real-int32-float64 corrupt_matrix.bin && chmod u+w corrupt_matrix.bin && printf '\\377\\377\\377\\375' | dd of=corrupt_matrix.bin bs=1 seek=16 conv=notrunc 2>/dev/null && $<TARGET_FILE:spmv_bench> -stencil_sizes 0 -f corrupt_matrix.bin -repeats 1")
+set_tests_properties(bench_bad_matrix_file PROPERTIES LABELS "bench" TIMEOUT 60)
