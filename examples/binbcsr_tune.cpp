@@ -159,8 +159,6 @@ int main(int argc, char **argv)
       s.now = Now;
       PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-repeats", &s.repeats, nullptr));
       PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-batch", &s.batch, nullptr));
-      PetscCheck(s.repeats >= 1 && s.batch >= 1, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
-                 "-repeats and -batch must be >= 1");
       PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-tune_cache", &s.tune_cache, nullptr));
       PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-sweep_verbose", &s.verbose, nullptr));
       PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-stencil_sizes", sizes, &nsizes, &flg));
