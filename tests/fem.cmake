@@ -36,6 +36,9 @@ fem_test(fem_bad_box_counts nonzero "cell counts nx,ny,nz must be whole numbers"
 fem_test(fem_bad_box_too_many nonzero "6e\\+15 tetrahedra, more than 32-bit" ${FEM} -mesh_box 1,1,1,100000,100000,100000 -steps 1)
 fem_test(fem_bad_gravity_count nonzero "-gravity needs gx,gy,gz \\(3 numbers\\)" ${FEM} ${FEM_SMALL} -gravity 0,0,1,2)
 fem_test(fem_bad_mesh_size nonzero "-mesh_size must be positive and finite" ${FEM} ${FEM_SMALL} -mesh_size -1)
+# a tiny size is refused before gmsh runs (it ran for hours, printing nothing)
+fem_test(fem_bad_tiny_mesh_size nonzero "-mesh_size 1e-05 would mesh .* into about .* tetrahedra, over -mesh_max_elements 2e\\+07"
+         ${FEM} -mesh examples/meshes/bunny.geo -mesh_size 1e-5 -steps 1)
 fem_test(fem_bad_infinite_density nonzero "density must be > 0 and finite" ${FEM} ${FEM_SMALL} -density inf)
 fem_test(fem_mpi2_aij 0 "ranks=2 .*status=ok" ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_SMALL} -fem_order 2 -mat_type aij)
 set_tests_properties(fem_mpi2_aij PROPERTIES LABELS "fem;mpi")
