@@ -107,8 +107,9 @@ PetscErrorCode TimeCOO(const StencilGrid &g, PetscInt repeats)
 int main(int argc, char **argv)
 {
   StencilGrid          grid;
-  PetscInt             widths[16] = {1, 2, 4, 8, 16, 32}, nw = 6, repeats = 15, batch = 10, bs = 3;
-  PetscInt             streams[4] = {4}, ns = 1;
+  // the lists have one place more than they may hold: PETSc drops what does not fit without a word
+  PetscInt             widths[17] = {1, 2, 4, 8, 16, 32}, nw = 6, repeats = 15, batch = 10, bs = 3;
+  PetscInt             streams[5] = {4}, ns = 1;
   PetscBool            coo = PETSC_FALSE;
   std::vector<Variant> vars;
   Mat                  aij, baij;
@@ -119,12 +120,14 @@ int main(int argc, char **argv)
   grid.nx = grid.ny = grid.nz = 48;
   PetscCall(StencilGridFromOptions(nullptr, &grid));
   {
-    PetscInt  nset = 16;
+    PetscInt  nset = 17;
     PetscBool flg;
     PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-bin_widths", widths, &nset, &flg));
+    PetscCheck(nset <= 16, PETSC_COMM_WORLD, PETSC_ERR_ARG_SIZ, "-bin_widths takes at most 16 widths");
     if (flg) nw = nset;
-    nset = 4;
+    nset = 5;
     PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-streams", streams, &nset, &flg));
+    PetscCheck(nset <= 4, PETSC_COMM_WORLD, PETSC_ERR_ARG_SIZ, "-streams takes at most 4 stream counts (1,2,4,8)");
     if (flg) ns = nset;
   }
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-repeats", &repeats, nullptr));
@@ -155,13 +158,14 @@ int main(int argc, char **argv)
       SweepSettings s;
       char          buf[4096] = "";
       PetscBool     flg;
-      PetscInt      sizes[8] = {32, 48}, nsizes = 8;
+      PetscInt      sizes[9] = {32, 48}, nsizes = 9;
       s.now = Now;
       PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-repeats", &s.repeats, nullptr));
       PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-batch", &s.batch, nullptr));
       PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-tune_cache", &s.tune_cache, nullptr));
       PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-sweep_verbose", &s.verbose, nullptr));
       PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-stencil_sizes", sizes, &nsizes, &flg));
+      PetscCheck(nsizes <= 8, PETSC_COMM_WORLD, PETSC_ERR_ARG_SIZ, "-stencil_sizes takes at most 8 sizes");
       if (!flg) nsizes = 2;
       PetscCall(PetscPrintf(PETSC_COMM_SELF,
                             "binbcsr_tune -sweep: ms per MatMult, median of %" PetscInt_FMT

@@ -62,8 +62,8 @@ int main(int argc, char **argv)
   PetscBool             hanging = PETSC_FALSE, sphere = PETSC_FALSE, exact = PETSC_FALSE, set;
   char                  pins[32] = "corners";
   DriverOutput          out;
-  PetscReal             radius = 0.3, centre[3] = {0, -0.5, 0};
-  PetscInt              ncentre = 3;
+  PetscReal             radius = 0.3, centre[4] = {0, -0.5, 0}; // one place more: a fourth number is seen
+  PetscInt              ncentre = 4;
   physics::ClothParams  params;
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-cloth_n", &n, nullptr));
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, "-cloth_size", &opt.size, nullptr));

@@ -85,6 +85,24 @@ PetscErrorCode GetOptions(Options &o)
   PetscBool set;
   PetscFunctionBegin;
   PetscOptionsBegin(PETSC_COMM_WORLD, nullptr, "FEM driver options", "fem");
+  // A list of numbers: PETSc reads at most the array's length and drops the rest without a word
+  // (-initial_perturb 27,0,-0.3,-0.35,9 moved the node and ignored the 9), so each list is read into a
+  // longer buffer and must hold exactly its count.
+  const auto numbers = [&](const char *name, const char *what, PetscReal *value, PetscInt count,
+                           PetscBool *given) -> PetscErrorCode {
+    PetscReal buf[16];
+    PetscInt  got = 16;
+    PetscBool here;
+    PetscFunctionBeginUser;
+    for (PetscInt k = 0; k < count; ++k) buf[k] = value[k];
+    PetscCall(PetscOptionsRealArray(name, what, "", buf, &got, &here));
+    PetscCheck(!here || got == count, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG,
+               "%s needs %s (%" PetscInt_FMT " numbers), got %s%" PetscInt_FMT, name, what, count,
+               got == 16 ? "at least " : "", got);
+    for (PetscInt k = 0; here && k < count; ++k) value[k] = buf[k];
+    if (given) *given = here;
+    PetscFunctionReturn(0);
+  };
   PetscCall(PetscOptionsString("-mesh", "gmsh mesh (.msh 2.2/4.1 ASCII) or geometry (.geo, meshed by gmsh)",
                                "", o.mesh, o.mesh, sizeof o.mesh, nullptr));
   PetscCall(PetscOptionsReal("-mesh_size", "gmsh characteristic length for .geo input", "", o.mesh_size,
@@ -97,11 +115,7 @@ PetscErrorCode GetOptions(Options &o)
   PetscCheck(o.mesh_max_elements >= 1 && std::isfinite(o.mesh_max_elements), PETSC_COMM_WORLD,
              PETSC_ERR_ARG_OUTOFRANGE, "-mesh_max_elements must be at least 1 and finite, not %g",
              (double)o.mesh_max_elements);
-  n = 6;
-  PetscCall(PetscOptionsRealArray("-mesh_box", "lx,ly,lz,nx,ny,nz: box of 6 tets per cell", "", o.box, &n,
-                                  &o.box_set));
-  PetscCheck(!o.box_set || n == 6, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG,
-             "-mesh_box needs lx,ly,lz,nx,ny,nz");
+  PetscCall(numbers("-mesh_box", "lx,ly,lz,nx,ny,nz", o.box, 6, &o.box_set)); // a box of 6 tets per cell
   for (int k = 3; o.box_set && k < 6; ++k) // counts become ints: a value past their range is no count
     PetscCheck(o.box[k] >= 1 && o.box[k] <= 1e6 && o.box[k] == std::floor(o.box[k]), PETSC_COMM_WORLD,
                PETSC_ERR_ARG_OUTOFRANGE, "-mesh_box: the cell counts nx,ny,nz must be whole numbers in [1, 1e6], got %g",
@@ -120,25 +134,12 @@ PetscErrorCode GetOptions(Options &o)
   PetscCall(PetscOptionsReal("-dt", "time step (s)", "", o.dt, &o.dt, nullptr));
   PetscCall(
     PetscOptionsInt("-steps", "time steps (Newton iterations with -static)", "", o.steps, &o.steps, nullptr));
-  { // read into one more place than it takes, so that a fourth number is seen (it was dropped)
-    PetscReal g[4] = {o.gravity[0], o.gravity[1], o.gravity[2], 0};
-    n              = 4;
-    PetscCall(PetscOptionsRealArray("-gravity", "gx,gy,gz", "", g, &n, &set));
-    PetscCheck(!set || n == 3, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "-gravity needs gx,gy,gz (3 numbers)");
-    for (int k = 0; k < 3; ++k) o.gravity[k] = g[k];
-  }
-  n = 2;
-  PetscCall(
-    PetscOptionsRealArray("-rayleigh", "alpha,beta: damping D = alpha M + beta K", "", o.rayleigh, &n, &set));
-  PetscCheck(!set || n == 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "-rayleigh needs alpha,beta");
+  PetscCall(numbers("-gravity", "gx,gy,gz", o.gravity, 3, nullptr));
+  PetscCall(numbers("-rayleigh", "alpha,beta", o.rayleigh, 2, nullptr)); // damping D = alpha M + beta K
   PetscCall(PetscOptionsString("-fix",
                                "none | xmin|xmax|ymin|ymax|zmin|zmax[:fraction of the extent, default 0.01]",
                                "", o.fix, o.fix, sizeof o.fix, nullptr));
-  n = 6;
-  PetscCall(PetscOptionsRealArray("-fix_box", "x0,y0,z0,x1,y1,z1: fix the nodes in this box", "", o.fix_box,
-                                  &n, &o.fix_box_set));
-  PetscCheck(!o.fix_box_set || n == 6, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG,
-             "-fix_box needs x0,y0,z0,x1,y1,z1");
+  PetscCall(numbers("-fix_box", "x0,y0,z0,x1,y1,z1", o.fix_box, 6, &o.fix_box_set)); // fix the nodes inside
   PetscCall(PetscOptionsString("-vtk", "write PREFIX_NNNN.vtu frames and PREFIX.pvd", "", o.vtk, o.vtk,
                                sizeof o.vtk, nullptr));
   PetscCall(
@@ -194,17 +195,21 @@ PetscErrorCode GetOptions(Options &o)
   PetscCall(PetscOptionsBool("-fem_quiet", "no progress line per step", "", o.quiet, &o.quiet, nullptr));
   PetscCall(PetscOptionsBool("-static", "solve K(x) dx = f(x) + f_ext by Newton steps instead of time steps",
                              "", o.is_static, &o.is_static, nullptr));
-  n = 3;
-  PetscCall(PetscOptionsRealArray("-initial_velocity", "vx,vy,vz", "", o.v0, &n, nullptr));
-  n = 3;
-  PetscCall(PetscOptionsRealArray("-initial_spin", "wx,wy,wz: rigid angular velocity about the centroid", "",
-                                  o.spin, &n, nullptr));
+  PetscCall(numbers("-initial_velocity", "vx,vy,vz", o.v0, 3, nullptr));
+  PetscCall(numbers("-initial_spin", "wx,wy,wz", o.spin, 3, nullptr)); // rigid, about the centroid
   PetscCall(PetscOptionsReal("-initial_stretch", "scale initial positions about the centroid", "", o.stretch,
                              &o.stretch, nullptr));
-  n = 4;
-  PetscCall(PetscOptionsRealArray("-initial_perturb",
-                                  "node,dx,dy,dz: move one node (e.g. to invert an element)", "", o.perturb,
-                                  &n, nullptr));
+  {
+    PetscBool perturb;
+    PetscCall(numbers("-initial_perturb", "node,dx,dy,dz", o.perturb, 4, &perturb)); // e.g. to invert an element
+    PetscCheck(!perturb || (o.perturb[0] >= 0 && o.perturb[0] == std::floor(o.perturb[0]) &&
+                            o.perturb[0] <= PETSC_MAX_INT),
+               PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-initial_perturb: the node must be a node number, got %g",
+               (double)o.perturb[0]);
+    for (int d = 1; d < 4; ++d)
+      PetscCheck(std::isfinite(o.perturb[d]), PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+                 "-initial_perturb: dx,dy,dz must be finite");
+  }
   PetscOptionsEnd();
   PetscCheck(o.dt > 0 && std::isfinite(o.dt), PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
              "-dt must be positive");

@@ -561,8 +561,9 @@ int main(int argc, char **argv)
   }
 
   std::vector<MatrixSource> sources;
-  PetscInt                  sizes[16], nsizes = 16;
+  PetscInt                  sizes[17], nsizes = 17; // one more than it takes: PETSc drops extras silently
   PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-stencil_sizes", sizes, &nsizes, &flg));
+  PetscCheck(nsizes <= 16, PETSC_COMM_WORLD, PETSC_ERR_ARG_SIZ, "-stencil_sizes takes at most 16 sizes");
   if (!flg) {
     nsizes   = 3;
     sizes[0] = 16;

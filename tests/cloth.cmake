@@ -120,9 +120,12 @@ add_test(NAME cloth_bad_infinite_stiffness COMMAND ${EXPECT_RUN} nonzero "stiffn
                                                   -- ${CLOTH} -cloth_n 4 -cloth_k_stretch inf)
 add_test(NAME cloth_bad_sphere_centre COMMAND ${EXPECT_RUN} nonzero "sphere needs a finite centre"
                                              -- ${CLOTH} -cloth_n 4 -sphere -sphere_centre nan,0,0)
+# PETSc reads at most as many numbers as the array holds and drops the rest without a word
+add_test(NAME cloth_bad_sphere_centre_count COMMAND ${EXPECT_RUN} nonzero "-sphere_centre needs 3 numbers, got 4"
+                                                   -- ${CLOTH} -cloth_n 4 -sphere -sphere_centre 0,-0.5,0,7)
 set_tests_properties(cloth_drape_sphere cloth_scene_stretch_bounded cloth_scene_stretch_bounded_80 cloth_stiff_dt30 cloth_same_result_mat_types cloth_bad_dt cloth_bad_n cloth_bad_pins
                      cloth_bad_stiffness cloth_bad_strain_limit_omega cloth_bad_huge_n cloth_bad_infinite_stiffness
-                     cloth_bad_sphere_centre PROPERTIES LABELS "cloth" TIMEOUT 60)
+                     cloth_bad_sphere_centre cloth_bad_sphere_centre_count PROPERTIES LABELS "cloth" TIMEOUT 60)
 
 add_test(NAME cloth_mpi_np2
          COMMAND ${SUMMARY_SAME} "energy_final:1e-9 max_stretch:1e-9 contacts:0" 1e-6

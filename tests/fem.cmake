@@ -39,6 +39,13 @@ fem_test(fem_bad_mesh_size nonzero "-mesh_size must be positive and finite" ${FE
 # a tiny size is refused before gmsh runs (it ran for hours, printing nothing)
 fem_test(fem_bad_tiny_mesh_size nonzero "-mesh_size 1e-05 would mesh .* into about .* tetrahedra, over -mesh_max_elements 2e\\+07"
          ${FEM} -mesh examples/meshes/bunny.geo -mesh_size 1e-5 -steps 1)
+# lists of numbers: PETSc reads as many as the array holds and dropped the rest without a word
+fem_test(fem_bad_perturb_count nonzero "-initial_perturb needs node,dx,dy,dz \\(4 numbers\\), got 5" ${FEM} ${FEM_SMALL}
+         -initial_perturb 27,0,-0.3,-0.35,9)
+fem_test(fem_bad_perturb_node nonzero "-initial_perturb: the node must be a node number, got 2.5" ${FEM} ${FEM_SMALL}
+         -initial_perturb 2.5,0,0,0)
+fem_test(fem_bad_box_count nonzero "-mesh_box needs lx,ly,lz,nx,ny,nz \\(6 numbers\\), got 7" ${FEM}
+         -mesh_box 1,0.1,0.1,8,2,2,7 -steps 1)
 fem_test(fem_bad_infinite_density nonzero "density must be > 0 and finite" ${FEM} ${FEM_SMALL} -density inf)
 fem_test(fem_mpi2_aij 0 "ranks=2 .*status=ok" ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_SMALL} -fem_order 2 -mat_type aij)
 set_tests_properties(fem_mpi2_aij PROPERTIES LABELS "fem;mpi")
