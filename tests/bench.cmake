@@ -47,3 +47,9 @@ add_test(NAME bench_bad_matrix_file
          COMMAND ${EXPECT_RUN} nonzero "corrupt_matrix.bin: row 0 has length -3"
                  -- sh -c "cp ${PETSC_DATAFILES_DIR}/matrices/spd-real-int32-float64 corrupt_matrix.bin && chmod u+w corrupt_matrix.bin && printf '\\377\\377\\377\\375' | dd of=corrupt_matrix.bin bs=1 seek=16 conv=notrunc 2>/dev/null && $<TARGET_FILE:spmv_bench> -stencil_sizes 0 -f corrupt_matrix.bin -repeats 1")
 set_tests_properties(bench_bad_matrix_file PROPERTIES LABELS "bench" TIMEOUT 60)
+# An overflowing shift: every solve meets Inf (DIVERGED_NANORINF). Those are not timed, and the targets
+# say they were not measured (the speed-up column printed NaN beside the reason).
+add_test(NAME bench_solve_overflow_not_timed
+         COMMAND ${EXPECT_RUN} 0 "mcg +binbcsr +n/a +\\(not timed: the solve ended DIVERGED_NANORINF\\).*target: mcg\\+binbcsr per iteration vs cg\\+baij: not measured"
+                 -- $<TARGET_FILE:solve_bench> -stencil_n 6 -stencil_shift 1e300 -repeats 1)
+set_tests_properties(bench_solve_overflow_not_timed PROPERTIES LABELS "bench" TIMEOUT 60)
