@@ -287,9 +287,10 @@ int main(int argc, char **argv)
     if (out.vtk && n % out.vtk_every == 0) PetscCall(SyncScene(comm, solver.split, scene));
     PetscCall(write_frame(n));
     StepHealth health;
-    // A breakdown that switched the step to the regularised matrix is the physics' own recovery; any
-    // other failed solve leaves the impulses it produced (or zeros) in the step.
-    if (rs.diverged_solves - diverged0 > (r.singular_detected ? 1 : 0))
+    // A breakdown that switched the step to the regularised matrix, or a warm start solved again from
+    // zero, is the physics' own recovery; any other failed solve leaves the impulses it produced (or
+    // zeros) in the step.
+    if (rs.diverged_solves - diverged0 > r.recovered_solves)
       health.solver_reason = rs.worst_reason;
     health.energy      = energy;
     health.joint_error = r.joint_error;

@@ -11,6 +11,11 @@ add_test(NAME articulated_chain
 add_test(NAME articulated_loop
          COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && joint_error_max<1e-6 && loops==1"
                  -- ${ART} -options_file ${OPTS}/loop.opts -progress_every 1000)
+# Warm-started: the last step's corrections were a guess 6e4 times worse than zero at step 2
+# (DIVERGED_DTOL before the first iteration) and the run stopped; such a start is solved again from zero.
+add_test(NAME articulated_loop_warm_start
+         COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && joint_error_max<1e-6 && solver_failures==0 && steps==200"
+                 -- ${ART} -options_file ${OPTS}/loop.opts -joint_warm_start -steps 200 -progress_every 1000)
 add_test(NAME articulated_mass_ratio_1e4
          COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && joint_error_max<1e-6"
                  -- ${ART} -options_file ${OPTS}/mass_ratio.opts -chain_mass_first 1e2 -chain_mass_last 1e-2 -steps 240 -progress_every 1000)
@@ -75,7 +80,7 @@ add_test(NAME articulated_bad_mass
          COMMAND ${EXPECT_RUN} nonzero "masses must be positive" -- ${ART} -options_file ${OPTS}/chain.opts -chain_mass_first 0)
 add_test(NAME articulated_bad_scene
          COMMAND ${EXPECT_RUN} nonzero "unknown -scene trampoline" -- ${ART} -scene trampoline)
-set_tests_properties(articulated_bridge_icc articulated_bridge_icc_binbcsr articulated_bridge_full_binbcsr articulated_bad_halvings articulated_chain articulated_loop articulated_mass_ratio_1e4 articulated_mass_ratio_1e8_finite
+set_tests_properties(articulated_bridge_icc articulated_bridge_icc_binbcsr articulated_bridge_full_binbcsr articulated_bad_halvings articulated_chain articulated_loop articulated_loop_warm_start articulated_mass_ratio_1e4 articulated_mass_ratio_1e8_finite
                      articulated_bridge_small articulated_same_result_mat_types articulated_bad_dt articulated_bad_mass
                      articulated_bad_scene PROPERTIES LABELS "articulated" TIMEOUT 60)
 

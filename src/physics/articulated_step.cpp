@@ -201,15 +201,24 @@ ArticulatedStepReport articulated_step(ArticulatedScene &scene, ArticulatedSolve
     refill();
   };
   // A breakdown on the unregularised matrix means A is (numerically) singular: regularise and retry.
+  // A warm start that fails is solved again from zero: the last step's impulses can be far worse than
+  // no guess (a loop scene's corrections after the velocity stabilisation: a residual 6e4 times |b|,
+  // which PETSc stops as DIVERGED_DTOL before its first iteration).
   auto solve = [&](const std::vector<double> &guess) {
+    const bool warm = params.warm_start && guess.size() == s.impulses.size();
     set_initial_guess(params, guess, s.impulses);
     LinearSolveResult r = linear_solver.solve(s.rhs, s.impulses);
     report.linear_solves++, report.linear_iterations += r.iterations;
+    if (!r.converged && warm) {
+      std::fill(s.impulses.begin(), s.impulses.end(), 0.0);
+      r = linear_solver.solve(s.rhs, s.impulses);
+      report.linear_solves++, report.linear_iterations += r.iterations, report.recovered_solves++;
+    }
     if (r.breakdown && !s.regularised) {
       switch_to_regularised();
       set_initial_guess(params, guess, s.impulses);
       r = linear_solver.solve(s.rhs, s.impulses);
-      report.linear_solves++, report.linear_iterations += r.iterations;
+      report.linear_solves++, report.linear_iterations += r.iterations, report.recovered_solves++;
     }
     for (double v : s.impulses)
       if (!std::isfinite(v)) {

@@ -46,6 +46,10 @@ struct ArticulatedStepReport {
   bool   singular_detected = false; // this step found A singular and switched to regularisation
   bool   stalled           = false; // a correction could not reduce the error
   int    halvings          = 0;     // impulses halved back by the line search (each costs a prediction)
+  // failed solves the step recovered from by solving again: the breakdown that switched it to the
+  // regularised matrix, and warm starts that failed (a guess far worse than zero: DIVERGED_DTOL at
+  // iteration 0) and were solved again from zero
+  int    recovered_solves = 0;
 };
 
 // How the work of a step is split over processes that each hold the whole scene (the PETSc drivers with
