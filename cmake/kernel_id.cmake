@@ -1,12 +1,14 @@
-# cmake -DSRC=<source dir> -DOUT=<header> -P cmake/kernel_id.cmake
+# cmake -DSRC=<source dir> -DOUT=<header> -DFILES=<a|b|...> -P cmake/kernel_id.cmake
 # Writes OUT with BINBCSR_KERNEL_ID, the first 12 hex digits of an MD5 over the sources whose change can
-# change which layout runs fastest: the product bodies, the layout build and the tuner. The tuning cache
+# change which layout runs fastest: the product bodies, the layout build and the tuner (FILES, paths
+# relative to SRC separated by '|': CMakeLists.txt lists them once, KERNEL_ID_SOURCES). The tuning cache
 # keys its entries with it, so a library whose kernels changed measures again instead of taking the
 # choices another version made (docs/tuning.md). OUT is rewritten only when the id changes.
-file(GLOB_RECURSE files LIST_DIRECTORIES false
-     "${SRC}/src/mat_binbcsr/kernels/*.h" "${SRC}/src/mat_binbcsr/kernels/*.cpp" "${SRC}/src/mat_binbcsr/kernels/*.cuh")
-list(APPEND files "${SRC}/src/mat_binbcsr/seq/binbcsr_tune.cpp" "${SRC}/src/mat_binbcsr/seq/binbcsr_build.cpp"
-     "${SRC}/src/mat_binbcsr/seq/binbcsr_mult.cpp" "${SRC}/src/binbcsr_cpu.h")
+string(REPLACE "|" ";" relative "${FILES}")
+set(files "")
+foreach(f IN LISTS relative)
+  list(APPEND files "${SRC}/${f}")
+endforeach()
 list(SORT files)
 set(all "")
 foreach(f IN LISTS files)
