@@ -31,6 +31,10 @@ BlockPattern::WritePlan make_write_plan(const std::vector<int> &element_slots, i
                 "a write term must fit 16 bits");
   std::vector<char>                           written(blocks, 0);
   std::vector<std::pair<int, unsigned short>> terms; // (COO block, term) of one group
+  struct Run {
+    int start, count, first; // the block's terms in `terms`, and whether the group writes it first
+  };
+  std::vector<Run> runs;
   plan.group_offsets.push_back(0);
   plan.write_offsets.push_back(0);
   for (size_t g0 = 0; g0 < count; g0 += group) {
@@ -49,16 +53,27 @@ BlockPattern::WritePlan make_write_plan(const std::vector<int> &element_slots, i
     }
     std::stable_sort(terms.begin(), terms.end(),
                      [](const auto &x, const auto &y) { return x.first < y.first; });
-    for (size_t k = 0; k < terms.size(); ++k) { // the group's blocks ascending, each with its terms
-      const int s = terms[k].first;
-      if (k == 0 || s != terms[k - 1].first) {
-        if (k > 0) plan.write_offsets.push_back(static_cast<int>(plan.write_terms.size()));
-        plan.write_slots.push_back(written[s] ? s : s | kFirstContribution);
-        written[s] = 1;
-      }
-      plan.write_terms.push_back(terms[k].second);
+    // The group's blocks (first term, term count), then in runs of equal term count and first write,
+    // ascending within a run: the write-out's loop over a block's terms and its store-or-add then take
+    // the same branches block after block. In ascending order alone they changed from block to block
+    // (of quadratic_47k's 344k block writes 230k have one term, 93k two) and the mispredictions
+    // serialised the write-out (~17 ns per block written). Each block's terms keep element order.
+    runs.clear();
+    for (size_t k = 0; k < terms.size(); ++k) {
+      if (k == 0 || terms[k].first != terms[k - 1].first) runs.push_back({static_cast<int>(k), 0, 0});
+      runs.back().count++;
     }
-    if (!terms.empty()) plan.write_offsets.push_back(static_cast<int>(plan.write_terms.size()));
+    for (Run &b : runs) b.first = written[terms[b.start].first] ? 0 : 1;
+    std::stable_sort(runs.begin(), runs.end(), [](const Run &x, const Run &y) {
+      return x.count != y.count ? x.count < y.count : x.first > y.first;
+    });
+    for (const Run &b : runs) {
+      const int s = terms[b.start].first;
+      plan.write_slots.push_back(b.first ? s | kFirstContribution : s);
+      written[s] = 1;
+      for (int t = 0; t < b.count; ++t) plan.write_terms.push_back(terms[b.start + t].second);
+      plan.write_offsets.push_back(static_cast<int>(plan.write_terms.size()));
+    }
     plan.group_offsets.push_back(static_cast<int>(plan.write_slots.size()));
   }
   return plan;

@@ -49,8 +49,9 @@ struct BlockPattern {
   std::vector<int> identity_slots; // COO blocks that hold the identity (fixed nodes)
   bool             merged = false; // element blocks summed into unique COO blocks by the caller
   // The batched loop's write-out (element_batch.hpp's write groups): group g writes the COO blocks
-  // write_slots[group_offsets[g] .. group_offsets[g+1]) (ascending; kFirstContribution set in the
-  // first group that writes the block), block k the sum of its terms
+  // write_slots[group_offsets[g] .. group_offsets[g+1]) (by term count, first writes before the others,
+  // ascending within those runs; kFirstContribution set in the first group that writes the block),
+  // block k the sum of its terms
   // write_terms[write_offsets[k] .. write_offsets[k+1]) in element order, each term
   // 2 (element in the group * upper blocks per element + packed pair) + 1 where its block goes in transposed.
   struct WritePlan {

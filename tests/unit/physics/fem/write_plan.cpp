@@ -1,6 +1,7 @@
 // The batched loop's grouped write-out (BlockPattern::plan): on a mesh whose elements share blocks
 // within and across write groups, the plan lists every element block contribution once and marks one
-// first write per COO block, and the batched loop's sums equal the scalar loop's (element order) to
+// first write per COO block, each block once per group in runs of equal term count (the write-out's
+// branches taken alike block after block), and the batched loop's sums equal the scalar loop's (element order) to
 // rounding, in every body set, merged or not, whole matrix or upper triangle.
 #include <catch2/catch.hpp>
 
@@ -49,8 +50,24 @@ TEST_CASE("grouped write-out: one term per element block, one first write per CO
           for (int k = w.group_offsets[g]; k < w.group_offsets[g + 1]; ++k) {
             const int s = w.write_slots[k];
             if (s & kFirstContribution) ++firsts[s & kSlotIndexMask];
-            if (k > w.group_offsets[g]) CHECK((w.write_slots[k - 1] & kSlotIndexMask) < (s & kSlotIndexMask));
+            // runs of equal term count (growing), first writes before the others, ascending within a
+            // run: every block of the group once
+            if (k > w.group_offsets[g]) {
+              const int  prev = w.write_slots[k - 1];
+              const int  n0 = w.write_offsets[k] - w.write_offsets[k - 1], n1 = w.write_offsets[k + 1] - w.write_offsets[k];
+              const bool f0 = prev & kFirstContribution, f1 = s & kFirstContribution;
+              CHECK(n0 <= n1);
+              if (n0 == n1) CHECK(f0 >= f1);
+              if (n0 == n1 && f0 == f1) CHECK((prev & kSlotIndexMask) < (s & kSlotIndexMask));
+            }
           }
+        for (size_t g = 0; g + 1 < w.group_offsets.size(); ++g) {
+          std::vector<int> group_blocks;
+          for (int k = w.group_offsets[g]; k < w.group_offsets[g + 1]; ++k)
+            group_blocks.push_back(w.write_slots[k] & kSlotIndexMask);
+          std::sort(group_blocks.begin(), group_blocks.end());
+          CHECK(std::adjacent_find(group_blocks.begin(), group_blocks.end()) == group_blocks.end());
+        }
         for (int s : p.identity_slots) firsts[s] = 1;
         CHECK(std::count(firsts.begin(), firsts.end(), 1) == static_cast<long>(p.rows.size()));
 
