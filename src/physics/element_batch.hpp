@@ -35,9 +35,10 @@ constexpr int kSlotIndexMask     = kFirstContribution - 1;
 
 // The batched loop writes its blocks out per group of kElementLanes * write_group_batches(npe) listed
 // elements: it sums the contributions of the group's elements to each COO block it touches (in the
-// group's stage, 45 KB for P1, 63 KB for P2) and adds each sum into the values once, in ascending block
-// order (BlockPattern::plan). Linear_38k's 602k element blocks become 247k additions into its 93k COO
-// blocks (quadratic_47k: 496k -> 344k into 202k). Groups of half or twice the size measured no better.
+// group's stage, 45 KB for P1, 63 KB for P2) and adds each sum into the values once, the blocks in runs
+// of equal term count (BlockPattern::plan). Linear_38k's 602k element blocks become 247k additions into
+// its 93k COO blocks (quadratic_47k: 496k -> 344k into 202k). Groups of half or twice the size measured
+// no better (twice, again with the runs: within the noise, Zen 5, 2026-12-05).
 constexpr int write_group_batches(int npe) { return npe == 4 ? 8 : 2; }
 
 // What the element loop can also measure of the state it assembles, the figures of the drivers' run
