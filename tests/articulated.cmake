@@ -16,6 +16,12 @@ add_test(NAME articulated_loop
 add_test(NAME articulated_loop_warm_start
          COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && joint_error_max<1e-6 && solver_failures==0 && steps==200"
                  -- ${ART} -options_file ${OPTS}/loop.opts -joint_warm_start -steps 200 -progress_every 1000)
+# ... but a warm start that only runs out of iterations is kept, not solved a second time from zero:
+# one solve per stabilisation and per correction
+add_test(NAME articulated_warm_start_max_it_solved_once
+         COMMAND ${SUMMARY_CHECK} "steps==20 && solves<=steps*(1+corrections_per_step)"
+                 -- ${ART} -options_file ${OPTS}/chain.opts -joint_warm_start -ksp_max_it 3 -steps 20
+                    -on_solver_failure continue -progress_every 1000)
 add_test(NAME articulated_mass_ratio_1e4
          COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && joint_error_max<1e-6"
                  -- ${ART} -options_file ${OPTS}/mass_ratio.opts -chain_mass_first 1e2 -chain_mass_last 1e-2 -steps 240 -progress_every 1000)
@@ -80,7 +86,7 @@ add_test(NAME articulated_bad_mass
          COMMAND ${EXPECT_RUN} nonzero "masses must be positive" -- ${ART} -options_file ${OPTS}/chain.opts -chain_mass_first 0)
 add_test(NAME articulated_bad_scene
          COMMAND ${EXPECT_RUN} nonzero "unknown -scene trampoline" -- ${ART} -scene trampoline)
-set_tests_properties(articulated_bridge_icc articulated_bridge_icc_binbcsr articulated_bridge_full_binbcsr articulated_bad_halvings articulated_chain articulated_loop articulated_loop_warm_start articulated_mass_ratio_1e4 articulated_mass_ratio_1e8_finite
+set_tests_properties(articulated_bridge_icc articulated_bridge_icc_binbcsr articulated_bridge_full_binbcsr articulated_bad_halvings articulated_chain articulated_loop articulated_loop_warm_start articulated_warm_start_max_it_solved_once articulated_mass_ratio_1e4 articulated_mass_ratio_1e8_finite
                      articulated_bridge_small articulated_same_result_mat_types articulated_bad_dt articulated_bad_mass
                      articulated_bad_scene PROPERTIES LABELS "articulated" TIMEOUT 60)
 

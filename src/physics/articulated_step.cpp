@@ -147,11 +147,13 @@ double velocity_errors(const ArticulatedScene &scene, ArticulatedSolver &s, cons
 }
 
 // The initial guess for a solve: `guess` if warm starting with one of the right size, otherwise zero.
-void set_initial_guess(const ArticulatedParams &params, const std::vector<double> &guess,
-                       std::vector<double> &x)
+// Returns whether the guess was taken.
+bool set_initial_guess(const ArticulatedParams &params, const std::vector<double> &guess, std::vector<double> &x)
 {
-  if (params.warm_start && guess.size() == x.size()) std::copy(guess.begin(), guess.end(), x.begin());
+  const bool warm = params.warm_start && guess.size() == x.size();
+  if (warm) std::copy(guess.begin(), guess.end(), x.begin());
   else std::fill(x.begin(), x.end(), 0.0);
+  return warm;
 }
 
 } // namespace
@@ -201,15 +203,15 @@ ArticulatedStepReport articulated_step(ArticulatedScene &scene, ArticulatedSolve
     refill();
   };
   // A breakdown on the unregularised matrix means A is (numerically) singular: regularise and retry.
-  // A warm start that fails is solved again from zero: the last step's impulses can be far worse than
-  // no guess (a loop scene's corrections after the velocity stabilisation: a residual 6e4 times |b|,
-  // which PETSc stops as DIVERGED_DTOL before its first iteration).
+  // A warm start that breaks down is solved again from zero: the last step's impulses can be far worse
+  // than no guess (a loop scene's corrections after the velocity stabilisation: a residual 6e4 times
+  // |b|, which PETSc stops as DIVERGED_DTOL before its first iteration). Running out of iterations is
+  // no such failure (fixed-iteration runs end that way on purpose) and is not solved twice.
   auto solve = [&](const std::vector<double> &guess) {
-    const bool warm = params.warm_start && guess.size() == s.impulses.size();
-    set_initial_guess(params, guess, s.impulses);
-    LinearSolveResult r = linear_solver.solve(s.rhs, s.impulses);
+    const bool        warm = set_initial_guess(params, guess, s.impulses);
+    LinearSolveResult r    = linear_solver.solve(s.rhs, s.impulses);
     report.linear_solves++, report.linear_iterations += r.iterations;
-    if (!r.converged && warm) {
+    if (r.breakdown && warm) {
       std::fill(s.impulses.begin(), s.impulses.end(), 0.0);
       r = linear_solver.solve(s.rhs, s.impulses);
       report.linear_solves++, report.linear_iterations += r.iterations, report.recovered_solves++;

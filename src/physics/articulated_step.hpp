@@ -47,7 +47,7 @@ struct ArticulatedStepReport {
   bool   stalled           = false; // a correction could not reduce the error
   int    halvings          = 0;     // impulses halved back by the line search (each costs a prediction)
   // failed solves the step recovered from by solving again: the breakdown that switched it to the
-  // regularised matrix, and warm starts that failed (a guess far worse than zero: DIVERGED_DTOL at
+  // regularised matrix, and warm starts that broke down (a guess far worse than zero: DIVERGED_DTOL at
   // iteration 0) and were solved again from zero
   int    recovered_solves = 0;
 };
