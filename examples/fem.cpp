@@ -248,7 +248,11 @@ unsigned long long Fnv1a64(const std::string &text)
 }
 
 // Meshes a .geo with gmsh into a cache next to the program (build/meshes), on rank 0.
-PetscErrorCode MeshGeo(MPI_Comm comm, const std::string geo, double size, std::string *msh)
+PetscErrorCode EstimateGeoTets(MPI_Comm comm, const std::string &geo, double size, double *volume, double *tets);
+
+// max_tets: a size whose mesh is estimated to have more tetrahedra is refused before gmsh runs (0: no
+// bound); the estimate is made only when the mesh is not in the cache yet.
+PetscErrorCode MeshGeo(MPI_Comm comm, const std::string geo, double size, double max_tets, std::string *msh)
 {
   PetscMPIInt rank;
   char        exe[PETSC_MAX_PATH_LEN] = "";
@@ -276,8 +280,18 @@ PetscErrorCode MeshGeo(MPI_Comm comm, const std::string geo, double size, std::s
     std::snprintf(key, sizeof key, "%016llx", (unsigned long long)Fnv1a64(text + '\0' + options));
   }
   PetscCallMPI(MPI_Bcast(key, sizeof key, MPI_CHAR, 0, comm));
-  *msh = dir + "/" + base + "_" + key + ".msh";
-  if (!rank && !failed && !file_exists(*msh)) {
+  *msh     = dir + "/" + base + "_" + key + ".msh";
+  int make = !rank && !failed && !file_exists(*msh);
+  PetscCallMPI(MPI_Bcast(&make, 1, MPI_INT, 0, comm));
+  if (make && size > 0 && max_tets > 0) {
+    double volume, tets;
+    PetscCall(EstimateGeoTets(comm, geo, size, &volume, &tets));
+    PetscCheck(tets <= max_tets, comm, PETSC_ERR_ARG_OUTOFRANGE,
+               "-mesh_size %g would mesh %s (%.4g m^3) into about %.3g tetrahedra, over -mesh_max_elements "
+               "%.3g: choose a larger -mesh_size (%.3g gives about that many)",
+               size, geo.c_str(), volume, tets, max_tets, size * std::cbrt(tets / max_tets));
+  }
+  if (make) {
     mkdir(dir.c_str(), 0755);
     const std::string tmp = *msh + ".tmp." + std::to_string(getpid()) + ".msh";
     std::string       cmd = "gmsh " + options + "'" + geo + "' -o '" + tmp + "' > /dev/null 2>&1";
@@ -299,7 +313,7 @@ PetscErrorCode EstimateGeoTets(MPI_Comm comm, const std::string &geo, double siz
 {
   std::string coarse;
   PetscFunctionBegin;
-  PetscCall(MeshGeo(comm, geo, 0, &coarse));
+  PetscCall(MeshGeo(comm, geo, 0, 0, &coarse));
   std::string error;
   *volume = 0;
   try {
@@ -398,18 +412,8 @@ int main(int argc, char **argv)
   std::string mesh_name;
   {
     std::string msh = o.mesh;
-    if (msh.size() > 4 && msh.substr(msh.size() - 4) == ".geo") {
-      if (o.mesh_size > 0) {
-        double volume, tets;
-        PetscCall(EstimateGeoTets(comm, msh, o.mesh_size, &volume, &tets));
-        PetscCheck(tets <= o.mesh_max_elements, comm, PETSC_ERR_ARG_OUTOFRANGE,
-                   "-mesh_size %g would mesh %s (%.4g m^3) into about %.3g tetrahedra, over "
-                   "-mesh_max_elements %.3g: choose a larger -mesh_size (%.3g gives about that many)",
-                   (double)o.mesh_size, msh.c_str(), volume, tets, (double)o.mesh_max_elements,
-                   (double)o.mesh_size * std::cbrt(tets / o.mesh_max_elements));
-      }
-      PetscCall(MeshGeo(comm, msh, o.mesh_size, &msh));
-    }
+    if (msh.size() > 4 && msh.substr(msh.size() - 4) == ".geo")
+      PetscCall(MeshGeo(comm, msh, o.mesh_size, o.mesh_max_elements, &msh));
     std::string error;
     try {
       if (!msh.empty()) {
