@@ -60,10 +60,10 @@ BlockPattern::WritePlan make_write_plan(const std::vector<int> &element_slots, i
     // serialised the write-out (~17 ns per block written). Each block's terms keep element order.
     runs.clear();
     for (size_t k = 0; k < terms.size(); ++k) {
-      if (k == 0 || terms[k].first != terms[k - 1].first) runs.push_back({static_cast<int>(k), 0, 0});
+      if (k == 0 || terms[k].first != terms[k - 1].first)
+        runs.push_back({static_cast<int>(k), 0, written[terms[k].first] ? 0 : 1});
       runs.back().count++;
     }
-    for (Run &b : runs) b.first = written[terms[b.start].first] ? 0 : 1;
     std::stable_sort(runs.begin(), runs.end(), [](const Run &x, const Run &y) {
       return x.count != y.count ? x.count < y.count : x.first > y.first;
     });
