@@ -5,6 +5,8 @@
 #include <petsc/private/pcmgimpl.h>  // the levels' smoothers as they are
 #include <petsc/private/petscimpl.h> // PetscObjectStateGet
 
+#include <utility>
+
 namespace {
 
 PetscErrorCode IsBinBCSR(Mat A, PetscBool *binbcsr)
@@ -61,7 +63,7 @@ PetscErrorCode RefillFromBAIJ(Mat A, Mat *copy)
         for (PetscInt c = 0; c < bs; ++c) // BAIJ blocks are column-major
           for (PetscInt r = 0; r < bs; ++r) i.push_back(bs * br + r), j.push_back(bs * ja[k] + c);
     PetscCall(MatRestoreRowIJ(A, 0, PETSC_FALSE, PETSC_TRUE, &nb, &ia, &ja, &done));
-    PetscCall(CreateSingle(A, PETSC_TRUE, i, j, copy));
+    PetscCall(CreateSingle(A, PETSC_TRUE, std::move(i), std::move(j), copy));
   }
   PetscScalar *a;
   PetscCall(MatSeqBAIJGetArray(A, &a));
@@ -87,7 +89,7 @@ PetscErrorCode CreateFromAIJRows(Mat A, PetscBool upper, Mat *copy)
     for (PetscInt k = 0; k < ncols; ++k) i.push_back(r), j.push_back(cols[k]);
     PetscCall(MatRestoreRow(A, r, &ncols, &cols, nullptr));
   }
-  PetscCall(CreateSingle(A, upper, i, j, copy));
+  PetscCall(CreateSingle(A, upper, std::move(i), std::move(j), copy));
   PetscFunctionReturn(0);
 }
 
