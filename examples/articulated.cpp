@@ -290,8 +290,10 @@ int main(int argc, char **argv)
     // A breakdown that switched the step to the regularised matrix, or a warm start solved again from
     // zero, is the physics' own recovery; any other failed solve leaves the impulses it produced (or
     // zeros) in the step.
-    if (rs.diverged_solves - diverged0 > r.recovered_solves)
+    if (rs.diverged_solves - diverged0 > r.recovered_solves) {
       health.solver_reason = rs.worst_reason;
+      health.solver_detail = rs.worst_detail;
+    }
     health.energy      = energy;
     health.joint_error = r.joint_error;
     health.finite      = finite && std::isfinite(energy);

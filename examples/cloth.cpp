@@ -126,7 +126,8 @@ int main(int argc, char **argv)
   } catch (const std::invalid_argument &e) {
     SETERRQ(comm, PETSC_ERR_ARG_OUTOFRANGE, "cloth: %s", e.what());
   } catch (const std::bad_alloc &) {
-    SETERRQ(comm, PETSC_ERR_MEM, "cloth: not enough memory for a %" PetscInt_FMT " x %" PetscInt_FMT " cloth", n, n);
+    SETERRQ(comm, PETSC_ERR_MEM, "cloth: not enough memory for a %" PetscInt_FMT " x %" PetscInt_FMT " cloth",
+            n, n);
   }
   cloth.sphere.enabled      = sphere;
   cloth.sphere.radius       = radius;
@@ -254,6 +255,7 @@ int main(int argc, char **argv)
     PetscCall(write_frame(step));
     StepHealth health;
     health.solver_reason = rs.last.reason;
+    health.solver_detail = rs.last.pc_failure;
     health.energy        = physics::cloth_energy(cloth);
     health.finite        = finite && std::isfinite(health.energy);
     health.max_stretch   = r.max_stretch;

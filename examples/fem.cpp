@@ -44,7 +44,7 @@ namespace {
 
 struct Options {
   char      mesh[PETSC_MAX_PATH_LEN] = "";
-  PetscReal mesh_size                = 0; // for .geo files
+  PetscReal mesh_size                = 0;   // for .geo files
   PetscReal mesh_max_elements        = 2e7; // refuse a -mesh_size estimated to give more tetrahedra
   PetscReal box[6]                   = {1, 0.1, 0.1, 20, 2, 2};
   PetscBool box_set                  = PETSC_FALSE;
@@ -110,15 +110,16 @@ PetscErrorCode GetOptions(Options &o)
   PetscCheck(o.mesh_size >= 0 && std::isfinite(o.mesh_size), PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
              "-mesh_size must be positive and finite (0: the .geo file's own), not %g", (double)o.mesh_size);
   PetscCall(PetscOptionsReal("-mesh_max_elements",
-                             "a -mesh_size whose mesh would have about more tetrahedra than this is refused", "",
-                             o.mesh_max_elements, &o.mesh_max_elements, nullptr));
+                             "a -mesh_size whose mesh would have about more tetrahedra than this is refused",
+                             "", o.mesh_max_elements, &o.mesh_max_elements, nullptr));
   PetscCheck(o.mesh_max_elements >= 1 && std::isfinite(o.mesh_max_elements), PETSC_COMM_WORLD,
              PETSC_ERR_ARG_OUTOFRANGE, "-mesh_max_elements must be at least 1 and finite, not %g",
              (double)o.mesh_max_elements);
   PetscCall(numbers("-mesh_box", "lx,ly,lz,nx,ny,nz", o.box, 6, &o.box_set)); // a box of 6 tets per cell
   for (int k = 3; o.box_set && k < 6; ++k) // counts become ints: a value past their range is no count
     PetscCheck(o.box[k] >= 1 && o.box[k] <= 1e6 && o.box[k] == std::floor(o.box[k]), PETSC_COMM_WORLD,
-               PETSC_ERR_ARG_OUTOFRANGE, "-mesh_box: the cell counts nx,ny,nz must be whole numbers in [1, 1e6], got %g",
+               PETSC_ERR_ARG_OUTOFRANGE,
+               "-mesh_box: the cell counts nx,ny,nz must be whole numbers in [1, 1e6], got %g",
                (double)o.box[k]);
   PetscCall(
     PetscOptionsInt("-fem_order", "1 (4-node) or 2 (10-node) tetrahedra", "", o.order, &o.order, nullptr));
@@ -201,11 +202,12 @@ PetscErrorCode GetOptions(Options &o)
                              &o.stretch, nullptr));
   {
     PetscBool perturb;
-    PetscCall(numbers("-initial_perturb", "node,dx,dy,dz", o.perturb, 4, &perturb)); // e.g. to invert an element
+    PetscCall(
+      numbers("-initial_perturb", "node,dx,dy,dz", o.perturb, 4, &perturb)); // e.g. to invert an element
     PetscCheck(!perturb || (o.perturb[0] >= 0 && o.perturb[0] == std::floor(o.perturb[0]) &&
                             o.perturb[0] <= PETSC_MAX_INT),
-               PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-initial_perturb: the node must be a node number, got %g",
-               (double)o.perturb[0]);
+               PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+               "-initial_perturb: the node must be a node number, got %g", (double)o.perturb[0]);
     for (int d = 1; d < 4; ++d)
       PetscCheck(std::isfinite(o.perturb[d]), PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
                  "-initial_perturb: dx,dy,dz must be finite");
@@ -248,7 +250,8 @@ unsigned long long Fnv1a64(const std::string &text)
 }
 
 // Meshes a .geo with gmsh into a cache next to the program (build/meshes), on rank 0.
-PetscErrorCode EstimateGeoTets(MPI_Comm comm, const std::string &geo, double size, double *volume, double *tets);
+PetscErrorCode EstimateGeoTets(MPI_Comm comm, const std::string &geo, double size, double *volume,
+                               double *tets);
 
 // max_tets: a size whose mesh is estimated to have more tetrahedra is refused before gmsh runs (0: no
 // bound); the estimate is made only when the mesh is not in the cache yet.
@@ -309,7 +312,8 @@ PetscErrorCode MeshGeo(MPI_Comm comm, const std::string geo, double size, double
 // tetrahedra are a little larger on average: armadillo.geo at 0.0175 is estimated at 80,000 and meshed
 // into 60,448, bunny.geo at 0.03 at 5,450 and 4,471. Without the bound a tiny size ran gmsh for hours,
 // printing nothing.
-PetscErrorCode EstimateGeoTets(MPI_Comm comm, const std::string &geo, double size, double *volume, double *tets)
+PetscErrorCode EstimateGeoTets(MPI_Comm comm, const std::string &geo, double size, double *volume,
+                               double *tets)
 {
   std::string coarse;
   PetscFunctionBegin;
@@ -565,6 +569,7 @@ int main(int argc, char **argv)
         info.element_ms + info.setvalues_ms, info.solve_ms));
     StepHealth health;
     health.solver_reason     = info.stats.reason;
+    health.solver_detail     = info.stats.pc_failure;
     health.energy            = info.energy;
     health.finite            = info.finite && std::isfinite(health.energy);
     health.inverted_fraction = info.inverted_fraction;

@@ -86,6 +86,11 @@ add_test(NAME articulated_bad_mass
          COMMAND ${EXPECT_RUN} nonzero "masses must be positive" -- ${ART} -options_file ${OPTS}/chain.opts -chain_mass_first 0)
 add_test(NAME articulated_bad_scene
          COMMAND ${EXPECT_RUN} nonzero "unknown -scene trampoline" -- ${ART} -scene trampoline)
+# A failed preconditioner is named with its reason (src/sim/pc_failure.h; every LU pivot counts as zero).
+add_test(NAME articulated_pc_failure_named
+         COMMAND ${EXPECT_RUN} 2 "failed \\(DIVERGED_PC_FAILED, preconditioner: FACTOR_NUMERIC_ZEROPIVOT\\)"
+                 -- ${ART} -options_file ${OPTS}/chain.opts -steps 2 -mat_type aij -ksp_type cg -pc_type lu -pc_factor_zeropivot 1e300)
+set_tests_properties(articulated_pc_failure_named PROPERTIES LABELS "articulated" TIMEOUT 60)
 set_tests_properties(articulated_bridge_icc articulated_bridge_icc_binbcsr articulated_bridge_full_binbcsr articulated_bad_halvings articulated_chain articulated_loop articulated_loop_warm_start articulated_warm_start_max_it_solved_once articulated_mass_ratio_1e4 articulated_mass_ratio_1e8_finite
                      articulated_bridge_small articulated_same_result_mat_types articulated_bad_dt articulated_bad_mass
                      articulated_bad_scene PROPERTIES LABELS "articulated" TIMEOUT 60)

@@ -106,6 +106,11 @@ set_tests_properties(cloth_mg_converges_like_tight cloth_mg_energy_as_tight clot
                      cloth_mg_single_smoothers_only_with_blocks cloth_mg_bad_smoother_precision
                      PROPERTIES LABELS "cloth" TIMEOUT 60)
 set_tests_properties(cloth_mg_distributed_blocks_named PROPERTIES LABELS "cloth;mpi" PROCESSORS 2 TIMEOUT 60)
+# A failed preconditioner is named with its reason (src/sim/pc_failure.h; every LU pivot counts as zero).
+add_test(NAME cloth_pc_failure_named
+         COMMAND ${EXPECT_RUN} nonzero "DIVERGED_PC_FAILED, preconditioner: FACTOR_NUMERIC_ZEROPIVOT[;)]"
+                 -- ${CLOTH} -cloth_n 8 -steps 2 -mat_type aij -ksp_type cg -pc_type lu -pc_factor_zeropivot 1e300)
+set_tests_properties(cloth_pc_failure_named PROPERTIES LABELS "cloth" TIMEOUT 60)
 add_test(NAME cloth_bad_dt COMMAND ${EXPECT_RUN} nonzero "time step must be positive" -- ${CLOTH} -cloth_n 4 -dt 0)
 add_test(NAME cloth_bad_n COMMAND ${EXPECT_RUN} nonzero "at least 2 x 2" -- ${CLOTH} -cloth_n 1)
 add_test(NAME cloth_bad_pins COMMAND ${EXPECT_RUN} nonzero "unknown -cloth_pins elbows" -- ${CLOTH} -cloth_n 4 -cloth_pins elbows)

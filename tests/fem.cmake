@@ -135,6 +135,17 @@ fem_test(fem_solver_failure_continue 0 "steps=3 .*solver_failures=3 .*ended=comp
 # A state that stops being finite ends the run with exit code 3 (the kinetic energy of 1e200 m/s overflows).
 fem_test(fem_nonfinite_stop 3 "error: step 1 left a nonfinite state.*ended=nonfinite_state@step1 status=nonfinite"
          ${FEM} ${FEM_SMALL} -initial_velocity 0,0,1e200)
+# A failed preconditioner is named with what failed inside it (src/sim/pc_failure.h): an LU whose every
+# pivot counts as zero (-pc_factor_zeropivot 1e300), the same in a GAMG level's smoother and in a block of
+# block Jacobi on 2 ranks (the solve's DIVERGED_PC_FAILED alone did not say which, nor why).
+set(FEM_PC_FAILS ${FEM_SMALL} -mat_type aij -ksp_type cg)
+fem_test(fem_pc_failure_named nonzero "DIVERGED_PC_FAILED, preconditioner: FACTOR_NUMERIC_ZEROPIVOT[;)]"
+         ${FEM} ${FEM_PC_FAILS} -pc_type lu -pc_factor_zeropivot 1e300)
+fem_test(fem_gamg_level_failure_named nonzero "DIVERGED_PC_FAILED, level [0-9]+ smoother: FACTOR_NUMERIC_ZEROPIVOT[;)]"
+         ${FEM} ${FEM_PC_FAILS} -pc_type gamg -mg_levels_pc_type ilu -mg_levels_pc_factor_zeropivot 1e300)
+fem_test(fem_mpi2_block_failure_named nonzero "DIVERGED_PC_FAILED, block [0-9]+: FACTOR_NUMERIC_ZEROPIVOT on rank 0[;)]"
+         ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_PC_FAILS} -pc_type bjacobi -sub_pc_type lu -sub_pc_factor_zeropivot 1e300)
+set_tests_properties(fem_mpi2_block_failure_named PROPERTIES LABELS "fem;mpi")
 # A NaN in the scene is bad input.
 fem_test(fem_nan_gravity_error nonzero "-gravity, -initial_velocity and -initial_spin must be finite" ${FEM} ${FEM_SMALL} -gravity 0,0,nan)
 fem_test(fem_bad_on_solver_failure_error nonzero "-on_solver_failure must be stop or continue" ${FEM} ${FEM_SMALL} -on_solver_failure maybe)

@@ -191,7 +191,11 @@ static PetscErrorCode Solve(ReplicatedSolver *rs, const std::vector<double> &rhs
   rs->solves++;
   rs->iterations += rs->last.iterations;
   rs->solve_ms += 1e3 * (t1 - t0);
-  if (rs->last.reason < 0) rs->worst_reason = rs->last.reason, rs->diverged_solves++;
+  if (rs->last.reason < 0) {
+    rs->worst_reason = rs->last.reason;
+    rs->worst_detail = rs->last.pc_failure;
+    rs->diverged_solves++;
+  }
   PetscFunctionReturn(0);
 }
 

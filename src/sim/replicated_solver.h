@@ -47,7 +47,8 @@ struct ReplicatedSolver {
   long long          solves = 0, iterations = 0;
   double             solve_ms = 0, setvalues_ms = 0;
   SolveStats         last;
-  KSPConvergedReason worst_reason    = KSP_CONVERGED_ITERATING; // most recent negative reason, if any
+  KSPConvergedReason worst_reason = KSP_CONVERGED_ITERATING; // most recent negative reason, if any
+  std::string        worst_detail;                           // its SolveStats::pc_failure
   long long          diverged_solves = 0;
   PetscErrorCode     error = 0; // first PETSc error inside a callback (the physics API has no error codes)
 };

@@ -28,6 +28,14 @@ PetscErrorCode GetChoice(MPI_Comm comm, const char *name, const char *a, const c
   PetscFunctionReturn(0);
 }
 
+// The failed solve's reason, with what failed inside it where the driver knows (StepHealth::solver_detail).
+std::string Reason(const StepHealth &h)
+{
+  std::string r = KSPConvergedReasons[h.solver_reason];
+  if (!h.solver_detail.empty()) r += ", " + h.solver_detail;
+  return r;
+}
+
 } // namespace
 
 PetscErrorCode RunGuardFromOptions(MPI_Comm comm, const HealthBounds &scene, RunGuard *g)
@@ -59,11 +67,8 @@ PetscErrorCode RunGuardCheckStep(MPI_Comm comm, RunGuard *g, long long step, con
     g->exit_code = 3;
     std::snprintf(msg, sizeof msg, "nonfinite_state@step%lld", step);
     g->ended = msg;
-    PetscCall(
-      PetscPrintf(comm, "error: step %lld left a nonfinite state (NaN or Inf)%s; stopping\n", step,
-                  h.solver_reason < 0
-                    ? (std::string(" after the solver's ") + KSPConvergedReasons[h.solver_reason]).c_str()
-                    : ""));
+    PetscCall(PetscPrintf(comm, "error: step %lld left a nonfinite state (NaN or Inf)%s; stopping\n", step,
+                          h.solver_reason < 0 ? (" after the solver's " + Reason(h)).c_str() : ""));
     *stop = true;
     PetscFunctionReturn(0);
   }
@@ -78,7 +83,7 @@ PetscErrorCode RunGuardCheckStep(MPI_Comm comm, RunGuard *g, long long step, con
       PetscCall(PetscPrintf(
         comm,
         "error: the linear solve of step %lld failed (%s); stopping (-on_solver_failure continue integrates on)\n",
-        step, KSPConvergedReasons[h.solver_reason]));
+        step, Reason(h).c_str()));
       *stop = true;
       PetscFunctionReturn(0);
     }
@@ -98,7 +103,8 @@ PetscErrorCode RunGuardCheckStep(MPI_Comm comm, RunGuard *g, long long step, con
   else if (std::isfinite(b.max_stretch) && std::isfinite(h.max_stretch) && h.max_stretch > b.max_stretch)
     std::snprintf(msg, sizeof msg, "a spring is stretched to %.4g x its rest length (bound %.3g)",
                   h.max_stretch, b.max_stretch);
-  else if (std::isfinite(b.joint_error) && h.joint_error > b.joint_error) // an infinite gap too; NaN: no figure
+  else if (std::isfinite(b.joint_error) &&
+           h.joint_error > b.joint_error) // an infinite gap too; NaN: no figure
     std::snprintf(msg, sizeof msg, "a joint is %.4g m open after the step (bound %.3g m)", h.joint_error,
                   b.joint_error);
   if (msg[0]) {

@@ -37,11 +37,12 @@ struct HealthBounds {
 struct StepHealth {
   KSPConvergedReason solver_reason =
     KSP_CONVERGED_ITERATING; // negative: the step's result rests on a failed solve
-  bool   finite            = true;
-  double energy            = NAN;
-  double inverted_fraction = NAN;
-  double max_stretch       = NAN;
-  double joint_error       = NAN;
+  std::string solver_detail; // with the failure: what in the solver failed (pc_failure.h), or empty
+  bool        finite            = true;
+  double      energy            = NAN;
+  double      inverted_fraction = NAN;
+  double      max_stretch       = NAN;
+  double      joint_error       = NAN;
 };
 
 struct RunGuard {

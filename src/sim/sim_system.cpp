@@ -1,5 +1,7 @@
 #include "sim/sim_system.h"
 
+#include "sim/pc_failure.h"
+
 #include <petscbinbcsr.h>
 
 #include <algorithm>
@@ -351,6 +353,8 @@ PetscErrorCode BlockSystemSolve(BlockSystem *sys, const PetscScalar *rhs_local, 
     PetscCall(KSPGetIterationNumber(sys->ksp, &stats->iterations));
     PetscCall(KSPGetResidualNorm(sys->ksp, &stats->residual_norm));
     PetscCall(KSPGetConvergedReason(sys->ksp, &stats->reason));
+    stats->pc_failure.clear();
+    if (stats->reason == KSP_DIVERGED_PC_FAILED) PetscCall(DescribePCFailure(sys->ksp, &stats->pc_failure));
     stats->ms = 1e3 * (t1 - t0);
   }
   PetscFunctionReturn(0);

@@ -23,6 +23,7 @@
 #pragma once
 #include "sim/smoother_copy.h"
 #include <petscksp.h>
+#include <string>
 #include <vector>
 
 struct BlockSystem {
@@ -38,9 +39,9 @@ struct BlockSystem {
     PETSC_FALSE; // blocks below the diagonal are ignored or mirrored from above (sbaij, binbcsr
                  // symmetric storage or COO mirror): the caller lists the upper triangle
   std::vector<PetscInt> coo_block_row, coo_block_col; // kept for the fallback path and for dumps
-  const PetscScalar    *last_values = nullptr; // the caller's array from the last SetValues (for dumps)
-  PetscBool             values_set  = PETSC_FALSE; // SetValues was called (a rank without blocks has no array)
-  GAMGSmootherCopies    gamg_copies;           // -gamg_smoother_precision single (smoother_copy.h)
+  const PetscScalar    *last_values = nullptr;    // the caller's array from the last SetValues (for dumps)
+  PetscBool             values_set = PETSC_FALSE; // SetValues was called (a rank without blocks has no array)
+  GAMGSmootherCopies    gamg_copies;              // -gamg_smoother_precision single (smoother_copy.h)
   // -initial_guess_scaled: a nonzero initial guess x0 is replaced by a x0, a minimising ||b - a A x0||
   // (0 where x0 is no better than zero), at the cost of one product. r: its work vector.
   PetscBool guess_scaled = PETSC_FALSE;
@@ -53,6 +54,7 @@ struct SolveStats {
   PetscReal          residual_norm = 0; // as the KSP reports it (0 when the KSP computes none)
   KSPConvergedReason reason        = KSP_CONVERGED_ITERATING;
   double             ms            = 0; // wall-clock milliseconds of KSPSolve
+  std::string        pc_failure;        // with KSP_DIVERGED_PC_FAILED: what failed (pc_failure.h)
 };
 
 // n_block_rows_local may be PETSC_DECIDE. Call after PetscInitialize and plug-in registration.
