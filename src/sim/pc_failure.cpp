@@ -29,11 +29,12 @@ PetscErrorCode LocalFailure(PC pc, const std::string &where, std::string *what)
       else PetscCall(PCMGGetCoarseSolve(pc, &smoother));
       if (!smoother) continue;
       PetscCall(KSPGetPC(smoother, &spc));
-      PetscCall(LocalFailure(spc, in + (l > 0 ? "level " + std::to_string(l) + " smoother" : "coarse solve"), what));
+      PetscCall(
+        LocalFailure(spc, in + (l > 0 ? "level " + std::to_string(l) + " smoother" : "coarse solve"), what));
     }
   } else if (blocks && pc->setupcalled) { // the blocks exist once the PC is set up
-    PetscInt n = 0, first = 0;
-    KSP     *sub = nullptr;
+    PetscInt  n = 0, first = 0;
+    KSP      *sub = nullptr;
     PetscBool bjacobi;
     PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCBJACOBI, &bjacobi));
     if (bjacobi) PetscCall(PCBJacobiGetSubKSP(pc, &n, &first, &sub));
@@ -46,7 +47,8 @@ PetscErrorCode LocalFailure(PC pc, const std::string &where, std::string *what)
   }
   if (!what->empty()) PetscFunctionReturn(0);
   PetscCall(PCGetFailedReasonRank(pc, &reason));
-  if (reason != PC_NOERROR) *what = (where.empty() ? std::string("preconditioner") : where) + ": " + PCFailedReasons[reason];
+  if (reason != PC_NOERROR)
+    *what = (where.empty() ? std::string("preconditioner") : where) + ": " + PCFailedReasons[reason];
   PetscFunctionReturn(0);
 }
 
