@@ -3,6 +3,8 @@
 //
 //   fem -mesh_box 1,0.1,0.1,20,2,2 -fem_order 2 -fix xmin -steps 50 -mat_type binbcsr -ksp_type mcg
 //   fem -mesh examples/meshes/armadillo.geo -mesh_size 0.08 -fem_order 2 -vtk out/arma
+//   -write_positions / -reference_positions FILE: the final positions, in the input's node order, written
+//   or compared (rms and largest distance in the summary; src/sim/position_file.h)
 //
 // Parallel runs (mpiexec -n P): every rank holds the whole mesh and state; METIS splits the nodes
 // into P contiguous ranges (src/physics/partition), each rank assembles the elements inside its range
@@ -16,6 +18,7 @@
 
 #include "sim/fem_health.h"
 #include "sim/fem_simulation.h"
+#include "sim/position_file.h"
 #include "sim/summary.h"
 #include "physics/box_mesh.hpp"
 #include "physics/corotational_assembly.hpp"
@@ -694,6 +697,12 @@ int main(int argc, char **argv)
   s.add("energy_initial", guard.energy0);
   s.add("energy_final", total_energy());
   s.add("ksp_reason", std::string(KSPConvergedReasons[last_reason]));
+  { // in the input's node order: the simulation's numbering depends on the rank count (METIS + RCM)
+    std::vector<double> xyz(x.size());
+    for (int i = 0; i < n_nodes; ++i)
+      for (int d = 0; d < 3; ++d) xyz[3 * i + d] = x[3 * sim.new_of_old[i] + d];
+    PetscCall(DriverComparePositions(comm, xyz, s));
+  }
   RunGuardAddSummary(s, guard);
   PetscCall(PrintSummary(comm, s));
 

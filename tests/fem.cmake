@@ -146,6 +146,24 @@ fem_test(fem_gamg_level_failure_named nonzero "DIVERGED_PC_FAILED, level [0-9]+ 
 fem_test(fem_mpi2_block_failure_named nonzero "DIVERGED_PC_FAILED, block [0-9]+: FACTOR_NUMERIC_ZEROPIVOT on rank 0[;)]"
          ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_PC_FAILS} -pc_type bjacobi -sub_pc_type lu -sub_pc_factor_zeropivot 1e300)
 set_tests_properties(fem_mpi2_block_failure_named PROPERTIES LABELS "fem;mpi")
+# -write_positions / -reference_positions (src/sim/position_file.h), in the input's node order: a tight
+# solve on 2 ranks with binbcsr matches the same solve on 1 rank with aij to rounding (the simulation's
+# numbering differs between the two), a loose one does not; an unwritable file is an error.
+set(FEM_SUMMARY_CHECK ${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_check.sh)
+set(FEM_POSITIONS ${FEM_SMALL} -steps 5 -ksp_type cg -ksp_rtol 1e-12)
+set(FEM_POSITIONS_REF ${CMAKE_CURRENT_BINARY_DIR}/fem_positions_reference.txt)
+add_test(NAME fem_positions_reference
+         COMMAND ${FEM_SUMMARY_CHECK} "steps==5" -- ${FEM} ${FEM_POSITIONS} -mat_type aij -write_positions ${FEM_POSITIONS_REF})
+add_test(NAME fem_mpi2_positions_as_reference
+         COMMAND ${FEM_SUMMARY_CHECK} "ranks==2 && max_position_diff!=\"\" && rms_position_diff<1e-12 && max_position_diff<1e-12"
+                 -- ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_POSITIONS} -mat_type binbcsr -reference_positions ${FEM_POSITIONS_REF})
+add_test(NAME fem_loose_solve_positions_differ
+         COMMAND ${FEM_SUMMARY_CHECK} "rms_position_diff>1e-7 && max_position_diff>=rms_position_diff"
+                 -- ${FEM} ${FEM_POSITIONS} -mat_type aij -ksp_rtol 1e-2 -reference_positions ${FEM_POSITIONS_REF})
+set_tests_properties(fem_positions_reference PROPERTIES FIXTURES_SETUP fem_positions LABELS "fem" TIMEOUT 60)
+set_tests_properties(fem_mpi2_positions_as_reference PROPERTIES FIXTURES_REQUIRED fem_positions LABELS "fem;mpi" TIMEOUT 60)
+set_tests_properties(fem_loose_solve_positions_differ PROPERTIES FIXTURES_REQUIRED fem_positions LABELS "fem" TIMEOUT 60)
+fem_test(fem_bad_write_positions nonzero "-write_positions: cannot write" ${FEM} ${FEM_SMALL} -write_positions /nonexistent-dir/positions.txt)
 # A NaN in the scene is bad input.
 fem_test(fem_nan_gravity_error nonzero "-gravity, -initial_velocity and -initial_spin must be finite" ${FEM} ${FEM_SMALL} -gravity 0,0,nan)
 fem_test(fem_bad_on_solver_failure_error nonzero "-on_solver_failure must be stop or continue" ${FEM} ${FEM_SMALL} -on_solver_failure maybe)
