@@ -252,12 +252,12 @@ unsigned long long Fnv1a64(const std::string &text)
   return h;
 }
 
-// Meshes a .geo with gmsh into a cache next to the program (build/meshes), on rank 0.
 PetscErrorCode EstimateGeoTets(MPI_Comm comm, const std::string &geo, double size, double *volume,
                                double *tets);
 
-// max_tets: a size whose mesh is estimated to have more tetrahedra is refused before gmsh runs (0: no
-// bound); the estimate is made only when the mesh is not in the cache yet.
+// Meshes a .geo with gmsh into a cache next to the program (build/meshes), on rank 0. max_tets: a size
+// whose mesh is estimated to have more tetrahedra is refused before gmsh runs (0: no bound); the
+// estimate is made only when the mesh is not in the cache yet.
 PetscErrorCode MeshGeo(MPI_Comm comm, const std::string geo, double size, double max_tets, std::string *msh)
 {
   PetscMPIInt rank;
