@@ -10,7 +10,8 @@
 // -streams 1,2,4,8 times each matrix with each stream count (one matrix per width and precision:
 // the stream count is a traversal order, set before each batch).
 //
-// -sweep: every (bin width 4/8/16(/32 for bs 1), streams 1/2/4/8, body set the CPU has) against the autotuned default
+// -sweep: every (bin width 4/8/16(/32 for bs 1), streams 1/2/4/8, body set the CPU has, prefetch distance
+// 0/1024/4096 bytes or those of -sweep_prefetch) against the autotuned default
 // (nothing set, -mat_binbcsr_tune auto) for whole and symmetric storage in double and single precision,
 // on the stencils of -stencil_sizes (default 32,48) and on every PETSc binary file of -f (comma list,
 // block size from -bs, default 3; the drivers write them with -dump_matrix FILE). Per matrix and
@@ -106,7 +107,7 @@ PetscErrorCode TimeCOO(const StencilGrid &g, PetscInt repeats)
 
 int main(int argc, char **argv)
 {
-  StencilGrid          grid;
+  StencilGrid grid;
   // the lists have one place more than they may hold: PETSc drops what does not fit without a word
   PetscInt             widths[17] = {1, 2, 4, 8, 16, 32}, nw = 6, repeats = 15, batch = 10, bs = 3;
   PetscInt             streams[5] = {4}, ns = 1;
@@ -127,7 +128,8 @@ int main(int argc, char **argv)
     if (flg) nw = nset;
     nset = 5;
     PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-streams", streams, &nset, &flg));
-    PetscCheck(nset <= 4, PETSC_COMM_WORLD, PETSC_ERR_ARG_SIZ, "-streams takes at most 4 stream counts (1,2,4,8)");
+    PetscCheck(nset <= 4, PETSC_COMM_WORLD, PETSC_ERR_ARG_SIZ,
+               "-streams takes at most 4 stream counts (1,2,4,8)");
     if (flg) ns = nset;
   }
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-repeats", &repeats, nullptr));
@@ -135,9 +137,11 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-bs", &bs, nullptr));
   PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-coo", &coo, nullptr));
   /* -bs 0 divided by zero in MatSetBlockSize, -repeats 0 printed the unset minimum (1e300) */
-  PetscCheck(bs == 1 || bs == 3, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-bs must be 1 or 3, not %" PetscInt_FMT, bs);
+  PetscCheck(bs == 1 || bs == 3, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+             "-bs must be 1 or 3, not %" PetscInt_FMT, bs);
   PetscCheck(repeats >= 1 && batch >= 1, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
-             "-repeats and -batch must be >= 1 (got %" PetscInt_FMT " and %" PetscInt_FMT ")", repeats, batch);
+             "-repeats and -batch must be >= 1 (got %" PetscInt_FMT " and %" PetscInt_FMT ")", repeats,
+             batch);
   for (PetscInt i = 0; i < nw; i++)
     PetscCheck(widths[i] >= 1, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
                "-bin_widths must be >= 1, not %" PetscInt_FMT, widths[i]);
@@ -164,6 +168,13 @@ int main(int argc, char **argv)
       PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-batch", &s.batch, nullptr));
       PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-tune_cache", &s.tune_cache, nullptr));
       PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-sweep_verbose", &s.verbose, nullptr));
+      {
+        PetscInt pfs[16], npf = 16;
+        PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-sweep_prefetch", pfs, &npf, &flg));
+        if (flg) s.prefetches.assign(pfs, pfs + npf);
+        PetscCheck(!flg || npf > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
+                   "-sweep_prefetch: give at least one distance");
+      }
       PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-stencil_sizes", sizes, &nsizes, &flg));
       PetscCheck(nsizes <= 8, PETSC_COMM_WORLD, PETSC_ERR_ARG_SIZ, "-stencil_sizes takes at most 8 sizes");
       if (!flg) nsizes = 2;

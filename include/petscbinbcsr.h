@@ -64,6 +64,13 @@ PETSC_EXTERN PetscErrorCode MatBinBCSRGetCOOMirror(Mat, PetscBool *);
    -mat_binbcsr_streams. The setter is a no-op and the getter answers 1 on matrices of other types. */
 PETSC_EXTERN PetscErrorCode MatBinBCSRSetStreams(Mat, PetscInt);
 PETSC_EXTERN PetscErrorCode MatBinBCSRGetStreams(Mat, PetscInt *);
+/* Prefetch: how many bytes ahead of the slot group being multiplied the products (block size 1 or 3,
+   bin width 4, 8, 16 or 32) prefetch the values in software; 0 turns the software prefetch off. A
+   multiple of 64 in [0, 65536], default 4096, chosen by the tuner when not set. Results are the same for
+   any value. Option -mat_binbcsr_prefetch. The setter is a no-op and the getter answers 0 on matrices
+   of other types. */
+PETSC_EXTERN PetscErrorCode MatBinBCSRSetPrefetch(Mat, PetscInt);
+PETSC_EXTERN PetscErrorCode MatBinBCSRGetPrefetch(Mat, PetscInt *);
 /* Tuning on this machine (option -mat_binbcsr_tune auto|off, default auto): when the layout is built
    from the final pattern (first final assembly, COO preallocation, conversion, load), the bin width
    and the stream count that were not set explicitly are chosen by timing products of a sample of the
@@ -76,8 +83,8 @@ typedef enum {
   MAT_BINBCSR_TUNE_AUTO = 1
 } MatBinBCSRTune;
 PETSC_EXTERN const char *const MatBinBCSRTunes[];
-PETSC_EXTERN PetscErrorCode MatBinBCSRSetTune(Mat, MatBinBCSRTune);
-PETSC_EXTERN PetscErrorCode MatBinBCSRGetTune(Mat, MatBinBCSRTune *);
+PETSC_EXTERN PetscErrorCode    MatBinBCSRSetTune(Mat, MatBinBCSRTune);
+PETSC_EXTERN PetscErrorCode    MatBinBCSRGetTune(Mat, MatBinBCSRTune *);
 /* The tuner's choices are kept per machine (CPU model, cores, kernel bodies) and matrix class (block
    size, precision, storage, size, row lengths) in $XDG_CACHE_HOME/petscbinbcsr/tune.txt (else
    ~/.cache/petscbinbcsr/tune.txt), so a later run takes them without timing. Option
@@ -157,8 +164,8 @@ typedef enum {
   MAT_BINBCSR_DEVICE_CUDA      = 2
 } MatBinBCSRDevice;
 PETSC_EXTERN const char *const MatBinBCSRDevices[];
-PETSC_EXTERN PetscErrorCode MatBinBCSRSetDevice(Mat, MatBinBCSRDevice);
-PETSC_EXTERN PetscErrorCode MatBinBCSRGetDevice(Mat, MatBinBCSRDevice *);
+PETSC_EXTERN PetscErrorCode    MatBinBCSRSetDevice(Mat, MatBinBCSRDevice);
+PETSC_EXTERN PetscErrorCode    MatBinBCSRGetDevice(Mat, MatBinBCSRDevice *);
 
 /* KSPMCG: run exactly n iterations per solve, computing no norm (n = 0: off, use the tolerances).
    Option -ksp_mcg_fixed_iterations n. */

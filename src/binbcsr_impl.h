@@ -6,6 +6,9 @@
 /* Default MatBinBCSRSetStreams (seq and mpi): 4 runs of bins swept side by side (docs/mat_binbcsr.md:
    on the 48^3 stencil 2, 4, 6 and 8 runs all beat 1; 4 was the fastest or within the noise of it). */
 #define BINBCSR_DEFAULT_STREAMS 4
+/* Default MatBinBCSRSetPrefetch: values prefetched 4 KiB ahead (chosen on a Sapphire Rapids core; the
+   tuner times 0, 1 and 4 KiB where it is not set, docs/tuning.md). */
+#define BINBCSR_DEFAULT_PREFETCH 4096
 
 #include <petscbinbcsr.h>
 #include <petsc/private/petscimpl.h>

@@ -40,10 +40,11 @@ namespace {
 
 struct Variant {
   Mat                 A  = nullptr;
-  PetscInt            bw = 0, streams = 0;              // streams set before each batch (0: the matrix's own)
-  MatBinBCSRKernel    kernel = MAT_BINBCSR_KERNEL_AUTO; // set before each batch
-  bool                owner  = false;
-  double              best   = 1e300;
+  PetscInt            bw = 0, streams = 0; // streams set before each batch (0: the matrix's own)
+  PetscInt            prefetch = -1;       // set before each batch (-1: the matrix's own)
+  MatBinBCSRKernel    kernel   = MAT_BINBCSR_KERNEL_AUTO; // set before each batch
+  bool                owner    = false;
+  double              best     = 1e300;
   std::vector<double> t; // ms per MatMult of each round
   double              median() const
   {
@@ -123,6 +124,7 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
     PetscCall(MatBinBCSRGetBinWidth(tuned.A, &tuned.bw));
     PetscCall(MatBinBCSRGetStreams(tuned.A, &tuned.streams));
     PetscCall(MatBinBCSRGetKernel(tuned.A, &tuned.kernel));
+    PetscCall(MatBinBCSRGetPrefetch(tuned.A, &tuned.prefetch));
     base.A = ref;
     for (PetscInt bw : widths) {
       Mat A;
@@ -133,13 +135,16 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
           PetscBool avail;
           PetscCall(MatBinBCSRKernelAvailable(k, &avail));
           if (!avail) continue;
-          Variant v;
-          v.A       = A;
-          v.bw      = bw;
-          v.streams = K;
-          v.kernel  = k;
-          v.owner   = vars.empty() || vars.back().A != A;
-          vars.push_back(v);
+          for (PetscInt pf : s.prefetches) {
+            Variant v;
+            v.A        = A;
+            v.bw       = bw;
+            v.streams  = K;
+            v.kernel   = k;
+            v.prefetch = pf;
+            v.owner    = vars.empty() || vars.back().A != A;
+            vars.push_back(v);
+          }
         }
     }
     // The order of a round: every binbcsr matrix is timed after another binbcsr matrix. What ran just
@@ -164,6 +169,7 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
       for (Variant *v : all) {
         if (v != &tuned && v->streams) PetscCall(MatBinBCSRSetStreams(v->A, v->streams));
         if (v != &tuned && v != &base) PetscCall(MatBinBCSRSetKernel(v->A, v->kernel));
+        if (v != &tuned && v != &base) PetscCall(MatBinBCSRSetPrefetch(v->A, v->prefetch));
         PetscCall(MatMult(v->A, x, y)); // warm
         const double a = s.now();
         for (PetscInt b = 0; b < s.batch; b++) PetscCall(MatMult(v->A, x, y));
@@ -182,21 +188,23 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
                *p       = prec == MAT_BINBCSR_PRECISION_SINGLE ? "single" : "double";
     if (s.verbose) {
       for (const Variant &v : vars)
-        PetscCall(PetscPrintf(
-          PETSC_COMM_SELF, "  %-14s %-9s %-6s bw %2" PetscInt_FMT " K %" PetscInt_FMT " %-8s %9.4f ms\n",
-          name.c_str(), storage, p, v.bw, v.streams, MatBinBCSRKernels[v.kernel], 1e3 * v.median()));
+        PetscCall(PetscPrintf(PETSC_COMM_SELF,
+                              "  %-14s %-9s %-6s bw %2" PetscInt_FMT " K %" PetscInt_FMT
+                              " %-8s pf %5" PetscInt_FMT " %9.4f ms\n",
+                              name.c_str(), storage, p, v.bw, v.streams, MatBinBCSRKernels[v.kernel],
+                              v.prefetch, 1e3 * v.median()));
       PetscCall(PetscPrintf(PETSC_COMM_SELF, "  tuner: %s\n", line.c_str()));
     }
     PetscCall(PetscPrintf(
       PETSC_COMM_SELF,
-      "%-14s %-9s %-6s best %2" PetscInt_FMT "/%" PetscInt_FMT "/%-8s %8.4f   tuned %2" PetscInt_FMT
-      "/%" PetscInt_FMT
-      "/%-8s %8.4f   tuned/best %5.3f (min %5.3f)   %s %8.4f  tuned x %s %5.2f   tuning %6.1f ms "
+      "%-14s %-9s %-6s best %2" PetscInt_FMT "/%" PetscInt_FMT "/%s/%-5" PetscInt_FMT
+      " %8.4f   tuned %2" PetscInt_FMT "/%" PetscInt_FMT "/%s/%-5" PetscInt_FMT
+      " %8.4f   tuned/best %5.3f (min %5.3f)   %s %8.4f  tuned x %s %5.2f   tuning %6.1f ms "
       "(build %.0f ms)\n",
-      name.c_str(), storage, p, best->bw, best->streams, MatBinBCSRKernels[best->kernel],
-      1e3 * best->median(), tuned.bw, tuned.streams, MatBinBCSRKernels[tuned.kernel], 1e3 * tuned.median(),
-      PairedRatio(tuned, *best), tuned.best / best->best, bs > 1 ? "baij" : "aij", 1e3 * base.median(),
-      bs > 1 ? "baij" : "aij", PairedRatio(base, tuned), cost, 1e3 * (t1 - t0)));
+      name.c_str(), storage, p, best->bw, best->streams, MatBinBCSRKernels[best->kernel], best->prefetch,
+      1e3 * best->median(), tuned.bw, tuned.streams, MatBinBCSRKernels[tuned.kernel], tuned.prefetch,
+      1e3 * tuned.median(), PairedRatio(tuned, *best), tuned.best / best->best, bs > 1 ? "baij" : "aij",
+      1e3 * base.median(), bs > 1 ? "baij" : "aij", PairedRatio(base, tuned), cost, 1e3 * (t1 - t0)));
     for (Variant &v : vars)
       if (v.owner) PetscCall(MatDestroy(&v.A));
     PetscCall(MatDestroy(&tuned.A));

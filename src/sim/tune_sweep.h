@@ -1,17 +1,19 @@
-// binbcsr_tune -sweep: every (bin width, stream count, kernel body set) of MATSEQBINBCSR against the autotuned default
+// binbcsr_tune -sweep: every (bin width, stream count, kernel body set, prefetch distance) of MATSEQBINBCSR against the autotuned default
 // (-mat_binbcsr_tune auto, nothing set) on one matrix, whole and symmetric storage, double and single
 // precision, timed round-robin in one run; prints per case the sweep's best, the tuned choice and
 // tuned / best, with seqbaij (seqaij for bs 1) as the reference.
 #pragma once
 #include <petscmat.h>
 #include <string>
+#include <vector>
 
 struct SweepSettings {
   PetscInt  repeats    = 5;           // rounds
   PetscInt  batch      = 5;           // MatMults per variant per round
   PetscBool tune_cache = PETSC_FALSE; // the tuned matrix may use the cache file (default: it measures)
   PetscBool verbose    = PETSC_FALSE; // every variant's time, not only the summary line
-  double (*now)()      = nullptr;     // the clock
+  std::vector<PetscInt> prefetches = {0, 1024, 4096}; // software prefetch distances swept (bytes)
+  double (*now)()                  = nullptr;         // the clock
 };
 
 // A MATSEQBINBCSR copy of the assembled seq matrix src (its rows through MatSetValues) with block size

@@ -70,6 +70,10 @@ PetscErrorCode MatBinBCSRReadOptions_Private(Mat A, PetscOptionItems *PetscOptio
   PetscCall(OptionInt(PetscOptionsObject, A, "-mat_binbcsr_streams",
                       "Runs of bins the product sweeps side by side (1, 2, 4, 8)", "MatBinBCSRSetStreams",
                       MatBinBCSRGetStreams, MatBinBCSRSetStreams));
+  PetscCall(
+    OptionInt(PetscOptionsObject, A, "-mat_binbcsr_prefetch",
+              "Bytes ahead the products prefetch the values (0: none; a multiple of 64, at most 65536)",
+              "MatBinBCSRSetPrefetch", MatBinBCSRGetPrefetch, MatBinBCSRSetPrefetch));
   PetscCall(OptionEnum(PetscOptionsObject, A, "-mat_binbcsr_device",
                        "Device copy: none, reference (host executor), cuda (one process only)",
                        "MatBinBCSRSetDevice", MatBinBCSRDevices, MatBinBCSRGetDevice, MatBinBCSRSetDevice));

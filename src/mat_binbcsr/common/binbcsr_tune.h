@@ -1,9 +1,10 @@
 /*
    The per-machine tuning of MATSEQBINBCSR (seq/binbcsr_tune.cpp) and its cache file
    (binbcsr_tune_cache.cpp). The tuner runs when a layout is built from a final pattern: it times
-   products of a sample of the matrix for the candidate bin widths and stream counts, keeps the
-   fastest, and remembers the choice per machine and matrix class in a small text file under
-   $XDG_CACHE_HOME/petscbinbcsr/ (~/.cache/petscbinbcsr/), so the next run starts tuned.
+   products of a sample of the matrix for the candidate bin widths, stream counts, body sets and
+   software prefetch distances, keeps the fastest, and remembers the choice per machine and matrix
+   class in a small text file under $XDG_CACHE_HOME/petscbinbcsr/ (~/.cache/petscbinbcsr/), so the next
+   run starts tuned.
 */
 #ifndef BINBCSR_TUNE_H
 #define BINBCSR_TUNE_H
@@ -25,9 +26,10 @@ PETSC_INTERN PetscErrorCode BinBCSRTuneSettingsGet(Mat, BinBCSRTuneSettings *);
 
 /* One choice of the tuner; what the cache file stores per key. */
 struct BinBCSRTuneChoice {
-  PetscInt bw      = 0;
-  PetscInt streams = 0;
-  PetscInt kernel  = 0; /* MatBinBCSRKernel; AUTO: the dispatch's default */
+  PetscInt bw       = 0;
+  PetscInt streams  = 0;
+  PetscInt kernel   = 0; /* MatBinBCSRKernel; AUTO: the dispatch's default */
+  PetscInt prefetch = 0; /* bytes ahead (MatBinBCSRSetPrefetch) */
 };
 
 /* The machine part of a cache key: CPU model string, online cores, the kernel bodies compiled in. */

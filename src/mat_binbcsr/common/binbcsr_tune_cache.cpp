@@ -1,7 +1,7 @@
 /* The tuning cache file of MATSEQBINBCSR: one text line per (machine, matrix class),
 
-     # petscbinbcsr tune cache v3
-     <machine key> TAB <matrix class> TAB <bin width> <streams> <body set>
+     # petscbinbcsr tune cache v4
+     <machine key> TAB <matrix class> TAB <bin width> <streams> <body set> <prefetch bytes>
 
    read whole and rewritten whole (a temporary file renamed over the old one). The file only saves
    time: whatever is wrong with it makes the tuner measure again, never fail or use a bad layout.
@@ -10,7 +10,8 @@
    that ran 2.3x slower with it) holds choices this one would not make, so it is dropped quietly and
    measured again. The version also moves when bodies change what is fastest: v3 came with the
    hand-written AVX2 bodies, after which a Zen 3 core ran the 48^3 stencil's whole single product
-   fastest at bin width 4, where v2 files held 16 (measured with the compiler-vectorised ones).
+   fastest at bin width 4, where v2 files held 16 (measured with the compiler-vectorised ones); v4 added
+   the software prefetch distance, which v3 choices were timed at 4096 bytes only.
    Since then the machine key ends with the kernel id (BINBCSR_KERNEL_ID, a hash of the bodies', the
    layout build's and the tuner's sources made by the build): a library whose kernels changed takes none
    of the choices an earlier one made, and its first store drops them. Without it a choice stayed in the
@@ -31,7 +32,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-static const char *const cache_header      = "# petscbinbcsr tune cache v3";
+static const char *const cache_header      = "# petscbinbcsr tune cache v4";
 static const char *const cache_header_stem = "# petscbinbcsr tune cache v"; /* of every version */
 
 /* The machine without the kernel id: CPU, cores and the best body set. */
@@ -95,21 +96,25 @@ static bool ReadCache(const std::string &path, std::map<std::string, BinBCSRTune
       return false;
     }
     std::istringstream v(line.substr(t2 + 1));
-    long               bw = 0, streams = 0;
+    long               bw = 0, streams = 0, prefetch = -1;
     std::string        body, rest;
     int                kernel = -1;
-    if (v >> bw >> streams >> body)
+    if (v >> bw >> streams >> body >> prefetch)
       for (int k = 0; k <= (int)binbcsr::BodySet::AVX512; k++)
         if (body == binbcsr::body_set_name((binbcsr::BodySet)k) &&
             binbcsr::body_set_available((binbcsr::BodySet)k))
           kernel = k;
     if (kernel < 0 || (v >> rest) || bw < 1 || bw > 1024 ||
-        (streams != 1 && streams != 2 && streams != 4 && streams != 8)) {
-      why = "line " + std::to_string(n) + ": choice \"" + line.substr(t2 + 1) +
-            "\" is not a bin width in [1, 1024], streams 1, 2, 4 or 8 and a body set this CPU has";
+        (streams != 1 && streams != 2 && streams != 4 && streams != 8) || prefetch < 0 || prefetch > 65536 ||
+        prefetch % 64) {
+      why =
+        "line " + std::to_string(n) + ": choice \"" + line.substr(t2 + 1) +
+        "\" is not a bin width in [1, 1024], streams 1, 2, 4 or 8, a body set this CPU has and a prefetch "
+        "distance (a multiple of 64 in [0, 65536])";
       return false;
     }
-    entries[line.substr(0, t2)] = BinBCSRTuneChoice{(PetscInt)bw, (PetscInt)streams, (PetscInt)kernel};
+    entries[line.substr(0, t2)] =
+      BinBCSRTuneChoice{(PetscInt)bw, (PetscInt)streams, (PetscInt)kernel, (PetscInt)prefetch};
   }
   return true;
 }
@@ -206,7 +211,7 @@ PetscErrorCode BinBCSRTuneCacheStore(const std::string &key, const BinBCSRTuneCh
 
   PetscFunctionBegin;
   if (path.empty()) PetscFunctionReturn(0);
-  if (!ReadCache(path, entries, why)) entries.clear(); /* a corrupt file is replaced (the lookup warned) */
+  if (!ReadCache(path, entries, why)) entries.clear();  /* a corrupt file is replaced (the lookup warned) */
   for (auto it = entries.begin(); it != entries.end();) /* other kernels' choices for this machine */
     it = StaleForThisMachine(it->first) ? entries.erase(it) : std::next(it);
   entries[key] = c;
@@ -221,7 +226,7 @@ PetscErrorCode BinBCSRTuneCacheStore(const std::string &key, const BinBCSRTuneCh
     out << cache_header << "\n";
     for (const auto &[k, v] : entries)
       out << k << "\t" << v.bw << " " << v.streams << " "
-          << binbcsr::body_set_name((binbcsr::BodySet)v.kernel) << "\n";
+          << binbcsr::body_set_name((binbcsr::BodySet)v.kernel) << " " << v.prefetch << "\n";
     out.close();
     if (!out) {
       PetscCall(PetscInfo(nullptr, "Cannot write the tuning cache %s\n", tmp.c_str()));

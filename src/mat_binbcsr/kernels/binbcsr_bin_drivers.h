@@ -99,9 +99,10 @@ template <int K, class F> inline void for_each_sweep(int nbins, F &&f)
    across lanes). x_c of a padding slot reads as zero (a select, no branch): its zero value times a
    NaN or Inf of x would put a NaN into a row that does not have one. */
 template <int BS, int BW, typename V>
-inline void group_mult(const V *t, const int *c, const double *x, double (*acc)[BW], int k, const int *nz)
+inline void group_mult(const V *t, const int *c, const double *x, double (*acc)[BW], int k, const int *nz,
+                       int pf)
 {
-  prefetch_values(t, BW * BS * BS * (int)sizeof(V));
+  prefetch_values(t, BW * BS * BS * (int)sizeof(V), pf);
   if (unit_stride<BW>(c)) { /* consecutive columns: x_c by plain loads, no gathers */
     const double *xs = x + (size_t)c[0] * BS;
     BINBCSR_LANE_LOOP
@@ -143,16 +144,17 @@ inline void bins_sweep(const BinMatrix &m, const int *bins, const double *x, con
   if constexpr (BS == 3 && BW == 8) {
     double(*accq[K])[8];
     for (int q = 0; q < K; q++) accq[q] = acc[q];
-    avx512::bins_mult_3x8<K>(s.t, s.c, s.len, nz, x, m.nbs, accq);
+    avx512::bins_mult_3x8<K>(s.t, s.c, s.len, nz, x, m.nbs, accq, m.prefetch);
   } else
 #endif
 #if defined(BINBCSR_HAND_AVX2)
     if constexpr (BS == 3 && (BW == 4 || BW == 8 || BW == 16))
-    hand4::bins_mult_3x4<K, BW>(s.t, s.c, s.len, nz, x, m.nbs, acc);
+    hand4::bins_mult_3x4<K, BW>(s.t, s.c, s.len, nz, x, m.nbs, acc, m.prefetch);
   else
 #endif
     interleave_groups<K>(s.len, [&](int q, int k) {
-      group_mult<BS, BW, V>(s.t[q] + (size_t)k * BW * BS2, s.c[q] + (size_t)k * BW, x, acc[q], k, nz[q]);
+      group_mult<BS, BW, V>(s.t[q] + (size_t)k * BW * BS2, s.c[q] + (size_t)k * BW, x, acc[q], k, nz[q],
+                            m.prefetch);
     });
   for (int q = 0; q < K; q++) {
     /* y += A x in place: an empty bin changes nothing (the off-diagonal part of an MPI matrix is
@@ -237,15 +239,16 @@ void sym_mult_fixed(const BinMatrix &m, const double *x, const double *, double 
     for (int q = 0; q < Kc; q++) r0[q] = bins[q] * BW;
     diagonal_groups<Kc, BW>(m, bins, kd);
 #if defined(BINBCSR_HAND_AVX512)
-    if constexpr (BS == 3 && BW == 8) avx512::sym_bins_mult_3x8<Kc>(s.t, s.c, s.len, r0, m.mbs, kd, x, y);
+    if constexpr (BS == 3 && BW == 8)
+      avx512::sym_bins_mult_3x8<Kc>(s.t, s.c, s.len, r0, m.mbs, kd, x, y, m.prefetch);
     else
 #endif
 #if defined(BINBCSR_HAND_AVX2)
       if constexpr (BS == 3 && (BW == 4 || BW == 8 || BW == 16))
-      hand4::sym_bins_mult_3x4<Kc, BW>(s.t, s.c, s.len, r0, m.mbs, kd, x, y);
+      hand4::sym_bins_mult_3x4<Kc, BW>(s.t, s.c, s.len, r0, m.mbs, kd, x, y, m.prefetch);
     else
 #endif
-      sym_bins_mult<Kc, BS, BW, V, int>(s.t, s.c, s.len, r0, m.mbs, kd, x, y);
+      sym_bins_mult<Kc, BS, BW, V, int>(s.t, s.c, s.len, r0, m.mbs, kd, x, y, m.prefetch);
     if (dot && K == 1)
       d += dot_range(x, y, (size_t)r0[0] * BS, (size_t)(m.mbs < r0[0] + BW ? m.mbs : r0[0] + BW) * BS);
   });

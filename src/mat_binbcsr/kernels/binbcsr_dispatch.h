@@ -28,6 +28,7 @@ struct BinMatrix {
   const double *val;                              /* double values, or NULL */
   const float  *valf;                             /* single values, or NULL */
   int           nbins, mbs, nbs, bs, bw, streams; /* nbs: block columns (x has nbs * bs entries) */
+  int           prefetch; /* bytes the products prefetch the values ahead (0: none; prefetch_values) */
   bool          sym;
 };
 

@@ -30,20 +30,23 @@
 namespace binbcsr {
 inline namespace BINBCSR_BODY_SET {
 
-/* Software prefetch of the value stream, CPU only. One core streaming one array out of cache is
-   limited by how many cache lines it has in flight, not by the memory: the hardware prefetcher alone
-   left the product at 73-79% of the triad bandwidth (27-point stencil, 48^3 nodes, double), 1 KB
-   ahead gained nothing for double and about 10 points for single, 4 KB ahead brought both to 85-94%
-   and helps the in-cache sizes as well (docs/mat_binbcsr.md). */
-constexpr int                         prefetch_ahead_bytes = 4096;
-template <typename V> BINBCSR_HD void prefetch_values(const V *tile, int nbytes)
+/* Software prefetch of the value stream, CPU only: the nbytes of a slot group, `ahead` bytes ahead of
+   it (0: none). One core streaming one array out of cache is limited by how many cache lines it has
+   in flight, not by the memory: on a Sapphire Rapids core the hardware prefetcher alone left the
+   product at 73-79% of the triad bandwidth (27-point stencil, 48^3 nodes, double), 1 KB ahead gained
+   nothing for double and about 10 points for single, 4 KB ahead brought both to 85-94%; on a Zen 5 VM
+   in some minutes 4 KB ahead made the same product 1.7x slower than none (docs/tuning.md). So the
+   distance is a run-time value of the matrix that the tuner chooses (MatBinBCSRSetPrefetch), not a
+   constant: the branch on it is taken the same way for a whole product. */
+template <typename V> BINBCSR_HD void prefetch_values(const V *tile, int nbytes, int ahead)
 {
 #if !defined(__CUDACC__) && defined(__GNUC__)
-  for (int q = 0; q < nbytes; q += 64)
-    __builtin_prefetch((const char *)tile + prefetch_ahead_bytes + q, 0, 3);
+  if (ahead > 0)
+    for (int q = 0; q < nbytes; q += 64) __builtin_prefetch((const char *)tile + ahead + q, 0, 3);
 #else
   (void)tile;
   (void)nbytes;
+  (void)ahead;
 #endif
 }
 
@@ -221,10 +224,10 @@ BINBCSR_HD void sym_unit_group_mult(const V *t, const double *xs, const double (
    colouring). */
 template <int BS, int BW, typename V, typename I>
 BINBCSR_HD void sym_group_mult(const V *t, const I *c, I r0, const I *own, const double (*xr)[BW],
-                               const double *x, double *y, double (*acc)[BW], int k, const int *kd)
+                               const double *x, double *y, double (*acc)[BW], int k, const int *kd, int pf)
 {
   constexpr int BS2 = BS * BS;
-  prefetch_values(t, BW * BS2 * (int)sizeof(V));
+  prefetch_values(t, BW * BS2 * (int)sizeof(V), pf);
   if (unit_stride<BW>(
         c)) { /* contiguous x_c and y_c: plain loads and stores instead of gathers and scatters */
     const I c0 = c[0];
@@ -262,10 +265,11 @@ BINBCSR_HD void sym_group_mult(const V *t, const I *c, I r0, const I *own, const
    (zeros, column own = mbs - 1, masked out) and their acc is dropped. kd[q][l]: the slot group of
    the diagonal block of lane l of bin q (-1: none), which tells padding from the diagonal block. On exit y_r += acc for the real
    lanes of every bin. Scatters of one bin may land in the rows of another bin of the sweep: all are
-   additions into y, and a bin's own rows are added only at its end. */
+   additions into y, and a bin's own rows are added only at its end. pf: the prefetch distance in bytes
+   (prefetch_values). */
 template <int K, int BS, int BW, typename V, typename I>
 BINBCSR_HD void sym_bins_mult(const V *const *bin_val, const I *const *bin_col, const int *len, const I *r0,
-                              I mbs, const int (*kd)[BW], const double *x, double *y)
+                              I mbs, const int (*kd)[BW], const double *x, double *y, int pf)
 {
   constexpr int BS2 = BS * BS;
   double        acc[K][BS][BW], xr[K][BS][BW];
@@ -282,7 +286,7 @@ BINBCSR_HD void sym_bins_mult(const V *const *bin_val, const I *const *bin_col, 
   }
   interleave_groups<K>(len, [&](int q, int k) {
     sym_group_mult<BS, BW, V, I>(bin_val[q] + (long)k * BW * BS2, bin_col[q] + (long)k * BW, r0[q], own[q],
-                                 xr[q], x, y, acc[q], k, kd[q]);
+                                 xr[q], x, y, acc[q], k, kd[q], pf);
   });
   for (int q = 0; q < K; q++)
     for (int l = 0; l < BW; l++)

@@ -160,6 +160,26 @@ static PetscErrorCode MatBinBCSRGetStreams_MPIBinBCSR(Mat mat, PetscInt *streams
   PetscFunctionReturn(0);
 }
 
+static PetscErrorCode MatBinBCSRSetPrefetch_MPIBinBCSR(Mat mat, PetscInt bytes)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  b->prefetch = bytes;
+  PetscCall(MatMPIBinBCSRSetOnParts(mat, MatBinBCSRSetPrefetch, bytes));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatBinBCSRGetPrefetch_MPIBinBCSR(Mat mat, PetscInt *bytes)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  if (b->A) PetscCall(MatBinBCSRGetPrefetch(b->A, bytes));
+  else *bytes = b->prefetch >= 0 ? b->prefetch : BINBCSR_DEFAULT_PREFETCH;
+  PetscFunctionReturn(0);
+}
+
 /* Each rank tunes its own parts (diagonal and off-diagonal) when their layouts are built. */
 static PetscErrorCode MatBinBCSRSetTune_MPIBinBCSR(Mat mat, MatBinBCSRTune t)
 {
@@ -355,6 +375,7 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRCreatePart(Mat mat, PetscInt m, PetscIn
   if (b->bin_width) PetscCall(MatBinBCSRSetBinWidth(*part, b->bin_width));
   if (b->precision_set) PetscCall(MatBinBCSRSetPrecision(*part, b->precision));
   if (b->streams) PetscCall(MatBinBCSRSetStreams(*part, b->streams));
+  if (b->prefetch >= 0) PetscCall(MatBinBCSRSetPrefetch(*part, b->prefetch));
   if (b->kernel) PetscCall(MatBinBCSRSetKernel(*part, b->kernel));
   if (b->tune >= 0) PetscCall(MatBinBCSRSetTune(*part, (MatBinBCSRTune)b->tune));
   if (b->tune_cache >= 0) PetscCall(MatBinBCSRSetTuneCache(*part, b->tune_cache ? PETSC_TRUE : PETSC_FALSE));
@@ -541,6 +562,8 @@ static const BinBCSRComposed composed[] = {
   BINBCSR_COMPOSED("MatBinBCSRGetCOOMirror_C", MatBinBCSRGetCOOMirror_MPIBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRSetStreams_C", MatBinBCSRSetStreams_MPIBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRGetStreams_C", MatBinBCSRGetStreams_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRSetPrefetch_C", MatBinBCSRSetPrefetch_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRGetPrefetch_C", MatBinBCSRGetPrefetch_MPIBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRSetTune_C", MatBinBCSRSetTune_MPIBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRGetTune_C", MatBinBCSRGetTune_MPIBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRSetTuneCache_C", MatBinBCSRSetTuneCache_MPIBinBCSR),

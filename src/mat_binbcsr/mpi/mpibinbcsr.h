@@ -71,6 +71,7 @@ struct Mat_MPIBinBCSR {
   PetscInt            bin_width          = 0;           /* 0: the inner type's default */
   PetscBool           precision_set      = PETSC_FALSE;
   PetscInt            streams            = 0;  /* MatBinBCSRSetStreams; 0: the parts' default */
+  PetscInt            prefetch           = -1; /* MatBinBCSRSetPrefetch; -1: the parts' default */
   PetscInt            tune               = -1; /* MatBinBCSRSetTune for the parts; -1: theirs */
   PetscInt            tune_cache         = -1; /* MatBinBCSRSetTuneCache for the parts; -1: theirs */
   MatBinBCSRKernel    kernel             = MAT_BINBCSR_KERNEL_AUTO; /* MatBinBCSRSetKernel */

@@ -211,6 +211,7 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRCopyConfig(Mat from, Mat to)
   c->precision_set      = b->precision_set;
   c->precision          = b->precision;
   c->streams            = b->streams;
+  c->prefetch           = b->prefetch;
   c->tune               = b->tune;
   c->tune_cache         = b->tune_cache;
   c->kernel             = b->kernel;

@@ -238,6 +238,15 @@ static PetscErrorCode MatBinBCSRSetStreams_SeqBinBCSR(Mat A, PetscInt streams)
   PetscFunctionReturn(0);
 }
 
+/* A prefetch distance set by the user: the tuner keeps it. */
+static PetscErrorCode MatBinBCSRSetPrefetch_SeqBinBCSR(Mat A, PetscInt bytes)
+{
+  PetscFunctionBegin;
+  ((Mat_SeqBinBCSR *)A->data)->prefetch     = bytes;
+  ((Mat_SeqBinBCSR *)A->data)->prefetch_set = PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MatBinBCSRSetTune_SeqBinBCSR(Mat A, MatBinBCSRTune t)
 {
   PetscFunctionBegin;
@@ -283,6 +292,8 @@ static const BinBCSRComposed composed[] = {
                    (&MatSeqBinBCSRGetField<PetscBool, &Mat_SeqBinBCSR::coo_mirror>)),
   BINBCSR_COMPOSED("MatBinBCSRSetStreams_C", MatBinBCSRSetStreams_SeqBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRGetStreams_C", (&MatSeqBinBCSRGetField<PetscInt, &Mat_SeqBinBCSR::streams>)),
+  BINBCSR_COMPOSED("MatBinBCSRSetPrefetch_C", MatBinBCSRSetPrefetch_SeqBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRGetPrefetch_C", (&MatSeqBinBCSRGetField<PetscInt, &Mat_SeqBinBCSR::prefetch>)),
   BINBCSR_COMPOSED("MatBinBCSRSetTune_C", MatBinBCSRSetTune_SeqBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRGetTune_C", MatBinBCSRGetTune_SeqBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRSetTuneCache_C", MatBinBCSRSetTuneCache_SeqBinBCSR),
@@ -328,6 +339,7 @@ PetscErrorCode MatCreate_SeqBinBCSR(Mat A)
   a->bw          = BinBCSRDefaultBinWidth(1);
   a->precision   = MAT_BINBCSR_PRECISION_DOUBLE;
   a->streams     = BINBCSR_DEFAULT_STREAMS;
+  a->prefetch    = BINBCSR_DEFAULT_PREFETCH;
   a->tune        = -1;
   a->tune_cache  = -1;
   a->roworiented = PETSC_TRUE;

@@ -56,18 +56,20 @@ struct BinBCSRStaging; /* the pattern and values while the matrix is being fille
 
 typedef struct {
   /* configuration */
-  PetscInt            bw;          /* bin width: (block) rows per bin */
-  PetscBool           bw_set;      /* set by the user; otherwise the layout build takes the default of
+  PetscInt            bw;           /* bin width: (block) rows per bin */
+  PetscBool           bw_set;       /* set by the user; otherwise the layout build takes the default of
                                     its block size (BinBCSRDefaultBinWidth) */
-  MatBinBCSRPrecision precision;   /* value storage; products accumulate in double */
-  PetscInt            nonew;       /* 0: new nonzeros allowed (only before the layout exists);
+  MatBinBCSRPrecision precision;    /* value storage; products accumulate in double */
+  PetscInt            nonew;        /* 0: new nonzeros allowed (only before the layout exists);
                                     1: new locations silently ignored (MAT_NEW_NONZERO_LOCATIONS false);
                                    -1: error (MAT_NEW_NONZERO_LOCATION_ERR); -2: error beyond the
                                     preallocation (MAT_NEW_NONZERO_ALLOCATION_ERR). Once the layout
                                     exists a new location is an error unless nonew == 1. */
-  PetscBool           roworiented; /* MAT_ROW_ORIENTED for MatSetValues(Blocked) */
-  PetscInt            streams;     /* MatBinBCSRSetStreams: runs of bins the product sweeps side by side */
-  PetscBool           streams_set; /* set by the user before the layout build: the tuner keeps it */
+  PetscBool           roworiented;  /* MAT_ROW_ORIENTED for MatSetValues(Blocked) */
+  PetscInt            streams;      /* MatBinBCSRSetStreams: runs of bins the product sweeps side by side */
+  PetscBool           streams_set;  /* set by the user before the layout build: the tuner keeps it */
+  PetscInt            prefetch;     /* MatBinBCSRSetPrefetch: bytes the products prefetch values ahead */
+  PetscBool           prefetch_set; /* set by the user: the tuner keeps it */
   PetscInt            tune; /* MatBinBCSRTune; -1: not set (the option, else auto, at the layout build) */
   PetscInt            tune_cache; /* MatBinBCSRSetTuneCache: 1 on, 0 off, -1 not set (the option, else on) */
   char                tune_info[768]; /* what the tuner tried and chose at the last layout build (MatView) */

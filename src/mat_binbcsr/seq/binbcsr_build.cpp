@@ -218,6 +218,7 @@ PetscErrorCode MatSeqBinBCSRBuildLayout(Mat A, const PetscInt bi[], const PetscI
   PetscCall(MatSeqBinBCSRResetLayout(A));
   if (!a->bw_set) a->bw = BinBCSRDefaultBinWidth(a->bs);
   if (!a->streams_set) a->streams = BINBCSR_DEFAULT_STREAMS;
+  if (!a->prefetch_set) a->prefetch = BINBCSR_DEFAULT_PREFETCH;
   PetscCall(MatSeqBinBCSRTune(A, bi, bj)); /* outside the build's log event: it has its own */
   PetscCall(PetscLogEventBegin(MAT_BinBCSR_BuildLayout, A, 0, 0, 0));
   bw       = a->bw;

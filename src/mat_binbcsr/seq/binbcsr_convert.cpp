@@ -79,6 +79,8 @@ static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues
   b->roworiented  = a->roworiented;
   b->streams      = a->streams;
   b->streams_set  = a->streams_set;
+  b->prefetch     = a->prefetch;
+  b->prefetch_set = a->prefetch_set;
   b->kernel       = a->kernel;
   b->kernel_tuned = a->kernel_tuned;
   b->tune         = a->tune;
@@ -443,6 +445,9 @@ PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
       PetscCall(PetscViewerASCIIPrintf(
         viewer, "product: %" PetscInt_FMT " run(s) of bins swept side by side (-mat_binbcsr_streams)\n",
         a->streams));
+      PetscCall(PetscViewerASCIIPrintf(
+        viewer, "product: values prefetched %" PetscInt_FMT " bytes ahead%s (-mat_binbcsr_prefetch)\n",
+        a->prefetch, a->prefetch ? "" : " (no software prefetch)"));
     }
     PetscCall(PetscViewerASCIIPrintf(viewer, "product body: %s (-mat_binbcsr_kernel %s)\n",
                                      binbcsr::body_set_name(MatSeqBinBCSRSelectBody(a).set),

@@ -22,6 +22,7 @@ static binbcsr::BinMatrix BinMatrixOf(const Mat_SeqBinBCSR *a)
   m.bs                 = (int)a->bs;
   m.bw                 = (int)a->bw;
   m.streams            = (int)a->streams;
+  m.prefetch           = (int)a->prefetch;
   m.sym                = a->sym ? true : false;
   return m;
 }

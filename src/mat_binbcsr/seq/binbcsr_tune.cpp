@@ -1,4 +1,5 @@
-/* MATSEQBINBCSR: the per-machine tuning of the bin width and the stream count (-mat_binbcsr_tune).
+/* MATSEQBINBCSR: the per-machine tuning of the bin width, the stream count, the body set and the
+   software prefetch distance (-mat_binbcsr_tune).
 
    It runs where a layout is built from a final pattern (MatSeqBinBCSRBuildLayout: first final
    assembly, COO preallocation, conversion, load), before the layout exists, so the matrix is built
@@ -10,12 +11,13 @@
    is read from memory by every product, so the sample is too: its arrays are dropped from the caches
    before each timed product.
 
-   Candidates, in races (rounds of the candidates in turn, as many as the budget of about 30 products
+   Candidates, in races (rounds of the candidates in turn, as many as the budget of about 40 products
    or 50 ms of product time admits): the widths (4, 8, 16, and 32 for bs 1) at one stream, with the
    untuned default beside them; the stream counts 1, 2, 4, 8 at the best width; the other kernel body
-   sets the CPU has (kernels/binbcsr_dispatch.h) at the best width and streams; last the
-   configurations within 10% of the best, again. A width, stream count or body set given explicitly
-   (option or MatBinBCSRSet*) is kept and only the others are tuned. Products are timed in this
+   sets the CPU has (kernels/binbcsr_dispatch.h) at the best width and streams; the prefetch distances
+   0, 1024 and 4096 bytes at the best of those; last the configurations within 10% of the best, again.
+   A width, stream count, body set or prefetch distance given explicitly (option or MatBinBCSRSet*) is
+   kept and only the others are tuned. Products are timed in this
    thread's CPU time (the budget too); the cost reported is wall time. */
 #include "binbcsr.h"
 #include "../common/binbcsr_tune.h"
@@ -29,7 +31,7 @@
 namespace {
 
 constexpr double   budget_seconds  = 0.050;
-constexpr PetscInt budget_products = 30;
+constexpr PetscInt budget_products = 40; /* 30 before the prefetch distances were timed too */
 constexpr PetscInt min_tune_kib =
   512; /* smaller matrices live in L2: any layout does (-mat_binbcsr_tune_min_kib) */
 
@@ -37,7 +39,7 @@ constexpr PetscInt min_tune_kib =
    bytes), mean row length bucket (log2) and row-length spread (coefficient of variation in quarters),
    plus the parameters set explicitly (their values are part of the question). */
 std::string MatrixClass(const Mat_SeqBinBCSR *a, size_t vbytes, double mean, double cv, PetscBool bw_fixed,
-                        PetscBool k_fixed, PetscBool body_fixed)
+                        PetscBool k_fixed, PetscBool body_fixed, PetscBool pf_fixed)
 {
   std::string c = "bs " + std::to_string(a->bs) + " " +
                   (a->precision == MAT_BINBCSR_PRECISION_SINGLE ? "single" : "double") +
@@ -48,6 +50,7 @@ std::string MatrixClass(const Mat_SeqBinBCSR *a, size_t vbytes, double mean, dou
   if (bw_fixed) c += " bw=" + std::to_string(a->bw);
   if (k_fixed) c += " streams=" + std::to_string(a->streams);
   if (body_fixed) c += std::string(" kernel=") + MatBinBCSRKernels[a->kernel];
+  if (pf_fixed) c += " prefetch=" + std::to_string(a->prefetch);
   return c;
 }
 
@@ -119,12 +122,13 @@ struct Timer {
   /* Seconds of one product of T with K streams (the product op itself: no log events, no checks).
      No product runs untimed to warm up: the sample's pages are written when it is filled, and its
      arrays are read from memory at every product anyway (cold). */
-  PetscErrorCode Time(Mat T, PetscInt K, double *sec)
+  PetscErrorCode Time(Mat T, PetscInt K, PetscInt pf, double *sec)
   {
     Mat_SeqBinBCSR *t = (Mat_SeqBinBCSR *)T->data;
 
     PetscFunctionBegin;
-    t->streams = K;
+    t->streams  = K;
+    t->prefetch = pf;
     /* A matrix larger than the last-level cache streams from memory at every product; a sample of
        about twice that cache still partly stays in it from one timed product to the next (a victim
        L3 keeps part of what a pass evicts), and then rewards the bodies that compute fastest rather
@@ -152,6 +156,7 @@ struct Tried {
   PetscInt bw, K;
   double   sec;
   PetscInt kernel;       /* MatBinBCSRKernel; AUTO: the dispatch's default body */
+  PetscInt pf;           /* prefetch distance, bytes */
   PetscInt products = 0; /* timed so far */
 };
 
@@ -231,8 +236,8 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
     SetInfo(a, "off (-mat_binbcsr_tune off)");
     PetscFunctionReturn(0);
   }
-  if (a->bw_set && a->streams_set && !body_free) {
-    SetInfo(a, "nothing to tune: bin width, streams and kernel set explicitly");
+  if (a->bw_set && a->streams_set && !body_free && a->prefetch_set) {
+    SetInfo(a, "nothing to tune: bin width, streams, kernel and prefetch set explicitly");
     PetscFunctionReturn(0);
   }
   if (bs != 1 && bs != 3) {
@@ -267,25 +272,27 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
     PetscCall(PetscLogEventEnd(MAT_BinBCSR_Tune, A, 0, 0, 0));
     PetscFunctionReturn(0);
   }
-  const std::string key =
-    BinBCSRTuneMachineKey() + "\t" +
-    MatrixClass(a, vbytes, mean, cv, a->bw_set, a->streams_set, body_free ? PETSC_FALSE : PETSC_TRUE);
+  const std::string key = BinBCSRTuneMachineKey() + "\t" +
+                          MatrixClass(a, vbytes, mean, cv, a->bw_set, a->streams_set,
+                                      body_free ? PETSC_FALSE : PETSC_TRUE, a->prefetch_set);
   if (use_cache) {
     BinBCSRTuneChoice c;
     PetscCall(BinBCSRTuneCacheLookup(key, &c, &found));
     if (found && (!a->bw_set || c.bw == a->bw) && (!a->streams_set || c.streams == a->streams) &&
-        (body_free || c.kernel == (PetscInt)a->kernel) &&
+        (body_free || c.kernel == (PetscInt)a->kernel) && (!a->prefetch_set || c.prefetch == a->prefetch) &&
         (c.bw == 4 || c.bw == 8 || c.bw == 16 || (c.bw == 32 && bs == 1))) {
-      a->bw      = c.bw;
-      a->streams = c.streams;
+      a->bw       = c.bw;
+      a->streams  = c.streams;
+      a->prefetch = c.prefetch;
       if (body_free && c.kernel != (PetscInt)MAT_BINBCSR_KERNEL_AUTO) {
         a->kernel       = (MatBinBCSRKernel)c.kernel;
         a->kernel_tuned = PETSC_TRUE;
       }
       PetscCall(PetscTime(&t_end));
       SetInfo(a, "bin width " + std::to_string(c.bw) + ", streams " + std::to_string(c.streams) +
-                   ", kernel " + MatBinBCSRKernels[c.kernel] + " from the cache " + BinBCSRTuneCachePath() +
-                   " (" + Fmt("%.3f", 1e3 * (t_end - t_start)) + " ms)");
+                   ", kernel " + MatBinBCSRKernels[c.kernel] + ", prefetch " + std::to_string(c.prefetch) +
+                   " from the cache " + BinBCSRTuneCachePath() + " (" + Fmt("%.3f", 1e3 * (t_end - t_start)) +
+                   " ms)");
       PetscCall(PetscInfo(A, "Tuning: %s\n", a->tune_info));
       PetscCall(PetscLogEventEnd(MAT_BinBCSR_Tune, A, 0, 0, 0));
       PetscFunctionReturn(0);
@@ -340,7 +347,7 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
   };
   auto entry = [&](const Tried &c) -> Tried & {
     for (Tried &t : tried)
-      if (t.bw == c.bw && t.K == c.K && t.kernel == c.kernel) return t;
+      if (t.bw == c.bw && t.K == c.K && t.kernel == c.kernel && t.pf == c.pf) return t;
     tried.push_back(c);
     return tried.back();
   };
@@ -365,7 +372,7 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
         double t;
         PetscCall(layout(c.bw, &T));
         ((Mat_SeqBinBCSR *)T->data)->kernel = (MatBinBCSRKernel)c.kernel;
-        PetscCall(tm.Time(T, c.K, &t));
+        PetscCall(tm.Time(T, c.K, c.pf, &t));
         Tried &e = entry(c);
         e.sec    = std::min(e.sec, t);
         e.products++;
@@ -388,20 +395,21 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
       if (entry(c).sec < b.sec) b = entry(c);
     return b;
   };
-  const PetscInt kernel0 = (PetscInt)a->kernel, K0 = a->streams_set ? a->streams : 1;
+  const PetscInt kernel0 = (PetscInt)a->kernel, K0 = a->streams_set ? a->streams : 1,
+                 pf0 = a->prefetch_set ? a->prefetch : BINBCSR_DEFAULT_PREFETCH;
   /* 1. the widths at one stream (the fastest count on most machines, and the cheapest product), with
         the untuned default beside them: what the choice gains is measured against it */
   std::vector<Tried> cs;
-  for (PetscInt bw : widths) cs.push_back({bw, K0, 1e30, kernel0});
+  for (PetscInt bw : widths) cs.push_back({bw, K0, 1e30, kernel0, pf0});
   const Tried dflt = {a->bw_set ? a->bw : bw_default, a->streams_set ? a->streams : BINBCSR_DEFAULT_STREAMS,
-                      1e30, kernel0};
+                      1e30, kernel0, pf0};
   if (dflt.K != K0) cs.push_back(dflt);
   PetscCall(race(cs, 3));
   Tried best = best_of(cs);
   /* 2. the stream counts at the best width */
   if (counts.size() > 1) {
     cs.clear();
-    for (PetscInt K : counts) cs.push_back({best.bw, K, 1e30, kernel0});
+    for (PetscInt K : counts) cs.push_back({best.bw, K, 1e30, kernel0, pf0});
     PetscCall(race(cs, 2));
     best = best_of(cs);
   }
@@ -417,14 +425,24 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
       if (std::find(seen.begin(), seen.end(), b.mult) != seen.end() || b.set != (binbcsr::BodySet)k)
         continue; /* the same body, or a fallback */
       seen.push_back(b.mult);
-      cs.push_back({best.bw, best.K, 1e30, (PetscInt)k});
+      cs.push_back({best.bw, best.K, 1e30, (PetscInt)k, pf0});
     }
     if (cs.size() > 1) {
       PetscCall(race(cs, 2));
       best = best_of(cs);
     }
   }
-  /* 4. the configurations within 10% of the best, again in turn: coordinate steps compared each
+  /* 4. the software prefetch distances at the best so far: on a Zen 5 VM 4 KiB ahead (the Xeon's
+        choice) made the 48^3 stencil's product 1.7x slower than none in some minutes and none of the
+        distances was ahead in others, so it is measured with the rest (docs/tuning.md) */
+  if (!a->prefetch_set) {
+    cs = {best};
+    for (PetscInt pf : {(PetscInt)0, (PetscInt)1024, (PetscInt)4096})
+      if (pf != best.pf) cs.push_back({best.bw, best.K, 1e30, best.kernel, pf});
+    PetscCall(race(cs, 2));
+    best = best_of(cs);
+  }
+  /* 5. the configurations within 10% of the best, again in turn: coordinate steps compared each
         parameter at the others' provisional values, and a near tie is where a drift decides */
   cs.clear();
   for (const Tried &t : tried)
@@ -436,13 +454,15 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
   for (Mat &T : layouts) PetscCall(MatDestroy(&T));
   PetscCall(VecDestroy(&tm.x));
   PetscCall(VecDestroy(&tm.y));
-  a->bw      = best.bw;
-  a->streams = best.K;
+  a->bw       = best.bw;
+  a->streams  = best.K;
+  a->prefetch = best.pf;
   if (body_free && best.kernel != (PetscInt)MAT_BINBCSR_KERNEL_AUTO) {
     a->kernel       = (MatBinBCSRKernel)best.kernel;
     a->kernel_tuned = PETSC_TRUE;
   }
-  if (use_cache) PetscCall(BinBCSRTuneCacheStore(key, BinBCSRTuneChoice{best.bw, best.K, best.kernel}));
+  if (use_cache)
+    PetscCall(BinBCSRTuneCacheStore(key, BinBCSRTuneChoice{best.bw, best.K, best.kernel, best.pf}));
   PetscCall(PetscTime(&t_end));
 
   /* the report: what was tried, the choice against the untuned default, what it cost */
@@ -454,14 +474,15 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
             (t.kernel != (body_free ? (PetscInt)MAT_BINBCSR_KERNEL_AUTO : (PetscInt)a->kernel)
                ? std::string("/") + MatBinBCSRKernels[t.kernel]
                : std::string("")) +
-            " " + Fmt("%.3g", 1e3 * t.sec);
-    if (t.bw == dflt.bw && t.K == dflt.K && t.kernel == dflt.kernel && t.sec < 1e29) t_default = t.sec;
+            (t.pf != pf0 ? "/pf" + std::to_string(t.pf) : std::string("")) + " " + Fmt("%.3g", 1e3 * t.sec);
+    if (t.bw == dflt.bw && t.K == dflt.K && t.kernel == dflt.kernel && t.pf == dflt.pf && t.sec < 1e29)
+      t_default = t.sec;
   }
   std::string info = "bin width " + std::to_string(best.bw) + ", streams " + std::to_string(best.K) +
-                     ", kernel " + MatBinBCSRKernels[best.kernel] + " measured on block rows " +
-                     std::to_string(r0) + ".." + std::to_string(r0 + nr - 1) + " of " + std::to_string(mbs) +
-                     (tm.cold ? ", read from memory" : ", in cache") +
-                     " (ms per sample product, width/streams[/kernel]: " + list +
+                     ", kernel " + MatBinBCSRKernels[best.kernel] + ", prefetch " + std::to_string(best.pf) +
+                     " measured on block rows " + std::to_string(r0) + ".." + std::to_string(r0 + nr - 1) +
+                     " of " + std::to_string(mbs) + (tm.cold ? ", read from memory" : ", in cache") +
+                     " (ms per sample product, width/streams[/kernel][/pf bytes]: " + list +
                      (skipped ? "; " + std::to_string(skipped) + " left out by the budget" : "") + ")";
   const double cost = t_end - t_start;
   info += "; cost " + Fmt("%.1f", 1e3 * cost) + " ms (" + Fmt("%.1f", 1e3 * tm.seconds) + " ms CPU in " +
@@ -481,7 +502,8 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
 /* After MatBinBCSRSetPrecision changed the precision of a built matrix: the choice was timed in the
    old precision, and on a Zen 4 core the 48^3 stencil's best width is 4 in double and 8 in single
    (1.3x apart each way). The width is the layout's and stays (a new layout would drop the COO maps and
-   the colouring); the stream count and the body set, where the tuner chose them, are timed again in
+   the colouring); the stream count, the body set and the prefetch distance, where the tuner chose
+   them, are timed again in
    the new precision, on the pattern read back from the layout. */
 PetscErrorCode MatSeqBinBCSRRetune(Mat A)
 {
@@ -491,7 +513,8 @@ PetscErrorCode MatSeqBinBCSRRetune(Mat A)
 
   PetscFunctionBegin;
   if (!a->built || a->tune != (PetscInt)MAT_BINBCSR_TUNE_AUTO) PetscFunctionReturn(0);
-  if (a->streams_set && !a->kernel_tuned && a->kernel != MAT_BINBCSR_KERNEL_AUTO) PetscFunctionReturn(0);
+  if (a->streams_set && a->prefetch_set && !a->kernel_tuned && a->kernel != MAT_BINBCSR_KERNEL_AUTO)
+    PetscFunctionReturn(0);
   bj.reserve((size_t)a->nz);
   for (PetscInt r = 0; r < a->mbs; r++) { /* whole storage: every block; symmetric: the upper ones */
     if (a->sym)

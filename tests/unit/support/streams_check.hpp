@@ -62,4 +62,28 @@ inline void check_streams(Mat A, const Pattern &p)
   }
 }
 
+// MatBinBCSRSetPrefetch: a software prefetch changes no arithmetic, so every distance must give the
+// same bits as no prefetch, at every stream count (a distance past the end of the values prefetches
+// addresses that are never read: harmless, and checked here with the largest one). Changes A's
+// streams and prefetch distance.
+inline void check_prefetch(Mat A, const Pattern &p)
+{
+  for (PetscInt streams : {1, 4}) {
+    CAPTURE(streams);
+    REQUIRE(MatBinBCSRSetStreams(A, streams) == 0);
+    REQUIRE(MatBinBCSRSetPrefetch(A, 0) == 0);
+    const Products none = products(A, p);
+    for (PetscInt pf : {64, 1024, 4096, 65536}) {
+      CAPTURE(pf);
+      REQUIRE(MatBinBCSRSetPrefetch(A, pf) == 0);
+      const Products got = products(A, p);
+      CHECK(got.mult == none.mult);
+      CHECK(got.mult_add == none.mult_add);
+      CHECK(got.mult_add_in_place == none.mult_add_in_place);
+      CHECK(got.mult_dot == none.mult_dot);
+      CHECK(got.dot == none.dot);
+    }
+  }
+}
+
 } // namespace mat_core

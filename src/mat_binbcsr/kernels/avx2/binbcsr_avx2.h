@@ -183,7 +183,8 @@ BINBCSR_AVX2_INLINE void chunk_mult_3x4(const V *t, const I *c, const double *x,
    of K bins in interleave_groups' order, and acc[q][i][l] += the rows' sums. */
 template <int K, int BW, typename V, typename I>
 BINBCSR_AVX2_INLINE void bins_mult_3x4(const V *const *bin_val, const I *const *bin_col, const int *len,
-                                       const int (*nz)[BW], const double *x, int ncols, double (*acc)[3][BW])
+                                       const int (*nz)[BW], const double *x, int ncols, double (*acc)[3][BW],
+                                       int pf)
 {
   constexpr int H = BW / 4;
   static_assert(BW % 4 == 0 && sizeof(I) == 4, "chunks of 4 lanes, 32-bit column indices");
@@ -198,7 +199,7 @@ BINBCSR_AVX2_INLINE void bins_mult_3x4(const V *const *bin_val, const I *const *
     len, [&](int q, int k) __attribute__((always_inline)) {
       const V *t = bin_val[q] + (long)k * 9 * BW;
       const I *c = bin_col[q] + (long)k * BW;
-      prefetch_values(t, 9 * BW * (int)sizeof(V));
+      prefetch_values(t, 9 * BW * (int)sizeof(V), pf);
       for (int h = 0; h < H; h++) chunk_mult_3x4<BW>(t + 4 * h, c + 4 * h, x, ncols, a[q][h], k, n[q][h]);
     });
   for (int q = 0; q < K; q++)
@@ -283,7 +284,7 @@ BINBCSR_AVX2_INLINE void sym_chunk_end(const SymChunk3x4 &b, double *y)
 template <int K, int BW, typename V, typename I>
 BINBCSR_AVX2_INLINE void sym_bins_mult_3x4(const V *const *bin_val, const I *const *bin_col, const int *len,
                                            const I *r0, I mbs, const int (*kd)[BW], const double *x,
-                                           double *y)
+                                           double *y, int pf)
 {
   constexpr int H = BW / 4;
   static_assert(BW % 4 == 0 && sizeof(I) == 4, "chunks of 4 lanes, 32-bit column indices");
@@ -294,7 +295,7 @@ BINBCSR_AVX2_INLINE void sym_bins_mult_3x4(const V *const *bin_val, const I *con
     len, [&](int q, int k) __attribute__((always_inline)) {
       const V *t = bin_val[q] + (long)k * 9 * BW;
       const I *c = bin_col[q] + (long)k * BW;
-      prefetch_values(t, 9 * BW * (int)sizeof(V));
+      prefetch_values(t, 9 * BW * (int)sizeof(V), pf);
       for (int h = 0; h < H; h++) sym_chunk_group<BW>(b[q][h], t + 4 * h, c + 4 * h, k, x, (int)mbs, y);
     });
   for (int q = 0; q < K; q++)

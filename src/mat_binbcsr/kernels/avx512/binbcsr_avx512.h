@@ -125,10 +125,10 @@ BINBCSR_AVX512_INLINE void load_xc_3x8(const I *c, __m256i ci, __mmask8 real, co
    columns of x. */
 template <typename V, typename I>
 BINBCSR_AVX512_INLINE void group_mult_3x8(const V *t, const I *c, const double *x, int ncols, __m512d *a,
-                                          __mmask8 real)
+                                          __mmask8 real, int pf)
 {
   static_assert(sizeof(I) == 4, "32-bit column indices");
-  prefetch_values(t, 72 * (int)sizeof(V));
+  prefetch_values(t, 72 * (int)sizeof(V), pf);
   const __m256i ci = _mm256_loadu_si256((const __m256i *)c);
   __m512d       x0, x1, x2;
   load_xc_3x8(c, ci, real, x, ncols, x0, x1, x2);
@@ -147,7 +147,7 @@ BINBCSR_AVX512_INLINE void group_mult_3x8(const V *t, const I *c, const double *
 template <int K, typename V, typename I>
 BINBCSR_AVX512_INLINE void bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, const int *len,
                                          const int (*nz)[8], const double *x, int ncols,
-                                         double (*const *acc)[8])
+                                         double (*const *acc)[8], int pf)
 {
   __m512d a[K][3];
   __m256i n[K]; /* the lanes' real blocks: slot group k of lane l is real when k < n[l] */
@@ -162,7 +162,7 @@ BINBCSR_AVX512_INLINE void bins_mult_3x8(const V *const *bin_val, const I *const
   const auto group = [&](int q, int k) __attribute__((always_inline))
   {
     group_mult_3x8(bin_val[q] + (long)k * 72, bin_col[q] + (long)k * 8, x, ncols, a[q],
-                   _mm256_cmpgt_epi32_mask(n[q], _mm256_set1_epi32(k)));
+                   _mm256_cmpgt_epi32_mask(n[q], _mm256_set1_epi32(k)), pf);
   };
   for (int k = 0; k < common; k++)
     for (int q = 0; q < K; q++) group(q, k);
@@ -212,14 +212,14 @@ BINBCSR_AVX512_INLINE void sym_bin_begin_3x8(SymBin3x8<V, I> &b, const V *bin_va
 }
 
 template <typename V, typename I>
-BINBCSR_AVX512_INLINE void sym_bin_group_3x8(SymBin3x8<V, I> &b, const double *x, I mbs, double *y)
+BINBCSR_AVX512_INLINE void sym_bin_group_3x8(SymBin3x8<V, I> &b, const double *x, I mbs, double *y, int pf)
 {
   static_assert(sizeof(I) == 4, "32-bit column indices");
   const V *t = b.t;
   const I *c = b.c;
   b.t += 72;
   b.c += 8;
-  prefetch_values(t, 72 * (int)sizeof(V));
+  prefetch_values(t, 72 * (int)sizeof(V), pf);
   const __m256i ci = _mm256_loadu_si256((const __m256i *)c);
   __m512d       v[9], xc[3], s[3];
   for (int e = 0; e < 9; e++) v[e] = load8(t + e * 8);
@@ -285,7 +285,7 @@ BINBCSR_AVX512_INLINE void sym_bin_end_3x8(const SymBin3x8<V, I> &b, double *y)
 template <int K, typename V, typename I>
 BINBCSR_AVX512_INLINE void sym_bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, const int *len,
                                              const I *r0, I mbs, const int (*kd)[8], const double *x,
-                                             double *y)
+                                             double *y, int pf)
 {
   /* interleave_groups' order written out: through its lambda this body ran slower (upper double at
      48^3, three alternations: 7.0-7.6 ms against 6.5-6.9) */
@@ -296,9 +296,9 @@ BINBCSR_AVX512_INLINE void sym_bins_mult_3x8(const V *const *bin_val, const I *c
     common = len[q] < common ? len[q] : common;
   }
   for (int k = 0; k < common; k++)
-    for (int q = 0; q < K; q++) sym_bin_group_3x8(b[q], x, mbs, y);
+    for (int q = 0; q < K; q++) sym_bin_group_3x8(b[q], x, mbs, y, pf);
   for (int q = 0; q < K; q++)
-    for (int k = common; k < len[q]; k++) sym_bin_group_3x8(b[q], x, mbs, y);
+    for (int k = common; k < len[q]; k++) sym_bin_group_3x8(b[q], x, mbs, y, pf);
   for (int q = 0; q < K; q++) sym_bin_end_3x8(b[q], y);
 }
 

@@ -59,6 +59,8 @@ TEST_CASE("a binbcsr matrix set to another type keeps none of its composed funct
                                     "MatBinBCSRGetCOOMirror_C",
                                     "MatBinBCSRSetStreams_C",
                                     "MatBinBCSRGetStreams_C",
+                                    "MatBinBCSRSetPrefetch_C",
+                                    "MatBinBCSRGetPrefetch_C",
                                     "MatSetPreallocationCOO_C",
                                     "MatSetValuesCOO_C",
                                     "MatMultDotLocal_C",

@@ -20,6 +20,7 @@ TEST_CASE("every streams count gives the one-run product up to rounding", "[mat_
   for (const Pattern &p : patterns) {
     Mat A = build(p, MATSEQBINBCSR, bw, prec);
     check_streams(A, p);
+    check_prefetch(A, p);
     MatDestroy(&A);
   }
 }
@@ -53,6 +54,45 @@ TEST_CASE("streams: default, option, view, duplicate and bad values", "[mat_core
   REQUIRE(MatBinBCSRSetStreams(R, 8) == 0);
   REQUIRE(MatBinBCSRGetStreams(R, &streams) == 0);
   CHECK(streams == 1);
+  MatDestroy(&A);
+  MatDestroy(&B);
+  MatDestroy(&R);
+}
+
+TEST_CASE("prefetch: default, option, view, duplicate and bad values", "[mat_core][prefetch]")
+{
+  const Pattern p = fem_pattern(6, 5, 4);
+  Mat           A = build(p, MATSEQBINBCSR), B, R = build(p, MATSEQAIJ);
+  PetscInt      pf;
+  REQUIRE(MatBinBCSRGetPrefetch(A, &pf) == 0);
+  CHECK(pf == 4096); // the untuned default (build() leaves a matrix this small untuned)
+  CHECK(info_view(A).find("product: values prefetched 4096 bytes ahead") != std::string::npos);
+
+  REQUIRE(PetscOptionsSetValue(nullptr, "-mat_binbcsr_prefetch", "0") == 0);
+  REQUIRE(MatBinBCSRSetFromOptions(A) == 0);
+  REQUIRE(PetscOptionsClearValue(nullptr, "-mat_binbcsr_prefetch") == 0);
+  REQUIRE(MatBinBCSRGetPrefetch(A, &pf) == 0);
+  CHECK(pf == 0);
+  CHECK(info_view(A).find("prefetched 0 bytes ahead (no software prefetch)") != std::string::npos);
+  REQUIRE(MatBinBCSRSetPrefetch(A, 1024) == 0);
+  REQUIRE(MatDuplicate(A, MAT_COPY_VALUES, &B) == 0);
+  REQUIRE(MatBinBCSRGetPrefetch(B, &pf) == 0);
+  CHECK(pf == 1024);
+
+  for (PetscInt bad : {-64, -1, 100, 65600, 1 << 20}) {
+    CAPTURE(bad);
+    CHECK(MatBinBCSRSetPrefetch(A, bad) == PETSC_ERR_ARG_OUTOFRANGE);
+  }
+  REQUIRE(MatBinBCSRGetPrefetch(A, &pf) == 0);
+  CHECK(pf == 1024);
+  REQUIRE(PetscOptionsSetValue(nullptr, "-mat_binbcsr_prefetch", "1000") == 0);
+  CHECK(MatBinBCSRSetFromOptions(A) == PETSC_ERR_ARG_OUTOFRANGE);
+  REQUIRE(PetscOptionsClearValue(nullptr, "-mat_binbcsr_prefetch") == 0);
+
+  // other types: the setter does nothing, the getter answers 0
+  REQUIRE(MatBinBCSRSetPrefetch(R, 4096) == 0);
+  REQUIRE(MatBinBCSRGetPrefetch(R, &pf) == 0);
+  CHECK(pf == 0);
   MatDestroy(&A);
   MatDestroy(&B);
   MatDestroy(&R);

@@ -23,6 +23,7 @@ TEST_CASE("symmetric storage: every streams count gives the one-run product up t
   for (const Pattern &p : patterns) {
     Mat A = build_sym(p, bw, prec);
     check_streams(A, p);
+    check_prefetch(A, p);
     MatDestroy(&A);
   }
 }

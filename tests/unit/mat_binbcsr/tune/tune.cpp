@@ -162,6 +162,12 @@ TEST_CASE("tuning chooses among the candidates; products and values stay exact",
         PetscBool avx2;
         REQUIRE(MatBinBCSRKernelAvailable(MAT_BINBCSR_KERNEL_AVX2, &avx2) == 0);
         if (avx2) CHECK(txt.find("/portable ") != std::string::npos); // the other body sets were timed too
+        // and the prefetch distances other than the default
+        CHECK(txt.find("/pf0 ") != std::string::npos);
+        CHECK(txt.find("/pf1024 ") != std::string::npos);
+        PetscInt pf = -1;
+        REQUIRE(MatBinBCSRGetPrefetch(A, &pf) == 0);
+        CHECK((pf == 0 || pf == 1024 || pf == 4096));
         check_same(A, R, p);
         Mat D;
         REQUIRE(MatDuplicate(A, MAT_COPY_VALUES, &D) == 0);
@@ -229,12 +235,41 @@ TEST_CASE("tuning: explicit settings win", "[tune]")
     MatDestroy(&A);
   }
   {
+    // width, streams and kernel set: only the prefetch distance is timed
     o.set("-mat_binbcsr_bin_width", "4");
     o.set("-mat_binbcsr_streams", "8");
     Mat A = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
     CHECK(bin_width(A) == 4);
     CHECK(streams(A) == 8);
+    auto txt = info_view(A);
+    CAPTURE(txt);
+    CHECK(txt.find("nothing to tune") == std::string::npos);
+    CHECK(txt.find(" 4/8/pf0 ") != std::string::npos);
+    CHECK(txt.find(" 4/8/pf1024 ") != std::string::npos);
+    CHECK(txt.find(" 8/") == std::string::npos);
+    MatDestroy(&A);
+    // and with the distance set too, nothing is
+    o.set("-mat_binbcsr_prefetch", "1024");
+    A           = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
+    PetscInt pf = -1;
+    REQUIRE(MatBinBCSRGetPrefetch(A, &pf) == 0);
+    CHECK(pf == 1024);
     CHECK(info_view(A).find("nothing to tune") != std::string::npos);
+    MatDestroy(&A);
+  }
+  {
+    // only the distance set: kept, the rest tuned at it
+    for (const char *n : {"-mat_binbcsr_bin_width", "-mat_binbcsr_streams", "-mat_binbcsr_kernel"})
+      REQUIRE(PetscOptionsClearValue(nullptr, n) == 0);
+    o.set("-mat_binbcsr_prefetch", "0");
+    Mat      A  = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
+    PetscInt pf = -1;
+    REQUIRE(MatBinBCSRGetPrefetch(A, &pf) == 0);
+    CHECK(pf == 0);
+    const auto txt = info_view(A);
+    CHECK(txt.find("measured on block rows") != std::string::npos);
+    CHECK(txt.find("/pf1024 ") == std::string::npos); // no other distance timed
+    CHECK(txt.find("/pf4096 ") == std::string::npos);
     MatDestroy(&A);
   }
 }
@@ -261,8 +296,9 @@ TEST_CASE("tuning: a precision change times the streams again, at the layout's w
     check_same(A, R, p); // the values converted once, the products those of the fixed configuration
     MatDestroy(&R);
     MatDestroy(&A);
-    // explicit streams and kernel: nothing is timed again
+    // explicit streams, kernel and prefetch distance: nothing is timed again
     o.set("-mat_binbcsr_kernel", "portable");
+    o.set("-mat_binbcsr_prefetch", "4096");
     A = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, sym, MAT_BINBCSR_TUNE_AUTO, 0, 2);
     REQUIRE(MatBinBCSRSetPrecision(A, MAT_BINBCSR_PRECISION_SINGLE) == 0);
     CHECK(info_view(A).find("after the precision change") == std::string::npos);
@@ -288,7 +324,7 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
     ss << in.rdbuf();
     content = ss.str();
   }
-  CHECK(content.rfind("# petscbinbcsr tune cache v3\n", 0) == 0);
+  CHECK(content.rfind("# petscbinbcsr tune cache v4\n", 0) == 0);
   CHECK(content.find("bs 3 double whole") != std::string::npos);
 #if defined(__x86_64__) || defined(__i386__)
   // the machine is named with CPUID's family and model: VMs of several CPU generations share a name
@@ -299,6 +335,13 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
   CHECK(info_view(B).find("from the cache") != std::string::npos);
   CHECK(bin_width(B) == bin_width(A));
   CHECK(streams(B) == streams(A));
+  {
+    PetscInt pa = -1, pb = -2;
+    REQUIRE(MatBinBCSRGetPrefetch(A, &pa) == 0);
+    REQUIRE(MatBinBCSRGetPrefetch(B, &pb) == 0);
+    CHECK(pb == pa);
+    CHECK((pa == 0 || pa == 1024 || pa == 4096));
+  }
   MatDestroy(&B);
   // another class (single precision) is measured and added
   B = build_tuned(p, MAT_BINBCSR_PRECISION_SINGLE, false, MAT_BINBCSR_TUNE_AUTO);
@@ -316,9 +359,16 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
   const std::string key =
     content.substr(content.find('\n') + 1, content.rfind('\t') - content.find('\n') - 1);
   for (const std::string bad :
-       {std::string("garbage\n\x01\x02"), std::string("# petscbinbcsr tune cache v3\n") + key + "\t7 3\n",
-        std::string("# petscbinbcsr tune cache v3\n") + key + "\t32 1\n",
-        std::string("# petscbinbcsr tune cache v3\n") + key + "\tx\n", std::string(""),
+       {std::string("garbage\n\x01\x02"), std::string("# petscbinbcsr tune cache v4\n") + key + "\t7 3\n",
+        std::string("# petscbinbcsr tune cache v4\n") + key + "\t32 1\n",
+        std::string("# petscbinbcsr tune cache v4\n") + key + "\tx\n", std::string(""),
+        // the prefetch distance: missing (a v3 line under a v4 header), negative, not a multiple of 64,
+        // too far
+        std::string("# petscbinbcsr tune cache v4\n") + key + "\t16 1 portable\n",
+        std::string("# petscbinbcsr tune cache v4\n") + key + "\t16 1 portable -64\n",
+        std::string("# petscbinbcsr tune cache v4\n") + key + "\t16 1 portable 100\n",
+        std::string("# petscbinbcsr tune cache v4\n") + key + "\t16 1 portable 131072\n",
+        std::string("# petscbinbcsr tune cache v3\n") + key + "\t16 1 portable\n",
         std::string("# petscbinbcsr tune cache v1\n") + key + "\t16 1 auto\n",
         std::string("# petscbinbcsr tune cache v2\n") + key + "\t16 1 auto\n"}) {
     CAPTURE(bad);
@@ -336,7 +386,7 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
     std::ifstream in(file); // rewritten, valid
     std::string   first;
     std::getline(in, first);
-    CHECK(first == "# petscbinbcsr tune cache v3");
+    CHECK(first == "# petscbinbcsr tune cache v4");
   }
   // this machine's entries written by a library with other kernels (another kernel id), or by one from
   // before the id was in the key: not taken (measured again), and dropped by the store that follows
@@ -349,9 +399,11 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
     CAPTURE(stale);
     {
       std::ofstream out(file, std::ios::trunc);
-      out << "# petscbinbcsr tune cache v3\n" << stale << "\t16 1 portable\n"
-          << "Another CPU (family 1 model 2) | 64 cores | avx2 | kernels 000000000000\tbs 3 double whole size "
-             "2^20 rowlen 2^4 spread 0\t16 2 portable\n";
+      out
+        << "# petscbinbcsr tune cache v4\n"
+        << stale << "\t16 1 portable 0\n"
+        << "Another CPU (family 1 model 2) | 64 cores | avx2 | kernels 000000000000\tbs 3 double whole size "
+           "2^20 rowlen 2^4 spread 0\t16 2 portable 1024\n";
     }
     Mat C = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
     CHECK(info_view(C).find("measured on block rows") != std::string::npos);
@@ -360,8 +412,8 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
     std::ifstream     in(file);
     std::stringstream ss;
     ss << in.rdbuf();
-    CHECK(ss.str().find(stale + "\t") == std::string::npos); // dropped
-    CHECK(ss.str().find(key + "\t") != std::string::npos);   // the new choice
+    CHECK(ss.str().find(stale + "\t") == std::string::npos);  // dropped
+    CHECK(ss.str().find(key + "\t") != std::string::npos);    // the new choice
     CHECK(ss.str().find("Another CPU") != std::string::npos); // other machines' entries kept
   }
   // an unreadable cache folder: no file written, no error
@@ -445,16 +497,18 @@ TEST_CASE("tuning cache check", "[.cache_check]")
   REQUIRE(in.good());
   std::string line;
   std::getline(in, line);
-  CHECK(line == "# petscbinbcsr tune cache v3");
+  CHECK(line == "# petscbinbcsr tune cache v4");
   int n = 0;
   while (std::getline(in, line)) {
     CAPTURE(line);
     const size_t t1 = line.find('\t'), t2 = line.find('\t', t1 + 1);
     REQUIRE(t2 != std::string::npos);
-    int bw = 0, k = 0;
-    CHECK(sscanf(line.c_str() + t2 + 1, "%d %d", &bw, &k) == 2);
+    int  bw = 0, k = 0, pf = -1;
+    char body[32];
+    CHECK(sscanf(line.c_str() + t2 + 1, "%d %d %31s %d", &bw, &k, body, &pf) == 4);
     CHECK((bw == 4 || bw == 8 || bw == 16));
     CHECK((k == 1 || k == 2 || k == 4 || k == 8));
+    CHECK((pf == 0 || pf == 1024 || pf == 4096));
     n++;
   }
   CHECK(n >= 1);
