@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# bench/tradeoff.sh BUILD OUT QUICK: the speed/accuracy study over examples/fem (the cantilever), then the
+# bench/tradeoff.sh BUILD OUT QUICK [scenes]: the speed/accuracy study over examples/fem (the cantilever), then the
 # solver trade of the cloth and linear_38k scenes (at the end of the file).
 #
 # Two scenes, one knob changed at a time from a base point; every run reports its time per step
@@ -82,6 +82,8 @@ point() {
   echo "$scene,$knob,$order,$cells,$prec,$cg,$dt,$ms,$cost,$err,$reason" >>"$csv"
 }
 
+# PARTS (optional 4th argument): "scenes" runs only the scenes' solver trade below, not the cantilever.
+if [ "${4:-all}" != scenes ]; then
 if [ "$quick" = 1 ]; then
   cells_list=(10 20); fixed_list=(10 100); rtol_list=(1e-3); dt_list=(0.04 0.01); T=0.05
 else
@@ -152,6 +154,7 @@ do for [s in "static dynamic"] {
 unset multiplot
 EOF
 echo "  wrote $csv, $out/tradeoff.png"
+fi # the cantilever study
 
 # ---- The scenes' solver trade: the cloth (options/cloth.opts) and linear_38k (options/linear_38k.opts),
 # error against ms per step over the solver settings. Error after T_SCENE of simulated time against a
