@@ -191,6 +191,8 @@ scene_point() {
       for (i = 2; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] }
       err = v["rms_position_diff"]
       r = v["ksp_reason"]; if (r == "") r = v["diverged_solves"] > 0 ? "diverged_solves=" v["diverged_solves"] : "ok"
+      # the run guard'"'"'s verdict (inverted elements, energy growth): a fast point that blew up is no trade
+      if (v["status"] != "" && v["status"] != "ok") r = r ";" v["status"] " in " v["unstable_steps"] " steps"
       printf "%s,%s,%s,%.4e,%s,%s\n", sc, nm, v["ms_per_step"], err, v["cg_its"], r }' "$log" >>"$scene_csv"
 }
 
@@ -223,6 +225,10 @@ if [ "$quick" != 1 ]; then
       scene_point linear_38k "$name" "${fbase[@]}" -ksp_max_it 5000 -ksp_reuse_preconditioner 0 $args \
         -reference_positions "$fref"
     done
+    # the thesis's own setting (options/linear_38k_thesis.opts: 30 Jacobi iterations warm-started from
+    # the last step's dv, single storage), to compare with the fixed counts from zero above
+    scene_point linear_38k thesis_fixed30 "$fem" -options_file options/linear_38k_thesis.opts -steps 100 \
+      -fem_timer cpu -reference_positions "$fref"
   else
     note "linear_38k reference run failed (see $out/tradeoff_linear_38k_reference.log)"
   fi
@@ -243,8 +249,8 @@ if [ ${#plots[@]} -gt 0 ]; then
     echo 'set key outside right top noenhanced'; echo 'set format y "10^{%L}"'
     for p in "${plots[@]}"; do
       IFS='|' read -r sc title <<<"$p"
-      echo "set title \"$title\""
-      echo "plot for [k in \"jacobi_fixed jacobi pbjacobi pbjacobi_single gamg\"] \"$out/tradeoff_$sc.dat\" using (strcol(3) eq k ? \$1 : NaN):2 with points pt 7 ps 1.3 title k"
+      echo "set title \"$title\" noenhanced"
+      echo "plot for [k in \"jacobi_fixed thesis_fixed jacobi pbjacobi pbjacobi_single gamg gridmg\"] \"$out/tradeoff_$sc.dat\" using (strcol(3) eq k ? \$1 : NaN):2 with points pt 7 ps 1.3 title k"
     done
     echo 'unset multiplot'
   } | gnuplot 2>&1 | grep -v "Skipping data file with no valid points" || true
