@@ -256,6 +256,10 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
   PetscCall(KSPSetFromOptions(sys->ksp));
   PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-initial_guess_scaled", &sys->guess_scaled, nullptr));
   if (sys->guess_scaled) PetscCall(VecDuplicate(sys->b, &sys->r));
+  PetscCall(
+    PetscOptionsGetReal(nullptr, nullptr, "-reuse_preconditioner_growth", &sys->reuse_growth, nullptr));
+  PetscCheck(sys->reuse_growth == 0 || sys->reuse_growth >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE,
+             "-reuse_preconditioner_growth %g: 0 (never set up again) or >= 1", (double)sys->reuse_growth);
   PetscCall(GAMGSmootherCopiesFromOptions(comm, &sys->gamg_copies));
   PetscFunctionReturn(0);
 }
@@ -342,9 +346,28 @@ PetscErrorCode BlockSystemSolve(BlockSystem *sys, const PetscScalar *rhs_local, 
   const double t0 = MPI_Wtime();
   if (stats) stats->guess_scale = 1;
   if (nonzero_guess && sys->guess_scaled) PetscCall(ScaleGuess(sys, stats));
+  PetscBool reuse, rebuild = PETSC_FALSE;
+  PetscCall(KSPGetReusePreconditioner(sys->ksp, &reuse));
+  if (reuse && sys->rebuild_next) { // this solve sets the preconditioner up again (before the copies look)
+    PetscCall(KSPSetReusePreconditioner(sys->ksp, PETSC_FALSE));
+    rebuild = PETSC_TRUE;
+  }
   PetscCall(GAMGSmootherCopiesUpdate(sys->ksp, &sys->gamg_copies));
   PetscCall(KSPSolve(sys->ksp, sys->b, sys->x));
-  const double       t1 = MPI_Wtime();
+  const double t1 = MPI_Wtime();
+  if (reuse) {
+    PetscInt its;
+    PetscCall(KSPGetIterationNumber(sys->ksp, &its));
+    if (rebuild) {
+      PetscCall(KSPSetReusePreconditioner(sys->ksp, PETSC_TRUE));
+      sys->pc_rebuilds++;
+    }
+    if (rebuild || sys->its_after_setup < 0) sys->its_after_setup = its;
+    // the same on every rank: the iteration count is the KSP's, collective
+    sys->rebuild_next = sys->reuse_growth > 0 && its > sys->reuse_growth * PetscMax(sys->its_after_setup, 1)
+                          ? PETSC_TRUE
+                          : PETSC_FALSE;
+  }
   const PetscScalar *xa;
   PetscCall(VecGetArrayRead(sys->x, &xa));
   std::memcpy(sol_local, xa, n * sizeof(PetscScalar));

@@ -46,6 +46,15 @@ struct BlockSystem {
   // (0 where x0 is no better than zero), at the cost of one product. r: its work vector.
   PetscBool guess_scaled = PETSC_FALSE;
   Vec       r            = nullptr;
+  // -reuse_preconditioner_growth G (with -ksp_reuse_preconditioner): once a solve takes more than G
+  // times the iterations of the first solve after the last set-up, the next solve sets the
+  // preconditioner up again on the current matrix (0: never). A reused set-up goes stale as the
+  // corotational matrix turns: linear_38k's GAMG needed 14 iterations per solve over 20 steps and 48 on
+  // average over 100 (docs/fem.md).
+  PetscReal reuse_growth    = 0;
+  PetscInt  its_after_setup = -1; // iterations of the first solve after the last set-up (-1: none yet)
+  PetscBool rebuild_next    = PETSC_FALSE;
+  PetscInt  pc_rebuilds     = 0; // set-ups forced by reuse_growth
 };
 
 struct SolveStats {
