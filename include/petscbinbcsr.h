@@ -73,10 +73,11 @@ PETSC_EXTERN PetscErrorCode MatBinBCSRSetPrefetch(Mat, PetscInt);
 PETSC_EXTERN PetscErrorCode MatBinBCSRGetPrefetch(Mat, PetscInt *);
 /* Tuning on this machine (option -mat_binbcsr_tune auto|off, default auto): when the layout is built
    from the final pattern (first final assembly, COO preallocation, conversion, load), the bin width
-   and the stream count that were not set explicitly are chosen by timing products of a sample of the
-   matrix with the candidates (widths 4, 8, 16, and 32 for block size 1; streams 1, 2, 4, 8), within
-   about 30 products or 50 ms. Set before the layout is built. Matrices with under 512 KiB of values
-   keep the defaults. -mat_view ::ascii_info says what was tried and chosen; log event BinBCSRTune.
+   and the stream count, body set and prefetch distance that were not set explicitly are chosen by
+   timing products of a sample of the matrix with the candidates (widths 4, 8, 16, and 32 for block
+   size 1; streams 1, 2, 4, 8; the body sets the CPU has; 0, 1024 and 4096 bytes), within about 40
+   products or 50 ms of product time. Set before the layout is built. Matrices with under 512 KiB of
+   values keep the defaults. -mat_view ::ascii_info says what was tried and chosen; log event BinBCSRTune.
    The setters are no-ops and the getters answer off / PETSC_FALSE on matrices of other types. */
 typedef enum {
   MAT_BINBCSR_TUNE_OFF  = 0,

@@ -378,9 +378,10 @@ PetscErrorCode MatBinBCSRSetPrefetch(Mat A, PetscInt bytes)
 BINBCSR_TRY_GETTER(MatBinBCSRGetPrefetch, Mat, MAT_CLASSID, PetscInt, PetscValidIntPointer, 0)
 
 /*@
-   MatBinBCSRSetTune - Whether the layout build times the candidate bin widths and stream counts on
-   this machine and keeps the fastest (MAT_BINBCSR_TUNE_AUTO, the default) or takes the defaults
-   (MAT_BINBCSR_TUNE_OFF). A bin width or stream count set explicitly is never changed.
+   MatBinBCSRSetTune - Whether the layout build times the candidate bin widths, stream counts, body
+   sets and prefetch distances on this machine and keeps the fastest (MAT_BINBCSR_TUNE_AUTO, the
+   default) or takes the defaults (MAT_BINBCSR_TUNE_OFF). A bin width, stream count, body set or
+   prefetch distance set explicitly is never changed.
 
    Logically collective; set before the layout is built. Option: -mat_binbcsr_tune auto|off
 @*/
