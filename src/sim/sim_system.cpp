@@ -355,9 +355,9 @@ PetscErrorCode BlockSystemSolve(BlockSystem *sys, const PetscScalar *rhs_local, 
   PetscCall(GAMGSmootherCopiesUpdate(sys->ksp, &sys->gamg_copies));
   PetscCall(KSPSolve(sys->ksp, sys->b, sys->x));
   const double t1 = MPI_Wtime();
+  PetscInt     its;
+  PetscCall(KSPGetIterationNumber(sys->ksp, &its));
   if (reuse) {
-    PetscInt its;
-    PetscCall(KSPGetIterationNumber(sys->ksp, &its));
     if (rebuild) {
       PetscCall(KSPSetReusePreconditioner(sys->ksp, PETSC_TRUE));
       sys->pc_rebuilds++;
@@ -373,7 +373,7 @@ PetscErrorCode BlockSystemSolve(BlockSystem *sys, const PetscScalar *rhs_local, 
   std::memcpy(sol_local, xa, n * sizeof(PetscScalar));
   PetscCall(VecRestoreArrayRead(sys->x, &xa));
   if (stats) {
-    PetscCall(KSPGetIterationNumber(sys->ksp, &stats->iterations));
+    stats->iterations = its;
     PetscCall(KSPGetResidualNorm(sys->ksp, &stats->residual_norm));
     PetscCall(KSPGetConvergedReason(sys->ksp, &stats->reason));
     stats->pc_failure.clear();

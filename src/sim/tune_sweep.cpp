@@ -168,8 +168,10 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
       }
       for (Variant *v : all) {
         if (v != &tuned && v->streams) PetscCall(MatBinBCSRSetStreams(v->A, v->streams));
-        if (v != &tuned && v != &base) PetscCall(MatBinBCSRSetKernel(v->A, v->kernel));
-        if (v != &tuned && v != &base) PetscCall(MatBinBCSRSetPrefetch(v->A, v->prefetch));
+        if (v != &tuned && v != &base) {
+          PetscCall(MatBinBCSRSetKernel(v->A, v->kernel));
+          PetscCall(MatBinBCSRSetPrefetch(v->A, v->prefetch));
+        }
         PetscCall(MatMult(v->A, x, y)); // warm
         const double a = s.now();
         for (PetscInt b = 0; b < s.batch; b++) PetscCall(MatMult(v->A, x, y));
