@@ -81,6 +81,15 @@ BlockPattern::WritePlan make_write_plan(const std::vector<int> &element_slots, i
 
 } // namespace
 
+std::vector<int> listed_element_nodes(const FemModel &model, const std::vector<int> &elements)
+{
+  const int        npe = model.npe;
+  std::vector<int> nodes(elements.size() * npe);
+  for (size_t i = 0; i < elements.size(); ++i)
+    std::copy_n(&model.mesh.elements[static_cast<size_t>(elements[i]) * npe], npe, &nodes[i * npe]);
+  return nodes;
+}
+
 BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &elements,
                                 const std::vector<char> &fixed, int owned_begin, int owned_end, bool merge,
                                 const LowerTriangle &lower)
@@ -130,7 +139,8 @@ BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &e
           written[*s] = 1;
           *s |= kFirstContribution;
         }
-  p.plan = make_write_plan(p.element_slots, npe, elements.size(), p.rows.size());
+  p.plan               = make_write_plan(p.element_slots, npe, elements.size(), p.rows.size());
+  p.plan.element_nodes = listed_element_nodes(model, elements);
   for (int v = owned_begin; v < owned_end; ++v)
     if (fixed[v]) {
       p.identity_slots.push_back(static_cast<int>(p.rows.size()));

@@ -54,9 +54,12 @@ struct BlockPattern {
   // block k the sum of its terms
   // write_terms[write_offsets[k] .. write_offsets[k+1]) in element order, each term
   // 2 (element in the group * upper blocks per element + packed pair) + 1 where its block goes in transposed.
+  // element_nodes: the listed elements' nodes (npe each) in list order, which the batched loop reads
+  // in order instead of through the element numbers (listed_element_nodes).
   struct WritePlan {
     std::vector<int>            group_offsets, write_slots, write_offsets;
     std::vector<unsigned short> write_terms;
+    std::vector<int>            element_nodes;
   } plan;
 };
 // (kFirstContribution and kSlotIndexMask, the marks in element_slots: element_batch.hpp.)
@@ -74,6 +77,9 @@ struct LowerTriangle {
 BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &elements,
                                 const std::vector<char> &fixed, int owned_begin, int owned_end,
                                 bool merge_duplicates, const LowerTriangle &lower = {});
+
+// The nodes of `elements` (npe each, the mesh's order within an element) in list order.
+std::vector<int> listed_element_nodes(const FemModel &model, const std::vector<int> &elements);
 
 // Sizes block_values for the pattern and sets the identity blocks (fixed nodes), which the element
 // loop does not write. Call before assemble_elements (once is enough while the array is kept).

@@ -51,21 +51,21 @@ long long assemble_elements_batched(const FemModel &model, const std::vector<int
   for (int a = 0; a < npe; ++a)
     for (int b = 0; b < npe; ++b) Mref[npe * a + b] = model.reference_mass(a, b);
   ElementBatchArgs args;
-  args.npe                = npe;
-  args.corotational       = model.settings.corotational;
-  args.element_nodes      = model.mesh.elements.data();
-  args.rest_positions     = model.mesh.nodes.data();
-  args.rest_shape_inverse = model.rest_shape_inverse.data()->data();
-  args.volume             = model.volume.data();
-  args.reference_mass     = Mref;
-  args.elements           = elements.data();
-  args.count              = elements.size();
-  args.x                  = x;
-  args.v                  = v;
-  args.values             = values;
-  args.rhs                = rhs;
-  args.rotations          = rotations;
-  double sums[3]          = {0, 0, 0};
+  args.npe          = npe;
+  args.corotational = model.settings.corotational;
+  std::vector<int> listed; // without a pattern (forces only): copied here
+  const bool       planned = pattern && pattern->plan.element_nodes.size() == elements.size() * npe;
+  if (!planned) listed = listed_element_nodes(model, elements);
+  args.listed_nodes   = planned ? pattern->plan.element_nodes.data() : listed.data();
+  args.count          = elements.size();
+  args.rest_positions = model.mesh.nodes.data();
+  args.reference_mass = Mref;
+  args.x              = x;
+  args.v              = v;
+  args.values         = values;
+  args.rhs            = rhs;
+  args.rotations      = rotations;
+  double sums[3]      = {0, 0, 0};
   if (energy) {
     args.energy         = sums;
     args.element_energy = energy->per_element;

@@ -73,15 +73,15 @@ double element_kernel_flops(int order, bool with_blocks);
 
 // One call's inputs and outputs as plain arrays (the model's, flattened by the dispatch).
 struct ElementBatchArgs {
-  int           npe                = 4;
-  bool          corotational       = true;
-  const int    *element_nodes      = nullptr; // npe per element (the mesh's)
-  const double *rest_positions     = nullptr; // 3 per node
-  const double *rest_shape_inverse = nullptr; // 9 per element: Dm^-1, column-major
-  const double *volume             = nullptr; // per element
-  const double *reference_mass     = nullptr; // npe x npe (symmetric), per unit density and volume
-  const int    *elements           = nullptr; // the listed elements ...
-  std::size_t   count              = 0;       // ... and their number
+  int  npe          = 4;
+  bool corotational = true;
+  // The nodes of the listed elements, npe per element in list order (BlockPattern::plan's copy: read
+  // in order, not through the element numbers). Dm^-1 and the volume are not passed: the bodies
+  // compute them from the rest positions (kernels::rest_shape).
+  const int    *listed_nodes   = nullptr;
+  std::size_t   count          = 0;       // listed elements
+  const double *rest_positions = nullptr; // 3 per node
+  const double *reference_mass = nullptr; // npe x npe (symmetric), per unit density and volume
   // BlockPattern::plan; null: no blocks
   const int            *group_offsets = nullptr, *write_slots = nullptr, *write_offsets = nullptr;
   const unsigned short *write_terms = nullptr;

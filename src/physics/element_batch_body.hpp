@@ -49,10 +49,10 @@ template <int N> struct alignas(64) Batch {
   double               elastic[W], kinetic[W], inverted[W]; // the state's figures (ElementBatchArgs::energy)
 };
 
-// Lane l <- element e: its nodes' positions, velocities and rest positions, Dm^-1 and volume.
-template <int N> inline void gather(const ElementBatchArgs &a, int e, int l, Batch<N> &b)
+// Lane l <- listed element i: its nodes' positions, velocities and rest positions.
+template <int N> inline void gather(const ElementBatchArgs &a, std::size_t i, int l, Batch<N> &b)
 {
-  const int *nodes = a.element_nodes + static_cast<std::size_t>(e) * N;
+  const int *nodes = a.listed_nodes + i * N;
   for (int c = 0; c < N; ++c) {
     const std::size_t n = 3 * static_cast<std::size_t>(nodes[c]);
     for (int d = 0; d < 3; ++d) {
@@ -61,9 +61,6 @@ template <int N> inline void gather(const ElementBatchArgs &a, int e, int l, Bat
       b.X[(3 * c + d) * W + l] = a.rest_positions[n + d];
     }
   }
-  const double *Dinv = a.rest_shape_inverse + 9 * static_cast<std::size_t>(e);
-  for (int j = 0; j < 9; ++j) b.Dinv[j * W + l] = Dinv[j];
-  b.vol[l] = a.volume[e];
 }
 
 // Asks for the cache lines batch [start, start + m) will touch in x, v, X and rhs (its nodes'
@@ -71,7 +68,7 @@ template <int N> inline void gather(const ElementBatchArgs &a, int e, int l, Bat
 template <int N> inline void prefetch_nodes(const ElementBatchArgs &a, std::size_t start, int m)
 {
   for (int l = 0; l < m; ++l) {
-    const int *nodes = a.element_nodes + static_cast<std::size_t>(a.elements[start + l]) * N;
+    const int *nodes = a.listed_nodes + (start + l) * N;
     for (int c = 0; c < N; ++c) {
       const std::size_t n = 3 * static_cast<std::size_t>(nodes[c]);
       __builtin_prefetch(a.x + n);
@@ -224,7 +221,9 @@ template <int N, bool Blocks, bool MassDamping> long long run(const ElementBatch
       if (start + W < n) prefetch_nodes<N>(a, start + W, n - start - W < W ? int(n - start - W) : W);
       if (Blocks) prefetch_blocks(a, k0 + kn * jb / GB, k0 + kn * (jb + 1) / GB);
       // Lanes past the end repeat the last element; nothing of theirs is written out.
-      for (int l = 0; l < W; ++l) gather<N>(a, a.elements[start + (l < m ? l : m - 1)], l, b);
+      for (int l = 0; l < W; ++l) gather<N>(a, start + (l < m ? l : m - 1), l, b);
+#pragma omp simd
+      for (int l = 0; l < W; ++l) rest_shape<W>(b.X + l, b.Dinv + l, b.vol + l);
       if (a.corotational) {
 #pragma omp simd
         for (int l = 0; l < W; ++l) deformation_gradient<W>(b.x + l, b.Dinv + l, b.F + l);
@@ -262,7 +261,7 @@ template <int N, bool Blocks, bool MassDamping> long long run(const ElementBatch
       // Forces (and rotations) out in element order, lane after lane; the blocks to the stage.
       for (int l = 0; l < m; ++l) {
         const std::size_t i     = start + l;
-        const int        *nodes = a.element_nodes + static_cast<std::size_t>(a.elements[i]) * N;
+        const int        *nodes = a.listed_nodes + i * N;
         if (a.rotations)
           for (int q = 0; q < 9; ++q) a.rotations[9 * i + q] = b.R[q * W + l];
         for (int c = 0; c < N; ++c)
