@@ -139,7 +139,25 @@ BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &e
           written[*s] = 1;
           *s |= kFirstContribution;
         }
-  p.plan               = make_write_plan(p.element_slots, npe, elements.size(), p.rows.size());
+  p.plan = make_write_plan(p.element_slots, npe, elements.size(), p.rows.size());
+  if (merge) {
+    // Number the COO blocks in the order the batched loop first writes them: its first writes then
+    // run along the values instead of jumping about them in row order, and its later additions find
+    // blocks written a few groups before (quadratic_47k's 14.5 MB of values exceed the caches).
+    std::vector<int> renumber(p.rows.size(), -1);
+    int              next = 0;
+    for (int s : p.plan.write_slots)
+      if (renumber[s & kSlotIndexMask] < 0) renumber[s & kSlotIndexMask] = next++;
+    for (int &r : renumber)
+      if (r < 0) r = next++; // (no element writes it: not expected, kept for completeness)
+    std::vector<int> rows(p.rows.size()), cols(p.cols.size());
+    for (size_t k = 0; k < p.rows.size(); ++k) rows[renumber[k]] = p.rows[k], cols[renumber[k]] = p.cols[k];
+    p.rows.swap(rows);
+    p.cols.swap(cols);
+    for (int &s : p.element_slots)
+      if (s >= 0) s = renumber[s & kSlotIndexMask] | (s & kFirstContribution);
+    p.plan = make_write_plan(p.element_slots, npe, elements.size(), p.rows.size());
+  }
   p.plan.element_nodes = listed_element_nodes(model, elements);
   for (int v = owned_begin; v < owned_end; ++v)
     if (fixed[v]) {
