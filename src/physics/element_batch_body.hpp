@@ -183,8 +183,7 @@ __attribute__((noinline)) void batch_energy(const ElementBatchArgs &a, Batch<N> 
   const ElementConstants &k = a.k;
 #pragma omp simd
   for (int l = 0; l < W; ++l) {
-    if constexpr (N == 4)
-      b.elastic[l] = p1_elastic_energy<W>(b.x + l, b.X + l, b.Dinv + l, b.R + l, b.vol[l], k.lambda, k.mu);
+    if constexpr (N == 4) b.elastic[l] = p1_elastic_energy<W>(b.F + l, b.R + l, b.vol[l], k.lambda, k.mu);
     else b.elastic[l] = p2_elastic_energy<W>(b.x + l, b.X + l, b.Dinv + l, b.R + l, b.vol[l], k.lambda, k.mu);
     b.kinetic[l]  = kinetic_energy<W, N>(b.v + l, Mref, b.vol[l], k.density);
     b.inverted[l] = corner_inverted<W>(b.x + l);
@@ -224,9 +223,9 @@ template <int N, bool Blocks, bool MassDamping> long long run(const ElementBatch
       for (int l = 0; l < W; ++l) gather<N>(a, start + (l < m ? l : m - 1), l, b);
 #pragma omp simd
       for (int l = 0; l < W; ++l) rest_shape<W>(b.X + l, b.Dinv + l, b.vol + l);
-      if (a.corotational) {
 #pragma omp simd
-        for (int l = 0; l < W; ++l) deformation_gradient<W>(b.x + l, b.Dinv + l, b.F + l);
+      for (int l = 0; l < W; ++l) deformation_gradient<W>(b.x + l, b.Dinv + l, b.F + l);
+      if (a.corotational) {
 #pragma omp simd
         for (int l = 0; l < W; ++l) b.ok[l] = polar_rotation<W>(b.F + l, b.R + l);
         for (int l = 0; l < m; ++l) {

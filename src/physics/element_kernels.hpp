@@ -311,18 +311,18 @@ BINBCSR_PHYS_HD double strain_product(const double A[9], const double B[9], doub
 }
 
 // The elastic energy u^T K0 u / 2 of a linear tetrahedron: V sigma(G) : G / 2 with the constant
-// displacement gradient G = sum_b u_b g_b^T (K0 = V B^T D B, no stored K0 read).
+// displacement gradient G = sum_b u_b g_b^T, u_b = R^T x_b - X_b, which is R^T F - I (sum_b x_b g_b^T
+// = Ds Dm^-1 = F, sum_b X_b g_b^T = Dm Dm^-1 = I): no stored K0 and no nodal vectors read.
 template <int S>
-BINBCSR_PHYS_HD double p1_elastic_energy(const double *x, const double *X, const double *Dinv,
-                                         const double *R, double vol, double lambda, double mu)
+BINBCSR_PHYS_HD double p1_elastic_energy(const double *F, const double *R, double vol, double lambda,
+                                         double mu)
 {
-  double g[4][3], u[4][3], G[9];
-  barycentric_gradients<S>(Dinv, g);
-  rest_frame_displacement<S, 4>(x, X, R, u);
+  double G[9];
   BINBCSR_PHYS_UNROLL
   for (int i = 0; i < 3; ++i) BINBCSR_PHYS_UNROLL
-  for (int j = 0; j < 3; ++j)
-    G[3 * i + j] = u[0][i] * g[0][j] + u[1][i] * g[1][j] + u[2][i] * g[2][j] + u[3][i] * g[3][j];
+  for (int j = 0; j < 3; ++j) // (R^T F)_ij = sum_k R_ki F_kj, column-major
+    G[3 * i + j] = R[(3 * i) * S] * F[(3 * j) * S] + R[(3 * i + 1) * S] * F[(3 * j + 1) * S] +
+                   R[(3 * i + 2) * S] * F[(3 * j + 2) * S] - (i == j ? 1.0 : 0.0);
   return 0.5 * vol * strain_product(G, G, lambda, mu);
 }
 
