@@ -58,6 +58,7 @@ long long assemble_elements_batched(const FemModel &model, const std::vector<int
   if (!planned) listed = listed_element_nodes(model, elements);
   args.listed_nodes   = planned ? pattern->plan.element_nodes.data() : listed.data();
   args.count          = elements.size();
+  args.nodes          = static_cast<std::size_t>(model.node_count());
   args.rest_positions = model.mesh.nodes.data();
   args.reference_mass = Mref;
   args.x              = x;

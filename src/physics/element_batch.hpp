@@ -80,6 +80,7 @@ struct ElementBatchArgs {
   // compute them from the rest positions (kernels::rest_shape).
   const int    *listed_nodes   = nullptr;
   std::size_t   count          = 0;       // listed elements
+  std::size_t   nodes          = 0;       // the mesh's nodes (x, v, rest_positions: 3 each)
   const double *rest_positions = nullptr; // 3 per node
   const double *reference_mass = nullptr; // npe x npe (symmetric), per unit density and volume
   // BlockPattern::plan; null: no blocks

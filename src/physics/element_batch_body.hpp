@@ -219,8 +219,15 @@ template <int N, bool Blocks, bool MassDamping> long long run(const ElementBatch
       const int m = n - start < W ? static_cast<int>(n - start) : W;
       if (start + W < n) prefetch_nodes<N>(a, start + W, n - start - W < W ? int(n - start - W) : W);
       if (Blocks) prefetch_blocks(a, k0 + kn * jb / GB, k0 + kn * (jb + 1) / GB);
-      // Lanes past the end repeat the last element; nothing of theirs is written out.
-      for (int l = 0; l < W; ++l) gather<N>(a, start + (l < m ? l : m - 1), l, b);
+        // Lanes past the end repeat the last element; nothing of theirs is written out.
+#if BINBCSR_ELEMENT_BATCH_AVX512
+      static_assert(W == 8, "a batch's row is one AVX-512 register");
+      if (m == W)
+        avx512::gather_nodes<N>(a.listed_nodes + start * N, a.nodes, a.x, a.v, a.rest_positions, b.x, b.v,
+                                b.X);
+      else
+#endif
+        for (int l = 0; l < W; ++l) gather<N>(a, start + (l < m ? l : m - 1), l, b);
 #pragma omp simd
       for (int l = 0; l < W; ++l) rest_shape<W>(b.X + l, b.Dinv + l, b.vol + l);
 #pragma omp simd
