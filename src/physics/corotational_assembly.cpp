@@ -36,7 +36,8 @@ BlockPattern::WritePlan make_write_plan(const std::vector<int> &element_slots, i
   };
   std::vector<Run> runs;
   plan.group_offsets.push_back(0);
-  plan.write_offsets.push_back(0);
+  plan.group_terms.push_back(0);
+  plan.run_offsets.push_back(0);
   for (size_t g0 = 0; g0 < count; g0 += group) {
     terms.clear();
     for (size_t i = g0; i < std::min(count, g0 + group); ++i) {
@@ -67,14 +68,18 @@ BlockPattern::WritePlan make_write_plan(const std::vector<int> &element_slots, i
     std::stable_sort(runs.begin(), runs.end(), [](const Run &x, const Run &y) {
       return x.count != y.count ? x.count < y.count : x.first > y.first;
     });
-    for (const Run &b : runs) {
-      const int s = terms[b.start].first;
+    for (size_t r = 0; r < runs.size(); ++r) {
+      const Run &b = runs[r];
+      const int  s = terms[b.start].first;
       plan.write_slots.push_back(b.first ? s | kFirstContribution : s);
       written[s] = 1;
       for (int t = 0; t < b.count; ++t) plan.write_terms.push_back(terms[b.start + t].second);
-      plan.write_offsets.push_back(static_cast<int>(plan.write_terms.size()));
+      if (r == 0 || b.count != runs[r - 1].count) plan.runs.insert(plan.runs.end(), {b.count, 0});
+      ++plan.runs.back();
     }
     plan.group_offsets.push_back(static_cast<int>(plan.write_slots.size()));
+    plan.group_terms.push_back(static_cast<int>(plan.write_terms.size()));
+    plan.run_offsets.push_back(static_cast<int>(plan.runs.size() / 2));
   }
   return plan;
 }

@@ -49,15 +49,18 @@ struct BlockPattern {
   std::vector<int> identity_slots; // COO blocks that hold the identity (fixed nodes)
   bool             merged = false; // element blocks summed into unique COO blocks by the caller
   // The batched loop's write-out (element_batch.hpp's write groups): group g writes the COO blocks
-  // write_slots[group_offsets[g] .. group_offsets[g+1]) (by term count, first writes before the others,
-  // ascending within those runs; kFirstContribution set in the first group that writes the block),
-  // block k the sum of its terms
-  // write_terms[write_offsets[k] .. write_offsets[k+1]) in element order, each term
-  // 2 (element in the group * upper blocks per element + packed pair) + 1 where its block goes in transposed.
+  // write_slots[group_offsets[g] .. group_offsets[g+1]) (kFirstContribution set in the first group
+  // that writes the block) in runs of equal term count: runs[2 r] terms per block for runs[2 r + 1]
+  // blocks, r in [run_offsets[g], run_offsets[g+1]), the term counts growing, first writes before the
+  // others and the blocks ascending within a run. The group's terms start at
+  // write_terms[group_terms[g]], each block's in element order, each term
+  // 2 (element in the group * upper blocks per element + packed pair) + 1 where its block goes in
+  // transposed. (A count per run rather than an offset per block: the write-out reads 4 bytes less
+  // per block written and loops a known number of times.)
   // element_nodes: the listed elements' nodes (npe each) in list order, which the batched loop reads
   // in order instead of through the element numbers (listed_element_nodes).
   struct WritePlan {
-    std::vector<int>            group_offsets, write_slots, write_offsets;
+    std::vector<int>            group_offsets, write_slots, group_terms, run_offsets, runs;
     std::vector<unsigned short> write_terms;
     std::vector<int>            element_nodes;
   } plan;

@@ -77,7 +77,9 @@ long long assemble_elements_batched(const FemModel &model, const std::vector<int
   if (values) {
     args.group_offsets = pattern->plan.group_offsets.data();
     args.write_slots   = pattern->plan.write_slots.data();
-    args.write_offsets = pattern->plan.write_offsets.data();
+    args.group_terms   = pattern->plan.group_terms.data();
+    args.run_offsets   = pattern->plan.run_offsets.data();
+    args.runs          = pattern->plan.runs.data();
     args.write_terms   = pattern->plan.write_terms.data();
   }
   const long long fallbacks = body_of(element_body_used(body))(args);

@@ -84,7 +84,8 @@ struct ElementBatchArgs {
   const double *rest_positions = nullptr; // 3 per node
   const double *reference_mass = nullptr; // npe x npe (symmetric), per unit density and volume
   // BlockPattern::plan; null: no blocks
-  const int            *group_offsets = nullptr, *write_slots = nullptr, *write_offsets = nullptr;
+  const int *group_offsets = nullptr, *write_slots = nullptr, *group_terms = nullptr, *run_offsets = nullptr,
+            *runs                   = nullptr;
   const unsigned short *write_terms = nullptr;
   const double         *x = nullptr, *v = nullptr; // 3 per node
   double               *values    = nullptr;       // 9 per COO block, or null

@@ -130,46 +130,48 @@ template <int N> inline void stage_batch(const Batch<N> &b, int j, Stage<N> &st)
 template <int N> inline void write_group(const ElementBatchArgs &a, std::size_t g, const Stage<N> &st)
 {
   // (Locals: the stores into the values may alias anything, so fields of `a` would be read again.)
-  const int *const slots = a.write_slots, *const offsets = a.write_offsets;
-  const unsigned short *const terms  = a.write_terms;
-  double *const               values = a.values;
-  const int                   k1     = a.group_offsets[g + 1];
-  for (int k = a.group_offsets[g]; k < k1; ++k) {
-    const unsigned short *t = terms + offsets[k], *const end = terms + offsets[k + 1];
+  const int *const slots = a.write_slots, *const runs = a.runs;
+  const unsigned short *t      = a.write_terms + a.group_terms[g];
+  double *const         values = a.values;
+  int                   k      = a.group_offsets[g];
+  for (int r = a.run_offsets[g], r1 = a.run_offsets[g + 1]; r < r1; ++r) {
+    const int count = runs[2 * r], k1 = k + runs[2 * r + 1];
+    for (; k < k1; ++k, t += count) {
 #if BINBCSR_ELEMENT_BATCH_AVX512
-    __m512d acc  = avx512::term(st.head[*t >> 1], *t & 1);
-    double  acc8 = st.tail[*t >> 1];
-    for (++t; t < end; ++t) {
-      acc = _mm512_add_pd(acc, avx512::term(st.head[*t >> 1], *t & 1));
-      acc8 += st.tail[*t >> 1];
-    }
-    avx512::write_block(values, slots[k], acc, acc8);
+      __m512d acc  = avx512::term(st.head[t[0] >> 1], t[0] & 1);
+      double  acc8 = st.tail[t[0] >> 1];
+      for (int i = 1; i < count; ++i) {
+        acc = _mm512_add_pd(acc, avx512::term(st.head[t[i] >> 1], t[i] & 1));
+        acc8 += st.tail[t[i] >> 1];
+      }
+      avx512::write_block(values, slots[k], acc, acc8);
 #elif BINBCSR_ELEMENT_BATCH_AVX2
-    __m256d lo, hi, tlo, thi;
-    avx2::term(st.head[*t >> 1], *t & 1, lo, hi);
-    double acc8 = st.tail[*t >> 1];
-    for (++t; t < end; ++t) {
-      avx2::term(st.head[*t >> 1], *t & 1, tlo, thi);
-      lo = _mm256_add_pd(lo, tlo);
-      hi = _mm256_add_pd(hi, thi);
-      acc8 += st.tail[*t >> 1];
-    }
-    avx2::write_block(values, slots[k], lo, hi, acc8);
+      __m256d lo, hi, tlo, thi;
+      avx2::term(st.head[t[0] >> 1], t[0] & 1, lo, hi);
+      double acc8 = st.tail[t[0] >> 1];
+      for (int i = 1; i < count; ++i) {
+        avx2::term(st.head[t[i] >> 1], t[i] & 1, tlo, thi);
+        lo = _mm256_add_pd(lo, tlo);
+        hi = _mm256_add_pd(hi, thi);
+        acc8 += st.tail[t[i] >> 1];
+      }
+      avx2::write_block(values, slots[k], lo, hi, acc8);
 #else
-    constexpr int kT[2][8] = {{0, 1, 2, 3, 4, 5, 6, 7}, {0, 3, 6, 1, 4, 7, 2, 5}}; // B, B^T
-    double        acc[9];
-    for (int e = 0; e < 8; ++e) acc[e] = st.head[*t >> 1][kT[*t & 1][e]];
-    acc[8] = st.tail[*t >> 1];
-    for (++t; t < end; ++t) {
-      for (int e = 0; e < 8; ++e) acc[e] += st.head[*t >> 1][kT[*t & 1][e]];
-      acc[8] += st.tail[*t >> 1];
-    }
-    double *out = values + 9 * static_cast<std::size_t>(slots[k] & kSlotIndexMask);
-    if (slots[k] & kFirstContribution)
-      for (int e = 0; e < 9; ++e) out[e] = acc[e];
-    else
-      for (int e = 0; e < 9; ++e) out[e] += acc[e];
+      constexpr int kT[2][8] = {{0, 1, 2, 3, 4, 5, 6, 7}, {0, 3, 6, 1, 4, 7, 2, 5}}; // B, B^T
+      double        acc[9];
+      for (int e = 0; e < 8; ++e) acc[e] = st.head[t[0] >> 1][kT[t[0] & 1][e]];
+      acc[8] = st.tail[t[0] >> 1];
+      for (int i = 1; i < count; ++i) {
+        for (int e = 0; e < 8; ++e) acc[e] += st.head[t[i] >> 1][kT[t[i] & 1][e]];
+        acc[8] += st.tail[t[i] >> 1];
+      }
+      double *out = values + 9 * static_cast<std::size_t>(slots[k] & kSlotIndexMask);
+      if (slots[k] & kFirstContribution)
+        for (int e = 0; e < 9; ++e) out[e] = acc[e];
+      else
+        for (int e = 0; e < 9; ++e) out[e] += acc[e];
 #endif
+    }
   }
 }
 

@@ -39,8 +39,26 @@ TEST_CASE("grouped write-out: one term per element block, one first write per CO
         REQUIRE(n > 3 * group);
         const BlockPattern::WritePlan &w = p.plan;
         REQUIRE(w.group_offsets.size() == static_cast<size_t>((n + group - 1) / group + 1));
-        REQUIRE(w.write_offsets.size() == w.write_slots.size() + 1);
-        CHECK(w.write_offsets.back() == static_cast<int>(w.write_terms.size()));
+        REQUIRE(w.group_terms.size() == w.group_offsets.size());
+        REQUIRE(w.run_offsets.size() == w.group_offsets.size());
+        CHECK(w.group_terms.back() == static_cast<int>(w.write_terms.size()));
+        CHECK(2 * static_cast<size_t>(w.run_offsets.back()) == w.runs.size());
+        // Each block's term count, from the runs: they cover every block and every term of its group.
+        std::vector<int> term_count;
+        for (size_t g = 0; g + 1 < w.group_offsets.size(); ++g) {
+          int blocks = 0, group_terms = 0;
+          for (int r = w.run_offsets[g]; r < w.run_offsets[g + 1]; ++r) {
+            CHECK(w.runs[2 * r] > 0);
+            CHECK(w.runs[2 * r + 1] > 0);
+            if (r > w.run_offsets[g]) CHECK(w.runs[2 * r] > w.runs[2 * r - 2]);
+            term_count.insert(term_count.end(), w.runs[2 * r + 1], w.runs[2 * r]);
+            blocks += w.runs[2 * r + 1];
+            group_terms += w.runs[2 * r] * w.runs[2 * r + 1];
+          }
+          CHECK(blocks == w.group_offsets[g + 1] - w.group_offsets[g]);
+          CHECK(group_terms == w.group_terms[g + 1] - w.group_terms[g]);
+        }
+        REQUIRE(term_count.size() == w.write_slots.size());
         size_t contributions = 0;
         for (int s : p.element_slots) contributions += s >= 0;
         // (the diagonal entry (a, a) of element_slots is one contribution, like any other)
@@ -54,7 +72,7 @@ TEST_CASE("grouped write-out: one term per element block, one first write per CO
             // run: every block of the group once
             if (k > w.group_offsets[g]) {
               const int  prev = w.write_slots[k - 1];
-              const int  n0 = w.write_offsets[k] - w.write_offsets[k - 1], n1 = w.write_offsets[k + 1] - w.write_offsets[k];
+              const int  n0 = term_count[k - 1], n1 = term_count[k];
               const bool f0 = prev & kFirstContribution, f1 = s & kFirstContribution;
               CHECK(n0 <= n1);
               if (n0 == n1) CHECK(f0 >= f1);
