@@ -76,7 +76,8 @@ struct LowerTriangle {
                                  // [part_offsets[p], part_offsets[p+1]) (empty: no exception)
 };
 // merge_duplicates: rows/cols are unique, numbered in the order of the batched loop's first writes
-// (the identity blocks last), and elements add into shared blocks; otherwise every element block has its own COO entry and the Mat type sums duplicates.
+// (the identity blocks last), and elements add into shared blocks; otherwise every element block has
+// its own COO entry and the Mat type sums duplicates.
 BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &elements,
                                 const std::vector<char> &fixed, int owned_begin, int owned_end,
                                 bool merge_duplicates, const LowerTriangle &lower = {});

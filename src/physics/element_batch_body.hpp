@@ -50,7 +50,7 @@ template <int N> struct alignas(64) Batch {
 };
 
 // Lane l <- listed element i: its nodes' positions, velocities and rest positions.
-template <int N> inline void gather(const ElementBatchArgs &a, std::size_t i, int l, Batch<N> &b)
+template <int N> inline void gather_lane(const ElementBatchArgs &a, std::size_t i, int l, Batch<N> &b)
 {
   const int *nodes = a.listed_nodes + i * N;
   for (int c = 0; c < N; ++c) {
@@ -61,6 +61,20 @@ template <int N> inline void gather(const ElementBatchArgs &a, std::size_t i, in
       b.X[(3 * c + d) * W + l] = a.rest_positions[n + d];
     }
   }
+}
+
+// The lanes <- listed elements [start, start + m); lanes past the end repeat the last element (nothing
+// of theirs is written out). AVX-512: a full batch's node rows by 4-wide loads (avx512::gather_nodes).
+template <int N> inline void gather(const ElementBatchArgs &a, std::size_t start, int m, Batch<N> &b)
+{
+#if BINBCSR_ELEMENT_BATCH_AVX512
+  static_assert(W == 8, "a batch's row is one AVX-512 register");
+  if (m == W) {
+    avx512::gather_nodes<N>(a.listed_nodes + start * N, a.nodes, a.x, a.v, a.rest_positions, b.x, b.v, b.X);
+    return;
+  }
+#endif
+  for (int l = 0; l < W; ++l) gather_lane<N>(a, start + (l < m ? l : m - 1), l, b);
 }
 
 // Asks for the cache lines batch [start, start + m) will touch in x, v, X and rhs (its nodes'
@@ -221,15 +235,7 @@ template <int N, bool Blocks, bool MassDamping> long long run(const ElementBatch
       const int m = n - start < W ? static_cast<int>(n - start) : W;
       if (start + W < n) prefetch_nodes<N>(a, start + W, n - start - W < W ? int(n - start - W) : W);
       if (Blocks) prefetch_blocks(a, k0 + kn * jb / GB, k0 + kn * (jb + 1) / GB);
-        // Lanes past the end repeat the last element; nothing of theirs is written out.
-#if BINBCSR_ELEMENT_BATCH_AVX512
-      static_assert(W == 8, "a batch's row is one AVX-512 register");
-      if (m == W)
-        avx512::gather_nodes<N>(a.listed_nodes + start * N, a.nodes, a.x, a.v, a.rest_positions, b.x, b.v,
-                                b.X);
-      else
-#endif
-        for (int l = 0; l < W; ++l) gather<N>(a, start + (l < m ? l : m - 1), l, b);
+      gather<N>(a, start, m, b);
 #pragma omp simd
       for (int l = 0; l < W; ++l) rest_shape<W>(b.X + l, b.Dinv + l, b.vol + l);
 #pragma omp simd
