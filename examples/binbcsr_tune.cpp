@@ -16,7 +16,9 @@
 // on the stencils of -stencil_sizes (default 32,48) and on every PETSc binary file of -f (comma list,
 // block size from -bs, default 3; the drivers write them with -dump_matrix FILE). Per matrix and
 // case one line: the sweep's best bw/K/body and ms, the tuned bw/K/body and ms, tuned / best, the reference
-// (seqbaij; seqaij for bs 1) and what the tuning cost. -sweep_verbose prints every variant;
+// (seqbaij; seqaij for bs 1) and what the tuning cost. The best is then timed again against the tuned
+// matrix alone, alternating, -sweep_confirm N rounds (default 9; 0: not), since the lowest of ~100
+// medians is biased low by the rounds that chose it. -sweep_verbose prints every variant;
 // -tune_cache 1 lets the tuned matrix use the cache file (default: it measures).
 //
 // The fixed variants are built with -mat_binbcsr_tune off semantics (MatBinBCSRSetTune).
@@ -168,6 +170,9 @@ int main(int argc, char **argv)
       PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-batch", &s.batch, nullptr));
       PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-tune_cache", &s.tune_cache, nullptr));
       PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-sweep_verbose", &s.verbose, nullptr));
+      PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-sweep_confirm", &s.confirm, nullptr));
+      PetscCheck(s.confirm >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+                 "-sweep_confirm must be >= 0 (got %" PetscInt_FMT ")", s.confirm);
       {
         PetscInt pfs[16], npf = 16;
         PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-sweep_prefetch", pfs, &npf, &flg));
@@ -182,8 +187,9 @@ int main(int argc, char **argv)
                             "binbcsr_tune -sweep: ms per MatMult, median of %" PetscInt_FMT
                             " rounds of %" PetscInt_FMT
                             " (%s time); best/tuned as bin width/streams; tuned/best and x baij: median"
-                            " of the rounds' ratios (min: the ratio of the minima)\n",
-                            s.repeats, s.batch, use_wall ? "wall" : "thread CPU"));
+                            " of the rounds' ratios (min: the ratio of the minima); confirmed: the"
+                            " same from %" PetscInt_FMT " fresh rounds of tuned against best alone\n",
+                            s.repeats, s.batch, use_wall ? "wall" : "thread CPU", s.confirm));
       for (PetscInt i = 0; i < nsizes; i++) {
         if (sizes[i] <= 0) continue;
         StencilGrid g;

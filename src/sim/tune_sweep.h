@@ -8,8 +8,12 @@
 #include <vector>
 
 struct SweepSettings {
-  PetscInt  repeats    = 5;           // rounds
-  PetscInt  batch      = 5;           // MatMults per variant per round
+  PetscInt repeats = 5; // rounds
+  PetscInt batch   = 5; // MatMults per variant per round
+  // Rounds of the head-to-head after the sweep: the tuned matrix against the sweep's best, alternating,
+  // timed afresh (0: none). The best is the lowest of ~100 medians, so the sweep's own rounds flatter
+  // it; the fresh rounds do not (the ratio reported as "confirmed").
+  PetscInt  confirm    = 9;
   PetscBool tune_cache = PETSC_FALSE; // the tuned matrix may use the cache file (default: it measures)
   PetscBool verbose    = PETSC_FALSE; // every variant's time, not only the summary line
   std::vector<PetscInt> prefetches = {0, 1024, 4096}; // software prefetch distances swept (bytes)
