@@ -61,6 +61,7 @@ long long assemble_elements_batched(const FemModel &model, const std::vector<int
   args.nodes          = static_cast<std::size_t>(model.node_count());
   args.rest_positions = model.mesh.nodes.data();
   args.reference_mass = Mref;
+  args.diagonal_mass  = model.diagonal_mass;
   args.x              = x;
   args.v              = v;
   args.values         = values;

@@ -83,6 +83,7 @@ struct ElementBatchArgs {
   std::size_t   nodes          = 0;       // the mesh's nodes (x, v, rest_positions: 3 each)
   const double *rest_positions = nullptr; // 3 per node
   const double *reference_mass = nullptr; // npe x npe (symmetric), per unit density and volume
+  bool          diagonal_mass  = false;   // reference_mass is diagonal (lumped)
   // BlockPattern::plan; null: no blocks
   const int *group_offsets = nullptr, *write_slots = nullptr, *group_terms = nullptr, *run_offsets = nullptr,
             *runs                   = nullptr;

@@ -201,8 +201,15 @@ __attribute__((noinline)) void batch_energy(const ElementBatchArgs &a, Batch<N> 
   for (int l = 0; l < W; ++l) {
     if constexpr (N == 4) b.elastic[l] = p1_elastic_energy<W>(b.F + l, b.R + l, b.vol[l], k.lambda, k.mu);
     else b.elastic[l] = p2_elastic_energy<W>(b.x + l, b.X + l, b.Dinv + l, b.R + l, b.vol[l], k.lambda, k.mu);
-    b.kinetic[l]  = kinetic_energy<W, N>(b.v + l, Mref, b.vol[l], k.density);
     b.inverted[l] = corner_inverted<W>(b.x + l);
+  }
+  if (a.diagonal_mass) {
+#pragma omp simd
+    for (int l = 0; l < W; ++l)
+      b.kinetic[l] = kinetic_energy_lumped<W, N>(b.v + l, Mref, b.vol[l], k.density);
+  } else {
+#pragma omp simd
+    for (int l = 0; l < W; ++l) b.kinetic[l] = kinetic_energy<W, N>(b.v + l, Mref, b.vol[l], k.density);
   }
   for (int l = 0; l < m; ++l) {
     sums[0] += b.elastic[l];
