@@ -56,6 +56,12 @@ PETSC_EXTERN PetscErrorCode MatBinBCSRGetSymmetricStorage(Mat, PetscBool *);
    answers PETSC_FALSE on matrices of other types. */
 PETSC_EXTERN PetscErrorCode MatBinBCSRSetCOOMirror(Mat, PetscBool);
 PETSC_EXTERN PetscErrorCode MatBinBCSRGetCOOMirror(Mat, PetscBool *);
+/* MatSetValuesCOO() with the values in single precision (one float per COO entry, in the order of
+   MatSetPreallocationCOO()): for a caller that fills a single-precision matrix, whose values are
+   rounded to float on storage anyway; it writes and the refill reads half the bytes. Entries that sum
+   into one value are summed in double, as MatSetValuesCOO() does. MATBINBCSR only (an error on other
+   types); on MATMPIBINBCSR the values are widened to PetscScalar first. */
+PETSC_EXTERN PetscErrorCode MatBinBCSRSetValuesCOOSingle(Mat, const float[], InsertMode);
 /* Streams: the product y = A x (block size 1 or 3, bin width 4, 8, 16 or 32; whole or symmetric storage) sweeps
    this many runs of consecutive bins side by side, so one core streams the values from that many
    places at once (the hardware prefetcher keeps more cache lines in flight for several streams):

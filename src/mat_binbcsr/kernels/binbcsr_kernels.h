@@ -295,17 +295,16 @@ BINBCSR_HD void sym_bins_mult(const V *const *bin_val, const I *const *bin_col, 
 }
 
 /* COO refill of one value: the sum of the entries perm[jmap[v] .. jmap[v+1]-1], where an index p < n
-   reads coo_v[p] and p >= n reads recv[p - n] (the MPI refill: the caller's values and the values
+   reads coo_v[p] (double or float) and p >= n reads recv[p - n] (the MPI refill: the caller's values and the values
    received from other ranks, without first copying both into one array). One source: n past every
    index, recv unused. */
-template <typename I>
-BINBCSR_HD double coo_gather(const double *coo_v, long n, const double *recv, const I *jmap, const I *perm,
-                             long v)
+template <typename I, typename T>
+BINBCSR_HD double coo_gather(const T *coo_v, long n, const double *recv, const I *jmap, const I *perm, long v)
 {
   double s = 0.0;
   for (I j = jmap[v]; j < jmap[v + 1]; j++) {
     const long p = perm[j];
-    s += p < n ? coo_v[p] : recv[p - n];
+    s += p < n ? (double)coo_v[p] : recv[p - n];
   }
   return s;
 }

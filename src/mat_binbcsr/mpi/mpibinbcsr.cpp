@@ -552,6 +552,7 @@ static const BinBCSRComposed composed[] = {
   BINBCSR_COMPOSED("MatMPIBAIJSetPreallocation_C", MatMPIBAIJSetPreallocation_MPIBinBCSR),
   BINBCSR_COMPOSED("MatSetPreallocationCOO_C", MatSetPreallocationCOO_MPIBinBCSR),
   BINBCSR_COMPOSED("MatSetValuesCOO_C", MatSetValuesCOO_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRSetValuesCOOSingle_C", MatBinBCSRSetValuesCOOSingle_MPIBinBCSR),
   BINBCSR_COMPOSED("MatMultDotLocal_C", MatMultDotLocal_MPIBinBCSR),
   BINBCSR_COMPOSED("MatAXPYGetPreallocation_C", MatAXPYGetPreallocation_BinBCSR),
   BINBCSR_COMPOSED("MatGetDiagonalBlock_C", MatGetDiagonalBlock_MPIBinBCSR),

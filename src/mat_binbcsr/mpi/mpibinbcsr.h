@@ -156,6 +156,7 @@ PETSC_INTERN PetscErrorCode MatAssemblyEnd_MPIBinBCSR(Mat, MatAssemblyType);
 PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_MPIBinBCSR(Mat, PetscCount, const PetscInt[],
                                                               const PetscInt[]);
 PETSC_INTERN PetscErrorCode MatSetValuesCOO_MPIBinBCSR(Mat, const PetscScalar[], InsertMode);
+PETSC_INTERN PetscErrorCode MatBinBCSRSetValuesCOOSingle_MPIBinBCSR(Mat, const float[], InsertMode);
 PETSC_INTERN PetscErrorCode MatMPIBinBCSRDestroyCoo(Mat);
 
 /* mpibinbcsr_ops.cpp */

@@ -368,3 +368,17 @@ PETSC_INTERN PetscErrorCode MatSetValuesCOO_MPIBinBCSR(Mat mat, const PetscScala
   b->coo_just_assembled = PETSC_TRUE; /* MatSetValuesCOO() assembles mat next; nothing is stashed */
   PetscFunctionReturn(0);
 }
+
+/* The single-precision values widened to PetscScalar: the exchange and the parts take PetscScalar. */
+PETSC_INTERN PetscErrorCode MatBinBCSRSetValuesCOOSingle_MPIBinBCSR(Mat mat, const float v[], InsertMode mode)
+{
+  MPIBinBCSRCoo *coo = MPIBinBCSR(mat)->coo;
+
+  PetscFunctionBegin;
+  PetscCheck(coo, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONGSTATE,
+             "Call MatSetPreallocationCOO() first");
+  std::vector<PetscScalar> w;
+  if (v) w.assign(v, v + coo->n);
+  PetscCall(MatSetValuesCOO_MPIBinBCSR(mat, v ? w.data() : nullptr, mode));
+  PetscFunctionReturn(0);
+}

@@ -302,6 +302,7 @@ static const BinBCSRComposed composed[] = {
   BINBCSR_COMPOSED("MatSeqBAIJSetPreallocation_C", MatSeqBAIJSetPreallocation_SeqBinBCSR),
   BINBCSR_COMPOSED("MatSetPreallocationCOO_C", MatSetPreallocationCOO_SeqBinBCSR),
   BINBCSR_COMPOSED("MatSetValuesCOO_C", MatSetValuesCOO_SeqBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRSetValuesCOOSingle_C", MatBinBCSRSetValuesCOOSingle_SeqBinBCSR),
   BINBCSR_COMPOSED("MatMultDotLocal_C", MatMultDotLocal_SeqBinBCSR),
   BINBCSR_COMPOSED("MatConvert_seqbinbcsr_seqaij_C", MatConvert_SeqBinBCSR_SeqAIJ),
   BINBCSR_COMPOSED("MatConvert_seqbinbcsr_seqbaij_C", MatConvert_SeqBinBCSR_SeqBAIJ),

@@ -266,6 +266,7 @@ PETSC_INTERN PetscErrorCode MatMultDiagonalBlock_SeqBinBCSR(Mat, Vec, Vec);
 PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_SeqBinBCSR(Mat, PetscCount, const PetscInt[],
                                                               const PetscInt[]);
 PETSC_INTERN PetscErrorCode MatSetValuesCOO_SeqBinBCSR(Mat, const PetscScalar[], InsertMode);
+PETSC_INTERN PetscErrorCode MatBinBCSRSetValuesCOOSingle_SeqBinBCSR(Mat, const float[], InsertMode);
 PETSC_INTERN PetscErrorCode MatGetRow_SeqBinBCSR(Mat, PetscInt, PetscInt *, PetscInt **, PetscScalar **);
 PETSC_INTERN PetscErrorCode MatRestoreRow_SeqBinBCSR(Mat, PetscInt, PetscInt *, PetscInt **, PetscScalar **);
 PETSC_INTERN PetscErrorCode MatDuplicate_SeqBinBCSR(Mat, MatDuplicateOption, Mat *);

@@ -161,8 +161,8 @@ namespace {
 /* Refill in row order q (CSR order: gathers from the same elements follow each other); the writes
    stay inside one bin's tiles at a time. perm indices below n read v, the others recv (see
    binbcsr::coo_gather). */
-template <int BS, bool ADD, typename V>
-void coo_refill(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const PetscScalar *v, long n,
+template <int BS, bool ADD, typename V, typename S>
+void coo_refill(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const S *v, long n,
                 const PetscScalar *recv)
 {
   const PetscInt  bs = BS ? BS : a->bs, bs2 = bs * bs, bw = a->bw;
@@ -237,13 +237,32 @@ bool build_slot_map(const Mat_SeqBinBCSR *a, const PetscInt *perm, long n, Petsc
   return true;
 }
 
-/* The refill by blocks: slot by slot in storage order, so the values are written in sequence. */
-template <int BS, bool ADD, typename V>
-void coo_refill_blocks(const Mat_SeqBinBCSR *a, V *val, const PetscInt *slot_ptr, const PetscInt *slot_src,
-                       const PetscScalar *v, long n, const PetscScalar *recv)
+/* sum += the BS x BS block at x (row-major), transposed if asked */
+template <int BS, typename T> inline void add_block(double *sum, const T *x, bool transposed)
 {
-  constexpr int  MAXB2 = BS ? BS * BS : 1;
-  const PetscInt bs = BS ? BS : a->bs, bs2 = bs * bs, bw = a->bw;
+  if (!transposed)
+    for (int e = 0; e < BS * BS; e++) sum[e] += (double)x[e];
+  else
+    for (int i = 0; i < BS; i++)
+      for (int j = 0; j < BS; j++) sum[i * BS + j] += (double)x[j * BS + i];
+}
+
+/* The refill by blocks: slot by slot in storage order, so the values are written in sequence. v: the
+   caller's values (double, or float for MatBinBCSRSetValuesCOOSingle), recv: received ones. */
+template <int BS, bool ADD, typename V, typename S>
+void coo_refill_blocks(const Mat_SeqBinBCSR *a, V *val, const PetscInt *slot_ptr, const PetscInt *slot_src,
+                       const S *v, long n, const PetscScalar *recv)
+{
+  /* source block at base: its first value's address (for the prefetch) and value e (plain order) */
+  const auto at = [&](long base) -> const void * {
+    return base < n ? (const void *)(v + base) : recv + (base - n);
+  };
+  const auto value = [&](long base, PetscInt e) -> double {
+    return base < n ? (double)v[base + e] : recv[base - n + e];
+  };
+  const std::size_t elem  = sizeof(S);
+  constexpr int     MAXB2 = BS ? BS * BS : 1;
+  const PetscInt    bs = BS ? BS : a->bs, bs2 = bs * bs, bw = a->bw;
   for (PetscInt s0 = 0; s0 < a->nslots; s0 += bw) { /* one column of a bin: bw lanes */
     /* the sources of the slot column four ahead: the caller's blocks are read in its order, not in
        storage order, and each read waited for memory */
@@ -251,10 +270,10 @@ void coo_refill_blocks(const Mat_SeqBinBCSR *a, V *val, const PetscInt *slot_ptr
       for (PetscInt l = 0; l < bw; l++) {
         const PetscInt p = slot_ptr[s0 + 4 * bw + l];
         if (p == slot_ptr[s0 + 4 * bw + l + 1]) continue;
-        const long         base = slot_src[p] >= 0 ? slot_src[p] : -1 - (long)slot_src[p];
-        const PetscScalar *x    = base < n ? v + base : recv + (base - n);
+        const long  base = slot_src[p] >= 0 ? slot_src[p] : -1 - (long)slot_src[p];
+        const char *x    = (const char *)at(base);
         __builtin_prefetch(x);
-        __builtin_prefetch(x + bs2 - 1);
+        __builtin_prefetch(x + (base < n ? elem : sizeof(PetscScalar)) * (bs2 - 1));
       }
     for (PetscInt l = 0; l < bw; l++) {
       const PetscInt p0 = slot_ptr[s0 + l], p1 = slot_ptr[s0 + l + 1];
@@ -263,14 +282,10 @@ void coo_refill_blocks(const Mat_SeqBinBCSR *a, V *val, const PetscInt *slot_ptr
       if (BS) {
         double sum[MAXB2] = {};
         for (PetscInt p = p0; p < p1; p++) {
-          const PetscInt     src  = slot_src[p];
-          const long         base = src >= 0 ? src : -1 - (long)src;
-          const PetscScalar *x    = base < n ? v + base : recv + (base - n);
-          if (src >= 0)
-            for (int e = 0; e < MAXB2; e++) sum[e] += x[e];
-          else
-            for (int i = 0; i < BS; i++)
-              for (int j = 0; j < BS; j++) sum[i * BS + j] += x[j * BS + i];
+          const PetscInt src  = slot_src[p];
+          const long     base = src >= 0 ? src : -1 - (long)src;
+          if (base < n) add_block<BS>(sum, v + base, src < 0);
+          else add_block<BS>(sum, recv + (base - n), src < 0);
         }
         for (int e = 0; e < MAXB2; e++)
           dst[(size_t)e * bw] = (V)(ADD ? (double)dst[(size_t)e * bw] + sum[e] : sum[e]);
@@ -279,10 +294,9 @@ void coo_refill_blocks(const Mat_SeqBinBCSR *a, V *val, const PetscInt *slot_ptr
           for (PetscInt j = 0; j < bs; j++) {
             double sum = 0;
             for (PetscInt p = p0; p < p1; p++) {
-              const PetscInt     src  = slot_src[p];
-              const long         base = src >= 0 ? src : -1 - (long)src;
-              const PetscScalar *x    = base < n ? v + base : recv + (base - n);
-              sum += src >= 0 ? x[i * bs + j] : x[j * bs + i];
+              const PetscInt src  = slot_src[p];
+              const long     base = src >= 0 ? src : -1 - (long)src;
+              sum += value(base, src >= 0 ? i * bs + j : j * bs + i);
             }
             V &d = dst[(size_t)(i * bs + j) * bw];
             d    = (V)(ADD ? (double)d + sum : sum);
@@ -292,35 +306,35 @@ void coo_refill_blocks(const Mat_SeqBinBCSR *a, V *val, const PetscInt *slot_ptr
   }
 }
 
-template <int BS, typename V>
-void coo_refill_mode(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const PetscScalar *v, long n,
+template <int BS, typename V, typename S>
+void coo_refill_mode(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const S *v, long n,
                      const PetscScalar *recv, InsertMode imode)
 {
   if (imode == ADD_VALUES) coo_refill<BS, true, V>(a, val, perm, v, n, recv);
   else coo_refill<BS, false, V>(a, val, perm, v, n, recv);
 }
 
-template <typename V>
-void coo_refill_any(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const PetscScalar *v, long n,
+template <typename V, typename S>
+void coo_refill_any(const Mat_SeqBinBCSR *a, V *val, const PetscInt *perm, const S *v, long n,
                     const PetscScalar *recv, InsertMode imode)
 {
   if (a->coo_slot_state == 1) {
     const bool      add = imode == ADD_VALUES;
     const PetscInt *ptr = a->coo_slot_ptr, *src = a->coo_slot_src;
     if (a->bs == 3)
-      add ? coo_refill_blocks<3, true, V>(a, val, ptr, src, v, n, recv)
-          : coo_refill_blocks<3, false, V>(a, val, ptr, src, v, n, recv);
+      add ? coo_refill_blocks<3, true>(a, val, ptr, src, v, n, recv)
+          : coo_refill_blocks<3, false>(a, val, ptr, src, v, n, recv);
     else if (a->bs == 1)
-      add ? coo_refill_blocks<1, true, V>(a, val, ptr, src, v, n, recv)
-          : coo_refill_blocks<1, false, V>(a, val, ptr, src, v, n, recv);
+      add ? coo_refill_blocks<1, true>(a, val, ptr, src, v, n, recv)
+          : coo_refill_blocks<1, false>(a, val, ptr, src, v, n, recv);
     else
-      add ? coo_refill_blocks<0, true, V>(a, val, ptr, src, v, n, recv)
-          : coo_refill_blocks<0, false, V>(a, val, ptr, src, v, n, recv);
+      add ? coo_refill_blocks<0, true>(a, val, ptr, src, v, n, recv)
+          : coo_refill_blocks<0, false>(a, val, ptr, src, v, n, recv);
     return;
   }
-  if (a->bs == 3) coo_refill_mode<3, V>(a, val, perm, v, n, recv, imode);
-  else if (a->bs == 1) coo_refill_mode<1, V>(a, val, perm, v, n, recv, imode);
-  else coo_refill_mode<0, V>(a, val, perm, v, n, recv, imode);
+  if (a->bs == 3) coo_refill_mode<3>(a, val, perm, v, n, recv, imode);
+  else if (a->bs == 1) coo_refill_mode<1>(a, val, perm, v, n, recv, imode);
+  else coo_refill_mode<0>(a, val, perm, v, n, recv, imode);
 }
 
 /* The block map if the list allows it (else the refill goes value by value), for the split n between
@@ -347,9 +361,10 @@ PetscErrorCode BuildSlotMap(Mat A, const PetscInt *perm, long n)
   PetscFunctionReturn(0);
 }
 
-/* The refill both entry points share; v == NULL means zeros. */
-PetscErrorCode SetValuesCOO(Mat A, const PetscInt *perm, const PetscScalar v[], long n,
-                            const PetscScalar recv[], InsertMode imode)
+/* The refill the entry points share; v == NULL means zeros. S: the caller's value type. */
+template <typename S>
+PetscErrorCode SetValuesCOO(Mat A, const PetscInt *perm, const S v[], long n, const PetscScalar recv[],
+                            InsertMode imode)
 {
   Mat_SeqBinBCSR *a  = (Mat_SeqBinBCSR *)A->data;
   const PetscInt  nv = a->nslots * a->bs2; /* padding included: it stays zero */
@@ -371,8 +386,8 @@ PetscErrorCode SetValuesCOO(Mat A, const PetscInt *perm, const PetscScalar v[], 
       if (a->val) PetscCall(PetscArrayzero(a->val, nv));
       else PetscCall(PetscArrayzero(a->valf, nv));
     }
-  } else if (a->val) coo_refill_any<double>(a, a->val, perm, v, n, recv, imode);
-  else coo_refill_any<float>(a, a->valf, perm, v, n, recv, imode);
+  } else if (a->val) coo_refill_any(a, a->val, perm, v, n, recv, imode);
+  else coo_refill_any(a, a->valf, perm, v, n, recv, imode);
   PetscCall(PetscLogEventEnd(MAT_BinBCSR_SetValuesCOO, A, 0, 0, 0));
   PetscFunctionReturn(0);
 }
@@ -385,6 +400,17 @@ PetscErrorCode MatSetValuesCOO_SeqBinBCSR(Mat A, const PetscScalar v[], InsertMo
   PetscFunctionBegin;
   PetscCheck(a->built && a->coo_jmap, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
              "MatSetValuesCOO needs MatSetPreallocationCOO first");
+  PetscCall(SetValuesCOO(A, a->coo_perm, v, (long)a->coo_n, nullptr, imode));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatBinBCSRSetValuesCOOSingle_SeqBinBCSR(Mat A, const float v[], InsertMode imode)
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+
+  PetscFunctionBegin;
+  PetscCheck(a->built && a->coo_jmap, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "MatBinBCSRSetValuesCOOSingle needs MatSetPreallocationCOO first");
   PetscCall(SetValuesCOO(A, a->coo_perm, v, (long)a->coo_n, nullptr, imode));
   PetscFunctionReturn(0);
 }

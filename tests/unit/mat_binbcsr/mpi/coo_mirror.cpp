@@ -9,6 +9,7 @@
 #include "support/fem_problem.hpp"
 
 #include <petscbinbcsr.h>
+#include <petsc/private/petscimpl.h> // PetscObjectStateGet
 
 #include <algorithm>
 #include <cmath>
@@ -173,7 +174,8 @@ TEST_CASE("COO mirror: binbcsr equals aij given the list and its transposes (bs 
         }
 }
 
-TEST_CASE("COO: a rank that lists no entries still gets those other ranks send it (bs 1 and 3)", "[mpi][coo_mirror]")
+TEST_CASE("COO: a rank that lists no entries still gets those other ranks send it (bs 1 and 3)",
+          "[mpi][coo_mirror]")
 {
   // Only rank 0 lists entries, every block row's diagonal block among them; the other ranks call with
   // no entries and no values (a null array, as an empty std::vector's data()). Their rows must hold
@@ -336,4 +338,93 @@ TEST_CASE("COO refill by whole blocks (plain, mirrored, repeated) equals aij; ot
             PCHK(MatDestroy(&A));
             PCHK(MatDestroy(&R));
           }
+}
+
+namespace {
+
+// ||A - B||_F (0: the same matrix), both converted to aij.
+double absolute_difference(Mat A, Mat B)
+{
+  Mat       CA, CB;
+  PetscReal d = -1;
+  if (MatConvert(A, MATAIJ, MAT_INITIAL_MATRIX, &CA)) return 1e300;
+  if (MatConvert(B, MATAIJ, MAT_INITIAL_MATRIX, &CB)) return 1e300;
+  MatAXPY(CA, -1.0, CB, DIFFERENT_NONZERO_PATTERN);
+  MatNorm(CA, NORM_FROBENIUS, &d);
+  MatDestroy(&CA);
+  MatDestroy(&CB);
+  return d;
+}
+
+} // namespace
+
+TEST_CASE("COO in single precision: the matrix the double list of the same values gives", "[mpi][coo_single]")
+{
+  for (MPI_Comm comm : {PETSC_COMM_WORLD, PETSC_COMM_SELF})
+    for (PetscInt bs : {1, 3})
+      for (bool mirror : {false, true})
+        for (bool sym : {false, true})
+          for (MatBinBCSRPrecision prec : {MAT_BINBCSR_PRECISION_DOUBLE, MAT_BINBCSR_PRECISION_SINGLE}) {
+            PetscMPIInt rank, size;
+            MPI_Comm_rank(comm, &rank);
+            MPI_Comm_size(comm, &size);
+            INFO("ranks " << size << " bs " << bs << " mirror " << mirror << " sym " << sym << " single "
+                          << (prec == MAT_BINBCSR_PRECISION_SINGLE));
+            const PetscInt nblocks = 17;
+            CooList        l       = random_list(nblocks, bs, 300, 777u + 5u * (unsigned)rank + (unsigned)bs);
+            // Whole 3x3 blocks too (the refill by blocks), each listed twice (summed).
+            if (bs == 3)
+              for (PetscInt b = 0; b + 1 < nblocks; b += 4)
+                for (int rep = 0; rep < 2; ++rep)
+                  for (PetscInt p = 0; p < 9; ++p) {
+                    l.i.push_back(3 * b + p / 3);
+                    l.j.push_back(3 * (b + 1) + p % 3);
+                    l.v.push_back(0.1 * (p + 1) * (rep + 1));
+                  }
+            std::vector<float> f(l.v.begin(), l.v.end());        // the values as floats ...
+            for (size_t k = 0; k < f.size(); ++k) l.v[k] = f[k]; // ... and the same values as doubles
+            Mat A, B;
+            for (Mat *M : {&A, &B}) {
+              PCHK(create(comm, MATBINBCSR, nblocks, bs, mirror, sym, nullptr, M));
+              PCHK(MatBinBCSRSetPrecision(*M, prec));
+              std::vector<PetscInt> i = l.i, j = l.j;
+              PCHK(MatSetPreallocationCOO(*M, (PetscCount)i.size(), i.data(), j.data()));
+            }
+            for (InsertMode mode : {INSERT_VALUES, ADD_VALUES, INSERT_VALUES}) {
+              PetscObjectState s0, s1;
+              PCHK(PetscObjectStateGet((PetscObject)B, &s0));
+              PCHK(MatSetValuesCOO(A, l.v.data(), mode));
+              PCHK(MatBinBCSRSetValuesCOOSingle(B, f.data(), mode));
+              PCHK(PetscObjectStateGet((PetscObject)B, &s1));
+              CHECK(s1 > s0); // a refill a KSP sees, as MatSetValuesCOO's
+              PetscBool assembled = PETSC_FALSE;
+              PCHK(MatAssembled(B, &assembled));
+              CHECK(assembled);
+              // the same sums in double in the same order, rounded once: the same matrix to the bit
+              CHECK(all_ranks(absolute_difference(A, B) == 0.0, comm));
+            }
+            PCHK(MatSetValuesCOO(A, nullptr, INSERT_VALUES)); // null: zeros
+            PCHK(MatBinBCSRSetValuesCOOSingle(B, nullptr, INSERT_VALUES));
+            CHECK(all_ranks(absolute_difference(A, B) == 0.0, comm));
+            PCHK(MatDestroy(&A));
+            PCHK(MatDestroy(&B));
+          }
+}
+
+TEST_CASE("COO in single precision: other types and unprepared matrices are errors", "[mpi][coo_single]")
+{
+  Mat      A;
+  PetscInt i[1] = {0}, j[1] = {0};
+  float    v[1] = {1};
+  PCHK(MatCreateSeqAIJ(PETSC_COMM_SELF, 3, 3, 1, nullptr, &A));
+  PCHK(MatSetPreallocationCOO(A, 1, i, j));
+  PetscPushErrorHandler(PetscReturnErrorHandler, nullptr);
+  CHECK(MatBinBCSRSetValuesCOOSingle(A, v, INSERT_VALUES) == PETSC_ERR_SUP);
+  PetscPopErrorHandler();
+  PCHK(MatDestroy(&A));
+  PCHK(create(PETSC_COMM_SELF, MATBINBCSR, 1, 3, false, false, nullptr, &A));
+  PetscPushErrorHandler(PetscReturnErrorHandler, nullptr);
+  CHECK(MatBinBCSRSetValuesCOOSingle(A, v, INSERT_VALUES) != 0); // no preallocation
+  PetscPopErrorHandler();
+  PCHK(MatDestroy(&A));
 }
