@@ -173,11 +173,22 @@ BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &e
   return p;
 }
 
-void reset_block_values(const BlockPattern &pattern, std::vector<double> &values)
+namespace {
+template <typename V> void reset_values(const BlockPattern &pattern, std::vector<V> &values)
 {
   values.resize(9 * pattern.rows.size());
   for (int s : pattern.identity_slots)
-    for (int k = 0; k < 9; ++k) values[9 * static_cast<size_t>(s) + k] = k % 4 == 0 ? 1.0 : 0.0;
+    for (int k = 0; k < 9; ++k) values[9 * static_cast<size_t>(s) + k] = k % 4 == 0 ? 1 : 0;
+}
+} // namespace
+
+void reset_block_values(const BlockPattern &pattern, std::vector<double> &values)
+{
+  reset_values(pattern, values);
+}
+void reset_block_values(const BlockPattern &pattern, std::vector<float> &values)
+{
+  reset_values(pattern, values);
 }
 
 namespace {
@@ -374,6 +385,31 @@ long long assemble_elements(const FemModel &model, const std::vector<int> &eleme
     assemble_kernel<4>(model, elements, x, v, c, pattern, block_values, rhs, rotations);
   else assemble_kernel<10>(model, elements, x, v, c, pattern, block_values, rhs, rotations);
   return 0;
+}
+
+long long assemble_elements_single(const FemModel &model, const std::vector<int> &elements, const double *x,
+                                   const double *v, const StepCoefficients &c, const BlockPattern *pattern,
+                                   float *block_values, double *rhs, Eigen::Matrix3d *rotations,
+                                   ElementKernel kernel, binbcsr::BodySet body, ElementEnergy *energy)
+{
+  if (!block_values || kernel == ElementKernel::Batched) {
+    if (block_values && !pattern)
+      throw std::invalid_argument("assemble_elements: block values need a pattern");
+    if (pattern && pattern->element_slots.size() != elements.size() * model.npe * model.npe)
+      throw std::invalid_argument("assemble_elements: pattern was built for another element list");
+    if (!block_values)
+      return assemble_elements(model, elements, x, v, c, pattern, static_cast<double *>(nullptr), rhs,
+                               rotations, kernel, body, energy);
+    return assemble_elements_batched_single(model, elements, x, v, c, pattern, block_values, rhs,
+                                            rotations ? rotations->data() : nullptr, body, energy);
+  }
+  // The reference loop writes double blocks: through a copy (the identity blocks included).
+  if (!pattern) throw std::invalid_argument("assemble_elements: block values need a pattern");
+  std::vector<double> wide(block_values, block_values + 9 * pattern->rows.size());
+  const long long     n =
+    assemble_elements(model, elements, x, v, c, pattern, wide.data(), rhs, rotations, kernel, body, energy);
+  std::copy(wide.begin(), wide.end(), block_values);
+  return n;
 }
 
 std::vector<double> elastic_forces(const FemModel &model, const double *x)

@@ -88,6 +88,7 @@ std::vector<int> listed_element_nodes(const FemModel &model, const std::vector<i
 // Sizes block_values for the pattern and sets the identity blocks (fixed nodes), which the element
 // loop does not write. Call before assemble_elements (once is enough while the array is kept).
 void reset_block_values(const BlockPattern &pattern, std::vector<double> &block_values);
+void reset_block_values(const BlockPattern &pattern, std::vector<float> &block_values);
 
 // Which element loop runs: Batched (element_batch.hpp: the kernels of element_kernels.hpp over SIMD
 // lanes, P2 from the barycentric gradients, in the body set `body` of assemble_elements) or Scalar
@@ -110,6 +111,16 @@ long long assemble_elements(const FemModel &model, const std::vector<int> &eleme
                             double *block_values, double *rhs, Eigen::Matrix3d *rotations = nullptr,
                             ElementKernel    kernel = ElementKernel::Batched,
                             binbcsr::BodySet body = binbcsr::BodySet::Auto, ElementEnergy *energy = nullptr);
+
+// The same with the blocks in single precision (for a matrix that stores single precision and takes
+// float COO values, MatBinBCSRSetValuesCOOSingle): each block is summed in double and rounded to float
+// where it is written; the batched loop writes half the bytes. (Scalar: through double blocks.)
+long long assemble_elements_single(const FemModel &model, const std::vector<int> &elements, const double *x,
+                                   const double *v, const StepCoefficients &c, const BlockPattern *pattern,
+                                   float *block_values, double *rhs, Eigen::Matrix3d *rotations = nullptr,
+                                   ElementKernel    kernel = ElementKernel::Batched,
+                                   binbcsr::BodySet body   = binbcsr::BodySet::Auto,
+                                   ElementEnergy   *energy = nullptr);
 
 // Elastic forces only (a_f = 1): f = sum_e f_e over all elements, 3 per node, overwritten.
 std::vector<double> elastic_forces(const FemModel &model, const double *x);

@@ -39,10 +39,13 @@ void element_fallback_rotation(const double *F, double *R)
   Eigen::Matrix3d::Map(R) = rotation_from_deformation(Eigen::Matrix3d::Map(F));
 }
 
-long long assemble_elements_batched(const FemModel &model, const std::vector<int> &elements, const double *x,
-                                    const double *v, const StepCoefficients &c, const BlockPattern *pattern,
-                                    double *values, double *rhs, double *rotations, binbcsr::BodySet body,
-                                    ElementEnergy *energy)
+namespace {
+
+// The call's arguments for the bodies; the blocks into values or values_single (one of them, or none).
+long long run_batched(const FemModel &model, const std::vector<int> &elements, const double *x,
+                      const double *v, const StepCoefficients &c, const BlockPattern *pattern, double *values,
+                      float *values_single, double *rhs, double *rotations, binbcsr::BodySet body,
+                      ElementEnergy *energy)
 {
   if (elements.empty()) return 0;
   static_assert(sizeof(Eigen::Matrix3d) == 9 * sizeof(double), "Dm^-1 is read as 9 packed doubles");
@@ -65,6 +68,7 @@ long long assemble_elements_batched(const FemModel &model, const std::vector<int
   args.x              = x;
   args.v              = v;
   args.values         = values;
+  args.values_single  = values_single;
   args.rhs            = rhs;
   args.rotations      = rotations;
   double sums[3]      = {0, 0, 0};
@@ -75,7 +79,7 @@ long long assemble_elements_batched(const FemModel &model, const std::vector<int
   args.k = kernels::ElementConstants{c.force,       c.stiffness_rhs,       c.mass_rhs,
                                      c.mass_matrix, c.stiffness_matrix,    model.lame.lambda,
                                      model.lame.mu, model.settings.density};
-  if (values) {
+  if (values || values_single) {
     args.group_offsets = pattern->plan.group_offsets.data();
     args.write_slots   = pattern->plan.write_slots.data();
     args.group_terms   = pattern->plan.group_terms.data();
@@ -90,6 +94,24 @@ long long assemble_elements_batched(const FemModel &model, const std::vector<int
     energy->inverted += sums[2];
   }
   return fallbacks;
+}
+
+} // namespace
+
+long long assemble_elements_batched(const FemModel &model, const std::vector<int> &elements, const double *x,
+                                    const double *v, const StepCoefficients &c, const BlockPattern *pattern,
+                                    double *values, double *rhs, double *rotations, binbcsr::BodySet body,
+                                    ElementEnergy *energy)
+{
+  return run_batched(model, elements, x, v, c, pattern, values, nullptr, rhs, rotations, body, energy);
+}
+
+long long assemble_elements_batched_single(const FemModel &model, const std::vector<int> &elements,
+                                           const double *x, const double *v, const StepCoefficients &c,
+                                           const BlockPattern *pattern, float *values, double *rhs,
+                                           double *rotations, binbcsr::BodySet body, ElementEnergy *energy)
+{
+  return run_batched(model, elements, x, v, c, pattern, nullptr, values, rhs, rotations, body, energy);
 }
 
 double element_kernel_flops(int order, bool with_blocks)

@@ -63,6 +63,13 @@ long long assemble_elements_batched(const FemModel &model, const std::vector<int
                                     binbcsr::BodySet body   = binbcsr::BodySet::Auto,
                                     ElementEnergy   *energy = nullptr);
 
+// The same with single-precision blocks (ElementBatchArgs::values_single).
+long long assemble_elements_batched_single(const FemModel &model, const std::vector<int> &elements,
+                                           const double *x, const double *v, const StepCoefficients &c,
+                                           const BlockPattern *pattern, float *block_values, double *rhs,
+                                           double *rotations, binbcsr::BodySet body = binbcsr::BodySet::Auto,
+                                           ElementEnergy *energy = nullptr);
+
 // The set assemble_elements_batched runs when asked for `want` (never Auto).
 binbcsr::BodySet element_body_used(binbcsr::BodySet want);
 
@@ -89,9 +96,10 @@ struct ElementBatchArgs {
             *runs                   = nullptr;
   const unsigned short *write_terms = nullptr;
   const double         *x = nullptr, *v = nullptr; // 3 per node
-  double               *values    = nullptr;       // 9 per COO block, or null
-  double               *rhs       = nullptr;       // 3 per node, accumulated
-  double               *rotations = nullptr;       // 9 per listed element, or null
+  double               *values        = nullptr;   // 9 per COO block, or null
+  float                *values_single = nullptr;   // the same in single precision (then values is null)
+  double               *rhs           = nullptr;   // 3 per node, accumulated
+  double               *rotations     = nullptr;   // 9 per listed element, or null
   // The state's figures (corotational_assembly.hpp's ElementEnergy), or null: elastic and kinetic
   // energy and the inverted corner tetrahedra, summed over the listed elements and added to energy[0..2];
   // per listed element the same three into element_energy (or null).

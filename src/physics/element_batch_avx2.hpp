@@ -48,6 +48,18 @@ inline void write_block(double *values, int s, __m256d lo, __m256d hi, double b8
   out[8] = (s & kFirstContribution) ? b8 : out[8] + b8;
 }
 
+// The same into single-precision values: the sum formed in double, rounded once per write.
+inline void write_block(float *values, int s, __m256d lo, __m256d hi, double b8)
+{
+  float        *out  = values + 9 * static_cast<std::size_t>(s & kSlotIndexMask);
+  const __m256d keep = _mm256_castsi256_pd(_mm256_set1_epi64x((s & kFirstContribution) ? 0 : -1));
+  _mm_storeu_ps(out,
+                _mm256_cvtpd_ps(_mm256_add_pd(lo, _mm256_and_pd(keep, _mm256_cvtps_pd(_mm_loadu_ps(out))))));
+  _mm_storeu_ps(
+    out + 4, _mm256_cvtpd_ps(_mm256_add_pd(hi, _mm256_and_pd(keep, _mm256_cvtps_pd(_mm_loadu_ps(out + 4))))));
+  out[8] = static_cast<float>((s & kFirstContribution) ? b8 : static_cast<double>(out[8]) + b8);
+}
+
 } // namespace avx2
 } // namespace batch
 } // namespace BINBCSR_ELEMENT_SET

@@ -53,6 +53,19 @@ inline void write_block(double *values, int s, __m512d b, double b8)
   _mm_store_sd(out + 8, _mm_mask_add_sd(t, add, _mm_load_sd(out + 8), t));
 }
 
+// The same into single-precision values (MatBinBCSRSetValuesCOOSingle): the sum is formed in double and
+// rounded once per write.
+inline void write_block(float *values, int s, __m512d b, double b8)
+{
+  float         *out = values + 9 * static_cast<std::size_t>(s & kSlotIndexMask);
+  const __mmask8 add = static_cast<__mmask8>(((s & kFirstContribution) != 0) - 1); // first: 0, else all
+  _mm256_storeu_ps(out,
+                   _mm512_cvtpd_ps(_mm512_mask_add_pd(b, add, _mm512_cvtps_pd(_mm256_loadu_ps(out)), b)));
+  const __m128d t = _mm_set_sd(b8);
+  const __m128d r = _mm_mask_add_sd(t, add, _mm_cvtss_sd(t, _mm_load_ss(out + 8)), t);
+  _mm_store_ss(out + 8, _mm_cvtsd_ss(_mm_setzero_ps(), r));
+}
+
 // Rows r0, r1, r2 <- entries 0, 1, 2 of 8 lanes' triples base[off[l] .. off[l] + 3): a 4-wide load
 // per lane and a transpose. The load reads one entry past the triple, so the triple that ends the
 // array (off[l] == end - 3) is loaded masked; masked loads throughout made the batch loop ~20%

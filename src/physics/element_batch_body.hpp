@@ -93,12 +93,18 @@ template <int N> inline void prefetch_nodes(const ElementBatchArgs &a, std::size
   }
 }
 
+// The value array the blocks go to: ElementBatchArgs::values (double) or values_single (float).
+template <typename V> inline V *block_values(const ElementBatchArgs &a);
+template <> inline double      *block_values<double>(const ElementBatchArgs &a) { return a.values; }
+template <> inline float       *block_values<float>(const ElementBatchArgs &a) { return a.values_single; }
+
 // And the COO blocks write_slots[k0, k1) (the group's write-out, a share per batch: the values are
-// several MB, 6.7 for linear_38k, so most blocks come from L3).
-inline void prefetch_blocks(const ElementBatchArgs &a, int k0, int k1)
+// several MB, 6.7 for linear_38k in double, so most blocks come from L3).
+template <typename V> inline void prefetch_blocks(const ElementBatchArgs &a, int k0, int k1)
 {
+  const V *const values = block_values<V>(a);
   for (int k = k0; k < k1; ++k) {
-    const double *out = a.values + 9 * static_cast<std::size_t>(a.write_slots[k] & kSlotIndexMask);
+    const V *out = values + 9 * static_cast<std::size_t>(a.write_slots[k] & kSlotIndexMask);
     __builtin_prefetch(out, 1);
     __builtin_prefetch(out + 8, 1);
   }
@@ -141,12 +147,13 @@ template <int N> inline void stage_batch(const Batch<N> &b, int j, Stage<N> &st)
 
 // Group g's write-out: each of its COO blocks gets the sum of its terms (stored where the group is the
 // first to write the block, added otherwise).
-template <int N> inline void write_group(const ElementBatchArgs &a, std::size_t g, const Stage<N> &st)
+template <int N, typename V>
+inline void write_group(const ElementBatchArgs &a, std::size_t g, const Stage<N> &st)
 {
   // (Locals: the stores into the values may alias anything, so fields of `a` would be read again.)
   const int *const slots = a.write_slots, *const runs = a.runs;
   const unsigned short *t      = a.write_terms + a.group_terms[g];
-  double *const         values = a.values;
+  V *const              values = block_values<V>(a);
   int                   k      = a.group_offsets[g];
   for (int r = a.run_offsets[g], r1 = a.run_offsets[g + 1]; r < r1; ++r) {
     const int count = runs[2 * r], k1 = k + runs[2 * r + 1];
@@ -179,11 +186,11 @@ template <int N> inline void write_group(const ElementBatchArgs &a, std::size_t 
         for (int e = 0; e < 8; ++e) acc[e] += st.head[t[i] >> 1][kT[t[i] & 1][e]];
         acc[8] += st.tail[t[i] >> 1];
       }
-      double *out = values + 9 * static_cast<std::size_t>(slots[k] & kSlotIndexMask);
+      V *out = values + 9 * static_cast<std::size_t>(slots[k] & kSlotIndexMask);
       if (slots[k] & kFirstContribution)
-        for (int e = 0; e < 9; ++e) out[e] = acc[e];
+        for (int e = 0; e < 9; ++e) out[e] = static_cast<V>(acc[e]);
       else
-        for (int e = 0; e < 9; ++e) out[e] += acc[e];
+        for (int e = 0; e < 9; ++e) out[e] = static_cast<V>(out[e] + acc[e]);
 #endif
     }
   }
@@ -222,7 +229,7 @@ __attribute__((noinline)) void batch_energy(const ElementBatchArgs &a, Batch<N> 
   }
 }
 
-template <int N, bool Blocks, bool MassDamping> long long run(const ElementBatchArgs &a)
+template <int N, bool Blocks, bool MassDamping, typename V = double> long long run(const ElementBatchArgs &a)
 {
   const ElementConstants &k = a.k;
   double                  Mref[N * N];
@@ -241,7 +248,7 @@ template <int N, bool Blocks, bool MassDamping> long long run(const ElementBatch
     for (int jb = 0; jb < GB && start < n; ++jb, start += W) {
       const int m = n - start < W ? static_cast<int>(n - start) : W;
       if (start + W < n) prefetch_nodes<N>(a, start + W, n - start - W < W ? int(n - start - W) : W);
-      if (Blocks) prefetch_blocks(a, k0 + kn * jb / GB, k0 + kn * (jb + 1) / GB);
+      if (Blocks) prefetch_blocks<V>(a, k0 + kn * jb / GB, k0 + kn * (jb + 1) / GB);
       gather<N>(a, start, m, b);
 #pragma omp simd
       for (int l = 0; l < W; ++l) rest_shape<W>(b.X + l, b.Dinv + l, b.vol + l);
@@ -291,7 +298,7 @@ template <int N, bool Blocks, bool MassDamping> long long run(const ElementBatch
       }
       if (Blocks) stage_batch<N>(b, jb, st);
     }
-    if (Blocks) write_group<N>(a, g, st);
+    if (Blocks) write_group<N, V>(a, g, st);
   }
   if (a.energy)
     for (int j = 0; j < 3; ++j) a.energy[j] += sums[j];
@@ -301,6 +308,7 @@ template <int N, bool Blocks, bool MassDamping> long long run(const ElementBatch
 template <int N> long long run_order(const ElementBatchArgs &a)
 {
   const bool damping = a.k.mass_rhs != 0;
+  if (a.values_single) return damping ? run<N, true, true, float>(a) : run<N, true, false, float>(a);
   if (a.values && damping) return run<N, true, true>(a);
   if (a.values) return run<N, true, false>(a);
   if (damping) return run<N, false, true>(a);

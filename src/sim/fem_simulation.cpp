@@ -169,15 +169,11 @@ PetscErrorCode ElementPass(FemSimulation *sim, double *element_s, double *comm_s
   if (sim->prepared && sim->x == sim->prepared_x && sim->v == sim->prepared_v &&
       SameCoefficients(sim->coefficients, sim->prepared_coefficients))
     PetscFunctionReturn(0);
-  const auto   now = sim->cpu_timer ? ProcessCpuTime : WallTime;
-  const double t0  = now();
-  physics::reset_block_values(sim->pattern, sim->values);
-  std::fill(sim->rhs_full.begin(), sim->rhs_full.end(), 0.0);
+  const auto             now = sim->cpu_timer ? ProcessCpuTime : WallTime;
+  const double           t0  = now();
   physics::ElementEnergy energy;
   PetscCall(PetscLogEventBegin(FEM_Elements, 0, 0, 0, 0));
-  const long long svd = physics::assemble_elements(
-    sim->model, sim->elements, sim->x.data(), sim->v.data(), sim->coefficients, &sim->pattern,
-    sim->values.data(), sim->rhs_full.data(), nullptr, sim->element_kernel, sim->element_body, &energy);
+  const long long svd = FemAssembleElements(sim, &energy);
   PetscCall(PetscLogFlops(physics::element_kernel_flops(sim->model.mesh.order, true) *
                           (PetscLogDouble)sim->elements.size()));
   PetscCall(PetscLogEventEnd(FEM_Elements, 0, 0, 0, 0));
@@ -236,7 +232,7 @@ PetscErrorCode FemSimulationStep(FemSimulation *sim, FemStepInfo *info)
       r         = sim->fixed[i] ? 0.0 : r + sim->rhs_gravity_scale * sim->f_gravity[3 * i + d];
     }
   const double t2 = now();
-  PetscCall(BlockSystemSetValues(&sim->sys, sim->values.data()));
+  PetscCall(FemSetSystemValues(sim));
   const double t3 = now();
   PetscCall(ExtrapolateGuess(sim));
   PetscCall(BlockSystemSolve(&sim->sys, sim->rhs_local.data(), sim->dv_local.data(), &info->stats));
@@ -268,6 +264,30 @@ PetscErrorCode FemSimulationStep(FemSimulation *sim, FemStepInfo *info)
   info->setvalues_ms = 1e3 * (t3 - t2);
   info->solve_ms     = 1e3 * (t4 - t3);
   info->total_ms     = 1e3 * (t5 - t0);
+  PetscFunctionReturn(0);
+}
+
+long long FemAssembleElements(FemSimulation *sim, physics::ElementEnergy *energy)
+{
+  std::fill(sim->rhs_full.begin(), sim->rhs_full.end(), 0.0);
+  if (sim->sys.single_values) {
+    physics::reset_block_values(sim->pattern, sim->values_single);
+    return physics::assemble_elements_single(sim->model, sim->elements, sim->x.data(), sim->v.data(),
+                                             sim->coefficients, &sim->pattern, sim->values_single.data(),
+                                             sim->rhs_full.data(), nullptr, sim->element_kernel,
+                                             sim->element_body, energy);
+  }
+  physics::reset_block_values(sim->pattern, sim->values);
+  return physics::assemble_elements(
+    sim->model, sim->elements, sim->x.data(), sim->v.data(), sim->coefficients, &sim->pattern,
+    sim->values.data(), sim->rhs_full.data(), nullptr, sim->element_kernel, sim->element_body, energy);
+}
+
+PetscErrorCode FemSetSystemValues(FemSimulation *sim)
+{
+  PetscFunctionBegin;
+  if (sim->sys.single_values) PetscCall(BlockSystemSetValuesSingle(&sim->sys, sim->values_single.data()));
+  else PetscCall(BlockSystemSetValues(&sim->sys, sim->values.data()));
   PetscFunctionReturn(0);
 }
 

@@ -80,6 +80,7 @@ struct FemSimulation {
   double                    state_energy = NAN, state_inverted_fraction = NAN;
   // work arrays
   std::vector<double> values, rhs_full, rhs_local, dv_local, dv_full;
+  std::vector<float>  values_single; // the blocks instead of values where sys.single_values
   std::vector<int>    counts, displs;
 };
 
@@ -96,3 +97,10 @@ PetscErrorCode FemSimulationStep(FemSimulation *sim, FemStepInfo *info);
 // the first for the initial ones. Collective.
 PetscErrorCode FemSimulationAssembleState(FemSimulation *sim, FemStepInfo *info);
 PetscErrorCode FemSimulationDestroy(FemSimulation *sim);
+// The element loop of (x, v) alone, untimed and without the pass's bookkeeping (a benchmark's): the
+// blocks into values, or into values_single where the system takes float values, the forces into
+// rhs_full (zeroed first), the state's figures into *energy (may be null). Returns the elements whose
+// rotation took the scalar path.
+long long FemAssembleElements(FemSimulation *sim, physics::ElementEnergy *energy);
+// The refill of the system's matrix from the blocks of the last element loop.
+PetscErrorCode FemSetSystemValues(FemSimulation *sim);

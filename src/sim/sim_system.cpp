@@ -232,6 +232,14 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
           cj[9 * k + 3 * r + c] = 3 * coo_block_col[k] + c;
         }
     PetscCall(MatSetPreallocationCOO(sys->A, (PetscCount)ci.size(), ci.data(), cj.data()));
+    {
+      PetscBool           seq_binbcsr;
+      MatBinBCSRPrecision precision;
+      PetscCall(PetscObjectTypeCompare((PetscObject)sys->A, MATSEQBINBCSR, &seq_binbcsr));
+      PetscCall(MatBinBCSRGetPrecision(sys->A, &precision));
+      sys->single_values =
+        seq_binbcsr && precision == MAT_BINBCSR_PRECISION_SINGLE ? PETSC_TRUE : PETSC_FALSE;
+    }
     PetscCall(PreallocateFromBlockPattern(comm, n_local, n_block_rows_global, graph_row, graph_col, nullptr,
                                           &sys->n_blocks));
   } else {
@@ -287,8 +295,9 @@ PetscErrorCode BlockSystemSetValues(BlockSystem *sys, const PetscScalar *block_v
 {
   PetscFunctionBegin;
   PetscCheck(sys && sys->A, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "BlockSystem not created");
-  sys->last_values = block_values;
-  sys->values_set  = PETSC_TRUE;
+  sys->last_values        = block_values;
+  sys->last_values_single = nullptr;
+  sys->values_set         = PETSC_TRUE;
   if (sys->native_coo) {
     PetscCall(MatSetValuesCOO(sys->A, block_values, INSERT_VALUES));
   } else {
@@ -300,6 +309,19 @@ PetscErrorCode BlockSystemSetValues(BlockSystem *sys, const PetscScalar *block_v
     PetscCall(MatAssemblyBegin(sys->A, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(sys->A, MAT_FINAL_ASSEMBLY));
   }
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode BlockSystemSetValuesSingle(BlockSystem *sys, const float *block_values)
+{
+  PetscFunctionBegin;
+  PetscCheck(sys && sys->A, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "BlockSystem not created");
+  PetscCheck(sys->single_values, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
+             "BlockSystemSetValuesSingle: this system's matrix takes BlockSystemSetValues");
+  sys->last_values        = nullptr;
+  sys->last_values_single = block_values;
+  sys->values_set         = PETSC_TRUE;
+  PetscCall(MatBinBCSRSetValuesCOOSingle(sys->A, block_values, INSERT_VALUES));
   PetscFunctionReturn(0);
 }
 
@@ -415,7 +437,9 @@ PetscErrorCode BlockSystemDumpMatrix(BlockSystem *sys, const char *path)
           for (int c = 0; c < 3; ++c) {
             ci.push_back(3 * (mirror ? bc : br) + r);
             cj.push_back(3 * (mirror ? br : bc) + c);
-            v.push_back(sys->last_values[9 * k + (mirror ? 3 * c + r : 3 * r + c)]);
+            v.push_back(sys->last_values_single
+                          ? sys->last_values_single[9 * k + (mirror ? 3 * c + r : 3 * r + c)]
+                          : sys->last_values[9 * k + (mirror ? 3 * c + r : 3 * r + c)]);
           }
     }
     PetscCall(MatSetPreallocationCOO(aij, (PetscCount)ci.size(), ci.data(), cj.data()));

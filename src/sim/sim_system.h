@@ -39,9 +39,13 @@ struct BlockSystem {
     PETSC_FALSE; // blocks below the diagonal are ignored or mirrored from above (sbaij, binbcsr
                  // symmetric storage or COO mirror): the caller lists the upper triangle
   std::vector<PetscInt> coo_block_row, coo_block_col; // kept for the fallback path and for dumps
-  const PetscScalar    *last_values = nullptr;    // the caller's array from the last SetValues (for dumps)
-  PetscBool             values_set = PETSC_FALSE; // SetValues was called (a rank without blocks has no array)
-  GAMGSmootherCopies    gamg_copies;              // -gamg_smoother_precision single (smoother_copy.h)
+  const PetscScalar    *last_values = nullptr; // the caller's array from the last SetValues (for dumps)
+  // The Mat takes float block values (BlockSystemSetValuesSingle): a seqbinbcsr that stores single
+  // precision, so values it rounds to float anyway are written and read at half the bytes.
+  PetscBool          single_values      = PETSC_FALSE;
+  const float       *last_values_single = nullptr; // as last_values, from the last SetValuesSingle
+  PetscBool          values_set = PETSC_FALSE; // SetValues was called (a rank without blocks has no array)
+  GAMGSmootherCopies gamg_copies;              // -gamg_smoother_precision single (smoother_copy.h)
   // -initial_guess_scaled: a nonzero initial guess x0 is replaced by a x0, a minimising ||b - a A x0||
   // (0 where x0 is no better than zero), at the cost of one product. r: its work vector.
   PetscBool guess_scaled = PETSC_FALSE;
@@ -91,6 +95,9 @@ PetscErrorCode BlockSystemSetRigidBodyModes(BlockSystem *sys, const PetscScalar 
 // replacing the previous values. The array is remembered (not copied) for BlockSystemDumpMatrix: keep
 // it alive until the next call or the dump.
 PetscErrorCode BlockSystemSetValues(BlockSystem *sys, const PetscScalar *block_values);
+// The same with float values, where sys->single_values (MatBinBCSRSetValuesCOOSingle: the blocks
+// rounded once to float where the caller wrote them; entries summed in double by the Mat).
+PetscErrorCode BlockSystemSetValuesSingle(BlockSystem *sys, const float *block_values);
 
 // Solves A sol = rhs for this rank's rows (3 * n_block_rows_local scalars each). sol_local is also
 // the initial guess when the KSP was told -ksp_initial_guess_nonzero (scaled first with
