@@ -247,7 +247,7 @@ void assemble_kernel(const FemModel &model, const std::vector<int> &elements, co
                         chunk_rotations);
     const int     e     = elements[i];
     const int    *nodes = &model.mesh.elements[static_cast<size_t>(e) * N];
-    const double *K0    = &model.stiffness[static_cast<size_t>(e) * NB * 9];
+    const double *K0    = element_stiffness_blocks(model, e);
     const Mat3    R     = chunk_rotations[i % kRotationChunk];
     if (rotations) rotations[i] = R;
     // z = a_f (R^T x - X) + a_K R^T v, so that rhs_a = -R sum_b K0_ab z_b in one product with K0.

@@ -31,10 +31,9 @@ FemModel make_fem_model(const TetMesh &mesh, const FemSettings &settings)
   m.settings   = settings;
   m.npe        = mesh.nodes_per_element();
   m.lame       = lame;
-  const int ne = mesh.element_count(), nb = packed_block_count(m.npe);
+  const int ne = mesh.element_count();
   m.rest_shape_inverse.resize(ne);
   m.volume.resize(ne);
-  m.stiffness.resize(static_cast<size_t>(ne) * nb * 9);
   for (int e = 0; e < ne; ++e) {
     const TetGeometry g = tet_geometry(corner_matrix(mesh, mesh.nodes.data(), e));
     if (mesh.order == 2) {
@@ -60,15 +59,28 @@ FemModel make_fem_model(const TetMesh &mesh, const FemSettings &settings)
     if (mesh.order == 1)
       for (int a = 0; a < 4; ++a)
         for (int d = 0; d < 3; ++d) m.gradients.push_back(g.grad_barycentric(a, d));
-    const Eigen::MatrixXd K   = element_stiffness(g, mesh.order, lame);
-    double               *out = &m.stiffness[static_cast<size_t>(e) * nb * 9];
-    for (int a = 0; a < m.npe; ++a)
-      for (int b = a; b < m.npe; ++b)
-        Eigen::Map<Eigen::Matrix3d>(out + 9 * packed_block(a, b, m.npe)) = K.block<3, 3>(3 * a, 3 * b);
   }
   m.reference_mass = reference_mass(mesh.order, settings.mass);
   m.diagonal_mass  = m.reference_mass.isDiagonal();
   return m;
+}
+
+const double *element_stiffness_blocks(const FemModel &model, int e)
+{
+  const int    ne = model.element_count(), nb = packed_block_count(model.npe);
+  const size_t per_element = static_cast<size_t>(nb) * 9;
+  if (model.stiffness.size() != static_cast<size_t>(ne) * per_element) {
+    model.stiffness.assign(static_cast<size_t>(ne) * per_element, 0.0);
+    for (int k = 0; k < ne; ++k) {
+      const TetGeometry     g   = tet_geometry(corner_matrix(model.mesh, model.mesh.nodes.data(), k));
+      const Eigen::MatrixXd K   = element_stiffness(g, model.mesh.order, model.lame);
+      double               *out = &model.stiffness[k * per_element];
+      for (int a = 0; a < model.npe; ++a)
+        for (int b = a; b < model.npe; ++b)
+          Eigen::Map<Eigen::Matrix3d>(out + 9 * packed_block(a, b, model.npe)) = K.block<3, 3>(3 * a, 3 * b);
+    }
+  }
+  return &model.stiffness[static_cast<size_t>(e) * per_element];
 }
 
 std::vector<double> gravity_forces(const FemModel &model, const std::array<double, 3> &g)
@@ -121,7 +133,7 @@ FemEnergy element_energy(const FemModel &model, const double *x, const double *v
   for (int a = 0; a < npe; ++a)
     u.segment<3>(3 * a) = R.transpose() * Eigen::Vector3d(x[3 * n[a]], x[3 * n[a] + 1], x[3 * n[a] + 2]) -
                           Eigen::Vector3d(X[3 * n[a]], X[3 * n[a] + 1], X[3 * n[a] + 2]);
-  const double *K = &model.stiffness[static_cast<size_t>(e) * packed_block_count(npe) * 9];
+  const double *K = element_stiffness_blocks(model, e);
   Ku.setZero();
   for (int a = 0; a < npe; ++a)
     for (int b = a; b < npe; ++b) {

@@ -30,7 +30,9 @@ struct FemModel {
   std::vector<double>          volume;             // per element
   // Per element the npe (npe+1) / 2 upper 3x3 blocks of K0 (block (a,b), a <= b, at
   // 9 * packed_block(a, b, npe) of the element's range; column-major like Eigen). K0_ba = K0_ab^T.
-  std::vector<double> stiffness;
+  // Built at its first use (element_stiffness_blocks): the batched element loop never reads it, and
+  // made with the model it was most of the model's set-up (linear_38k: 43 MB written at start).
+  mutable std::vector<double> stiffness;
   // Order 1 only: per element the 4 gradients of the barycentric coordinates (12 values, node-major),
   // so the kernel forms R K0 R^T from rotated gradients instead of reading K0.
   std::vector<double> gradients;
@@ -44,6 +46,9 @@ struct FemModel {
 
 // Validates the mesh (throws std::runtime_error) and the material (std::invalid_argument).
 FemModel make_fem_model(const TetMesh &mesh, const FemSettings &settings);
+
+// Element e's K0 blocks (FemModel::stiffness), every element's built at the first call.
+const double *element_stiffness_blocks(const FemModel &model, int e);
 
 // M g per node (3 per node): the consistent load of gravity g for the model's mass matrix.
 std::vector<double> gravity_forces(const FemModel &model, const std::array<double, 3> &g);

@@ -29,8 +29,12 @@ HealthBounds FemHealthBounds(const FemSimulation &sim)
   const auto   bb = physics::bounding_box(sim.model.mesh);
   const double diag =
     std::sqrt(std::pow(bb[3] - bb[0], 2) + std::pow(bb[4] - bb[1], 2) + std::pow(bb[5] - bb[2], 2));
-  const physics::FemEnergy e0 = physics::fem_energy(sim.model, sim.x.data(), sim.v.data());
-  HealthBounds             hb;
+  // The state's energy terms from its element pass where it ran (FemSimulationAssembleState), else by
+  // the definition (fem_energy, which builds every element's K0 for its walk).
+  physics::FemEnergy e0;
+  if (FemStateAssembled(sim)) e0.kinetic = sim.state_kinetic, e0.elastic = sim.state_elastic;
+  else e0 = physics::fem_energy(sim.model, sim.x.data(), sim.v.data());
+  HealthBounds hb;
   hb.energy_scale = std::sqrt(weight[0] * weight[0] + weight[1] * weight[1] + weight[2] * weight[2]) * diag +
                     std::abs(e0.kinetic) + std::abs(e0.elastic);
   hb.energy_growth     = 0.5;

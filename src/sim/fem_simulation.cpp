@@ -166,8 +166,7 @@ bool SameCoefficients(const physics::StepCoefficients &a, const physics::StepCoe
 PetscErrorCode ElementPass(FemSimulation *sim, double *element_s, double *comm_s, long long *svd_rotations)
 {
   PetscFunctionBegin;
-  if (sim->prepared && sim->x == sim->prepared_x && sim->v == sim->prepared_v &&
-      SameCoefficients(sim->coefficients, sim->prepared_coefficients))
+  if (FemStateAssembled(*sim) && SameCoefficients(sim->coefficients, sim->prepared_coefficients))
     PetscFunctionReturn(0);
   const auto             now = sim->cpu_timer ? ProcessCpuTime : WallTime;
   const double           t0  = now();
@@ -186,6 +185,8 @@ PetscErrorCode ElementPass(FemSimulation *sim, double *element_s, double *comm_s
   double       w  = 0; // the work of gravity (every rank holds the whole state)
   for (size_t k = 0; k < sim->x.size(); ++k) w += sim->f_gravity[k] * (sim->x[k] - sim->model.mesh.nodes[k]);
   sim->state_energy            = all[1] + all[0] - w;
+  sim->state_kinetic           = all[1];
+  sim->state_elastic           = all[0];
   sim->state_inverted_fraction = sim->model.element_count() ? all[2] / sim->model.element_count() : 0.0;
   sim->prepared_x              = sim->x;
   sim->prepared_v              = sim->v;
@@ -265,6 +266,11 @@ PetscErrorCode FemSimulationStep(FemSimulation *sim, FemStepInfo *info)
   info->solve_ms     = 1e3 * (t4 - t3);
   info->total_ms     = 1e3 * (t5 - t0);
   PetscFunctionReturn(0);
+}
+
+bool FemStateAssembled(const FemSimulation &sim)
+{
+  return sim.prepared && sim.x == sim.prepared_x && sim.v == sim.prepared_v;
 }
 
 long long FemAssembleElements(FemSimulation *sim, physics::ElementEnergy *energy)

@@ -78,6 +78,7 @@ struct FemSimulation {
   std::vector<double>       prepared_x, prepared_v;
   physics::StepCoefficients prepared_coefficients;
   double                    state_energy = NAN, state_inverted_fraction = NAN;
+  double                    state_kinetic = NAN, state_elastic = NAN; // state_energy's terms (no gravity)
   // work arrays
   std::vector<double> values, rhs_full, rhs_local, dv_local, dv_full;
   std::vector<float>  values_single; // the blocks instead of values where sys.single_values
@@ -97,6 +98,9 @@ PetscErrorCode FemSimulationStep(FemSimulation *sim, FemStepInfo *info);
 // the first for the initial ones. Collective.
 PetscErrorCode FemSimulationAssembleState(FemSimulation *sim, FemStepInfo *info);
 PetscErrorCode FemSimulationDestroy(FemSimulation *sim);
+// Whether the last element pass ran on the current x and v: state_energy, state_kinetic, state_elastic
+// and state_inverted_fraction are then that state's (summed over the ranks).
+bool FemStateAssembled(const FemSimulation &sim);
 // The element loop of (x, v) alone, untimed and without the pass's bookkeeping (a benchmark's): the
 // blocks into values, or into values_single where the system takes float values, the forces into
 // rhs_full (zeroed first), the state's figures into *energy (may be null). Returns the elements whose

@@ -181,8 +181,9 @@ double energy_roundoff(const FemModel &m, const double *x, int e, double energy)
     u2 +=
       (R.transpose() * Eigen::Vector3d::Map(x + 3 * nd[a]) - Eigen::Vector3d::Map(&m.mesh.nodes[3 * nd[a]]))
         .squaredNorm();
-  const int nb = packed_block_count(m.npe);
-  for (int j = 0; j < 9 * nb; ++j) k2 += std::pow(m.stiffness[static_cast<size_t>(e) * nb * 9 + j], 2);
+  const int     nb = packed_block_count(m.npe);
+  const double *K0 = element_stiffness_blocks(m, e);
+  for (int j = 0; j < 9 * nb; ++j) k2 += std::pow(K0[j], 2);
   return 1e-14 * std::sqrt(k2) * u2 + 1e-12 * std::fabs(energy) + 1e-300;
 }
 
