@@ -113,14 +113,22 @@ BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &e
     for (size_t p = 0; p + 1 < lower.part_offsets.size(); ++p)
       for (int v = lower.part_offsets[p]; v < lower.part_offsets[p + 1]; ++v) part[v] = static_cast<int>(p);
   }
+  const auto listed = [&](const int *nodes, int a, int b) {
+    return !fixed[nodes[a]] && !fixed[nodes[b]] &&
+           !(lower.drop && nodes[a] > nodes[b] && (part.empty() || part[nodes[a]] == part[nodes[b]]));
+  };
+  size_t count = 0; // sized first: grown as it went, its copies took ~6% of a one-step linear_38k run
   for (size_t i = 0; i < elements.size(); ++i) {
     const int *nodes = &model.mesh.elements[static_cast<size_t>(elements[i]) * npe];
     for (int a = 0; a < npe; ++a)
-      for (int b = 0; b < npe; ++b) {
-        if (fixed[nodes[a]] || fixed[nodes[b]]) continue;
-        if (lower.drop && nodes[a] > nodes[b] && (part.empty() || part[nodes[a]] == part[nodes[b]])) continue;
-        keyed.emplace_back(nodes[a] * n + nodes[b], (i * npe + a) * npe + b);
-      }
+      for (int b = 0; b < npe; ++b) count += listed(nodes, a, b);
+  }
+  keyed.reserve(count);
+  for (size_t i = 0; i < elements.size(); ++i) {
+    const int *nodes = &model.mesh.elements[static_cast<size_t>(elements[i]) * npe];
+    for (int a = 0; a < npe; ++a)
+      for (int b = 0; b < npe; ++b)
+        if (listed(nodes, a, b)) keyed.emplace_back(nodes[a] * n + nodes[b], (i * npe + a) * npe + b);
   }
   if (merge) std::sort(keyed.begin(), keyed.end());
   long long last = -1;
