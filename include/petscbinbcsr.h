@@ -60,7 +60,7 @@ PETSC_EXTERN PetscErrorCode MatBinBCSRGetCOOMirror(Mat, PetscBool *);
    MatSetPreallocationCOO()): for a caller that fills a single-precision matrix, whose values are
    rounded to float on storage anyway; it writes and the refill reads half the bytes. Entries that sum
    into one value are summed in double, as MatSetValuesCOO() does. MATBINBCSR only (an error on other
-   types); on MATMPIBINBCSR the values are widened to PetscScalar first. */
+   types); on MATMPIBINBCSR the entries sent to other ranks travel as PetscScalar. */
 PETSC_EXTERN PetscErrorCode MatBinBCSRSetValuesCOOSingle(Mat, const float[], InsertMode);
 /* Streams: the product y = A x (block size 1 or 3, bin width 4, 8, 16 or 32; whole or symmetric storage) sweeps
    this many runs of consecutive bins side by side, so one core streams the values from that many

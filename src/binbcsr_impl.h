@@ -62,6 +62,9 @@ PETSC_INTERN PetscErrorCode
                                                     PetscCount nsrc); /* from[] < n: the caller's values, else received */
 PETSC_INTERN PetscErrorCode MatSetValuesCOOTwoSources_SeqBinBCSR(Mat, const PetscScalar v[], PetscCount n,
                                                                  const PetscScalar recv[], InsertMode);
+/* the same with the caller's values in single precision (MatBinBCSRSetValuesCOOSingle) */
+PETSC_INTERN PetscErrorCode MatSetValuesCOOTwoSourcesSingle_SeqBinBCSR(Mat, const float v[], PetscCount n,
+                                                                       const PetscScalar recv[], InsertMode);
 
 /* An empty, set-up matrix of A's binbcsr type and configuration (bin width, precision, storage, MPI inner
    type) with the given local sizes and block sizes; and the MatAXPY_Basic hook built on it, composed as

@@ -233,12 +233,11 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
         }
     PetscCall(MatSetPreallocationCOO(sys->A, (PetscCount)ci.size(), ci.data(), cj.data()));
     {
-      PetscBool           seq_binbcsr;
+      PetscBool           binbcsr;
       MatBinBCSRPrecision precision;
-      PetscCall(PetscObjectTypeCompare((PetscObject)sys->A, MATSEQBINBCSR, &seq_binbcsr));
+      PetscCall(PetscObjectTypeCompareAny((PetscObject)sys->A, &binbcsr, MATSEQBINBCSR, MATMPIBINBCSR, ""));
       PetscCall(MatBinBCSRGetPrecision(sys->A, &precision));
-      sys->single_values =
-        seq_binbcsr && precision == MAT_BINBCSR_PRECISION_SINGLE ? PETSC_TRUE : PETSC_FALSE;
+      sys->single_values = binbcsr && precision == MAT_BINBCSR_PRECISION_SINGLE ? PETSC_TRUE : PETSC_FALSE;
     }
     PetscCall(PreallocateFromBlockPattern(comm, n_local, n_block_rows_global, graph_row, graph_col, nullptr,
                                           &sys->n_blocks));

@@ -40,7 +40,7 @@ struct BlockSystem {
                  // symmetric storage or COO mirror): the caller lists the upper triangle
   std::vector<PetscInt> coo_block_row, coo_block_col; // kept for the fallback path and for dumps
   const PetscScalar    *last_values = nullptr; // the caller's array from the last SetValues (for dumps)
-  // The Mat takes float block values (BlockSystemSetValuesSingle): a seqbinbcsr that stores single
+  // The Mat takes float block values (BlockSystemSetValuesSingle): a binbcsr that stores single
   // precision, so values it rounds to float anyway are written and read at half the bytes.
   PetscBool          single_values      = PETSC_FALSE;
   const float       *last_values_single = nullptr; // as last_values, from the last SetValuesSingle

@@ -292,8 +292,9 @@ BINBCSR_TRY_GETTER(MatBinBCSRGetCOOMirror, Mat, MAT_CLASSID, PetscBool, PetscVal
    holds rounded gives the same matrix as that double list. A double-precision matrix takes the floats
    as they are.
 
-   On `MATMPIBINBCSR` the values are widened to `PetscScalar` and take the path of `MatSetValuesCOO()`
-   (no saving). Matrices of other types have no such entry point: an error.
+   On `MATMPIBINBCSR` the parts read the floats as the sequential type does; the entries other ranks
+   own travel as `PetscScalar` (parts of another inner type get every value widened). Matrices of other
+   types have no such entry point: an error.
 
 .seealso: `MATBINBCSR`, `MatSetValuesCOO()`, `MatSetPreallocationCOO()`, `MatBinBCSRSetPrecision()`,
           `MatBinBCSRSetCOOMirror()`

@@ -4,6 +4,7 @@
 #include "mpibinbcsr.h"
 
 #include <algorithm>
+#include <type_traits>
 
 /* Sets the entries of one owned row; cols are global; vals NULL: zeros (PETSc's MatSetValues takes a
    NULL array as zeros; DMDA's preallocation inserts its pattern that way). */
@@ -330,7 +331,11 @@ PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_MPIBinBCSR(Mat mat, PetscCoun
   PetscFunctionReturn(0);
 }
 
-PETSC_INTERN PetscErrorCode MatSetValuesCOO_MPIBinBCSR(Mat mat, const PetscScalar v[], InsertMode mode)
+namespace {
+
+/* The refill of both parts from the caller's values v (double, or float for
+   MatBinBCSRSetValuesCOOSingle) and the entries other ranks send. */
+template <typename S> PetscErrorCode SetValuesCOO_MPIBinBCSR(Mat mat, const S v[], InsertMode mode)
 {
   Mat_MPIBinBCSR *b   = MPIBinBCSR(mat);
   MPIBinBCSRCoo  *coo = b->coo;
@@ -339,9 +344,9 @@ PETSC_INTERN PetscErrorCode MatSetValuesCOO_MPIBinBCSR(Mat mat, const PetscScala
   PetscCheck(coo, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONGSTATE,
              "Call MatSetPreallocationCOO() first");
   /* no values on this rank: its entries are zeros (as for the seq type); the exchange stays collective */
-  std::vector<PetscScalar> zeros;
+  std::vector<S> zeros;
   if (!v) {
-    zeros.assign((std::size_t)coo->n, 0.0);
+    zeros.assign((std::size_t)coo->n, (S)0);
     v = zeros.data();
   }
   for (std::size_t q = 0; q < coo->send_from.size(); q++) coo->sendbuf[q] = v[coo->send_from[q]];
@@ -349,8 +354,13 @@ PETSC_INTERN PetscErrorCode MatSetValuesCOO_MPIBinBCSR(Mat mat, const PetscScala
   const PetscCount n = coo->n;
   if (coo->composed) { /* each part gathers from v and recvbuf itself: no intermediate copy */
     PetscCall(PetscSFReduceEnd(coo->sf, MPIU_SCALAR, coo->sendbuf.data(), coo->recvbuf.data(), MPI_REPLACE));
-    PetscCall(MatSetValuesCOOTwoSources_SeqBinBCSR(b->A, v, n, coo->recvbuf.data(), mode));
-    PetscCall(MatSetValuesCOOTwoSources_SeqBinBCSR(b->B, v, n, coo->recvbuf.data(), mode));
+    if constexpr (std::is_same<S, float>::value) {
+      PetscCall(MatSetValuesCOOTwoSourcesSingle_SeqBinBCSR(b->A, v, n, coo->recvbuf.data(), mode));
+      PetscCall(MatSetValuesCOOTwoSourcesSingle_SeqBinBCSR(b->B, v, n, coo->recvbuf.data(), mode));
+    } else {
+      PetscCall(MatSetValuesCOOTwoSources_SeqBinBCSR(b->A, v, n, coo->recvbuf.data(), mode));
+      PetscCall(MatSetValuesCOOTwoSources_SeqBinBCSR(b->B, v, n, coo->recvbuf.data(), mode));
+    }
   } else {
     /* the local entries are gathered while the others travel */
     for (std::size_t k = 0; k < coo->a_from.size(); k++)
@@ -369,16 +379,15 @@ PETSC_INTERN PetscErrorCode MatSetValuesCOO_MPIBinBCSR(Mat mat, const PetscScala
   PetscFunctionReturn(0);
 }
 
-/* The single-precision values widened to PetscScalar: the exchange and the parts take PetscScalar. */
+} // namespace
+
+PETSC_INTERN PetscErrorCode MatSetValuesCOO_MPIBinBCSR(Mat mat, const PetscScalar v[], InsertMode mode)
+{
+  return SetValuesCOO_MPIBinBCSR(mat, v, mode);
+}
+
+/* The parts of binbcsr read the floats themselves; parts of another type get them widened (a_v, b_v). */
 PETSC_INTERN PetscErrorCode MatBinBCSRSetValuesCOOSingle_MPIBinBCSR(Mat mat, const float v[], InsertMode mode)
 {
-  MPIBinBCSRCoo *coo = MPIBinBCSR(mat)->coo;
-
-  PetscFunctionBegin;
-  PetscCheck(coo, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONGSTATE,
-             "Call MatSetPreallocationCOO() first");
-  std::vector<PetscScalar> w;
-  if (v) w.assign(v, v + coo->n);
-  PetscCall(MatSetValuesCOO_MPIBinBCSR(mat, v ? w.data() : nullptr, mode));
-  PetscFunctionReturn(0);
+  return SetValuesCOO_MPIBinBCSR(mat, v, mode);
 }

@@ -539,8 +539,9 @@ PetscErrorCode MatSeqBinBCSRComposeCOO(Mat A, const PetscCount from[], PetscCoun
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode MatSetValuesCOOTwoSources_SeqBinBCSR(Mat A, const PetscScalar v[], PetscCount n,
-                                                    const PetscScalar recv[], InsertMode imode)
+template <typename S>
+static PetscErrorCode SetValuesCOOTwoSources(Mat A, const S v[], PetscCount n, const PetscScalar recv[],
+                                             InsertMode imode)
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
 
@@ -552,4 +553,16 @@ PetscErrorCode MatSetValuesCOOTwoSources_SeqBinBCSR(Mat A, const PetscScalar v[]
   PetscCall(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY));
   PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatSetValuesCOOTwoSources_SeqBinBCSR(Mat A, const PetscScalar v[], PetscCount n,
+                                                    const PetscScalar recv[], InsertMode imode)
+{
+  return SetValuesCOOTwoSources(A, v, n, recv, imode);
+}
+
+PetscErrorCode MatSetValuesCOOTwoSourcesSingle_SeqBinBCSR(Mat A, const float v[], PetscCount n,
+                                                          const PetscScalar recv[], InsertMode imode)
+{
+  return SetValuesCOOTwoSources(A, v, n, recv, imode);
 }
