@@ -65,6 +65,25 @@ double PairedRatio(const Variant &a, const Variant &b)
   return q.empty() ? 0 : q[q.size() / 2];
 }
 
+// One round of v: where `configure`, its stream count, body and prefetch distance set first (a fixed
+// variant shares its matrix with the others of its width), then a warm product and the batch, timed;
+// its time per product appended to v->t.
+PetscErrorCode TimeRound(Variant *v, bool configure, Vec x, Vec y, const SweepSettings &s)
+{
+  PetscFunctionBeginUser;
+  if (configure && v->streams) PetscCall(MatBinBCSRSetStreams(v->A, v->streams));
+  if (configure) {
+    PetscCall(MatBinBCSRSetKernel(v->A, v->kernel));
+    PetscCall(MatBinBCSRSetPrefetch(v->A, v->prefetch));
+  }
+  PetscCall(MatMult(v->A, x, y)); // warm
+  const double a = s.now();
+  for (PetscInt b = 0; b < s.batch; b++) PetscCall(MatMult(v->A, x, y));
+  v->t.push_back((s.now() - a) / s.batch);
+  v->best = PetscMin(v->best, v->t.back());
+  PetscFunctionReturn(0);
+}
+
 // The "cost X ms" of the tuner's line in -mat_view ::ascii_info, or -1.
 PetscErrorCode TuneCost(Mat A, double *ms, std::string *line)
 {
@@ -166,18 +185,7 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
         all.push_back(v);
         if (all.size() == 2) all.push_back(&tuned);
       }
-      for (Variant *v : all) {
-        if (v != &tuned && v->streams) PetscCall(MatBinBCSRSetStreams(v->A, v->streams));
-        if (v != &tuned && v != &base) {
-          PetscCall(MatBinBCSRSetKernel(v->A, v->kernel));
-          PetscCall(MatBinBCSRSetPrefetch(v->A, v->prefetch));
-        }
-        PetscCall(MatMult(v->A, x, y)); // warm
-        const double a = s.now();
-        for (PetscInt b = 0; b < s.batch; b++) PetscCall(MatMult(v->A, x, y));
-        v->t.push_back((s.now() - a) / s.batch);
-        v->best = PetscMin(v->best, v->t.back());
-      }
+      for (Variant *v : all) PetscCall(TimeRound(v, v != &tuned && v != &base, x, y, s));
     }
     // the best: the lowest median (a minimum over rounds picks the luckiest of many variants)
     const Variant *best = &vars[0];
@@ -194,15 +202,7 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
     for (PetscInt r = 0; r < s.confirm; r++)
       for (Variant *v : r % 2 ? std::vector<Variant *>{&again_best, &again_tuned}
                               : std::vector<Variant *>{&again_tuned, &again_best}) {
-        if (v == &again_best) {
-          PetscCall(MatBinBCSRSetStreams(v->A, v->streams));
-          PetscCall(MatBinBCSRSetKernel(v->A, v->kernel));
-          PetscCall(MatBinBCSRSetPrefetch(v->A, v->prefetch));
-        }
-        PetscCall(MatMult(v->A, x, y)); // warm
-        const double a = s.now();
-        for (PetscInt b = 0; b < s.batch; b++) PetscCall(MatMult(v->A, x, y));
-        v->t.push_back((s.now() - a) / s.batch);
+        PetscCall(TimeRound(v, v == &again_best, x, y, s));
       }
     char confirmed[64] = "";
     if (s.confirm > 0)

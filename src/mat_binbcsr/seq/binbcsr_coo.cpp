@@ -499,26 +499,28 @@ PetscErrorCode SetValuesCOO(Mat A, const PetscInt *perm, const S v[], long n, co
 }
 } // namespace
 
-PetscErrorCode MatSetValuesCOO_SeqBinBCSR(Mat A, const PetscScalar v[], InsertMode imode)
+namespace {
+/* The refill from the caller's values alone (v double or float; `name` for the error) */
+template <typename S> PetscErrorCode SetValuesCOOOwn(Mat A, const S v[], InsertMode imode, const char *name)
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
 
   PetscFunctionBegin;
   PetscCheck(a->built && a->coo_jmap, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
-             "MatSetValuesCOO needs MatSetPreallocationCOO first");
+             "%s needs MatSetPreallocationCOO first", name);
   PetscCall(SetValuesCOO(A, a->coo_perm, v, (long)a->coo_n, nullptr, imode));
   PetscFunctionReturn(0);
+}
+} // namespace
+
+PetscErrorCode MatSetValuesCOO_SeqBinBCSR(Mat A, const PetscScalar v[], InsertMode imode)
+{
+  return SetValuesCOOOwn(A, v, imode, "MatSetValuesCOO");
 }
 
 PetscErrorCode MatBinBCSRSetValuesCOOSingle_SeqBinBCSR(Mat A, const float v[], InsertMode imode)
 {
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-
-  PetscFunctionBegin;
-  PetscCheck(a->built && a->coo_jmap, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
-             "MatBinBCSRSetValuesCOOSingle needs MatSetPreallocationCOO first");
-  PetscCall(SetValuesCOO(A, a->coo_perm, v, (long)a->coo_n, nullptr, imode));
-  PetscFunctionReturn(0);
+  return SetValuesCOOOwn(A, v, imode, "MatBinBCSRSetValuesCOOSingle");
 }
 
 PetscErrorCode MatSeqBinBCSRComposeCOO(Mat A, const PetscCount from[], PetscCount n, PetscCount nsrc)
