@@ -18,6 +18,22 @@ namespace {
 PetscErrorCode BuildSlotMap(Mat A, const PetscInt *perm, long n);
 }
 
+/* Sorts each block row's keys ((block column << 32) | source, rows at rowptr) and lists its distinct
+   block columns: the block CSR pattern bi, bj (bj as long as the keys). */
+static void SortedPattern(PetscInt mbs, const PetscInt *rowptr, uint64_t *key, PetscInt *bi, PetscInt *bj)
+{
+  bi[0] = 0;
+  for (PetscInt r = 0; r < mbs; r++) {
+    std::sort(key + rowptr[r], key + rowptr[r + 1]);
+    PetscInt nu = bi[r];
+    for (PetscInt p = rowptr[r]; p < rowptr[r + 1]; p++) {
+      const PetscInt c = (PetscInt)(key[p] >> 32);
+      if (nu == bi[r] || bj[nu - 1] != c) bj[nu++] = c;
+    }
+    bi[r + 1] = nu;
+  }
+}
+
 static PetscErrorCode PreallocateCOO(Mat A, PetscCount n, const PetscInt ci[], const PetscInt cj[])
 {
   Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
@@ -64,16 +80,7 @@ static PetscErrorCode PreallocateCOO(Mat A, PetscCount n, const PetscInt ci[], c
   /* the unique block columns of each row: the block CSR pattern */
   PetscCall(PetscMalloc1(mbs + 1, &bi));
   PetscCall(PetscMalloc1(nvalid, &bj));
-  bi[0] = 0;
-  for (PetscInt r = 0; r < mbs; r++) {
-    std::sort(key + rowptr[r], key + rowptr[r + 1]);
-    PetscInt nu = bi[r];
-    for (PetscInt p = rowptr[r]; p < rowptr[r + 1]; p++) {
-      const PetscInt c = (PetscInt)(key[p] >> 32);
-      if (nu == bi[r] || bj[nu - 1] != c) bj[nu++] = c;
-    }
-    bi[r + 1] = nu;
-  }
+  SortedPattern(mbs, rowptr, key, bi, bj);
   PetscCall(MatSeqBinBCSRBuildLayout(A, bi, bj)); /* sets a->bs, a->bw, ... and zero values */
 
   /* row-order value number q (see binbcsr.h) of every COO entry (-1: dropped) */
@@ -167,16 +174,7 @@ static PetscErrorCode PreallocateCOOBlocks(Mat A, PetscCount n, const PetscInt c
   PetscInt *bi, *bj;
   PetscCall(PetscMalloc1(mbs + 1, &bi));
   PetscCall(PetscMalloc1(PetscMax(nsrc, 1), &bj));
-  bi[0] = 0;
-  for (PetscInt r = 0; r < mbs; r++) {
-    std::sort(key.begin() + rowptr[r], key.begin() + rowptr[r + 1]);
-    PetscInt nu = bi[r];
-    for (PetscInt p = rowptr[r]; p < rowptr[r + 1]; p++) {
-      const PetscInt c = (PetscInt)(key[p] >> 32);
-      if (nu == bi[r] || bj[nu - 1] != c) bj[nu++] = c;
-    }
-    bi[r + 1] = nu;
-  }
+  SortedPattern(mbs, rowptr.data(), key.data(), bi, bj);
   PetscCall(MatSeqBinBCSRBuildLayout(A, bi, bj)); /* sets a->row_nz, a->nz, ... and zero values */
   PetscCall(PetscFree(bi));
   PetscCall(PetscFree(bj));
