@@ -47,7 +47,8 @@ struct FemModel {
 // Validates the mesh (throws std::runtime_error) and the material (std::invalid_argument).
 FemModel make_fem_model(const TetMesh &mesh, const FemSettings &settings);
 
-// Element e's K0 blocks (FemModel::stiffness), every element's built at the first call.
+// Element e's K0 blocks (FemModel::stiffness), every element's built at the first call (which writes
+// the model: not to be raced by two threads on one model).
 const double *element_stiffness_blocks(const FemModel &model, int e);
 
 // M g per node (3 per node): the consistent load of gravity g for the model's mass matrix.
