@@ -364,14 +364,23 @@ void assemble_kernel_p1(const FemModel &model, const std::vector<int> &elements,
 // The batched loop writes the rotations as 9 doubles each, into the caller's array of Matrix3d.
 static_assert(sizeof(Eigen::Matrix3d) == 9 * sizeof(double), "Matrix3d is not 9 packed doubles");
 
+namespace {
+// assemble_elements' argument checks (both precisions of the blocks).
+void check_pattern(const FemModel &model, const std::vector<int> &elements, const BlockPattern *pattern,
+                   bool block_values)
+{
+  if (block_values && !pattern) throw std::invalid_argument("assemble_elements: block values need a pattern");
+  if (pattern && pattern->element_slots.size() != elements.size() * model.npe * model.npe)
+    throw std::invalid_argument("assemble_elements: pattern was built for another element list");
+}
+} // namespace
+
 long long assemble_elements(const FemModel &model, const std::vector<int> &elements, const double *x,
                             const double *v, const StepCoefficients &c, const BlockPattern *pattern,
                             double *block_values, double *rhs, Eigen::Matrix3d *rotations,
                             ElementKernel kernel, binbcsr::BodySet body, ElementEnergy *energy)
 {
-  if (block_values && !pattern) throw std::invalid_argument("assemble_elements: block values need a pattern");
-  if (pattern && pattern->element_slots.size() != elements.size() * model.npe * model.npe)
-    throw std::invalid_argument("assemble_elements: pattern was built for another element list");
+  check_pattern(model, elements, pattern, block_values != nullptr);
   if (kernel == ElementKernel::Batched)
     return assemble_elements_batched(model, elements, x, v, c, block_values ? pattern : nullptr, block_values,
                                      rhs, rotations ? rotations->data() : nullptr, body, energy);
@@ -400,19 +409,14 @@ long long assemble_elements_single(const FemModel &model, const std::vector<int>
                                    float *block_values, double *rhs, Eigen::Matrix3d *rotations,
                                    ElementKernel kernel, binbcsr::BodySet body, ElementEnergy *energy)
 {
-  if (!block_values || kernel == ElementKernel::Batched) {
-    if (block_values && !pattern)
-      throw std::invalid_argument("assemble_elements: block values need a pattern");
-    if (pattern && pattern->element_slots.size() != elements.size() * model.npe * model.npe)
-      throw std::invalid_argument("assemble_elements: pattern was built for another element list");
-    if (!block_values)
-      return assemble_elements(model, elements, x, v, c, pattern, static_cast<double *>(nullptr), rhs,
-                               rotations, kernel, body, energy);
+  check_pattern(model, elements, pattern, block_values != nullptr);
+  if (!block_values)
+    return assemble_elements(model, elements, x, v, c, pattern, nullptr, rhs, rotations, kernel, body,
+                             energy);
+  if (kernel == ElementKernel::Batched)
     return assemble_elements_batched_single(model, elements, x, v, c, pattern, block_values, rhs,
                                             rotations ? rotations->data() : nullptr, body, energy);
-  }
   // The reference loop writes double blocks: through a copy (the identity blocks included).
-  if (!pattern) throw std::invalid_argument("assemble_elements: block values need a pattern");
   std::vector<double> wide(block_values, block_values + 9 * pattern->rows.size());
   const long long     n =
     assemble_elements(model, elements, x, v, c, pattern, wide.data(), rhs, rotations, kernel, body, energy);

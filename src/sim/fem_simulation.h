@@ -101,10 +101,10 @@ PetscErrorCode FemSimulationDestroy(FemSimulation *sim);
 // Whether the last element pass ran on the current x and v: state_energy, state_kinetic, state_elastic
 // and state_inverted_fraction are then that state's (summed over the ranks).
 bool FemStateAssembled(const FemSimulation &sim);
-// The element loop of (x, v) alone, untimed and without the pass's bookkeeping (a benchmark's): the
-// blocks into values, or into values_single where the system takes float values, the forces into
-// rhs_full (zeroed first), the state's figures into *energy (may be null). Returns the elements whose
-// rotation took the scalar path.
+// The element loop of (x, v) itself, which the step's pass times and keeps track of and a benchmark
+// calls alone: the blocks into values, or into values_single where the system takes float values, the
+// forces into rhs_full (zeroed first), the state's figures into *energy (may be null). Returns the
+// elements whose rotation took the scalar path.
 long long FemAssembleElements(FemSimulation *sim, physics::ElementEnergy *energy);
 // The refill of the system's matrix from the blocks of the last element loop.
 PetscErrorCode FemSetSystemValues(FemSimulation *sim);

@@ -357,16 +357,15 @@ template <int BS, bool ADD, typename V, typename S>
 void coo_refill_blocks(const Mat_SeqBinBCSR *a, V *val, const PetscInt *slot_ptr, const PetscInt *slot_src,
                        const S *v, long n, const PetscScalar *recv)
 {
-  /* source block at base: its first value's address (for the prefetch) and value e (plain order) */
-  const auto at = [&](long base) -> const void * {
-    return base < n ? (const void *)(v + base) : recv + (base - n);
+  /* value e (plain order) of the source block at base, and its address (for the prefetch) */
+  const auto address = [&](long base, PetscInt e) -> const void * {
+    return base < n ? (const void *)(v + base + e) : (const void *)(recv + (base - n) + e);
   };
   const auto value = [&](long base, PetscInt e) -> double {
     return base < n ? (double)v[base + e] : recv[base - n + e];
   };
-  const std::size_t elem  = sizeof(S);
-  constexpr int     MAXB2 = BS ? BS * BS : 1;
-  const PetscInt    bs = BS ? BS : a->bs, bs2 = bs * bs, bw = a->bw;
+  constexpr int  MAXB2 = BS ? BS * BS : 1;
+  const PetscInt bs = BS ? BS : a->bs, bs2 = bs * bs, bw = a->bw;
   for (PetscInt s0 = 0; s0 < a->nslots; s0 += bw) { /* one column of a bin: bw lanes */
     /* the sources of the slot column four ahead: the caller's blocks are read in its order, not in
        storage order, and each read waited for memory */
@@ -374,10 +373,9 @@ void coo_refill_blocks(const Mat_SeqBinBCSR *a, V *val, const PetscInt *slot_ptr
       for (PetscInt l = 0; l < bw; l++) {
         const PetscInt p = slot_ptr[s0 + 4 * bw + l];
         if (p == slot_ptr[s0 + 4 * bw + l + 1]) continue;
-        const long  base = slot_src[p] >= 0 ? slot_src[p] : -1 - (long)slot_src[p];
-        const char *x    = (const char *)at(base);
-        __builtin_prefetch(x);
-        __builtin_prefetch(x + (base < n ? elem : sizeof(PetscScalar)) * (bs2 - 1));
+        const long base = slot_src[p] >= 0 ? slot_src[p] : -1 - (long)slot_src[p];
+        __builtin_prefetch(address(base, 0));
+        __builtin_prefetch(address(base, bs2 - 1));
       }
     for (PetscInt l = 0; l < bw; l++) {
       const PetscInt p0 = slot_ptr[s0 + l], p1 = slot_ptr[s0 + l + 1];
