@@ -45,7 +45,8 @@ template <int N> struct alignas(64) Batch {
   double               Dinv[9 * W], F[9 * W], R[9 * W], vol[W];
   double               rhs[3 * N * W], blocks[NB * 9 * W];
   double               Q[N == 10 ? 16 * 9 * W : W]; // P2: the rotated gradient pairs (W: rows stay aligned)
-  double               ok[W];                       // polar_rotation's acceptance per lane
+  double               PX[9 * W], PC[9 * W], pdet[W], pflag[W], pchange[W]; // the polar iteration's state
+  double               ok[W];                                               // its acceptance per lane
   double               elastic[W], kinetic[W], inverted[W]; // the state's figures (ElementBatchArgs::energy)
 };
 
@@ -255,8 +256,25 @@ template <int N, bool Blocks, bool MassDamping, typename V = double> long long r
 #pragma omp simd
       for (int l = 0; l < W; ++l) deformation_gradient<W>(b.x + l, b.Dinv + l, b.F + l);
       if (a.corotational) {
+        // polar_rotation in pieces: the batch stops after kPolarEarlySteps when all its lanes pass.
 #pragma omp simd
-        for (int l = 0; l < W; ++l) b.ok[l] = polar_rotation<W>(b.F + l, b.R + l);
+        for (int l = 0; l < W; ++l) {
+          polar_start<W, W>(b.F + l, b.PX + l, b.PC + l, b.pdet + l, b.pflag + l);
+          polar_steps<W, 0, kPolarEarlySteps>(b.PX + l, b.PC + l, b.pdet + l, b.pflag + l, b.pchange + l);
+          b.ok[l] = polar_accepted(b.pdet[l], b.pflag[l], b.pchange[l]);
+        }
+        double passed = 1;
+        for (int l = 0; l < m; ++l) passed *= b.ok[l];
+        if (passed == 0) {
+#pragma omp simd
+          for (int l = 0; l < W; ++l) {
+            polar_steps<W, kPolarEarlySteps, kPolarSteps>(b.PX + l, b.PC + l, b.pdet + l, b.pflag + l,
+                                                          b.pchange + l);
+            b.ok[l] = polar_accepted(b.pdet[l], b.pflag[l], b.pchange[l]);
+          }
+        }
+#pragma omp simd
+        for (int l = 0; l < W; ++l) polar_finish<W, W>(b.PX + l, b.ok[l], b.R + l);
         for (int l = 0; l < m; ++l) {
           if (b.ok[l] != 0) continue; // rare: inverted, flat or strongly stretched elements
           double F[9], R[9];

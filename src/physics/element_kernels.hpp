@@ -71,9 +71,12 @@ constexpr double kPolarDetTolerance = 1e-8;
 // square roots and a division more, on the lanes' latency chain). Steps needed to pass the acceptance
 // test (20,000 random F per row): singular value ratios up to 1.02: 3; 1.5: 4; 4: 5; 10: 6, so 5 steps
 // pass every element stretched up to 4:1 and most at 10:1; the rest take the scalar path. Steps
-// after convergence keep the iterate (a rotation is a fixed point).
+// after convergence keep the iterate (a rotation is a fixed point). A batch whose lanes all pass after
+// kPolarEarlySteps stops there (element_batch_body.hpp): the scenes' elements are strained by a few
+// percent at most, and the two steps saved were ~7% of linear_38k's element loop.
 constexpr int kPolarSteps       = 5;
 constexpr int kPolarScaledSteps = 2;
+constexpr int kPolarEarlySteps  = 3;
 
 // Columns of cof(X) = det(X) X^-T (cross products of X's other two columns) and det X. T: double for
 // one element, or a lane packet (polar_decomposition.cpp's batched Newton iteration).
@@ -109,17 +112,21 @@ template <int S> BINBCSR_PHYS_HD void rest_shape(const double *Xc, double *Dinv,
   *volume = det / 6.0;
 }
 
-// R = polar factor of F by kPolarSteps scaled Newton steps X <- (g X + cof(X) / (g det X)) / 2, without
-// branches. Returns 1 where R passed the acceptance test, 0 where the caller must take the scalar
-// path (rotation_from_deformation: inverted or flat elements get the sign-corrected SVD rotation,
-// broken F the identity). R is then the identity, and no lane divides by zero or makes NaN on the way.
-// (A double, not a flag type: in the lane loop a 32-bit result would halve the vector width.)
-template <int S> BINBCSR_PHYS_HD double polar_rotation(const double *F, double *R)
+// The polar factor of F by scaled Newton steps X <- (g X + cof(X) / (g det X)) / 2, without branches,
+// in three pieces so that a batch can stop early: polar_start, polar_steps, polar_finish. The
+// iteration's state (X, cof X, det X, the lane's flag ok, the last step's change) lives at stride T:
+// registers for one call of polar_rotation, the batch's arrays between the pieces.
+//
+// The lane's flags are doubles (1 or 0), combined by products, and every choice a select: with bool
+// flags GCC mixed mask widths it could not vectorise, and without -fno-trapping-math (set for the
+// batch bodies, CMakeLists.txt) it kept the selects as branches; either left the lane loop scalar
+// (a Zen 3 core: linear_38k's element loop 21 ms, 14.2-14.6 ms vectorised).
+
+// The start X = F sqrt(3) / |F|; a lane that cannot start (inverted, flat, zero, Inf or NaN) gets
+// ok = 0 and runs on the identity, which stays put.
+template <int S, int T>
+BINBCSR_PHYS_HD void polar_start(const double *F, double *Xs, double *Cs, double *dets, double *oks)
 {
-  // The lane's flags are doubles (1 or 0), combined by products, and every choice a select: with bool
-  // flags GCC mixed mask widths it could not vectorise, and without -fno-trapping-math (set for the
-  // batch bodies, CMakeLists.txt) it kept the selects as branches; either left the lane loop scalar
-  // (a Zen 3 core: linear_38k's element loop 21 ms, 14.2-14.6 ms vectorised).
   double X[9], C[9], det, s2 = 0;
   BINBCSR_PHYS_UNROLL
   for (int j = 0; j < 9; ++j) s2 += F[j * S] * F[j * S];
@@ -131,16 +138,26 @@ template <int S> BINBCSR_PHYS_HD double polar_rotation(const double *F, double *
     X[j]           = finite != 0 ? f * k : (j % 4 == 0 ? 1.0 : 0.0);
   }
   cofactor3(X, C, det);
-  double ok = finite * (det > kPolarMinStartDet ? 1.0 : 0.0);
+  const double ok = finite * (det > kPolarMinStartDet ? 1.0 : 0.0);
   BINBCSR_PHYS_UNROLL
-  for (int j = 0; j < 9; ++j) { // lanes that cannot start run on the identity, which stays put
-    X[j] = ok != 0 ? X[j] : (j % 4 == 0 ? 1.0 : 0.0);
-    C[j] = ok != 0 ? C[j] : (j % 4 == 0 ? 1.0 : 0.0);
+  for (int j = 0; j < 9; ++j) {
+    Xs[j * T] = ok != 0 ? X[j] : (j % 4 == 0 ? 1.0 : 0.0);
+    Cs[j * T] = ok != 0 ? C[j] : (j % 4 == 0 ? 1.0 : 0.0);
   }
-  det           = ok != 0 ? det : 1.0;
-  double change = 0;
+  *dets = ok != 0 ? det : 1.0;
+  *oks  = ok;
+}
+
+// Newton steps First .. Last - 1 (the first kPolarScaledSteps of the whole iteration scaled); *change:
+// the last step's squared change.
+template <int T, int First, int Last>
+BINBCSR_PHYS_HD void polar_steps(double *Xs, double *Cs, double *dets, double *oks, double *changes)
+{
+  double X[9], C[9], det = *dets, ok = *oks, change = 0;
   BINBCSR_PHYS_UNROLL
-  for (int it = 0; it < kPolarSteps; ++it) {
+  for (int j = 0; j < 9; ++j) X[j] = Xs[j * T], C[j] = Cs[j * T];
+  BINBCSR_PHYS_UNROLL
+  for (int it = First; it < Last; ++it) {
     double g = 1;
     if (it < kPolarScaledSteps) { // a constant condition: resolved when the loop is unrolled
       double x2 = 0, c2 = 0;
@@ -160,10 +177,39 @@ template <int S> BINBCSR_PHYS_HD double polar_rotation(const double *F, double *
     ok *= (det > 0 ? 1.0 : 0.0) * (det < 1e300 ? 1.0 : 0.0);
     det = ok != 0 ? det : 1.0; // the lane is lost; keep its arithmetic finite
   }
-  ok *= (change < kPolarConverged2 ? 1.0 : 0.0) * (std::fabs(det - 1.0) < kPolarDetTolerance ? 1.0 : 0.0);
   BINBCSR_PHYS_UNROLL
-  for (int j = 0; j < 9; ++j) R[j * S] = ok != 0 ? X[j] : (j % 4 == 0 ? 1.0 : 0.0);
-  return ok;
+  for (int j = 0; j < 9; ++j) Xs[j * T] = X[j], Cs[j * T] = C[j];
+  *dets = det, *oks = ok, *changes = change;
+}
+
+// 1 where the iterate passes the acceptance test (its last step changed it by less than 1e-7 and |det -
+// 1| < 1e-8), else 0.
+BINBCSR_PHYS_HD double polar_accepted(double det, double ok, double change)
+{
+  return ok * (change < kPolarConverged2 ? 1.0 : 0.0) *
+         (std::fabs(det - 1.0) < kPolarDetTolerance ? 1.0 : 0.0);
+}
+
+// R = X where accepted, else the identity.
+template <int S, int T> BINBCSR_PHYS_HD void polar_finish(const double *Xs, double accepted, double *R)
+{
+  BINBCSR_PHYS_UNROLL
+  for (int j = 0; j < 9; ++j) R[j * S] = accepted != 0 ? Xs[j * T] : (j % 4 == 0 ? 1.0 : 0.0);
+}
+
+// R = polar factor of F by kPolarSteps steps. Returns 1 where R passed the acceptance test, 0 where the
+// caller must take the scalar path (rotation_from_deformation: inverted or flat elements get the
+// sign-corrected SVD rotation, broken F the identity). R is then the identity, and no lane divides by
+// zero or makes NaN on the way. (A double, not a flag type: in the lane loop a 32-bit result would
+// halve the vector width.)
+template <int S> BINBCSR_PHYS_HD double polar_rotation(const double *F, double *R)
+{
+  double X[9], C[9], det, ok, change;
+  polar_start<S, 1>(F, X, C, &det, &ok);
+  polar_steps<1, 0, kPolarSteps>(X, C, &det, &ok, &change);
+  const double accepted = polar_accepted(det, ok, change);
+  polar_finish<S, 1>(X, accepted, R);
+  return accepted;
 }
 
 // ---- shared element pieces ------------------------------------------------------------------------

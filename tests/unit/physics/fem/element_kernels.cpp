@@ -45,8 +45,9 @@ struct Elements {
   std::vector<int>    kind;
 };
 
-// n disjoint elements with random rest shapes (positive volume) and current shapes of every kind.
-Elements make_elements(int order, int n, unsigned seed)
+// n disjoint elements with random rest shapes (positive volume) and current shapes of every kind, or
+// of the kinds listed (element e: kinds[e % kinds.size()]).
+Elements make_elements(int order, int n, unsigned seed, const std::vector<int> &kinds = {})
 {
   std::mt19937                           rng(seed);
   std::uniform_real_distribution<double> u(-1, 1);
@@ -74,7 +75,7 @@ Elements make_elements(int order, int n, unsigned seed)
   s.v.resize(s.x.size());
   for (double &w : s.v) w = u(rng);
   for (int e = 0; e < n; ++e) {
-    const int  kind = e % kKinds;
+    const int  kind = kinds.empty() ? e % kKinds : kinds[e % kinds.size()];
     const int *nd   = &s.mesh.elements[static_cast<size_t>(e) * npe];
     s.kind.push_back(kind);
     const Eigen::Matrix3d Q = random_rotation(rng);
@@ -313,6 +314,71 @@ TEST_CASE("batched element kernels equal the scalar ones element by element, in 
           CHECK(t.block < 1e-13);
         }
       }
+}
+
+TEST_CASE("batches of slightly strained elements, which stop the Newton steps early, equal the scalar "
+          "kernels",
+          "[fem][kernel][batch]")
+{
+  // Every lane of most batches passes after kPolarEarlySteps (the other test's batches all hold a
+  // Large element and run every step).
+  const std::vector<binbcsr::BodySet> bodies = runnable_bodies();
+  for (int order : {1, 2}) {
+    INFO("order " << order);
+    const int              n        = 203;
+    const Elements         s        = make_elements(order, n, 41 + order, {Small, Rigid, Small});
+    const FemModel         m        = test_model(s, true, false);
+    std::vector<int>       elements = permuted_elements(n);
+    std::vector<char>      fixed(m.node_count(), 0);
+    const BlockPattern     p   = make_block_pattern(m, elements, fixed, 0, m.node_count(), false);
+    const StepCoefficients c   = implicit_euler_coefficients(0.01, 0.5, 0.002);
+    auto                   run = [&](ElementKernel kernel, binbcsr::BodySet body) {
+      LoopOutput o;
+      o.rhs.assign(s.x.size(), 0.0);
+      o.R.resize(n);
+      reset_block_values(p, o.values);
+      o.scalar_path = assemble_elements(m, elements, s.x.data(), s.v.data(), c, &p, o.values.data(),
+                                                          o.rhs.data(), o.R.data(), kernel, body);
+      return o;
+    };
+    const LoopOutput scalar = run(ElementKernel::Scalar, binbcsr::BodySet::Auto);
+    for (binbcsr::BodySet body : bodies) {
+      INFO("element body " << binbcsr::body_set_name(body));
+      const LoopOutput  batched = run(ElementKernel::Batched, body);
+      const Differences d = element_differences(m, elements, p, true, m.settings.young, scalar, batched);
+      CHECK(batched.scalar_path == 0);
+      CHECK(d.R < 1e-12);
+      CHECK(d.rhs < 1e-10);
+      CHECK(d.block < 1e-12);
+      CHECK(d.compared == n);
+    }
+  }
+}
+
+TEST_CASE("polar kernel in pieces: strains of ~1% pass after kPolarEarlySteps, at the full iteration's R",
+          "[fem][polar][batch]")
+{
+  std::mt19937                     rng(5);
+  std::normal_distribution<double> normal(0, 1);
+  int                              early = 0;
+  double                           worst = 0;
+  for (int k = 0; k < 2000; ++k) {
+    Eigen::Vector3d sv;
+    for (int d = 0; d < 3; ++d) sv[d] = 1.0 + 0.003 * normal(rng);
+    const Eigen::Matrix3d F = random_rotation(rng) * sv.asDiagonal() * random_rotation(rng);
+    double                X[9], C[9], det, ok, change, R[9], Rfull[9];
+    kernels::polar_start<1, 1>(F.data(), X, C, &det, &ok);
+    kernels::polar_steps<1, 0, kernels::kPolarEarlySteps>(X, C, &det, &ok, &change);
+    const double accepted = kernels::polar_accepted(det, ok, change);
+    early += accepted != 0;
+    kernels::polar_finish<1, 1>(X, accepted, R);
+    REQUIRE(kernels::polar_rotation<1>(F.data(), Rfull) != 0);
+    if (accepted != 0)
+      worst = std::max(worst, (Eigen::Matrix3d::Map(R) - Eigen::Matrix3d::Map(Rfull)).norm());
+    else CHECK((Eigen::Matrix3d::Map(R) - Eigen::Matrix3d::Identity()).norm() == 0);
+  }
+  CHECK(early > 1900);
+  CHECK(worst < 1e-14);
 }
 
 TEST_CASE("fixed-step polar kernel: the scalar rotation where it accepts, the fallback flag elsewhere",
