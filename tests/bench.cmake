@@ -31,6 +31,7 @@ foreach(case
     "spmv_negative|is no grid size|spmv_bench|-stencil_sizes -5"
     "spmv_bs0|-bs must be >= 1|spmv_bench|-stencil_sizes 0 -bs 0"
     "tune_streams_list|-streams takes at most 4 stream counts|binbcsr_tune|-stencil_n 8 -streams 1,2,4,8,1"
+    "tune_sweep_confirm|-sweep_confirm must be >= 0|binbcsr_tune|-sweep -stencil_sizes 4 -sweep_confirm -1"
     "spmv_sizes_list|-stencil_sizes takes at most 16 sizes|spmv_bench|-stencil_sizes 1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17")
   string(REPLACE "|" ";" parts "${case}")
   list(GET parts 0 name)
