@@ -84,6 +84,47 @@ BlockPattern::WritePlan make_write_plan(const std::vector<int> &element_slots, i
   return plan;
 }
 
+// The plan of the same element slots with the COO blocks renumbered (renumber: old -> new), made from
+// the plan itself: the groups, their blocks, term counts and first writes do not change, only the order
+// within a run of blocks the group does not write first (ascending in the new numbers; the first
+// writes are numbered in the order the plan makes them, so they are ascending already). The same
+// plan as make_write_plan of the renumbered slots, without sorting every group's terms again.
+void renumber_write_plan(BlockPattern::WritePlan &plan, const std::vector<int> &renumber)
+{
+  std::vector<int>            order, slots;
+  std::vector<unsigned short> terms;
+  for (size_t g = 0; g + 1 < plan.group_offsets.size(); ++g) {
+    int    k = plan.group_offsets[g];
+    size_t t = plan.group_terms[g];
+    for (int r = plan.run_offsets[g]; r < plan.run_offsets[g + 1]; ++r) {
+      const int count = plan.runs[2 * r], k1 = k + plan.runs[2 * r + 1];
+      int       j0 = k1;
+      for (int j = k; j < k1; ++j) {
+        const int s         = plan.write_slots[j];
+        plan.write_slots[j] = renumber[s & kSlotIndexMask] | (s & kFirstContribution);
+        if (!(s & kFirstContribution) && j0 == k1) j0 = j;
+      }
+      if (k1 - j0 > 1) {
+        order.resize(k1 - j0);
+        for (int i = 0; i < k1 - j0; ++i) order[i] = i;
+        std::sort(order.begin(), order.end(),
+                  [&](int a, int b) { return plan.write_slots[j0 + a] < plan.write_slots[j0 + b]; });
+        slots.assign(plan.write_slots.begin() + j0, plan.write_slots.begin() + k1);
+        const auto first_term = plan.write_terms.begin() + static_cast<std::ptrdiff_t>(t) +
+                                static_cast<std::ptrdiff_t>(j0 - k) * count;
+        terms.assign(first_term, first_term + static_cast<std::ptrdiff_t>(k1 - j0) * count);
+        for (int i = 0; i < k1 - j0; ++i) {
+          plan.write_slots[j0 + i] = slots[order[i]];
+          std::copy_n(terms.begin() + static_cast<std::ptrdiff_t>(order[i]) * count, count,
+                      first_term + static_cast<std::ptrdiff_t>(i) * count);
+        }
+      }
+      t += static_cast<size_t>(k1 - k) * count;
+      k = k1;
+    }
+  }
+}
+
 } // namespace
 
 std::vector<int> listed_element_nodes(const FemModel &model, const std::vector<int> &elements)
@@ -169,7 +210,7 @@ BlockPattern make_block_pattern(const FemModel &model, const std::vector<int> &e
     p.cols.swap(cols);
     for (int &s : p.element_slots)
       if (s >= 0) s = renumber[s & kSlotIndexMask] | (s & kFirstContribution);
-    p.plan = make_write_plan(p.element_slots, npe, elements.size(), p.rows.size());
+    renumber_write_plan(p.plan, renumber);
   }
   p.plan.element_nodes = listed_element_nodes(model, elements);
   for (int v = owned_begin; v < owned_end; ++v)
