@@ -45,9 +45,9 @@ template <int N> struct alignas(64) Batch {
   double               Dinv[9 * W], F[9 * W], R[9 * W], vol[W];
   double               rhs[3 * N * W], blocks[NB * 9 * W];
   double               Q[N == 10 ? 16 * 9 * W : W]; // P2: the rotated gradient pairs (W: rows stay aligned)
-  double               PX[9 * W], PC[9 * W], pdet[W], pflag[W], pchange[W]; // the polar iteration's state
-  double               ok[W];                                               // its acceptance per lane
-  double               elastic[W], kinetic[W], inverted[W]; // the state's figures (ElementBatchArgs::energy)
+  double PX[9 * W], PC[9 * W], pdet[W], pflag[W], pchange[W], pnear[W]; // the polar iteration's state
+  double ok[W];                                                         // its acceptance per lane
+  double elastic[W], kinetic[W], inverted[W]; // the state's figures (ElementBatchArgs::energy)
 };
 
 // Lane l <- listed element i: its nodes' positions, velocities and rest positions.
@@ -256,15 +256,42 @@ template <int N, bool Blocks, bool MassDamping, typename V = double> long long r
 #pragma omp simd
       for (int l = 0; l < W; ++l) deformation_gradient<W>(b.x + l, b.Dinv + l, b.F + l);
       if (a.corotational) {
-        // polar_rotation in pieces: the batch stops after kPolarEarlySteps when all its lanes pass.
+        // polar_rotation in pieces. A batch whose lanes all start near a rotation runs kPolarEarlySteps
+        // unscaled steps and stops there if every lane passes (the scenes' elements); otherwise, and
+        // for every other batch, polar_rotation's steps from the start again: kPolarEarlySteps, and
+        // the rest only when a lane has not passed. So the rotations accepted are those of
+        // polar_rotation, to within its tolerance, and so are the lanes it refuses.
 #pragma omp simd
         for (int l = 0; l < W; ++l) {
           polar_start<W, W>(b.F + l, b.PX + l, b.PC + l, b.pdet + l, b.pflag + l);
-          polar_steps<W, 0, kPolarEarlySteps>(b.PX + l, b.PC + l, b.pdet + l, b.pflag + l, b.pchange + l);
-          b.ok[l] = polar_accepted(b.pdet[l], b.pflag[l], b.pchange[l]);
+          b.pnear[l] = b.pdet[l] > kPolarNearDet ? b.pflag[l] : 0.0;
         }
-        double passed = 1;
-        for (int l = 0; l < m; ++l) passed *= b.ok[l];
+        double near = 1, passed = 0;
+        for (int l = 0; l < m; ++l) near *= b.pnear[l];
+        if (near != 0) {
+#pragma omp simd
+          for (int l = 0; l < W; ++l) {
+            polar_steps<W, 0, kPolarEarlySteps, 0>(b.PX + l, b.PC + l, b.pdet + l, b.pflag + l,
+                                                   b.pchange + l);
+            b.ok[l] = polar_accepted(b.pdet[l], b.pflag[l], b.pchange[l]);
+          }
+          passed = 1;
+          for (int l = 0; l < m; ++l) passed *= b.ok[l];
+          if (passed == 0) {
+#pragma omp simd
+            for (int l = 0; l < W; ++l)
+              polar_start<W, W>(b.F + l, b.PX + l, b.PC + l, b.pdet + l, b.pflag + l);
+          }
+        }
+        if (passed == 0) {
+#pragma omp simd
+          for (int l = 0; l < W; ++l) {
+            polar_steps<W, 0, kPolarEarlySteps>(b.PX + l, b.PC + l, b.pdet + l, b.pflag + l, b.pchange + l);
+            b.ok[l] = polar_accepted(b.pdet[l], b.pflag[l], b.pchange[l]);
+          }
+          passed = 1;
+          for (int l = 0; l < m; ++l) passed *= b.ok[l];
+        }
         if (passed == 0) {
 #pragma omp simd
           for (int l = 0; l < W; ++l) {

@@ -77,6 +77,12 @@ constexpr double kPolarDetTolerance = 1e-8;
 constexpr int kPolarSteps       = 5;
 constexpr int kPolarScaledSteps = 2;
 constexpr int kPolarEarlySteps  = 3;
+// The start X = F sqrt 3 / |F| has |X|^2 = 3, so det X <= 1, with 1 - det X ~ (sum of the squared
+// deviations of its singular values from 1) / 2. Where det X > kPolarNearDet they are within ~3% of 1:
+// Newton's steps need no scaling there (the deviation d goes to ~d^2 / 2 per step, so after three the
+// change is below 1e-7), and a batch of such lanes skips the two scaled steps' square roots and
+// division, which lie on the lanes' latency chain.
+constexpr double kPolarNearDet = 0.9996;
 
 // Columns of cof(X) = det(X) X^-T (cross products of X's other two columns) and det X. T: double for
 // one element, or a lane packet (polar_decomposition.cpp's batched Newton iteration).
@@ -148,9 +154,9 @@ BINBCSR_PHYS_HD void polar_start(const double *F, double *Xs, double *Cs, double
   *oks  = ok;
 }
 
-// Newton steps First .. Last - 1 (the first kPolarScaledSteps of the whole iteration scaled); *change:
-// the last step's squared change.
-template <int T, int First, int Last>
+// Newton steps First .. Last - 1 (the first Scaled of the whole iteration scaled); *change: the last
+// step's squared change.
+template <int T, int First, int Last, int Scaled = kPolarScaledSteps>
 BINBCSR_PHYS_HD void polar_steps(double *Xs, double *Cs, double *dets, double *oks, double *changes)
 {
   double X[9], C[9], det = *dets, ok = *oks, change = 0;
@@ -159,7 +165,7 @@ BINBCSR_PHYS_HD void polar_steps(double *Xs, double *Cs, double *dets, double *o
   BINBCSR_PHYS_UNROLL
   for (int it = First; it < Last; ++it) {
     double g = 1;
-    if (it < kPolarScaledSteps) { // a constant condition: resolved when the loop is unrolled
+    if (it < Scaled) { // a constant condition: resolved when the loop is unrolled
       double x2 = 0, c2 = 0;
       BINBCSR_PHYS_UNROLL
       for (int j = 0; j < 9; ++j) x2 += X[j] * X[j], c2 += C[j] * C[j];
