@@ -111,6 +111,60 @@ template <typename V> inline void prefetch_blocks(const ElementBatchArgs &a, int
   }
 }
 
+// 1 where the first m lanes of f are all non-zero.
+inline double all_lanes(const double *f, int m)
+{
+  double all = 1;
+  for (int l = 0; l < m; ++l) all *= f[l];
+  return all;
+}
+
+// The batch's rotations b.R from b.F and their acceptance b.ok: polar_rotation in pieces, one test per
+// batch, not per lane. A batch whose first m lanes all start near a rotation runs kPolarEarlySteps
+// unscaled steps and stops there if all pass (the scenes' elements); otherwise, and for every other
+// batch, polar_rotation's steps from the start: kPolarEarlySteps, and the rest only when a lane has
+// not passed. So the rotations accepted are those of polar_rotation, to its tolerance, and so are the
+// lanes it refuses.
+template <int N> inline __attribute__((always_inline)) void batch_rotations(Batch<N> &b, int m)
+{
+#pragma omp simd
+  for (int l = 0; l < W; ++l) {
+    polar_start<W, W>(b.F + l, b.PX + l, b.PC + l, b.pdet + l, b.pflag + l);
+    b.pnear[l] = b.pdet[l] > kPolarNearDet ? b.pflag[l] : 0.0;
+  }
+  double passed = 0;
+  if (all_lanes(b.pnear, m) != 0) {
+#pragma omp simd
+    for (int l = 0; l < W; ++l) {
+      polar_steps<W, 0, kPolarEarlySteps, 0>(b.PX + l, b.PC + l, b.pdet + l, b.pflag + l, b.pchange + l);
+      b.ok[l] = polar_accepted(b.pdet[l], b.pflag[l], b.pchange[l]);
+    }
+    passed = all_lanes(b.ok, m);
+    if (passed == 0) {
+#pragma omp simd
+      for (int l = 0; l < W; ++l) polar_start<W, W>(b.F + l, b.PX + l, b.PC + l, b.pdet + l, b.pflag + l);
+    }
+  }
+  if (passed == 0) {
+#pragma omp simd
+    for (int l = 0; l < W; ++l) {
+      polar_steps<W, 0, kPolarEarlySteps>(b.PX + l, b.PC + l, b.pdet + l, b.pflag + l, b.pchange + l);
+      b.ok[l] = polar_accepted(b.pdet[l], b.pflag[l], b.pchange[l]);
+    }
+    passed = all_lanes(b.ok, m);
+  }
+  if (passed == 0) {
+#pragma omp simd
+    for (int l = 0; l < W; ++l) {
+      polar_steps<W, kPolarEarlySteps, kPolarSteps>(b.PX + l, b.PC + l, b.pdet + l, b.pflag + l,
+                                                    b.pchange + l);
+      b.ok[l] = polar_accepted(b.pdet[l], b.pflag[l], b.pchange[l]);
+    }
+  }
+#pragma omp simd
+  for (int l = 0; l < W; ++l) polar_finish<W, W>(b.PX + l, b.ok[l], b.R + l);
+}
+
 // A write group's blocks, lane-major: entries 0..7 of (element in the group e, packed pair p) at
 // head[e * NB + p], entry 8 at tail[e * NB + p] (the AVX-512 body moves 8 entries as one register,
 // the AVX2 one as two).
@@ -256,52 +310,7 @@ template <int N, bool Blocks, bool MassDamping, typename V = double> long long r
 #pragma omp simd
       for (int l = 0; l < W; ++l) deformation_gradient<W>(b.x + l, b.Dinv + l, b.F + l);
       if (a.corotational) {
-        // polar_rotation in pieces. A batch whose lanes all start near a rotation runs kPolarEarlySteps
-        // unscaled steps and stops there if every lane passes (the scenes' elements); otherwise, and
-        // for every other batch, polar_rotation's steps from the start again: kPolarEarlySteps, and
-        // the rest only when a lane has not passed. So the rotations accepted are those of
-        // polar_rotation, to within its tolerance, and so are the lanes it refuses.
-#pragma omp simd
-        for (int l = 0; l < W; ++l) {
-          polar_start<W, W>(b.F + l, b.PX + l, b.PC + l, b.pdet + l, b.pflag + l);
-          b.pnear[l] = b.pdet[l] > kPolarNearDet ? b.pflag[l] : 0.0;
-        }
-        double near = 1, passed = 0;
-        for (int l = 0; l < m; ++l) near *= b.pnear[l];
-        if (near != 0) {
-#pragma omp simd
-          for (int l = 0; l < W; ++l) {
-            polar_steps<W, 0, kPolarEarlySteps, 0>(b.PX + l, b.PC + l, b.pdet + l, b.pflag + l,
-                                                   b.pchange + l);
-            b.ok[l] = polar_accepted(b.pdet[l], b.pflag[l], b.pchange[l]);
-          }
-          passed = 1;
-          for (int l = 0; l < m; ++l) passed *= b.ok[l];
-          if (passed == 0) {
-#pragma omp simd
-            for (int l = 0; l < W; ++l)
-              polar_start<W, W>(b.F + l, b.PX + l, b.PC + l, b.pdet + l, b.pflag + l);
-          }
-        }
-        if (passed == 0) {
-#pragma omp simd
-          for (int l = 0; l < W; ++l) {
-            polar_steps<W, 0, kPolarEarlySteps>(b.PX + l, b.PC + l, b.pdet + l, b.pflag + l, b.pchange + l);
-            b.ok[l] = polar_accepted(b.pdet[l], b.pflag[l], b.pchange[l]);
-          }
-          passed = 1;
-          for (int l = 0; l < m; ++l) passed *= b.ok[l];
-        }
-        if (passed == 0) {
-#pragma omp simd
-          for (int l = 0; l < W; ++l) {
-            polar_steps<W, kPolarEarlySteps, kPolarSteps>(b.PX + l, b.PC + l, b.pdet + l, b.pflag + l,
-                                                          b.pchange + l);
-            b.ok[l] = polar_accepted(b.pdet[l], b.pflag[l], b.pchange[l]);
-          }
-        }
-#pragma omp simd
-        for (int l = 0; l < W; ++l) polar_finish<W, W>(b.PX + l, b.ok[l], b.R + l);
+        batch_rotations<N>(b, m);
         for (int l = 0; l < m; ++l) {
           if (b.ok[l] != 0) continue; // rare: inverted, flat or strongly stretched elements
           double F[9], R[9];

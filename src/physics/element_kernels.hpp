@@ -73,7 +73,7 @@ constexpr double kPolarDetTolerance = 1e-8;
 // pass every element stretched up to 4:1 and most at 10:1; the rest take the scalar path. Steps
 // after convergence keep the iterate (a rotation is a fixed point). A batch whose lanes all pass after
 // kPolarEarlySteps stops there (element_batch_body.hpp): the scenes' elements are strained by a few
-// percent at most, and the two steps saved were ~7% of linear_38k's element loop.
+// percent at most, and the two steps saved were ~5% of linear_38k's element loop.
 constexpr int kPolarSteps       = 5;
 constexpr int kPolarScaledSteps = 2;
 constexpr int kPolarEarlySteps  = 3;
