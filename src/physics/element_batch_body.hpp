@@ -119,6 +119,29 @@ inline double all_lanes(const double *f, int m)
   return all;
 }
 
+// The iteration's start on every lane, and whether the lane starts near a rotation (b.pnear).
+template <int N> inline __attribute__((always_inline)) void batch_polar_start(Batch<N> &b)
+{
+#pragma omp simd
+  for (int l = 0; l < W; ++l) {
+    polar_start<W, W>(b.F + l, b.PX + l, b.PC + l, b.pdet + l, b.pflag + l);
+    b.pnear[l] = b.pdet[l] > kPolarNearDet ? b.pflag[l] : 0.0;
+  }
+}
+
+// Newton steps First .. Last - 1 on every lane (the first Scaled of the iteration scaled) and each
+// lane's acceptance (b.ok); 1 where the first m lanes all pass.
+template <int First, int Last, int Scaled = kPolarScaledSteps, int N>
+inline __attribute__((always_inline)) double batch_polar_steps(Batch<N> &b, int m)
+{
+#pragma omp simd
+  for (int l = 0; l < W; ++l) {
+    polar_steps<W, First, Last, Scaled>(b.PX + l, b.PC + l, b.pdet + l, b.pflag + l, b.pchange + l);
+    b.ok[l] = polar_accepted(b.pdet[l], b.pflag[l], b.pchange[l]);
+  }
+  return all_lanes(b.ok, m);
+}
+
 // The batch's rotations b.R from b.F and their acceptance b.ok: polar_rotation in pieces, one test per
 // batch, not per lane. A batch whose first m lanes all start near a rotation runs kPolarEarlySteps
 // unscaled steps and stops there if all pass (the scenes' elements); otherwise, and for every other
@@ -127,40 +150,14 @@ inline double all_lanes(const double *f, int m)
 // lanes it refuses.
 template <int N> inline __attribute__((always_inline)) void batch_rotations(Batch<N> &b, int m)
 {
-#pragma omp simd
-  for (int l = 0; l < W; ++l) {
-    polar_start<W, W>(b.F + l, b.PX + l, b.PC + l, b.pdet + l, b.pflag + l);
-    b.pnear[l] = b.pdet[l] > kPolarNearDet ? b.pflag[l] : 0.0;
-  }
+  batch_polar_start(b);
   double passed = 0;
   if (all_lanes(b.pnear, m) != 0) {
-#pragma omp simd
-    for (int l = 0; l < W; ++l) {
-      polar_steps<W, 0, kPolarEarlySteps, 0>(b.PX + l, b.PC + l, b.pdet + l, b.pflag + l, b.pchange + l);
-      b.ok[l] = polar_accepted(b.pdet[l], b.pflag[l], b.pchange[l]);
-    }
-    passed = all_lanes(b.ok, m);
-    if (passed == 0) {
-#pragma omp simd
-      for (int l = 0; l < W; ++l) polar_start<W, W>(b.F + l, b.PX + l, b.PC + l, b.pdet + l, b.pflag + l);
-    }
+    passed = batch_polar_steps<0, kPolarEarlySteps, 0>(b, m);
+    if (passed == 0) batch_polar_start(b); // again, for the scaled steps
   }
-  if (passed == 0) {
-#pragma omp simd
-    for (int l = 0; l < W; ++l) {
-      polar_steps<W, 0, kPolarEarlySteps>(b.PX + l, b.PC + l, b.pdet + l, b.pflag + l, b.pchange + l);
-      b.ok[l] = polar_accepted(b.pdet[l], b.pflag[l], b.pchange[l]);
-    }
-    passed = all_lanes(b.ok, m);
-  }
-  if (passed == 0) {
-#pragma omp simd
-    for (int l = 0; l < W; ++l) {
-      polar_steps<W, kPolarEarlySteps, kPolarSteps>(b.PX + l, b.PC + l, b.pdet + l, b.pflag + l,
-                                                    b.pchange + l);
-      b.ok[l] = polar_accepted(b.pdet[l], b.pflag[l], b.pchange[l]);
-    }
-  }
+  if (passed == 0) passed = batch_polar_steps<0, kPolarEarlySteps>(b, m);
+  if (passed == 0) batch_polar_steps<kPolarEarlySteps, kPolarSteps>(b, m);
 #pragma omp simd
   for (int l = 0; l < W; ++l) polar_finish<W, W>(b.PX + l, b.ok[l], b.R + l);
 }
