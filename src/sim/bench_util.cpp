@@ -20,6 +20,9 @@ PetscErrorCode ReplaceWithBinBCSR(Mat *A, PetscBool symmetric, MatBinBCSRPrecisi
   PetscCall(MatSetSizes(S, m, n, PETSC_DETERMINE, PETSC_DETERMINE));
   PetscCall(MatSetBlockSize(S, bs));
   PetscCall(MatSetType(S, MATBINBCSR));
+  /* the -mat_binbcsr_* options (bin width, streams, kernel, tuning, ...) as for the benchmarks' other
+     binbcsr matrices; the storage and precision this copy is for are set after them and win */
+  PetscCall(MatSetFromOptions(S));
   PetscCall(MatBinBCSRSetSymmetricStorage(S, symmetric));
   PetscCall(
     MatBinBCSRSetPrecision(S, precision)); /* before the layout build: the tuner times this precision */

@@ -6,7 +6,8 @@
 #include <vector>
 
 // Replaces *A (any assembled matrix type) by a MATBINBCSR copy with symmetric storage: all its rows
-// are handed over, the type keeps the upper block triangle (the _sym formats of the benchmarks).
+// are handed over, the type keeps the upper block triangle (the _sym formats of the benchmarks). The
+// options database's -mat_binbcsr_* options apply to the copy, except the storage and precision.
 PetscErrorCode ReplaceWithBinBCSRSymmetric(Mat *A);
 
 // The same with the storage and the value precision chosen (set before the layout is built, so the

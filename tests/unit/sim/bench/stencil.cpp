@@ -2,6 +2,7 @@
 #include <catch2/catch.hpp>
 #include <petscmat.h>
 
+#include "sim/bench_util.h"
 #include "sim/stencil.h"
 #include "sim/stream.h"
 
@@ -159,4 +160,36 @@ TEST_CASE("the last-level cache is read from sysfs or not claimed", "[bench][str
   std::ifstream size_file("/sys/devices/system/cpu/cpu0/cache/index0/size");
   if (size_file.good()) CHECK(LastLevelCacheBytes() > 0);
   else CHECK(LastLevelCacheBytes() == 0);
+}
+
+TEST_CASE("the benchmarks' single and symmetric copies take the -mat_binbcsr_* options", "[bench][stencil]")
+{
+  // The copies were once built without the options: a bin width or stream count given to spmv_bench
+  // applied to its binbcsr matrix but not to binbcsr_single or the _sym formats.
+  StencilGrid g;
+  g.nx = g.ny = g.nz = 4;
+  REQUIRE(PetscOptionsSetValue(nullptr, "-mat_binbcsr_bin_width", "16") == 0);
+  REQUIRE(PetscOptionsSetValue(nullptr, "-mat_binbcsr_streams", "2") == 0);
+  REQUIRE(PetscOptionsSetValue(nullptr, "-mat_binbcsr_precision", "double") == 0);
+  for (PetscBool sym : {PETSC_FALSE, PETSC_TRUE}) {
+    Mat A = Stencil(g, MATAIJ), ref = Stencil(g, MATAIJ);
+    REQUIRE(ReplaceWithBinBCSR(&A, sym, MAT_BINBCSR_PRECISION_SINGLE) == 0);
+    PetscInt            bw = 0, streams = 0;
+    PetscBool           stored_sym = PETSC_FALSE;
+    MatBinBCSRPrecision p;
+    REQUIRE(MatBinBCSRGetBinWidth(A, &bw) == 0);
+    REQUIRE(MatBinBCSRGetStreams(A, &streams) == 0);
+    REQUIRE(MatBinBCSRGetPrecision(A, &p) == 0);
+    REQUIRE(MatBinBCSRGetSymmetricStorage(A, &stored_sym) == 0);
+    CHECK(bw == 16);
+    CHECK(streams == 2);
+    CHECK(p == MAT_BINBCSR_PRECISION_SINGLE); // the copy's own precision wins over the option
+    CHECK(stored_sym == sym);
+    CHECK(MultDifference(ref, A) < 1e-5 * 26);
+    MatDestroy(&A);
+    MatDestroy(&ref);
+  }
+  REQUIRE(PetscOptionsClearValue(nullptr, "-mat_binbcsr_bin_width") == 0);
+  REQUIRE(PetscOptionsClearValue(nullptr, "-mat_binbcsr_streams") == 0);
+  REQUIRE(PetscOptionsClearValue(nullptr, "-mat_binbcsr_precision") == 0);
 }
