@@ -233,7 +233,15 @@ PetscErrorCode GetOptions(Options &o)
                "-gravity, -initial_velocity and -initial_spin must be finite");
   PetscCheck(std::isfinite(o.rayleigh[0]) && std::isfinite(o.rayleigh[1]) && std::isfinite(o.stretch),
              PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-rayleigh and -initial_stretch must be finite");
+  // D = alpha M + beta K: a negative coefficient feeds energy in instead of taking it out.
+  PetscCheck(o.rayleigh[0] >= 0 && o.rayleigh[1] >= 0, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+             "-rayleigh alpha,beta must be >= 0 (negative damping adds energy), got %g,%g",
+             (double)o.rayleigh[0], (double)o.rayleigh[1]);
   PetscCheck(o.steps >= 0, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-steps must be >= 0");
+  PetscCheck(o.bin_order_window >= 0, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+             "-fem_bin_order_window must be >= 0 (0: off)");
+  PetscCheck(o.element_bench >= 0, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+             "-fem_element_bench must be >= 0");
   PetscCheck(o.vtk_every >= 1, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-vtk_every must be >= 1");
   PetscFunctionReturn(0);
 }

@@ -181,6 +181,9 @@ set_tests_properties(fem_loose_solve_positions_differ PROPERTIES FIXTURES_REQUIR
 fem_test(fem_bad_write_positions nonzero "-write_positions: cannot write" ${FEM} ${FEM_SMALL} -write_positions /nonexistent-dir/positions.txt)
 # A NaN in the scene is bad input.
 fem_test(fem_nan_gravity_error nonzero "-gravity, -initial_velocity and -initial_spin must be finite" ${FEM} ${FEM_SMALL} -gravity 0,0,nan)
+fem_test(fem_negative_damping_error nonzero "-rayleigh alpha,beta must be >= 0 \\(negative damping adds energy\\), got -1" ${FEM} ${FEM_SMALL} -rayleigh -1,0)
+fem_test(fem_negative_bench_error nonzero "-fem_element_bench must be >= 0" ${FEM} ${FEM_SMALL} -fem_element_bench -3)
+fem_test(fem_negative_window_error nonzero "-fem_bin_order_window must be >= 0" ${FEM} ${FEM_SMALL} -fem_bin_order_window -5)
 fem_test(fem_bad_on_solver_failure_error nonzero "-on_solver_failure must be stop or continue" ${FEM} ${FEM_SMALL} -on_solver_failure maybe)
 # The .geo mesh cache is keyed on the file's contents and the meshing options: two files of the same
 # base name in different folders, one of them edited, get their own meshes (a box twice as long meshes to another element count).

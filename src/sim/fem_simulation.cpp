@@ -110,6 +110,12 @@ PetscErrorCode FemSimulationCreate(MPI_Comm comm, const FemScene &scene, FemSimu
   if (scene.rigid_body_modes)
     PetscCall(
       BlockSystemSetRigidBodyModes(&sim->sys, sim->model.mesh.nodes.data() + 3 * (size_t)sim->own_begin));
+  PetscCheck(
+    scene.rayleigh_alpha >= 0 && scene.rayleigh_beta >= 0 && std::isfinite(scene.rayleigh_alpha) &&
+      std::isfinite(scene.rayleigh_beta),
+    PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+    "Rayleigh damping alpha %g, beta %g: both must be finite and >= 0 (negative damping adds energy)",
+    scene.rayleigh_alpha, scene.rayleigh_beta);
   sim->x = sim->model.mesh.nodes;
   sim->v.assign(sim->x.size(), 0.0);
   sim->f_gravity         = physics::gravity_forces(sim->model, scene.gravity);
