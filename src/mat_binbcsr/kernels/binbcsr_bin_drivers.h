@@ -144,7 +144,9 @@ inline void bins_sweep(const BinMatrix &m, const int *bins, const double *x, con
   if constexpr (BS == 3 && BW == 8) {
     double(*accq[K])[8];
     for (int q = 0; q < K; q++) accq[q] = acc[q];
-    avx512::bins_mult_3x8<K>(s.t, s.c, s.len, nz, x, m.nbs, accq, m.prefetch);
+    bool xload[K];
+    for (int q = 0; q < K; q++) xload[q] = !m.bin_xload || m.bin_xload[bins[q]];
+    avx512::bins_mult_3x8<K>(s.t, s.c, s.len, nz, x, m.nbs, accq, m.prefetch, xload);
   } else
 #endif
 #if defined(BINBCSR_HAND_AVX2)

@@ -69,6 +69,47 @@ template <typename I> inline long row_slot(const I *bin_start, I bw, I r, I k)
   return bin_start[r / bw] + (long)k * bw + r % bw;
 }
 
+/* Whether slot group c[0 .. bw-1] of a whole-storage bin, whose lanes l with real & (1 << l) hold real
+   blocks, reads x_c as bw consecutive block columns but for at most two real lanes (the test of the
+   AVX-512 body's near_unit_3x8: a run anchored at the first real lane, else at the last, inside
+   [0, ncols)). */
+template <typename I> inline bool near_unit_group(const I *c, unsigned real, int bw, I ncols)
+{
+  if (!real) return false;
+  int lo = 0, hi = bw - 1;
+  while (!(real >> lo & 1u)) lo++;
+  while (!(real >> hi & 1u)) hi--;
+  for (const int anchor : {lo, hi}) {
+    const long base = (long)c[anchor] - anchor;
+    int        off  = 0;
+    for (int l = 0; l < bw; l++) off += (real >> l & 1u) && (long)c[l] != base + l;
+    if (off <= 2) return base >= 0 && base + bw <= (long)ncols;
+  }
+  return false;
+}
+
+/* xload[b] = 1 where at least half of bin b's slot groups pass near_unit_group, else 0: the hint that
+   lets a body gather x_c in the other bins without testing each group (on FE matrices most groups fail
+   the test, and its branches cost more than the loads save; a grid's bins pass it). Whole storage. */
+template <typename I>
+inline void xload_bins(const I *bin_start, const I *col, const I *row_nz, I mbs, I nbins, int bw, I ncols,
+                       unsigned char *xload)
+{
+  for (I b = 0; b < nbins; b++) {
+    const I len  = (bin_start[b + 1] - bin_start[b]) / bw;
+    I       pass = 0;
+    for (I k = 0; k < len; k++) {
+      unsigned real = 0;
+      for (int l = 0; l < bw; l++) {
+        const I r = b * bw + l;
+        if (r < mbs && k < row_nz[r]) real |= 1u << l;
+      }
+      pass += near_unit_group(col + bin_start[b] + k * bw, real, bw, ncols);
+    }
+    xload[b] = 2 * pass >= len;
+  }
+}
+
 } // namespace binbcsr
 
 #endif

@@ -79,6 +79,9 @@ typedef struct {
                                       are stored; entries below the block diagonal are ignored. The
                                       slots of a bin are ordered by an edge colouring (below). */
 
+  /* with the layout: [nbins], made at the first product that can use it (BinMatrix::bin_xload) */
+  unsigned char *bin_xload;
+
   /* the bin layout: valid once built (first final assembly, MatSetPreallocationCOO, MatConvert) */
   PetscBool  built;
   PetscInt   bs, bs2;    /* block size and its square */

@@ -20,6 +20,7 @@ static PetscErrorCode MatSeqBinBCSRFreeLayout(Mat_SeqBinBCSR *a)
   PetscCall(PetscFree(a->row_nz));
   PetscCall(PetscFree(a->diag_slot));
   PetscCall(PetscFree(a->col));
+  PetscCall(PetscFree(a->bin_xload));
   PetscCall(PetscFree(a->row_off));
   PetscCall(PetscFree(a->real_slot));
   PetscCall(PetscFree(a->lower_off));

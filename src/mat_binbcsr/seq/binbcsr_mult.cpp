@@ -24,7 +24,25 @@ static binbcsr::BinMatrix BinMatrixOf(const Mat_SeqBinBCSR *a)
   m.streams            = (int)a->streams;
   m.prefetch           = (int)a->prefetch;
   m.sym                = a->sym ? true : false;
+  m.bin_xload          = a->bin_xload;
   return m;
+}
+
+/* The AVX-512 whole-storage body's per-bin hint (BinMatrix::bin_xload), made at the first product that
+   runs that body and kept with the layout: one pass over the column indices. */
+static PetscErrorCode MatSeqBinBCSRXLoadBins(Mat_SeqBinBCSR *a, const binbcsr::Body &body)
+{
+  PetscFunctionBegin;
+  if (a->bin_xload || a->sym || a->bs != 3 || a->bw != 8 || body.set != binbcsr::BodySet::AVX512 || !a->nbins)
+    PetscFunctionReturn(0);
+  PetscCall(PetscMalloc1(a->nbins, &a->bin_xload));
+  binbcsr::xload_bins<PetscInt>(a->bin_start, a->col, a->row_nz, a->mbs, a->nbins, 8, a->nbs, a->bin_xload);
+  PetscInt n = 0;
+  for (PetscInt b = 0; b < a->nbins; b++) n += a->bin_xload[b];
+  PetscCall(PetscInfo(NULL,
+                      "x_c by loads in %" PetscInt_FMT " of %" PetscInt_FMT " bins, gathered in the others\n",
+                      n, a->nbins));
+  PetscFunctionReturn(0);
 }
 
 binbcsr::Body MatSeqBinBCSRSelectBody(const Mat_SeqBinBCSR *a)
@@ -54,7 +72,8 @@ static PetscErrorCode MatMultKernel_SeqBinBCSR(Mat A, Vec xx, Vec zz, Vec yy, Pe
   PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
              "MATSEQBINBCSR matrix has no layout: assemble it first");
   body = MatSeqBinBCSRSelectBody(a);
-  m    = BinMatrixOf(a);
+  PetscCall(MatSeqBinBCSRXLoadBins(a, body));
+  m = BinMatrixOf(a);
   if (a->bs > 8) PetscCall(PetscMalloc1(a->bs, &acc)); /* the lane-by-lane bodies' accumulators */
   else acc = acc_small;
   PetscCall(VecGetArrayRead(xx, &x));

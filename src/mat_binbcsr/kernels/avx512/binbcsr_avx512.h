@@ -102,11 +102,11 @@ BINBCSR_AVX512_INLINE void patch_xyz(const I *c, const double *x, __mmask8 off, 
    value times a NaN or Inf of x would be a NaN the row does not have. */
 template <typename I>
 BINBCSR_AVX512_INLINE void load_xc_3x8(const I *c, __m256i ci, __mmask8 real, const double *x, int ncols,
-                                       __m512d &x0, __m512d &x1, __m512d &x2)
+                                       __m512d &x0, __m512d &x1, __m512d &x2, bool try_loads = true)
 {
   int      base;
   __mmask8 off;
-  if (near_unit_3x8(c, ci, real, ncols, base, off)) {
+  if (try_loads && near_unit_3x8(c, ci, real, ncols, base, off)) {
     split_xyz(x + (long)base * 3, x0, x1, x2);
     if (off) patch_xyz(c, x, off, x0, x1, x2);
     x0 = _mm512_maskz_mov_pd(real, x0);
@@ -125,13 +125,13 @@ BINBCSR_AVX512_INLINE void load_xc_3x8(const I *c, __m256i ci, __mmask8 real, co
    columns of x. */
 template <typename V, typename I>
 BINBCSR_AVX512_INLINE void group_mult_3x8(const V *t, const I *c, const double *x, int ncols, __m512d *a,
-                                          __mmask8 real, int pf)
+                                          __mmask8 real, int pf, bool try_loads)
 {
   static_assert(sizeof(I) == 4, "32-bit column indices");
   prefetch_values(t, 72 * (int)sizeof(V), pf);
   const __m256i ci = _mm256_loadu_si256((const __m256i *)c);
   __m512d       x0, x1, x2;
-  load_xc_3x8(c, ci, real, x, ncols, x0, x1, x2);
+  load_xc_3x8(c, ci, real, x, ncols, x0, x1, x2, try_loads);
   a[0] = _mm512_fmadd_pd(load8(t + 16), x2,
                          _mm512_fmadd_pd(load8(t + 8), x1, _mm512_fmadd_pd(load8(t), x0, a[0])));
   a[1] = _mm512_fmadd_pd(load8(t + 40), x2,
@@ -147,7 +147,7 @@ BINBCSR_AVX512_INLINE void group_mult_3x8(const V *t, const I *c, const double *
 template <int K, typename V, typename I>
 BINBCSR_AVX512_INLINE void bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, const int *len,
                                          const int (*nz)[8], const double *x, int ncols,
-                                         double (*const *acc)[8], int pf)
+                                         double (*const *acc)[8], int pf, const bool *xload)
 {
   __m512d a[K][3];
   __m256i n[K]; /* the lanes' real blocks: slot group k of lane l is real when k < n[l] */
@@ -162,7 +162,7 @@ BINBCSR_AVX512_INLINE void bins_mult_3x8(const V *const *bin_val, const I *const
   const auto group = [&](int q, int k) __attribute__((always_inline))
   {
     group_mult_3x8(bin_val[q] + (long)k * 72, bin_col[q] + (long)k * 8, x, ncols, a[q],
-                   _mm256_cmpgt_epi32_mask(n[q], _mm256_set1_epi32(k)), pf);
+                   _mm256_cmpgt_epi32_mask(n[q], _mm256_set1_epi32(k)), pf, xload[q]);
   };
   for (int k = 0; k < common; k++)
     for (int q = 0; q < K; q++) group(q, k);

@@ -48,3 +48,40 @@ TEST_CASE("layout rule: value index of 3x3 tiles", "[layout]")
   CHECK(binbcsr::value_index(8 + 7, 8, bw, bs2) == 72 + 64 + 7);
   CHECK(binbcsr::value_index(16, 0, bw, bs2) == 144);
 }
+
+TEST_CASE("x_c by loads: the slot groups that pass and the bins' hint", "[layout]")
+{
+  // groups of 8 lanes (the AVX-512 body's width), 100 block columns
+  const unsigned all     = 0xff;
+  const int      unit[8] = {10, 11, 12, 13, 14, 15, 16, 17}, two_off[8] = {3, 11, 12, 13, 14, 15, 40, 17},
+            three_off[8] = {3, 11, 12, 13, 14, 15, 40, 41}, tail_run[8] = {0, 0, 0, 13, 14, 15, 16, 17},
+            past_end[8] = {93, 94, 95, 96, 97, 98, 99, 100}, scattered[8] = {5, 40, 2, 77, 13, 60, 31, 8};
+  CHECK(binbcsr::near_unit_group<int>(unit, all, 8, 100));
+  CHECK(binbcsr::near_unit_group<int>(two_off, all, 8, 100)); // two odd lanes, the run from the last
+  CHECK_FALSE(binbcsr::near_unit_group<int>(three_off, all, 8, 100));
+  CHECK_FALSE(binbcsr::near_unit_group<int>(tail_run, all, 8, 100)); // three lanes off either run
+  CHECK(binbcsr::near_unit_group<int>(tail_run, 0xf8, 8, 100));      // lanes 0-2 padding: the run from lane 3
+  CHECK_FALSE(binbcsr::near_unit_group<int>(past_end, all, 8, 100)); // the run leaves x
+  CHECK(binbcsr::near_unit_group<int>(past_end, all, 8, 101));
+  CHECK_FALSE(binbcsr::near_unit_group<int>(scattered, all, 8, 100));
+  CHECK_FALSE(binbcsr::near_unit_group<int>(unit, 0u, 8, 100)); // no real lane: nothing to load
+
+  // two bins of 8 rows, 4 groups each: bin 0 three unit groups and one scattered (hint 1), bin 1 one
+  // unit group and three scattered (hint 0); then 12 rows, bin 1 with 4 phantom lanes, whose columns
+  // (here 0) are not looked at: its groups 1 and 2 hold a run in lanes 0-3 (hint 1)
+  std::vector<int> bin_start = {0, 32, 64}, col(64), row_nz(16, 4);
+  for (int k = 0; k < 4; k++)
+    for (int l = 0; l < 8; l++) {
+      col[k * 8 + l]      = k < 3 ? 10 * k + l : scattered[l];
+      col[32 + k * 8 + l] = k == 0 ? 50 + l : scattered[(l + k) % 8];
+    }
+  unsigned char hint[2] = {7, 7};
+  binbcsr::xload_bins<int>(bin_start.data(), col.data(), row_nz.data(), 16, 2, 8, 100, hint);
+  CHECK(hint[0] == 1);
+  CHECK(hint[1] == 0);
+  for (int k = 1; k < 3; k++)
+    for (int l = 0; l < 8; l++) col[32 + k * 8 + l] = l < 4 ? 60 + l : 0;
+  binbcsr::xload_bins<int>(bin_start.data(), col.data(), row_nz.data(), 12, 2, 8, 100, hint);
+  CHECK(hint[0] == 1);
+  CHECK(hint[1] == 1);
+}
