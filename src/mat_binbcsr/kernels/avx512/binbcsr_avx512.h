@@ -69,6 +69,13 @@ BINBCSR_AVX512_INLINE bool near_unit_3x8(const I *c, __m256i ci, __mmask8 real, 
                                          __mmask8 &off)
 {
   const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  /* the common case first, one compare: 8 real lanes on consecutive columns (the lane counts and
+     branches below cost the cloth's in-cache product a quarter of its time) */
+  if (real == 0xFF) {
+    base = (int)c[0];
+    off  = (__mmask8)~_mm256_cmpeq_epi32_mask(ci, _mm256_add_epi32(_mm256_set1_epi32(base), iota));
+    if (!off && base + 8 <= ncols) return true;
+  }
   if (!real) return false;
   const int lo = __builtin_ctz(real), hi = 31 - __builtin_clz(real);
   base = (int)c[lo] - lo;
