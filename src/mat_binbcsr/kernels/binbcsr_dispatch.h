@@ -31,7 +31,7 @@ struct BinMatrix {
   int           prefetch; /* bytes the products prefetch the values ahead (0: none; prefetch_values) */
   bool          sym;
   /* [nbins] or NULL, whole storage, 3x3 blocks, width 8 (the AVX-512 body): 0 for a bin whose slot
-     groups mostly cannot load x_c as consecutive columns (near_unit_groups), so that the body gathers
+     groups mostly cannot load x_c as consecutive columns (near_unit_group), so that the body gathers
      there without testing each group; NULL: test every group. A hint: both ways read the same x_c. */
   const unsigned char *bin_xload;
 };

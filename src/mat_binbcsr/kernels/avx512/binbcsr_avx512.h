@@ -105,11 +105,12 @@ BINBCSR_AVX512_INLINE void patch_xyz(const I *c, const double *x, __mmask8 off, 
 
 /* x_c of a slot group's lanes as one register per component, zero in the lanes outside real: a
    unit-stride or near-unit group (near_unit_3x8) loads it, any other gathers it with 32-bit offsets
-   (a masked gather reads nothing for the lanes outside real). Zero, not x: a padding slot's zero
+   (a masked gather reads nothing for the lanes outside real; try_loads false: the bin's hint says its
+   groups mostly gather, so gather without the test). Zero, not x: a padding slot's zero
    value times a NaN or Inf of x would be a NaN the row does not have. */
 template <typename I>
 BINBCSR_AVX512_INLINE void load_xc_3x8(const I *c, __m256i ci, __mmask8 real, const double *x, int ncols,
-                                       __m512d &x0, __m512d &x1, __m512d &x2, bool try_loads = true)
+                                       __m512d &x0, __m512d &x1, __m512d &x2, bool try_loads)
 {
   int      base;
   __mmask8 off;
