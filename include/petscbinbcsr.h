@@ -77,11 +77,28 @@ PETSC_EXTERN PetscErrorCode MatBinBCSRGetStreams(Mat, PetscInt *);
    of other types. */
 PETSC_EXTERN PetscErrorCode MatBinBCSRSetPrefetch(Mat, PetscInt);
 PETSC_EXTERN PetscErrorCode MatBinBCSRGetPrefetch(Mat, PetscInt *);
+/* XLoad: how the whole-storage product of 3x3 blocks at bin width 8 with the AVX-512 body reads x_c
+   for a slot group (8 lanes). LOADS (the default): in the bins where at least half of the groups'
+   lanes read consecutive block columns, those groups load x with three vector loads and split it
+   into components, the other groups (and every group of the other bins) gather; GATHER: every group
+   gathers. The same x_c either way, so the same results; which is faster depends on the machine and
+   the matrix (on a Zen 5 core the 48^3 stencil in double ran about 10% faster gathering, in single
+   1.4x slower), so the tuner times both where it is not set. Option -mat_binbcsr_xload loads|gather.
+   Other shapes and bodies ignore it. The setter is a no-op and the getter answers LOADS on matrices
+   of other types. */
+typedef enum {
+  MAT_BINBCSR_XLOAD_LOADS  = 0,
+  MAT_BINBCSR_XLOAD_GATHER = 1
+} MatBinBCSRXLoad;
+PETSC_EXTERN const char *const MatBinBCSRXLoads[];
+PETSC_EXTERN PetscErrorCode    MatBinBCSRSetXLoad(Mat, MatBinBCSRXLoad);
+PETSC_EXTERN PetscErrorCode    MatBinBCSRGetXLoad(Mat, MatBinBCSRXLoad *);
 /* Tuning on this machine (option -mat_binbcsr_tune auto|off, default auto): when the layout is built
    from the final pattern (first final assembly, COO preallocation, conversion, load), the bin width
-   and the stream count, body set and prefetch distance that were not set explicitly are chosen by
-   timing products of a sample of the matrix with the candidates (widths 4, 8, 16, and 32 for block
-   size 1; streams 1, 2, 4, 8; the body sets the CPU has; 0, 1024 and 4096 bytes), within about 40
+   and the stream count, body set, prefetch distance and x load that were not set explicitly are
+   chosen by timing products of a sample of the matrix with the candidates (widths 4, 8, 16, and 32 for
+   block size 1; streams 1, 2, 4, 8; the body sets the CPU has; 0, 1024 and 4096 bytes; loads or
+   gathers where MatBinBCSRSetXLoad applies), within about 40
    products or 50 ms of product time. Set before the layout is built. Matrices with under 512 KiB of
    values keep the defaults. -mat_view ::ascii_info says what was tried and chosen; log event BinBCSRTune.
    The setters are no-ops and the getters answer off / PETSC_FALSE on matrices of other types. */

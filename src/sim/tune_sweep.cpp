@@ -43,6 +43,7 @@ struct Variant {
   PetscInt            bw = 0, streams = 0; // streams set before each batch (0: the matrix's own)
   PetscInt            prefetch = -1;       // set before each batch (-1: the matrix's own)
   MatBinBCSRKernel    kernel   = MAT_BINBCSR_KERNEL_AUTO; // set before each batch
+  MatBinBCSRXLoad     xload    = MAT_BINBCSR_XLOAD_LOADS; // set before each batch
   bool                owner    = false;
   double              best     = 1e300;
   std::vector<double> t; // ms per MatMult of each round
@@ -75,6 +76,7 @@ PetscErrorCode TimeRound(Variant *v, bool configure, Vec x, Vec y, const SweepSe
   if (configure) {
     PetscCall(MatBinBCSRSetKernel(v->A, v->kernel));
     PetscCall(MatBinBCSRSetPrefetch(v->A, v->prefetch));
+    PetscCall(MatBinBCSRSetXLoad(v->A, v->xload));
   }
   PetscCall(MatMult(v->A, x, y)); // warm
   const double a = s.now();
@@ -144,6 +146,7 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
     PetscCall(MatBinBCSRGetStreams(tuned.A, &tuned.streams));
     PetscCall(MatBinBCSRGetKernel(tuned.A, &tuned.kernel));
     PetscCall(MatBinBCSRGetPrefetch(tuned.A, &tuned.prefetch));
+    PetscCall(MatBinBCSRGetXLoad(tuned.A, &tuned.xload));
     base.A = ref;
     for (PetscInt bw : widths) {
       Mat A;
@@ -154,16 +157,21 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
           PetscBool avail;
           PetscCall(MatBinBCSRKernelAvailable(k, &avail));
           if (!avail) continue;
-          for (PetscInt pf : s.prefetches) {
-            Variant v;
-            v.A        = A;
-            v.bw       = bw;
-            v.streams  = K;
-            v.kernel   = k;
-            v.prefetch = pf;
-            v.owner    = vars.empty() || vars.back().A != A;
-            vars.push_back(v);
-          }
+          // the x load matters to the AVX-512 whole product of 3x3 blocks at width 8 only
+          const bool xl = bs == 3 && bw == 8 && !sym && k == MAT_BINBCSR_KERNEL_AVX512;
+          for (PetscInt pf : s.prefetches)
+            for (MatBinBCSRXLoad xload : {MAT_BINBCSR_XLOAD_LOADS, MAT_BINBCSR_XLOAD_GATHER}) {
+              if (xload == MAT_BINBCSR_XLOAD_GATHER && !xl) continue;
+              Variant v;
+              v.A        = A;
+              v.bw       = bw;
+              v.streams  = K;
+              v.kernel   = k;
+              v.prefetch = pf;
+              v.xload    = xload;
+              v.owner    = vars.empty() || vars.back().A != A;
+              vars.push_back(v);
+            }
         }
     }
     // The order of a round: every binbcsr matrix is timed after another binbcsr matrix. What ran just
@@ -216,22 +224,23 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
       for (const Variant &v : vars)
         PetscCall(PetscPrintf(PETSC_COMM_SELF,
                               "  %-14s %-9s %-6s bw %2" PetscInt_FMT " K %" PetscInt_FMT
-                              " %-8s pf %5" PetscInt_FMT " %9.4f ms\n",
+                              " %-8s pf %5" PetscInt_FMT " x %-6s %9.4f ms\n",
                               name.c_str(), storage, p, v.bw, v.streams, MatBinBCSRKernels[v.kernel],
-                              v.prefetch, 1e3 * v.median()));
+                              v.prefetch, MatBinBCSRXLoads[v.xload], 1e3 * v.median()));
       PetscCall(PetscPrintf(PETSC_COMM_SELF, "  tuner: %s\n", line.c_str()));
     }
     PetscCall(PetscPrintf(
       PETSC_COMM_SELF,
-      "%-14s %-9s %-6s best %2" PetscInt_FMT "/%" PetscInt_FMT "/%s/%-5" PetscInt_FMT
-      " %8.4f   tuned %2" PetscInt_FMT "/%" PetscInt_FMT "/%s/%-5" PetscInt_FMT
+      "%-14s %-9s %-6s best %2" PetscInt_FMT "/%" PetscInt_FMT "/%s/%" PetscInt_FMT "%-7s"
+      " %8.4f   tuned %2" PetscInt_FMT "/%" PetscInt_FMT "/%s/%" PetscInt_FMT "%-7s"
       " %8.4f   tuned/best %5.3f (min %5.3f)%s   %s %8.4f  tuned x %s %5.2f   tuning %6.1f ms "
       "(build %.0f ms)\n",
       name.c_str(), storage, p, best->bw, best->streams, MatBinBCSRKernels[best->kernel], best->prefetch,
-      1e3 * best->median(), tuned.bw, tuned.streams, MatBinBCSRKernels[tuned.kernel], tuned.prefetch,
-      1e3 * tuned.median(), PairedRatio(tuned, *best), tuned.best / best->best, confirmed,
-      bs > 1 ? "baij" : "aij", 1e3 * base.median(), bs > 1 ? "baij" : "aij", PairedRatio(base, tuned), cost,
-      1e3 * (t1 - t0)));
+      best->xload == MAT_BINBCSR_XLOAD_GATHER ? "/gather" : "", 1e3 * best->median(), tuned.bw, tuned.streams,
+      MatBinBCSRKernels[tuned.kernel], tuned.prefetch,
+      tuned.xload == MAT_BINBCSR_XLOAD_GATHER ? "/gather" : "", 1e3 * tuned.median(),
+      PairedRatio(tuned, *best), tuned.best / best->best, confirmed, bs > 1 ? "baij" : "aij",
+      1e3 * base.median(), bs > 1 ? "baij" : "aij", PairedRatio(base, tuned), cost, 1e3 * (t1 - t0)));
     for (Variant &v : vars)
       if (v.owner) PetscCall(MatDestroy(&v.A));
     PetscCall(MatDestroy(&tuned.A));

@@ -1,4 +1,4 @@
-// binbcsr_tune -sweep: every (bin width, stream count, kernel body set, prefetch distance) of MATSEQBINBCSR against the autotuned default
+// binbcsr_tune -sweep: every (bin width, stream count, kernel body set, prefetch distance, x load) of MATSEQBINBCSR against the autotuned default
 // (-mat_binbcsr_tune auto, nothing set) on one matrix, whole and symmetric storage, double and single
 // precision, timed round-robin in one run; prints per case the sweep's best, the tuned choice and
 // tuned / best, with seqbaij (seqaij for bs 1) as the reference.

@@ -74,6 +74,10 @@ PetscErrorCode MatBinBCSRReadOptions_Private(Mat A, PetscOptionItems *PetscOptio
     OptionInt(PetscOptionsObject, A, "-mat_binbcsr_prefetch",
               "Bytes ahead the products prefetch the values (0: none; a multiple of 64, at most 65536)",
               "MatBinBCSRSetPrefetch", MatBinBCSRGetPrefetch, MatBinBCSRSetPrefetch));
+  PetscCall(
+    OptionEnum(PetscOptionsObject, A, "-mat_binbcsr_xload",
+               "How products read x for slot groups on consecutive columns (3x3 blocks, width 8, AVX-512)",
+               "MatBinBCSRSetXLoad", MatBinBCSRXLoads, MatBinBCSRGetXLoad, MatBinBCSRSetXLoad));
   PetscCall(OptionEnum(PetscOptionsObject, A, "-mat_binbcsr_device",
                        "Device copy: none, reference (host executor), cuda (one process only)",
                        "MatBinBCSRSetDevice", MatBinBCSRDevices, MatBinBCSRGetDevice, MatBinBCSRSetDevice));

@@ -2,7 +2,7 @@
    The per-machine tuning of MATSEQBINBCSR (seq/binbcsr_tune.cpp) and its cache file
    (binbcsr_tune_cache.cpp). The tuner runs when a layout is built from a final pattern: it times
    products of a sample of the matrix for the candidate bin widths, stream counts, body sets and
-   software prefetch distances, keeps the fastest, and remembers the choice per machine and matrix
+   software prefetch distances (and x loads or gathers), keeps the fastest, and remembers the choice per machine and matrix
    class in a small text file under $XDG_CACHE_HOME/petscbinbcsr/ (~/.cache/petscbinbcsr/), so the next
    run starts tuned.
 */
@@ -30,6 +30,7 @@ struct BinBCSRTuneChoice {
   PetscInt streams  = 0;
   PetscInt kernel   = 0; /* MatBinBCSRKernel; AUTO: the dispatch's default */
   PetscInt prefetch = 0; /* bytes ahead (MatBinBCSRSetPrefetch) */
+  PetscInt xload    = 0; /* MatBinBCSRXLoad */
 };
 
 /* The machine part of a cache key: CPU model string, online cores, the kernel bodies compiled in. */

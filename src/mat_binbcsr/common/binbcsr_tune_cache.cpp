@@ -1,7 +1,7 @@
 /* The tuning cache file of MATSEQBINBCSR: one text line per (machine, matrix class),
 
-     # petscbinbcsr tune cache v4
-     <machine key> TAB <matrix class> TAB <bin width> <streams> <body set> <prefetch bytes>
+     # petscbinbcsr tune cache v5
+     <machine key> TAB <matrix class> TAB <bin width> <streams> <body set> <prefetch bytes> <x load>
 
    read whole and rewritten whole (a temporary file renamed over the old one). The file only saves
    time: whatever is wrong with it makes the tuner measure again, never fail or use a bad layout.
@@ -11,13 +11,15 @@
    measured again. The version also moves when bodies change what is fastest: v3 came with the
    hand-written AVX2 bodies, after which a Zen 3 core ran the 48^3 stencil's whole single product
    fastest at bin width 4, where v2 files held 16 (measured with the compiler-vectorised ones); v4 added
-   the software prefetch distance, which v3 choices were timed at 4096 bytes only.
+   the software prefetch distance, which v3 choices were timed at 4096 bytes only; v5 the x load
+   (loads or gather, MatBinBCSRSetXLoad), which v4 choices were timed with loads only.
    Since then the machine key ends with the kernel id (BINBCSR_KERNEL_ID, a hash of the bodies', the
    layout build's and the tuner's sources made by the build): a library whose kernels changed takes none
    of the choices an earlier one made, and its first store drops them. Without it a choice stayed in the
    file for good: on a Zen 5 VM the 32^3 stencil kept bin width 4 with the AVX2 body, chosen by an earlier
    build, 1.2-1.4x slower than the width 8 AVX-512 body that every new tuning chose. */
 #include "binbcsr_tune.h"
+#include <petscbinbcsr.h> /* MatBinBCSRXLoads */
 #include "binbcsr_machine.h"
 #include "../kernels/binbcsr_dispatch.h"
 #include "binbcsr_kernel_id.h" /* generated: BINBCSR_KERNEL_ID */
@@ -32,7 +34,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-static const char *const cache_header      = "# petscbinbcsr tune cache v4";
+static const char *const cache_header      = "# petscbinbcsr tune cache v5";
 static const char *const cache_header_stem = "# petscbinbcsr tune cache v"; /* of every version */
 
 /* The machine without the kernel id: CPU, cores and the best body set. */
@@ -97,24 +99,27 @@ static bool ReadCache(const std::string &path, std::map<std::string, BinBCSRTune
     }
     std::istringstream v(line.substr(t2 + 1));
     long               bw = 0, streams = 0, prefetch = -1;
-    std::string        body, rest;
-    int                kernel = -1;
-    if (v >> bw >> streams >> body >> prefetch)
+    std::string        body, xload, rest;
+    int                kernel = -1, xl = -1;
+    if (v >> bw >> streams >> body >> prefetch >> xload) {
+      for (int k = 0; k <= (int)MAT_BINBCSR_XLOAD_GATHER; k++)
+        if (xload == MatBinBCSRXLoads[k]) xl = k;
       for (int k = 0; k <= (int)binbcsr::BodySet::AVX512; k++)
         if (body == binbcsr::body_set_name((binbcsr::BodySet)k) &&
             binbcsr::body_set_available((binbcsr::BodySet)k))
           kernel = k;
-    if (kernel < 0 || (v >> rest) || bw < 1 || bw > 1024 ||
+    }
+    if (kernel < 0 || xl < 0 || (v >> rest) || bw < 1 || bw > 1024 ||
         (streams != 1 && streams != 2 && streams != 4 && streams != 8) || prefetch < 0 || prefetch > 65536 ||
         prefetch % 64) {
       why =
         "line " + std::to_string(n) + ": choice \"" + line.substr(t2 + 1) +
         "\" is not a bin width in [1, 1024], streams 1, 2, 4 or 8, a body set this CPU has and a prefetch "
-        "distance (a multiple of 64 in [0, 65536])";
+        "distance (a multiple of 64 in [0, 65536]) and an x load (loads or gather)";
       return false;
     }
     entries[line.substr(0, t2)] =
-      BinBCSRTuneChoice{(PetscInt)bw, (PetscInt)streams, (PetscInt)kernel, (PetscInt)prefetch};
+      BinBCSRTuneChoice{(PetscInt)bw, (PetscInt)streams, (PetscInt)kernel, (PetscInt)prefetch, (PetscInt)xl};
   }
   return true;
 }
@@ -226,7 +231,8 @@ PetscErrorCode BinBCSRTuneCacheStore(const std::string &key, const BinBCSRTuneCh
     out << cache_header << "\n";
     for (const auto &[k, v] : entries)
       out << k << "\t" << v.bw << " " << v.streams << " "
-          << binbcsr::body_set_name((binbcsr::BodySet)v.kernel) << " " << v.prefetch << "\n";
+          << binbcsr::body_set_name((binbcsr::BodySet)v.kernel) << " " << v.prefetch << " "
+          << MatBinBCSRXLoads[v.xload] << "\n";
     out.close();
     if (!out) {
       PetscCall(PetscInfo(nullptr, "Cannot write the tuning cache %s\n", tmp.c_str()));

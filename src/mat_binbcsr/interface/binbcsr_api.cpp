@@ -17,6 +17,7 @@
 .  -mat_binbcsr_coo_mirror                  - COO entries fill their transposed place, see `MatBinBCSRSetCOOMirror()`
 .  -mat_binbcsr_streams <k>                 - runs of bins the product sweeps side by side, see `MatBinBCSRSetStreams()`
 .  -mat_binbcsr_prefetch <bytes>            - software prefetch distance of the products, see `MatBinBCSRSetPrefetch()`
+.  -mat_binbcsr_xload <loads,gather>        - how products read x for consecutive columns, see `MatBinBCSRSetXLoad()`
 -  -mat_mpibinbcsr_inner_type <type>        - type of the parts of `MATMPIBINBCSR` (default seqbinbcsr)
 
    Level: beginner
@@ -73,7 +74,8 @@ M*/
 .  -mat_binbcsr_symmetric_storage    - upper triangle only, see `MatBinBCSRSetSymmetricStorage()`
 .  -mat_binbcsr_coo_mirror           - COO entries fill their transposed place, see `MatBinBCSRSetCOOMirror()`
 .  -mat_binbcsr_streams <k>          - runs of bins swept side by side, see `MatBinBCSRSetStreams()`
--  -mat_binbcsr_prefetch <bytes>     - software prefetch distance, see `MatBinBCSRSetPrefetch()`
+.  -mat_binbcsr_prefetch <bytes>     - software prefetch distance, see `MatBinBCSRSetPrefetch()`
+-  -mat_binbcsr_xload <loads,gather> - how products read x for consecutive columns, see `MatBinBCSRSetXLoad()`
 
    Level: beginner
 
@@ -427,6 +429,65 @@ PetscErrorCode MatBinBCSRSetPrefetch(Mat A, PetscInt bytes)
 .seealso: `MATBINBCSR`, `MatBinBCSRSetPrefetch()`
 @*/
 BINBCSR_TRY_GETTER(MatBinBCSRGetPrefetch, Mat, MAT_CLASSID, PetscInt, PetscValidIntPointer, 0)
+
+const char *const MatBinBCSRXLoads[] = {"loads", "gather", "MatBinBCSRXLoad", "MAT_BINBCSR_XLOAD_", nullptr};
+
+/*@
+   MatBinBCSRSetXLoad - Sets how the products of a `MATBINBCSR` matrix read x for a slot group whose
+   lanes read consecutive block columns: vector loads where the bin's hint allows, or gathers
+
+   Logically Collective
+
+   Input Parameters:
++  A     - the matrix
+-  xload - `MAT_BINBCSR_XLOAD_LOADS` (default) or `MAT_BINBCSR_XLOAD_GATHER`
+
+   Options Database Key:
+.  -mat_binbcsr_xload <loads,gather> - sets it
+
+   Level: advanced
+
+   Notes:
+   Applies to the whole-storage product of 3x3 blocks at bin width 8 with the AVX-512 body; other
+   shapes and bodies ignore it. With loads, the bins where at least half of the slot groups read
+   consecutive block columns load x for those groups (three vector loads, six permutes) and gather
+   for the others; with gather every group gathers. Both read the same x, so the results are the same.
+   Which is faster depends on the machine and the matrix: on a Zen 5 core the 48^3 stencil's product
+   in double ran about 10% faster gathering and in single 1.4x slower. Where it is not set, the tuner
+   (`MatBinBCSRSetTune()`) times both. It may change at any time. A no-op on matrices of other types.
+
+.seealso: `MATBINBCSR`, `MatBinBCSRGetXLoad()`, `MatBinBCSRSetTune()`
+@*/
+PetscErrorCode MatBinBCSRSetXLoad(Mat A, MatBinBCSRXLoad xload)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
+  PetscValidLogicalCollectiveEnum(A, xload, 2);
+  PetscCheck(xload == MAT_BINBCSR_XLOAD_LOADS || xload == MAT_BINBCSR_XLOAD_GATHER,
+             PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_OUTOFRANGE,
+             "Unknown x load %d: MAT_BINBCSR_XLOAD_LOADS or MAT_BINBCSR_XLOAD_GATHER", (int)xload);
+  PetscTryMethod(A, "MatBinBCSRSetXLoad_C", (Mat, MatBinBCSRXLoad), (A, xload));
+  PetscFunctionReturn(0);
+}
+
+/*@
+   MatBinBCSRGetXLoad - Gets how the products of a `MATBINBCSR` matrix read x for consecutive columns
+
+   Not Collective
+
+   Input Parameter:
+.  A - the matrix
+
+   Output Parameter:
+.  xload - `MAT_BINBCSR_XLOAD_LOADS` or `MAT_BINBCSR_XLOAD_GATHER` (set, or chosen by the tuner);
+           `MAT_BINBCSR_XLOAD_LOADS` on matrices of other types
+
+   Level: advanced
+
+.seealso: `MATBINBCSR`, `MatBinBCSRSetXLoad()`
+@*/
+BINBCSR_TRY_GETTER(MatBinBCSRGetXLoad, Mat, MAT_CLASSID, MatBinBCSRXLoad, PetscValidPointer,
+                   MAT_BINBCSR_XLOAD_LOADS)
 
 /*@
    MatBinBCSRSetTune - Whether the layout build times the candidate bin widths, stream counts, body

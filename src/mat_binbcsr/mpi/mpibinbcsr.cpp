@@ -170,6 +170,27 @@ static PetscErrorCode MatBinBCSRSetPrefetch_MPIBinBCSR(Mat mat, PetscInt bytes)
   PetscFunctionReturn(0);
 }
 
+static PetscErrorCode MatBinBCSRSetXLoad_MPIBinBCSR(Mat mat, MatBinBCSRXLoad xload)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  b->xload = (PetscInt)xload;
+  PetscCall(MatMPIBinBCSRSetOnParts(mat, MatBinBCSRSetXLoad, xload));
+  PetscFunctionReturn(0);
+}
+
+/* the diagonal part's (each part tunes its own where it is not set) */
+static PetscErrorCode MatBinBCSRGetXLoad_MPIBinBCSR(Mat mat, MatBinBCSRXLoad *xload)
+{
+  Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
+
+  PetscFunctionBegin;
+  if (b->A) PetscCall(MatBinBCSRGetXLoad(b->A, xload));
+  else *xload = b->xload >= 0 ? (MatBinBCSRXLoad)b->xload : MAT_BINBCSR_XLOAD_LOADS;
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MatBinBCSRGetPrefetch_MPIBinBCSR(Mat mat, PetscInt *bytes)
 {
   Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
@@ -376,6 +397,7 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRCreatePart(Mat mat, PetscInt m, PetscIn
   if (b->precision_set) PetscCall(MatBinBCSRSetPrecision(*part, b->precision));
   if (b->streams) PetscCall(MatBinBCSRSetStreams(*part, b->streams));
   if (b->prefetch >= 0) PetscCall(MatBinBCSRSetPrefetch(*part, b->prefetch));
+  if (b->xload >= 0) PetscCall(MatBinBCSRSetXLoad(*part, (MatBinBCSRXLoad)b->xload));
   if (b->kernel) PetscCall(MatBinBCSRSetKernel(*part, b->kernel));
   if (b->tune >= 0) PetscCall(MatBinBCSRSetTune(*part, (MatBinBCSRTune)b->tune));
   if (b->tune_cache >= 0) PetscCall(MatBinBCSRSetTuneCache(*part, b->tune_cache ? PETSC_TRUE : PETSC_FALSE));
@@ -565,6 +587,8 @@ static const BinBCSRComposed composed[] = {
   BINBCSR_COMPOSED("MatBinBCSRGetStreams_C", MatBinBCSRGetStreams_MPIBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRSetPrefetch_C", MatBinBCSRSetPrefetch_MPIBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRGetPrefetch_C", MatBinBCSRGetPrefetch_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRSetXLoad_C", MatBinBCSRSetXLoad_MPIBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRGetXLoad_C", MatBinBCSRGetXLoad_MPIBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRSetTune_C", MatBinBCSRSetTune_MPIBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRGetTune_C", MatBinBCSRGetTune_MPIBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRSetTuneCache_C", MatBinBCSRSetTuneCache_MPIBinBCSR),

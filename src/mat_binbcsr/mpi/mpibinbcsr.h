@@ -72,10 +72,11 @@ struct Mat_MPIBinBCSR {
   PetscBool           precision_set      = PETSC_FALSE;
   PetscInt            streams            = 0;  /* MatBinBCSRSetStreams; 0: the parts' default */
   PetscInt            prefetch           = -1; /* MatBinBCSRSetPrefetch; -1: the parts' default */
-  PetscInt            tune               = -1; /* MatBinBCSRSetTune for the parts; -1: theirs */
-  PetscInt            tune_cache         = -1; /* MatBinBCSRSetTuneCache for the parts; -1: theirs */
-  MatBinBCSRKernel    kernel             = MAT_BINBCSR_KERNEL_AUTO; /* MatBinBCSRSetKernel */
-  MatBinBCSRPrecision precision          = MAT_BINBCSR_PRECISION_DOUBLE;
+  PetscInt            xload      = -1; /* MatBinBCSRSetXLoad; -1: not set (the parts' tuners choose) */
+  PetscInt            tune       = -1; /* MatBinBCSRSetTune for the parts; -1: theirs */
+  PetscInt            tune_cache = -1; /* MatBinBCSRSetTuneCache for the parts; -1: theirs */
+  MatBinBCSRKernel    kernel     = MAT_BINBCSR_KERNEL_AUTO; /* MatBinBCSRSetKernel */
+  MatBinBCSRPrecision precision  = MAT_BINBCSR_PRECISION_DOUBLE;
   PetscBool           sym        = PETSC_FALSE; /* symmetric storage of the diagonal part (B stays full) */
   PetscBool           coo_mirror = PETSC_FALSE; /* MatBinBCSRSetCOOMirror */
 

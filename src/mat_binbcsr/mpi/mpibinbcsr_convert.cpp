@@ -212,6 +212,7 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRCopyConfig(Mat from, Mat to)
   c->precision          = b->precision;
   c->streams            = b->streams;
   c->prefetch           = b->prefetch;
+  c->xload              = b->xload;
   c->tune               = b->tune;
   c->tune_cache         = b->tune_cache;
   c->kernel             = b->kernel;

@@ -238,6 +238,16 @@ static PetscErrorCode MatBinBCSRSetStreams_SeqBinBCSR(Mat A, PetscInt streams)
   PetscFunctionReturn(0);
 }
 
+/* The x load set by the user: the tuner keeps it. The bins' hint is made again for it at the next
+   product. */
+static PetscErrorCode MatBinBCSRSetXLoad_SeqBinBCSR(Mat A, MatBinBCSRXLoad xload)
+{
+  PetscFunctionBegin;
+  PetscCall(MatSeqBinBCSRSetXLoad(A, xload));
+  ((Mat_SeqBinBCSR *)A->data)->xload_set = PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
 /* A prefetch distance set by the user: the tuner keeps it. */
 static PetscErrorCode MatBinBCSRSetPrefetch_SeqBinBCSR(Mat A, PetscInt bytes)
 {
@@ -294,6 +304,8 @@ static const BinBCSRComposed composed[] = {
   BINBCSR_COMPOSED("MatBinBCSRGetStreams_C", (&MatSeqBinBCSRGetField<PetscInt, &Mat_SeqBinBCSR::streams>)),
   BINBCSR_COMPOSED("MatBinBCSRSetPrefetch_C", MatBinBCSRSetPrefetch_SeqBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRGetPrefetch_C", (&MatSeqBinBCSRGetField<PetscInt, &Mat_SeqBinBCSR::prefetch>)),
+  BINBCSR_COMPOSED("MatBinBCSRSetXLoad_C", MatBinBCSRSetXLoad_SeqBinBCSR),
+  BINBCSR_COMPOSED("MatBinBCSRGetXLoad_C", (&MatSeqBinBCSRGetField<MatBinBCSRXLoad, &Mat_SeqBinBCSR::xload>)),
   BINBCSR_COMPOSED("MatBinBCSRSetTune_C", MatBinBCSRSetTune_SeqBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRGetTune_C", MatBinBCSRGetTune_SeqBinBCSR),
   BINBCSR_COMPOSED("MatBinBCSRSetTuneCache_C", MatBinBCSRSetTuneCache_SeqBinBCSR),

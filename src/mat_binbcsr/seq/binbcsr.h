@@ -79,7 +79,10 @@ typedef struct {
                                       are stored; entries below the block diagonal are ignored. The
                                       slots of a bin are ordered by an edge colouring (below). */
 
-  /* with the layout: [nbins], made at the first product that can use it (BinMatrix::bin_xload) */
+  MatBinBCSRXLoad xload;     /* MatBinBCSRSetXLoad: loads where bin_xload allows, or gathers everywhere */
+  PetscBool       xload_set; /* set by the user: the tuner keeps it */
+  /* with the layout: [nbins], made at the first product that can use it (BinMatrix::bin_xload) with
+     xload: the hint, or zeros (every group gathers); freed when xload changes */
   unsigned char *bin_xload;
 
   /* the bin layout: valid once built (first final assembly, MatSetPreallocationCOO, MatConvert) */
@@ -148,6 +151,10 @@ static inline PetscInt BinBCSRDefaultBinWidth(PetscInt bs) { return bs == 1 ? 16
 
 /* The product body for a's shape and body set (binbcsr_mult.cpp; the choice is select_body's). */
 binbcsr::Body MatSeqBinBCSRSelectBody(const Mat_SeqBinBCSR *a);
+/* a->xload = xload, the bins' hint dropped (made again at the next product) when it changes */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRSetXLoad(Mat, MatBinBCSRXLoad);
+/* the bins' hint for the current x load, made now if the body uses one (the tuner: not in a timed product) */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRXLoadHint(Mat);
 
 /* The value array of nv entries in the given precision (val or valf; the other stays NULL), 64-byte
    aligned: PETSc's allocator aligns to PETSC_MEMALIGN (16 bytes here), and a value array at 16 bytes

@@ -81,6 +81,8 @@ static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues
   b->streams_set  = a->streams_set;
   b->prefetch     = a->prefetch;
   b->prefetch_set = a->prefetch_set;
+  b->xload        = a->xload;
+  b->xload_set    = a->xload_set;
   b->kernel       = a->kernel;
   b->kernel_tuned = a->kernel_tuned;
   b->tune         = a->tune;
@@ -448,6 +450,12 @@ PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
       PetscCall(PetscViewerASCIIPrintf(
         viewer, "product: values prefetched %" PetscInt_FMT " bytes ahead%s (-mat_binbcsr_prefetch)\n",
         a->prefetch, a->prefetch ? "" : " (no software prefetch)"));
+      if (!a->sym && a->bs == 3 && a->bw == 8 && MatSeqBinBCSRSelectBody(a).set == binbcsr::BodySet::AVX512)
+        PetscCall(PetscViewerASCIIPrintf(
+          viewer, "product: x for consecutive columns by %s (-mat_binbcsr_xload %s)\n",
+          a->xload == MAT_BINBCSR_XLOAD_GATHER ? "gathers in every slot group"
+                                               : "loads where the bin's groups mostly allow",
+          MatBinBCSRXLoads[a->xload]));
     }
     PetscCall(PetscViewerASCIIPrintf(viewer, "product body: %s (-mat_binbcsr_kernel %s)\n",
                                      binbcsr::body_set_name(MatSeqBinBCSRSelectBody(a).set),

@@ -3,6 +3,7 @@
    shape and body set (MatBinBCSRSetKernel). */
 #include "binbcsr.h"
 #include "../kernels/binbcsr_dispatch.h"
+#include <algorithm>
 
 static_assert(sizeof(PetscInt) == sizeof(int), "the product bodies take 32-bit indices");
 
@@ -29,19 +30,42 @@ static binbcsr::BinMatrix BinMatrixOf(const Mat_SeqBinBCSR *a)
 }
 
 /* The AVX-512 whole-storage body's per-bin hint (BinMatrix::bin_xload), made at the first product that
-   runs that body and kept with the layout: one pass over the column indices. */
+   runs that body and kept with the layout: one pass over the column indices; all zeros (gather
+   everywhere) for MAT_BINBCSR_XLOAD_GATHER. */
 static PetscErrorCode MatSeqBinBCSRXLoadBins(Mat_SeqBinBCSR *a, const binbcsr::Body &body)
 {
   PetscFunctionBegin;
   if (a->bin_xload || a->sym || a->bs != 3 || a->bw != 8 || body.set != binbcsr::BodySet::AVX512 || !a->nbins)
     PetscFunctionReturn(0);
   PetscCall(PetscMalloc1(a->nbins, &a->bin_xload));
-  binbcsr::xload_bins<PetscInt>(a->bin_start, a->col, a->row_nz, a->mbs, a->nbins, 8, a->nbs, a->bin_xload);
+  if (a->xload == MAT_BINBCSR_XLOAD_GATHER)
+    std::fill(a->bin_xload, a->bin_xload + a->nbins, (unsigned char)0);
+  else
+    binbcsr::xload_bins<PetscInt>(a->bin_start, a->col, a->row_nz, a->mbs, a->nbins, 8, a->nbs, a->bin_xload);
   PetscInt n = 0;
   for (PetscInt b = 0; b < a->nbins; b++) n += a->bin_xload[b];
   PetscCall(PetscInfo(NULL,
                       "x_c by loads in %" PetscInt_FMT " of %" PetscInt_FMT " bins, gathered in the others\n",
                       n, a->nbins));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatSeqBinBCSRSetXLoad(Mat A, MatBinBCSRXLoad xload)
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+
+  PetscFunctionBegin;
+  if (a->xload != xload) PetscCall(PetscFree(a->bin_xload));
+  a->xload = xload;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MatSeqBinBCSRXLoadHint(Mat A)
+{
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+
+  PetscFunctionBegin;
+  if (a->built) PetscCall(MatSeqBinBCSRXLoadBins(a, MatSeqBinBCSRSelectBody(a)));
   PetscFunctionReturn(0);
 }
 

@@ -1,5 +1,5 @@
-/* MATSEQBINBCSR: the per-machine tuning of the bin width, the stream count, the body set and the
-   software prefetch distance (-mat_binbcsr_tune).
+/* MATSEQBINBCSR: the per-machine tuning of the bin width, the stream count, the body set, the
+   software prefetch distance and the x load (-mat_binbcsr_tune).
 
    It runs where a layout is built from a final pattern (MatSeqBinBCSRBuildLayout: first final
    assembly, COO preallocation, conversion, load), before the layout exists, so the matrix is built
@@ -15,9 +15,10 @@
    or 50 ms of product time admits): the widths (4, 8, 16, and 32 for bs 1) at one stream, with the
    untuned default beside them; the stream counts 1, 2, 4, 8 at the best width; the other kernel body
    sets the CPU has (kernels/binbcsr_dispatch.h) at the best width and streams; the prefetch distances
-   0, 1024 and 4096 bytes at the best of those; last the configurations within 10% of the best, again.
-   A width, stream count, body set or prefetch distance given explicitly (option or MatBinBCSRSet*) is
-   kept and only the others are tuned. Products are timed in this
+   0, 1024 and 4096 bytes at the best of those; x by loads or by gathers where the best is the AVX-512
+   whole product of 3x3 blocks at width 8 (MatBinBCSRSetXLoad); last the configurations within 10% of
+   the best, again. A width, stream count, body set, prefetch distance or x load given explicitly
+   (option or MatBinBCSRSet*) is kept and only the others are tuned. Products are timed in this
    thread's CPU time (the budget too); the cost reported is wall time. */
 #include "binbcsr.h"
 #include "../common/binbcsr_tune.h"
@@ -39,7 +40,7 @@ constexpr PetscInt min_tune_kib =
    bytes), mean row length bucket (log2) and row-length spread (coefficient of variation in quarters),
    plus the parameters set explicitly (their values are part of the question). */
 std::string MatrixClass(const Mat_SeqBinBCSR *a, size_t vbytes, double mean, double cv, PetscBool bw_fixed,
-                        PetscBool k_fixed, PetscBool body_fixed, PetscBool pf_fixed)
+                        PetscBool k_fixed, PetscBool body_fixed, PetscBool pf_fixed, PetscBool x_fixed)
 {
   std::string c = "bs " + std::to_string(a->bs) + " " +
                   (a->precision == MAT_BINBCSR_PRECISION_SINGLE ? "single" : "double") +
@@ -51,6 +52,7 @@ std::string MatrixClass(const Mat_SeqBinBCSR *a, size_t vbytes, double mean, dou
   if (k_fixed) c += " streams=" + std::to_string(a->streams);
   if (body_fixed) c += std::string(" kernel=") + MatBinBCSRKernels[a->kernel];
   if (pf_fixed) c += " prefetch=" + std::to_string(a->prefetch);
+  if (x_fixed) c += std::string(" xload=") + MatBinBCSRXLoads[a->xload];
   return c;
 }
 
@@ -122,13 +124,15 @@ struct Timer {
   /* Seconds of one product of T with K streams (the product op itself: no log events, no checks).
      No product runs untimed to warm up: the sample's pages are written when it is filled, and its
      arrays are read from memory at every product anyway (cold). */
-  PetscErrorCode Time(Mat T, PetscInt K, PetscInt pf, double *sec)
+  PetscErrorCode Time(Mat T, PetscInt K, PetscInt pf, PetscInt xg, double *sec)
   {
     Mat_SeqBinBCSR *t = (Mat_SeqBinBCSR *)T->data;
 
     PetscFunctionBegin;
     t->streams  = K;
     t->prefetch = pf;
+    PetscCall(MatSeqBinBCSRSetXLoad(T, (MatBinBCSRXLoad)xg));
+    PetscCall(MatSeqBinBCSRXLoadHint(T)); /* outside the timed product */
     /* A matrix larger than the last-level cache streams from memory at every product; a sample of
        about twice that cache still partly stays in it from one timed product to the next (a victim
        L3 keeps part of what a pass evicts), and then rewards the bodies that compute fastest rather
@@ -152,11 +156,21 @@ struct Timer {
   }
 };
 
+/* Whether the x load is the tuner's to choose: not set, and a whole product of 3x3 blocks that may run
+   at width 8 with the AVX-512 body (the only one that reads it). */
+bool XLoadFree(const Mat_SeqBinBCSR *a)
+{
+  return !a->xload_set && a->bs == 3 && !a->sym && (!a->bw_set || a->bw == 8) &&
+         (a->kernel == MAT_BINBCSR_KERNEL_AUTO || a->kernel == MAT_BINBCSR_KERNEL_AVX512) &&
+         binbcsr::body_set_available(binbcsr::BodySet::AVX512);
+}
+
 struct Tried {
   PetscInt bw, K;
   double   sec;
   PetscInt kernel;       /* MatBinBCSRKernel; AUTO: the dispatch's default body */
   PetscInt pf;           /* prefetch distance, bytes */
+  PetscInt xg       = 0; /* MatBinBCSRXLoad */
   PetscInt products = 0; /* timed so far */
 };
 
@@ -229,6 +243,7 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
     a->kernel       = MAT_BINBCSR_KERNEL_AUTO;
     a->kernel_tuned = PETSC_FALSE;
   }
+  if (!a->xload_set) PetscCall(MatSeqBinBCSRSetXLoad(A, MAT_BINBCSR_XLOAD_LOADS)); /* likewise */
   const PetscBool body_free = a->kernel == MAT_BINBCSR_KERNEL_AUTO ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(BinBCSRTuneSettingsGet(A, &set));
   const PetscBool use_cache = set.cache;
@@ -236,8 +251,8 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
     SetInfo(a, "off (-mat_binbcsr_tune off)");
     PetscFunctionReturn(0);
   }
-  if (a->bw_set && a->streams_set && !body_free && a->prefetch_set) {
-    SetInfo(a, "nothing to tune: bin width, streams, kernel and prefetch set explicitly");
+  if (a->bw_set && a->streams_set && !body_free && a->prefetch_set && !XLoadFree(a)) {
+    SetInfo(a, "nothing to tune: bin width, streams, kernel, prefetch and x load set explicitly");
     PetscFunctionReturn(0);
   }
   if (bs != 1 && bs != 3) {
@@ -274,16 +289,18 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
   }
   const std::string key = BinBCSRTuneMachineKey() + "\t" +
                           MatrixClass(a, vbytes, mean, cv, a->bw_set, a->streams_set,
-                                      body_free ? PETSC_FALSE : PETSC_TRUE, a->prefetch_set);
+                                      body_free ? PETSC_FALSE : PETSC_TRUE, a->prefetch_set, a->xload_set);
   if (use_cache) {
     BinBCSRTuneChoice c;
     PetscCall(BinBCSRTuneCacheLookup(key, &c, &found));
     if (found && (!a->bw_set || c.bw == a->bw) && (!a->streams_set || c.streams == a->streams) &&
         (body_free || c.kernel == (PetscInt)a->kernel) && (!a->prefetch_set || c.prefetch == a->prefetch) &&
+        (!a->xload_set || c.xload == (PetscInt)a->xload) &&
         (c.bw == 4 || c.bw == 8 || c.bw == 16 || (c.bw == 32 && bs == 1))) {
       a->bw       = c.bw;
       a->streams  = c.streams;
       a->prefetch = c.prefetch;
+      PetscCall(MatSeqBinBCSRSetXLoad(A, (MatBinBCSRXLoad)c.xload));
       if (body_free && c.kernel != (PetscInt)MAT_BINBCSR_KERNEL_AUTO) {
         a->kernel       = (MatBinBCSRKernel)c.kernel;
         a->kernel_tuned = PETSC_TRUE;
@@ -291,8 +308,8 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
       PetscCall(PetscTime(&t_end));
       SetInfo(a, "bin width " + std::to_string(c.bw) + ", streams " + std::to_string(c.streams) +
                    ", kernel " + MatBinBCSRKernels[c.kernel] + ", prefetch " + std::to_string(c.prefetch) +
-                   " from the cache " + BinBCSRTuneCachePath() + " (" + Fmt("%.3f", 1e3 * (t_end - t_start)) +
-                   " ms)");
+                   ", x load " + MatBinBCSRXLoads[c.xload] + " from the cache " + BinBCSRTuneCachePath() +
+                   " (" + Fmt("%.3f", 1e3 * (t_end - t_start)) + " ms)");
       PetscCall(PetscInfo(A, "Tuning: %s\n", a->tune_info));
       PetscCall(PetscLogEventEnd(MAT_BinBCSR_Tune, A, 0, 0, 0));
       PetscFunctionReturn(0);
@@ -347,7 +364,7 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
   };
   auto entry = [&](const Tried &c) -> Tried & {
     for (Tried &t : tried)
-      if (t.bw == c.bw && t.K == c.K && t.kernel == c.kernel && t.pf == c.pf) return t;
+      if (t.bw == c.bw && t.K == c.K && t.kernel == c.kernel && t.pf == c.pf && t.xg == c.xg) return t;
     tried.push_back(c);
     return tried.back();
   };
@@ -372,7 +389,7 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
         double t;
         PetscCall(layout(c.bw, &T));
         ((Mat_SeqBinBCSR *)T->data)->kernel = (MatBinBCSRKernel)c.kernel;
-        PetscCall(tm.Time(T, c.K, c.pf, &t));
+        PetscCall(tm.Time(T, c.K, c.pf, c.xg, &t));
         Tried &e = entry(c);
         e.sec    = std::min(e.sec, t);
         e.products++;
@@ -396,20 +413,25 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
     return b;
   };
   const PetscInt kernel0 = (PetscInt)a->kernel, K0 = a->streams_set ? a->streams : 1,
-                 pf0 = a->prefetch_set ? a->prefetch : BINBCSR_DEFAULT_PREFETCH;
+                 pf0 = a->prefetch_set ? a->prefetch : BINBCSR_DEFAULT_PREFETCH,
+                 xg0 = a->xload_set ? (PetscInt)a->xload : (PetscInt)MAT_BINBCSR_XLOAD_LOADS;
   /* 1. the widths at one stream (the fastest count on most machines, and the cheapest product), with
         the untuned default beside them: what the choice gains is measured against it */
   std::vector<Tried> cs;
-  for (PetscInt bw : widths) cs.push_back({bw, K0, 1e30, kernel0, pf0});
-  const Tried dflt = {a->bw_set ? a->bw : bw_default, a->streams_set ? a->streams : BINBCSR_DEFAULT_STREAMS,
-                      1e30, kernel0, pf0};
+  for (PetscInt bw : widths) cs.push_back({bw, K0, 1e30, kernel0, pf0, xg0});
+  const Tried dflt = {a->bw_set ? a->bw : bw_default,
+                      a->streams_set ? a->streams : BINBCSR_DEFAULT_STREAMS,
+                      1e30,
+                      kernel0,
+                      pf0,
+                      xg0};
   if (dflt.K != K0) cs.push_back(dflt);
   PetscCall(race(cs, 3));
   Tried best = best_of(cs);
   /* 2. the stream counts at the best width */
   if (counts.size() > 1) {
     cs.clear();
-    for (PetscInt K : counts) cs.push_back({best.bw, K, 1e30, kernel0, pf0});
+    for (PetscInt K : counts) cs.push_back({best.bw, K, 1e30, kernel0, pf0, xg0});
     PetscCall(race(cs, 2));
     best = best_of(cs);
   }
@@ -425,7 +447,7 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
       if (std::find(seen.begin(), seen.end(), b.mult) != seen.end() || b.set != (binbcsr::BodySet)k)
         continue; /* the same body, or a fallback */
       seen.push_back(b.mult);
-      cs.push_back({best.bw, best.K, 1e30, (PetscInt)k, pf0});
+      cs.push_back({best.bw, best.K, 1e30, (PetscInt)k, pf0, xg0});
     }
     if (cs.size() > 1) {
       PetscCall(race(cs, 2));
@@ -438,9 +460,23 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
   if (!a->prefetch_set) {
     cs = {best};
     for (PetscInt pf : {(PetscInt)0, (PetscInt)1024, (PetscInt)4096})
-      if (pf != best.pf) cs.push_back({best.bw, best.K, 1e30, best.kernel, pf});
+      if (pf != best.pf) cs.push_back({best.bw, best.K, 1e30, best.kernel, pf, xg0});
     PetscCall(race(cs, 2));
     best = best_of(cs);
+  }
+  /* 4b. x by gathers in every slot group against loads where the bins allow, where the best runs the
+        AVX-512 whole product of 3x3 blocks at width 8: on a Zen 5 VM gathers ran the 48^3 stencil in
+        double about 10% faster and in single 1.4x slower (MatBinBCSRSetXLoad) */
+  if (!a->xload_set && bs == 3 && best.bw == 8 && !a->sym) {
+    const binbcsr::Shape sh = {3, 8, (int)best.K, a->precision == MAT_BINBCSR_PRECISION_SINGLE, false};
+    if (binbcsr::select_body(sh, (binbcsr::BodySet)best.kernel).set == binbcsr::BodySet::AVX512) {
+      Tried g = best;
+      g.xg    = 1 - best.xg;
+      g.sec   = 1e30;
+      cs      = {best, g};
+      PetscCall(race(cs, 2));
+      best = best_of(cs);
+    }
   }
   /* 5. the configurations within 10% of the best, again in turn: coordinate steps compared each
         parameter at the others' provisional values, and a near tie is where a drift decides */
@@ -457,12 +493,13 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
   a->bw       = best.bw;
   a->streams  = best.K;
   a->prefetch = best.pf;
+  if (!a->xload_set) PetscCall(MatSeqBinBCSRSetXLoad(A, (MatBinBCSRXLoad)best.xg));
   if (body_free && best.kernel != (PetscInt)MAT_BINBCSR_KERNEL_AUTO) {
     a->kernel       = (MatBinBCSRKernel)best.kernel;
     a->kernel_tuned = PETSC_TRUE;
   }
   if (use_cache)
-    PetscCall(BinBCSRTuneCacheStore(key, BinBCSRTuneChoice{best.bw, best.K, best.kernel, best.pf}));
+    PetscCall(BinBCSRTuneCacheStore(key, BinBCSRTuneChoice{best.bw, best.K, best.kernel, best.pf, best.xg}));
   PetscCall(PetscTime(&t_end));
 
   /* the report: what was tried, the choice against the untuned default, what it cost */
@@ -474,15 +511,19 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
             (t.kernel != (body_free ? (PetscInt)MAT_BINBCSR_KERNEL_AUTO : (PetscInt)a->kernel)
                ? std::string("/") + MatBinBCSRKernels[t.kernel]
                : std::string("")) +
-            (t.pf != pf0 ? "/pf" + std::to_string(t.pf) : std::string("")) + " " + Fmt("%.3g", 1e3 * t.sec);
-    if (t.bw == dflt.bw && t.K == dflt.K && t.kernel == dflt.kernel && t.pf == dflt.pf && t.sec < 1e29)
+            (t.pf != pf0 ? "/pf" + std::to_string(t.pf) : std::string("")) +
+            (t.xg != dflt.xg ? std::string("/") + MatBinBCSRXLoads[t.xg] : std::string("")) + " " +
+            Fmt("%.3g", 1e3 * t.sec);
+    if (t.bw == dflt.bw && t.K == dflt.K && t.kernel == dflt.kernel && t.pf == dflt.pf && t.xg == dflt.xg &&
+        t.sec < 1e29)
       t_default = t.sec;
   }
   std::string info = "bin width " + std::to_string(best.bw) + ", streams " + std::to_string(best.K) +
                      ", kernel " + MatBinBCSRKernels[best.kernel] + ", prefetch " + std::to_string(best.pf) +
-                     " measured on block rows " + std::to_string(r0) + ".." + std::to_string(r0 + nr - 1) +
-                     " of " + std::to_string(mbs) + (tm.cold ? ", read from memory" : ", in cache") +
-                     " (ms per sample product, width/streams[/kernel][/pf bytes]: " + list +
+                     ", x load " + MatBinBCSRXLoads[best.xg] + " measured on block rows " +
+                     std::to_string(r0) + ".." + std::to_string(r0 + nr - 1) + " of " + std::to_string(mbs) +
+                     (tm.cold ? ", read from memory" : ", in cache") +
+                     " (ms per sample product, width/streams[/kernel][/pf bytes][/x load]: " + list +
                      (skipped ? "; " + std::to_string(skipped) + " left out by the budget" : "") + ")";
   const double cost = t_end - t_start;
   info += "; cost " + Fmt("%.1f", 1e3 * cost) + " ms (" + Fmt("%.1f", 1e3 * tm.seconds) + " ms CPU in " +
@@ -502,9 +543,8 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
 /* After MatBinBCSRSetPrecision changed the precision of a built matrix: the choice was timed in the
    old precision, and on a Zen 4 core the 48^3 stencil's best width is 4 in double and 8 in single
    (1.3x apart each way). The width is the layout's and stays (a new layout would drop the COO maps and
-   the colouring); the stream count, the body set and the prefetch distance, where the tuner chose
-   them, are timed again in
-   the new precision, on the pattern read back from the layout. */
+   the colouring); the stream count, the body set, the prefetch distance and the x load, where the
+   tuner chose them, are timed again in the new precision, on the pattern read back from the layout. */
 PetscErrorCode MatSeqBinBCSRRetune(Mat A)
 {
   Mat_SeqBinBCSR       *a = (Mat_SeqBinBCSR *)A->data;
@@ -513,7 +553,8 @@ PetscErrorCode MatSeqBinBCSRRetune(Mat A)
 
   PetscFunctionBegin;
   if (!a->built || a->tune != (PetscInt)MAT_BINBCSR_TUNE_AUTO) PetscFunctionReturn(0);
-  if (a->streams_set && a->prefetch_set && !a->kernel_tuned && a->kernel != MAT_BINBCSR_KERNEL_AUTO)
+  if (a->streams_set && a->prefetch_set && !a->kernel_tuned && a->kernel != MAT_BINBCSR_KERNEL_AUTO &&
+      !XLoadFree(a))
     PetscFunctionReturn(0);
   bj.reserve((size_t)a->nz);
   for (PetscInt r = 0; r < a->mbs; r++) { /* whole storage: every block; symmetric: the upper ones */

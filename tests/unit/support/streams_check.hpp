@@ -62,6 +62,16 @@ inline void check_streams(Mat A, const Pattern &p)
   }
 }
 
+// Every product of got the same bits as want's.
+inline void check_same_bits(const Products &got, const Products &want)
+{
+  CHECK(got.mult == want.mult);
+  CHECK(got.mult_add == want.mult_add);
+  CHECK(got.mult_add_in_place == want.mult_add_in_place);
+  CHECK(got.mult_dot == want.mult_dot);
+  CHECK(got.dot == want.dot);
+}
+
 // MatBinBCSRSetPrefetch: a software prefetch changes no arithmetic, so every distance must give the
 // same bits as no prefetch, at every stream count (a distance past the end of the values prefetches
 // addresses that are never read: harmless, and checked here with the largest one). Changes A's
@@ -76,13 +86,24 @@ inline void check_prefetch(Mat A, const Pattern &p)
     for (PetscInt pf : {64, 1024, 4096, 65536}) {
       CAPTURE(pf);
       REQUIRE(MatBinBCSRSetPrefetch(A, pf) == 0);
-      const Products got = products(A, p);
-      CHECK(got.mult == none.mult);
-      CHECK(got.mult_add == none.mult_add);
-      CHECK(got.mult_add_in_place == none.mult_add_in_place);
-      CHECK(got.mult_dot == none.mult_dot);
-      CHECK(got.dot == none.dot);
+      check_same_bits(products(A, p), none);
     }
+  }
+}
+
+// Gathering x in every slot group reads the same x_c as loading it where the bins allow: the same
+// products to the bit (the setting only matters for 3x3 blocks at width 8 with the AVX-512 body).
+inline void check_xload(Mat A, const Pattern &p)
+{
+  for (PetscInt streams : {1, 4}) {
+    CAPTURE(streams);
+    REQUIRE(MatBinBCSRSetStreams(A, streams) == 0);
+    REQUIRE(MatBinBCSRSetXLoad(A, MAT_BINBCSR_XLOAD_LOADS) == 0);
+    const Products loads = products(A, p);
+    REQUIRE(MatBinBCSRSetXLoad(A, MAT_BINBCSR_XLOAD_GATHER) == 0);
+    check_same_bits(products(A, p), loads);
+    REQUIRE(MatBinBCSRSetXLoad(A, MAT_BINBCSR_XLOAD_LOADS) == 0); // back: the hint made again
+    check_same_bits(products(A, p), loads);
   }
 }
 

@@ -61,6 +61,8 @@ TEST_CASE("a binbcsr matrix set to another type keeps none of its composed funct
                                     "MatBinBCSRGetStreams_C",
                                     "MatBinBCSRSetPrefetch_C",
                                     "MatBinBCSRGetPrefetch_C",
+                                    "MatBinBCSRSetXLoad_C",
+                                    "MatBinBCSRGetXLoad_C",
                                     "MatSetPreallocationCOO_C",
                                     "MatSetValuesCOO_C",
                                     "MatMultDotLocal_C",

@@ -21,6 +21,7 @@ TEST_CASE("every streams count gives the one-run product up to rounding", "[mat_
     Mat A = build(p, MATSEQBINBCSR, bw, prec);
     check_streams(A, p);
     check_prefetch(A, p);
+    check_xload(A, p);
     MatDestroy(&A);
   }
 }
@@ -54,6 +55,40 @@ TEST_CASE("streams: default, option, view, duplicate and bad values", "[mat_core
   REQUIRE(MatBinBCSRSetStreams(R, 8) == 0);
   REQUIRE(MatBinBCSRGetStreams(R, &streams) == 0);
   CHECK(streams == 1);
+  MatDestroy(&A);
+  MatDestroy(&B);
+  MatDestroy(&R);
+}
+
+TEST_CASE("x load: default, option, view, duplicate and bad values", "[mat_core][xload]")
+{
+  const Pattern   p = fem_pattern(6, 5, 4);
+  Mat             A = build(p, MATSEQBINBCSR, 8), B, R = build(p, MATSEQAIJ);
+  MatBinBCSRXLoad x;
+  PetscBool       avx512;
+  REQUIRE(MatBinBCSRKernelAvailable(MAT_BINBCSR_KERNEL_AVX512, &avx512) == 0);
+  REQUIRE(MatBinBCSRGetXLoad(A, &x) == 0);
+  CHECK(x == MAT_BINBCSR_XLOAD_LOADS); // the untuned default
+  REQUIRE(PetscOptionsSetValue(nullptr, "-mat_binbcsr_xload", "gather") == 0);
+  REQUIRE(MatBinBCSRSetFromOptions(A) == 0);
+  REQUIRE(PetscOptionsClearValue(nullptr, "-mat_binbcsr_xload") == 0);
+  REQUIRE(MatBinBCSRGetXLoad(A, &x) == 0);
+  CHECK(x == MAT_BINBCSR_XLOAD_GATHER);
+  // named where it applies: whole storage, 3x3 blocks, width 8, the AVX-512 body
+  if (avx512) CHECK(info_view(A).find("-mat_binbcsr_xload gather") != std::string::npos);
+  REQUIRE(MatDuplicate(A, MAT_COPY_VALUES, &B) == 0);
+  REQUIRE(MatBinBCSRGetXLoad(B, &x) == 0);
+  CHECK(x == MAT_BINBCSR_XLOAD_GATHER);
+  CHECK(MatBinBCSRSetXLoad(A, (MatBinBCSRXLoad)2) == PETSC_ERR_ARG_OUTOFRANGE);
+  REQUIRE(PetscOptionsSetValue(nullptr, "-mat_binbcsr_xload", "scatter") == 0);
+  CHECK(MatBinBCSRSetFromOptions(A) != 0);
+  REQUIRE(PetscOptionsClearValue(nullptr, "-mat_binbcsr_xload") == 0);
+  REQUIRE(MatBinBCSRGetXLoad(A, &x) == 0);
+  CHECK(x == MAT_BINBCSR_XLOAD_GATHER);
+  // other types: the setter does nothing, the getter answers loads
+  REQUIRE(MatBinBCSRSetXLoad(R, MAT_BINBCSR_XLOAD_GATHER) == 0);
+  REQUIRE(MatBinBCSRGetXLoad(R, &x) == 0);
+  CHECK(x == MAT_BINBCSR_XLOAD_LOADS);
   MatDestroy(&A);
   MatDestroy(&B);
   MatDestroy(&R);

@@ -324,7 +324,7 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
     ss << in.rdbuf();
     content = ss.str();
   }
-  CHECK(content.rfind("# petscbinbcsr tune cache v4\n", 0) == 0);
+  CHECK(content.rfind("# petscbinbcsr tune cache v5\n", 0) == 0);
   CHECK(content.find("bs 3 double whole") != std::string::npos);
 #if defined(__x86_64__) || defined(__i386__)
   // the machine is named with CPUID's family and model: VMs of several CPU generations share a name
@@ -368,6 +368,12 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
         std::string("# petscbinbcsr tune cache v4\n") + key + "\t16 1 portable -64\n",
         std::string("# petscbinbcsr tune cache v4\n") + key + "\t16 1 portable 100\n",
         std::string("# petscbinbcsr tune cache v4\n") + key + "\t16 1 portable 131072\n",
+        // the x load: missing (a v4 line under a v5 header), unknown, one token too many
+        std::string("# petscbinbcsr tune cache v5\n") + key + "\t16 1 portable 0\n",
+        std::string("# petscbinbcsr tune cache v5\n") + key + "\t16 1 portable 0 scatter\n",
+        std::string("# petscbinbcsr tune cache v5\n") + key + "\t16 1 portable 0 gather 1\n",
+        // a well-formed v4 file: another version, measured again
+        std::string("# petscbinbcsr tune cache v4\n") + key + "\t16 1 portable 0\n",
         std::string("# petscbinbcsr tune cache v3\n") + key + "\t16 1 portable\n",
         std::string("# petscbinbcsr tune cache v1\n") + key + "\t16 1 auto\n",
         std::string("# petscbinbcsr tune cache v2\n") + key + "\t16 1 auto\n"}) {
@@ -386,7 +392,7 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
     std::ifstream in(file); // rewritten, valid
     std::string   first;
     std::getline(in, first);
-    CHECK(first == "# petscbinbcsr tune cache v4");
+    CHECK(first == "# petscbinbcsr tune cache v5");
   }
   // this machine's entries written by a library with other kernels (another kernel id), or by one from
   // before the id was in the key: not taken (measured again), and dropped by the store that follows
@@ -400,10 +406,10 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
     {
       std::ofstream out(file, std::ios::trunc);
       out
-        << "# petscbinbcsr tune cache v4\n"
-        << stale << "\t16 1 portable 0\n"
+        << "# petscbinbcsr tune cache v5\n"
+        << stale << "\t16 1 portable 0 loads\n"
         << "Another CPU (family 1 model 2) | 64 cores | avx2 | kernels 000000000000\tbs 3 double whole size "
-           "2^20 rowlen 2^4 spread 0\t16 2 portable 1024\n";
+           "2^20 rowlen 2^4 spread 0\t16 2 portable 1024 gather\n";
     }
     Mat C = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
     CHECK(info_view(C).find("measured on block rows") != std::string::npos);
@@ -497,15 +503,16 @@ TEST_CASE("tuning cache check", "[.cache_check]")
   REQUIRE(in.good());
   std::string line;
   std::getline(in, line);
-  CHECK(line == "# petscbinbcsr tune cache v4");
+  CHECK(line == "# petscbinbcsr tune cache v5");
   int n = 0;
   while (std::getline(in, line)) {
     CAPTURE(line);
     const size_t t1 = line.find('\t'), t2 = line.find('\t', t1 + 1);
     REQUIRE(t2 != std::string::npos);
     int  bw = 0, k = 0, pf = -1;
-    char body[32];
-    CHECK(sscanf(line.c_str() + t2 + 1, "%d %d %31s %d", &bw, &k, body, &pf) == 4);
+    char body[32], xload[32] = "";
+    CHECK(sscanf(line.c_str() + t2 + 1, "%d %d %31s %d %31s", &bw, &k, body, &pf, xload) == 5);
+    CHECK((std::string(xload) == "loads" || std::string(xload) == "gather"));
     CHECK((bw == 4 || bw == 8 || bw == 16));
     CHECK((k == 1 || k == 2 || k == 4 || k == 8));
     CHECK((pf == 0 || pf == 1024 || pf == 4096));
