@@ -9,6 +9,19 @@
 
 namespace {
 
+PetscLogEvent COPIES_Update = 0;
+
+// -log_view event: making or refilling the copies of the levels' operators and transfers
+PetscErrorCode SmootherCopiesRegisterEvents()
+{
+  static PetscClassId classid = 0;
+  PetscFunctionBegin;
+  if (classid) PetscFunctionReturn(0);
+  PetscCall(PetscClassIdRegister("GAMGSmootherCopies", &classid));
+  PetscCall(PetscLogEventRegister("GAMGCopies", classid, &COPIES_Update));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode IsBinBCSR(Mat A, PetscBool *binbcsr)
 {
   PetscFunctionBegin;
@@ -273,6 +286,8 @@ PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
   PetscCall(KSPSetUp(ksp));
   PetscCall(PCSetUp(pc));
   PetscCall(PCMGGetLevels(pc, &nlev));
+  PetscCall(SmootherCopiesRegisterEvents());
+  PetscCall(PetscLogEventBegin(COPIES_Update, 0, 0, 0, 0));
   if ((PetscInt)c->copy.size() != nlev) {
     PetscCall(GAMGSmootherCopiesDestroy(c));
     c->enabled = true;
@@ -342,6 +357,7 @@ PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
     PetscCall(PCMGSetInterpolation(pc, l, c->interp_copy[l]));
     PetscCall(PCMGSetRestriction(pc, l, c->restrict_copy[l]));
   }
+  PetscCall(PetscLogEventEnd(COPIES_Update, 0, 0, 0, 0));
   PetscFunctionReturn(0);
 }
 
