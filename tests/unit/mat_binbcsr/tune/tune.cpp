@@ -359,15 +359,15 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
   const std::string key =
     content.substr(content.find('\n') + 1, content.rfind('\t') - content.find('\n') - 1);
   for (const std::string bad :
-       {std::string("garbage\n\x01\x02"), std::string("# petscbinbcsr tune cache v4\n") + key + "\t7 3\n",
-        std::string("# petscbinbcsr tune cache v4\n") + key + "\t32 1\n",
-        std::string("# petscbinbcsr tune cache v4\n") + key + "\tx\n", std::string(""),
-        // the prefetch distance: missing (a v3 line under a v4 header), negative, not a multiple of 64,
+       {std::string("garbage\n\x01\x02"), std::string("# petscbinbcsr tune cache v5\n") + key + "\t7 3\n",
+        std::string("# petscbinbcsr tune cache v5\n") + key + "\t32 1\n",
+        std::string("# petscbinbcsr tune cache v5\n") + key + "\tx\n", std::string(""),
+        // the prefetch distance: missing (a v3 line under a v5 header), negative, not a multiple of 64,
         // too far
-        std::string("# petscbinbcsr tune cache v4\n") + key + "\t16 1 portable\n",
-        std::string("# petscbinbcsr tune cache v4\n") + key + "\t16 1 portable -64\n",
-        std::string("# petscbinbcsr tune cache v4\n") + key + "\t16 1 portable 100\n",
-        std::string("# petscbinbcsr tune cache v4\n") + key + "\t16 1 portable 131072\n",
+        std::string("# petscbinbcsr tune cache v5\n") + key + "\t16 1 portable\n",
+        std::string("# petscbinbcsr tune cache v5\n") + key + "\t16 1 portable -64 loads\n",
+        std::string("# petscbinbcsr tune cache v5\n") + key + "\t16 1 portable 100 loads\n",
+        std::string("# petscbinbcsr tune cache v5\n") + key + "\t16 1 portable 131072 loads\n",
         // the x load: missing (a v4 line under a v5 header), unknown, one token too many
         std::string("# petscbinbcsr tune cache v5\n") + key + "\t16 1 portable 0\n",
         std::string("# petscbinbcsr tune cache v5\n") + key + "\t16 1 portable 0 scatter\n",
