@@ -83,7 +83,8 @@ PETSC_EXTERN PetscErrorCode MatBinBCSRGetPrefetch(Mat, PetscInt *);
    into components, the other groups (and every group of the other bins) gather; GATHER: every group
    gathers. The same x_c either way, so the same results; which is faster depends on the machine and
    the matrix (on a Zen 5 core the 48^3 stencil in double ran about 10% faster gathering, in single
-   1.4x slower), so the tuner times both where it is not set. Option -mat_binbcsr_xload loads|gather.
+   1.4x slower), so where it is not set the tuner times both and the matrix's first products
+   decide again. Option -mat_binbcsr_xload loads|gather.
    Other shapes and bodies ignore it. The setter is a no-op and the getter answers LOADS on matrices
    of other types. */
 typedef enum {

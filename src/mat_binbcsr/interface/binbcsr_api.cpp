@@ -454,7 +454,9 @@ const char *const MatBinBCSRXLoads[] = {"loads", "gather", "MatBinBCSRXLoad", "M
    for the others; with gather every group gathers. Both read the same x, so the results are the same.
    Which is faster depends on the machine and the matrix: on a Zen 5 core the 48^3 stencil's product
    in double ran about 10% faster gathering and in single 1.4x slower. Where it is not set, the tuner
-   (`MatBinBCSRSetTune()`) times both. It may change at any time. A no-op on matrices of other types.
+   (`MatBinBCSRSetTune()`) times both on a sample and the matrix's first products (after an untimed one,
+   eight alternating) decide again; setting it ends that. It may change at any time. A no-op on
+   matrices of other types.
 
 .seealso: `MATBINBCSR`, `MatBinBCSRGetXLoad()`, `MatBinBCSRSetTune()`
 @*/

@@ -244,7 +244,8 @@ static PetscErrorCode MatBinBCSRSetXLoad_SeqBinBCSR(Mat A, MatBinBCSRXLoad xload
 {
   PetscFunctionBegin;
   PetscCall(MatSeqBinBCSRSetXLoad(A, xload));
-  ((Mat_SeqBinBCSR *)A->data)->xload_set = PETSC_TRUE;
+  ((Mat_SeqBinBCSR *)A->data)->xload_set   = PETSC_TRUE;
+  ((Mat_SeqBinBCSR *)A->data)->xload_trial = 0; /* the user's choice stands */
   PetscFunctionReturn(0);
 }
 

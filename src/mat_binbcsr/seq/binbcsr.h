@@ -81,8 +81,12 @@ typedef struct {
 
   MatBinBCSRXLoad xload;     /* MatBinBCSRSetXLoad: loads where bin_xload allows, or gathers everywhere */
   PetscBool       xload_set; /* set by the user: the tuner keeps it */
-  /* with the layout: [nbins], made at the first product that can use it (BinMatrix::bin_xload) with
-     xload: the hint, or zeros (every group gathers); freed when xload changes */
+  /* the trial of the first products (binbcsr_mult.cpp): products left (0: none), the tuner's choice,
+     each mode's fastest product in seconds */
+  PetscInt xload_trial, xload_chosen;
+  double   xload_sec[2];
+  /* with the layout: [2 nbins], made at the first product that can use it (BinMatrix::bin_xload): the
+     hint for loads, then zeros for gather (every group gathers) */
   unsigned char *bin_xload;
 
   /* the bin layout: valid once built (first final assembly, MatSetPreallocationCOO, MatConvert) */
@@ -155,6 +159,10 @@ binbcsr::Body MatSeqBinBCSRSelectBody(const Mat_SeqBinBCSR *a);
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRSetXLoad(Mat, MatBinBCSRXLoad);
 /* the bins' hint for the current x load, made now if the body uses one (the tuner: not in a timed product) */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRXLoadHint(Mat);
+/* the x load trial of the first products: timed products after an untimed first */
+#define BINBCSR_XLOAD_TRIAL 9
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRXLoadTrialMode(Mat_SeqBinBCSR *);
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRXLoadTrialRecord(Mat_SeqBinBCSR *, double sec);
 
 /* The value array of nv entries in the given precision (val or valf; the other stays NULL), 64-byte
    aligned: PETSc's allocator aligns to PETSC_MEMALIGN (16 bytes here), and a value array at 16 bytes

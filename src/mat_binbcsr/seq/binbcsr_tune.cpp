@@ -165,6 +165,19 @@ bool XLoadFree(const Mat_SeqBinBCSR *a)
          binbcsr::body_set_available(binbcsr::BodySet::AVX512);
 }
 
+/* After the choice: where the x load was the tuner's and the chosen shape reads it, the matrix's first
+   products decide it again (MatSeqBinBCSRXLoadTrialMode, binbcsr_mult.cpp). */
+void StartXLoadTrial(Mat_SeqBinBCSR *a)
+{
+  const binbcsr::Shape sh = {3, 8, (int)a->streams, a->precision == MAT_BINBCSR_PRECISION_SINGLE, false};
+  if (!XLoadFree(a) || a->bw != 8 ||
+      binbcsr::select_body(sh, (binbcsr::BodySet)a->kernel).set != binbcsr::BodySet::AVX512)
+    return;
+  a->xload_chosen = (PetscInt)a->xload;
+  a->xload_sec[0] = a->xload_sec[1] = 1e30;
+  a->xload_trial                    = BINBCSR_XLOAD_TRIAL;
+}
+
 struct Tried {
   PetscInt bw, K;
   double   sec;
@@ -244,6 +257,7 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
     a->kernel_tuned = PETSC_FALSE;
   }
   if (!a->xload_set) PetscCall(MatSeqBinBCSRSetXLoad(A, MAT_BINBCSR_XLOAD_LOADS)); /* likewise */
+  a->xload_trial            = 0;
   const PetscBool body_free = a->kernel == MAT_BINBCSR_KERNEL_AUTO ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(BinBCSRTuneSettingsGet(A, &set));
   const PetscBool use_cache = set.cache;
@@ -305,6 +319,7 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
         a->kernel       = (MatBinBCSRKernel)c.kernel;
         a->kernel_tuned = PETSC_TRUE;
       }
+      StartXLoadTrial(a);
       PetscCall(PetscTime(&t_end));
       SetInfo(a, "bin width " + std::to_string(c.bw) + ", streams " + std::to_string(c.streams) +
                    ", kernel " + MatBinBCSRKernels[c.kernel] + ", prefetch " + std::to_string(c.prefetch) +
@@ -498,6 +513,7 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
     a->kernel       = (MatBinBCSRKernel)best.kernel;
     a->kernel_tuned = PETSC_TRUE;
   }
+  StartXLoadTrial(a);
   if (use_cache)
     PetscCall(BinBCSRTuneCacheStore(key, BinBCSRTuneChoice{best.bw, best.K, best.kernel, best.pf, best.xg}));
   PetscCall(PetscTime(&t_end));

@@ -3,6 +3,7 @@
 // trips, a corrupt one is ignored, bad values give errors. The cache lives in a folder of the test
 // run (XDG_CACHE_HOME, set by CTest; each case here points it at its own folder).
 #include "support/mat_support.hpp"
+#include "mat_binbcsr/seq/binbcsr.h" // BINBCSR_XLOAD_TRIAL
 #include <petscviewer.h>
 #include <cstdlib>
 #include <fstream>
@@ -306,6 +307,36 @@ TEST_CASE("tuning: a precision change times the streams again, at the layout's w
     MatDestroy(&A);
     PetscOptionsClearValue(nullptr, "-mat_binbcsr_kernel");
   }
+}
+
+TEST_CASE("tuning: the first products decide the x load", "[tune][xload]")
+{
+  Restore   r;
+  PetscBool avx512;
+  REQUIRE(MatBinBCSRKernelAvailable(MAT_BINBCSR_KERNEL_AVX512, &avx512) == 0);
+  if (!avx512) return; // the x load is read by the AVX-512 body only
+  fresh_cache("tune_xload_trial");
+  Opts o(false);
+  o.set("-mat_binbcsr_kernel", "avx512");
+  const Pattern p = fem_pattern(7, 7, 7, 3);
+  Mat           A = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO, 8);
+  Mat           R = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_OFF, 8, 1);
+  // every product of the trial, in either x load, is R's to the bit; its end is reported
+  for (int k = 0; k < BINBCSR_XLOAD_TRIAL + 1; k++) check_same(A, R, p);
+  CHECK(info_view(A).find("the first products: loads ") != std::string::npos);
+  MatBinBCSRXLoad x;
+  REQUIRE(MatBinBCSRGetXLoad(A, &x) == 0);
+  CHECK((x == MAT_BINBCSR_XLOAD_LOADS || x == MAT_BINBCSR_XLOAD_GATHER));
+  MatDestroy(&A);
+  // an x load set explicitly: no trial
+  o.set("-mat_binbcsr_xload", "gather");
+  A = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO, 8);
+  for (int k = 0; k < BINBCSR_XLOAD_TRIAL + 1; k++) check_same(A, R, p);
+  CHECK(info_view(A).find("the first products") == std::string::npos);
+  REQUIRE(MatBinBCSRGetXLoad(A, &x) == 0);
+  CHECK(x == MAT_BINBCSR_XLOAD_GATHER);
+  MatDestroy(&A);
+  MatDestroy(&R);
 }
 
 TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
