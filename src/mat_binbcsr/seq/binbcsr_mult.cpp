@@ -81,7 +81,9 @@ binbcsr::Body MatSeqBinBCSRSelectBody(const Mat_SeqBinBCSR *a)
    whole matrix in one process 7% faster gathering). The first product after the build is not timed
    (first touches); the next ones alternate loads and gathers, each mode's fastest counts, and the
    trial's end keeps the faster (the tuner's choice unless the other is 2% ahead). The same x_c either
-   way, so the same results throughout. */
+   way, so the same results throughout. Products of every kind count (y = A x, y = z + A x, with x.y):
+   they differ by a vector pass, a few percent of a product, which a caller alternating two kinds in
+   step with the modes would add to one of them; the 2% margin covers part of that, not all. */
 static double ThreadSeconds()
 {
   timespec ts;
