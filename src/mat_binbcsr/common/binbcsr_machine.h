@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <string>
+#include <ctime>
 #include <unistd.h>
 #if defined(__x86_64__) || defined(__i386__)
   #include <cpuid.h>
@@ -20,6 +21,16 @@
 #endif
 
 namespace binbcsr {
+
+/* CPU seconds of this thread: on a machine shared with other work the wall clock also counts the time
+   the process waits for a core, which would decide a timed choice (the tuner's, the x load trial's)
+   by chance. */
+inline double thread_cpu_seconds()
+{
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
 
 /* The CPU as the tuning cache names it. On x86: the brand string of CPUID leaves 0x80000002-4 and the
    family and model of leaf 1, "AMD EPYC 9654 96-Core Processor (family 25 model 17)". The family and

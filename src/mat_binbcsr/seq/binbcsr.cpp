@@ -238,12 +238,12 @@ static PetscErrorCode MatBinBCSRSetStreams_SeqBinBCSR(Mat A, PetscInt streams)
   PetscFunctionReturn(0);
 }
 
-/* The x load set by the user: the tuner keeps it. The bins' hint is made again for it at the next
-   product. */
+/* The x load set by the user: the tuner keeps it (the bins' hint holds both modes' arrays: it takes
+   effect at the next product). */
 static PetscErrorCode MatBinBCSRSetXLoad_SeqBinBCSR(Mat A, MatBinBCSRXLoad xload)
 {
   PetscFunctionBegin;
-  PetscCall(MatSeqBinBCSRSetXLoad(A, xload));
+  ((Mat_SeqBinBCSR *)A->data)->xload       = xload;
   ((Mat_SeqBinBCSR *)A->data)->xload_set   = PETSC_TRUE;
   ((Mat_SeqBinBCSR *)A->data)->xload_trial = 0; /* the user's choice stands */
   PetscFunctionReturn(0);

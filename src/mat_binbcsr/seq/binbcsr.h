@@ -155,14 +155,13 @@ static inline PetscInt BinBCSRDefaultBinWidth(PetscInt bs) { return bs == 1 ? 16
 
 /* The product body for a's shape and body set (binbcsr_mult.cpp; the choice is select_body's). */
 binbcsr::Body MatSeqBinBCSRSelectBody(const Mat_SeqBinBCSR *a);
-/* a->xload = xload, the bins' hint dropped (made again at the next product) when it changes */
-PETSC_INTERN PetscErrorCode MatSeqBinBCSRSetXLoad(Mat, MatBinBCSRXLoad);
-/* the bins' hint for the current x load, made now if the body uses one (the tuner: not in a timed product) */
+/* Whether a's products read the x load (MatBinBCSRSetXLoad): whole storage, 3x3 blocks, width 8, the
+   AVX-512 body */
+PETSC_INTERN PetscBool MatSeqBinBCSRReadsXLoad(const Mat_SeqBinBCSR *a);
+/* the bins' hint, made now if the body uses one (the tuner: not in a timed product) */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRXLoadHint(Mat);
-/* the x load trial of the first products: timed products after an untimed first */
+/* the x load trial of the first products (binbcsr_mult.cpp): products, the first untimed */
 #define BINBCSR_XLOAD_TRIAL 9
-PETSC_INTERN PetscErrorCode MatSeqBinBCSRXLoadTrialMode(Mat_SeqBinBCSR *);
-PETSC_INTERN PetscErrorCode MatSeqBinBCSRXLoadTrialRecord(Mat_SeqBinBCSR *, double sec);
 
 /* The value array of nv entries in the given precision (val or valf; the other stays NULL), 64-byte
    aligned: PETSc's allocator aligns to PETSC_MEMALIGN (16 bytes here), and a value array at 16 bytes

@@ -450,7 +450,7 @@ PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
       PetscCall(PetscViewerASCIIPrintf(
         viewer, "product: values prefetched %" PetscInt_FMT " bytes ahead%s (-mat_binbcsr_prefetch)\n",
         a->prefetch, a->prefetch ? "" : " (no software prefetch)"));
-      if (!a->sym && a->bs == 3 && a->bw == 8 && MatSeqBinBCSRSelectBody(a).set == binbcsr::BodySet::AVX512)
+      if (MatSeqBinBCSRReadsXLoad(a))
         PetscCall(PetscViewerASCIIPrintf(
           viewer, "product: x for consecutive columns by %s (-mat_binbcsr_xload %s)\n",
           a->xload == MAT_BINBCSR_XLOAD_GATHER ? "gathers in every slot group"

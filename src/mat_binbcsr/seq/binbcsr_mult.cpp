@@ -3,8 +3,8 @@
    shape and body set (MatBinBCSRSetKernel). */
 #include "binbcsr.h"
 #include "../kernels/binbcsr_dispatch.h"
+#include "../common/binbcsr_machine.h"
 #include <algorithm>
-#include <ctime>
 
 static_assert(sizeof(PetscInt) == sizeof(int), "the product bodies take 32-bit indices");
 
@@ -30,6 +30,16 @@ static binbcsr::BinMatrix BinMatrixOf(const Mat_SeqBinBCSR *a)
   return m;
 }
 
+static bool ReadsXLoad(const Mat_SeqBinBCSR *a, binbcsr::BodySet set)
+{
+  return !a->sym && a->bs == 3 && a->bw == 8 && set == binbcsr::BodySet::AVX512;
+}
+
+PetscBool MatSeqBinBCSRReadsXLoad(const Mat_SeqBinBCSR *a)
+{
+  return ReadsXLoad(a, MatSeqBinBCSRSelectBody(a).set) ? PETSC_TRUE : PETSC_FALSE;
+}
+
 /* The AVX-512 whole-storage body's per-bin hint (BinMatrix::bin_xload), made at the first product that
    runs that body and kept with the layout: one pass over the column indices. Two halves: the hint
    (MAT_BINBCSR_XLOAD_LOADS) and zeros (MAT_BINBCSR_XLOAD_GATHER, gather everywhere), so that the x load
@@ -37,8 +47,7 @@ static binbcsr::BinMatrix BinMatrixOf(const Mat_SeqBinBCSR *a)
 static PetscErrorCode MatSeqBinBCSRXLoadBins(Mat_SeqBinBCSR *a, const binbcsr::Body &body)
 {
   PetscFunctionBegin;
-  if (a->bin_xload || a->sym || a->bs != 3 || a->bw != 8 || body.set != binbcsr::BodySet::AVX512 || !a->nbins)
-    PetscFunctionReturn(0);
+  if (a->bin_xload || !a->nbins || !ReadsXLoad(a, body.set)) PetscFunctionReturn(0);
   PetscCall(PetscMalloc1(2 * a->nbins, &a->bin_xload));
   binbcsr::xload_bins<PetscInt>(a->bin_start, a->col, a->row_nz, a->mbs, a->nbins, 8, a->nbs, a->bin_xload);
   std::fill(a->bin_xload + a->nbins, a->bin_xload + 2 * a->nbins, (unsigned char)0);
@@ -47,15 +56,6 @@ static PetscErrorCode MatSeqBinBCSRXLoadBins(Mat_SeqBinBCSR *a, const binbcsr::B
   PetscCall(PetscInfo(NULL,
                       "x_c by loads in %" PetscInt_FMT " of %" PetscInt_FMT " bins, gathered in the others\n",
                       n, a->nbins));
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode MatSeqBinBCSRSetXLoad(Mat A, MatBinBCSRXLoad xload)
-{
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
-
-  PetscFunctionBegin;
-  a->xload = xload;
   PetscFunctionReturn(0);
 }
 
@@ -84,14 +84,7 @@ binbcsr::Body MatSeqBinBCSRSelectBody(const Mat_SeqBinBCSR *a)
    way, so the same results throughout. Products of every kind count (y = A x, y = z + A x, with x.y):
    they differ by a vector pass, a few percent of a product, which a caller alternating two kinds in
    step with the modes would add to one of them; the 2% margin covers part of that, not all. */
-static double ThreadSeconds()
-{
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-PetscErrorCode MatSeqBinBCSRXLoadTrialMode(Mat_SeqBinBCSR *a)
+static PetscErrorCode MatSeqBinBCSRXLoadTrialMode(Mat_SeqBinBCSR *a)
 {
   PetscFunctionBegin;
   /* products left: 2n+1 (the untimed first) down to 1; even counts the tuner's choice, odd the other */
@@ -100,7 +93,7 @@ PetscErrorCode MatSeqBinBCSRXLoadTrialMode(Mat_SeqBinBCSR *a)
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode MatSeqBinBCSRXLoadTrialRecord(Mat_SeqBinBCSR *a, double sec)
+static PetscErrorCode MatSeqBinBCSRXLoadTrialRecord(Mat_SeqBinBCSR *a, double sec)
 {
   PetscFunctionBegin;
   if (a->xload_trial < BINBCSR_XLOAD_TRIAL) a->xload_sec[a->xload] = PetscMin(a->xload_sec[a->xload], sec);
@@ -163,9 +156,9 @@ static PetscErrorCode MatMultKernel_SeqBinBCSR(Mat A, Vec xx, Vec zz, Vec yy, Pe
     PetscCall(VecGetArrayWrite(yy, &y));
   }
   if (trial) {
-    const double t0 = ThreadSeconds();
+    const double t0 = binbcsr::thread_cpu_seconds();
     body.mult(m, x, z, y, dot, acc);
-    PetscCall(MatSeqBinBCSRXLoadTrialRecord(a, ThreadSeconds() - t0));
+    PetscCall(MatSeqBinBCSRXLoadTrialRecord(a, binbcsr::thread_cpu_seconds() - t0));
   } else body.mult(m, x, z, y, dot, acc);
   PetscCall(VecRestoreArrayRead(xx, &x));
   if (zz == yy) PetscCall(VecRestoreArray(yy, &y));

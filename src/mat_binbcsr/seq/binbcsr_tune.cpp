@@ -113,14 +113,6 @@ struct Timer {
   PetscInt max_products = 0;
   bool     cold         = false; /* the sample's arrays dropped from the caches before each product */
 
-  /* CPU seconds of this thread: on a machine shared with other work the wall clock also counts the
-     time the process waits for a core, which would decide the choice by chance */
-  static double Now()
-  {
-    timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-  }
   /* Seconds of one product of T with K streams (the product op itself: no log events, no checks).
      No product runs untimed to warm up: the sample's pages are written when it is filled, and its
      arrays are read from memory at every product anyway (cold). */
@@ -131,7 +123,7 @@ struct Timer {
     PetscFunctionBegin;
     t->streams  = K;
     t->prefetch = pf;
-    PetscCall(MatSeqBinBCSRSetXLoad(T, (MatBinBCSRXLoad)xg));
+    t->xload    = (MatBinBCSRXLoad)xg;
     PetscCall(MatSeqBinBCSRXLoadHint(T)); /* outside the timed product */
     /* A matrix larger than the last-level cache streams from memory at every product; a sample of
        about twice that cache still partly stays in it from one timed product to the next (a victim
@@ -143,9 +135,9 @@ struct Timer {
                                  (size_t)t->nslots * t->bs2 * (t->val ? sizeof(MatScalar) : sizeof(float)));
       binbcsr::evict_from_caches(t->col, (size_t)t->nslots * sizeof(PetscInt));
     }
-    const double t0 = Now();
+    const double t0 = binbcsr::thread_cpu_seconds();
     PetscCall(MatMult_SeqBinBCSR(T, x, y));
-    *sec = Now() - t0;
+    *sec = binbcsr::thread_cpu_seconds() - t0;
     products++;
     seconds += *sec;
     PetscFunctionReturn(0);
@@ -166,13 +158,10 @@ bool XLoadFree(const Mat_SeqBinBCSR *a)
 }
 
 /* After the choice: where the x load was the tuner's and the chosen shape reads it, the matrix's first
-   products decide it again (MatSeqBinBCSRXLoadTrialMode, binbcsr_mult.cpp). */
+   products decide it again (binbcsr_mult.cpp). */
 void StartXLoadTrial(Mat_SeqBinBCSR *a)
 {
-  const binbcsr::Shape sh = {3, 8, (int)a->streams, a->precision == MAT_BINBCSR_PRECISION_SINGLE, false};
-  if (!XLoadFree(a) || a->bw != 8 ||
-      binbcsr::select_body(sh, (binbcsr::BodySet)a->kernel).set != binbcsr::BodySet::AVX512)
-    return;
+  if (!XLoadFree(a) || !MatSeqBinBCSRReadsXLoad(a)) return;
   a->xload_chosen = (PetscInt)a->xload;
   a->xload_sec[0] = a->xload_sec[1] = 1e30;
   a->xload_trial                    = BINBCSR_XLOAD_TRIAL;
@@ -256,7 +245,7 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
     a->kernel       = MAT_BINBCSR_KERNEL_AUTO;
     a->kernel_tuned = PETSC_FALSE;
   }
-  if (!a->xload_set) PetscCall(MatSeqBinBCSRSetXLoad(A, MAT_BINBCSR_XLOAD_LOADS)); /* likewise */
+  if (!a->xload_set) a->xload = MAT_BINBCSR_XLOAD_LOADS; /* likewise */
   a->xload_trial            = 0;
   const PetscBool body_free = a->kernel == MAT_BINBCSR_KERNEL_AUTO ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(BinBCSRTuneSettingsGet(A, &set));
@@ -314,7 +303,7 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
       a->bw       = c.bw;
       a->streams  = c.streams;
       a->prefetch = c.prefetch;
-      PetscCall(MatSeqBinBCSRSetXLoad(A, (MatBinBCSRXLoad)c.xload));
+      a->xload    = (MatBinBCSRXLoad)c.xload;
       if (body_free && c.kernel != (PetscInt)MAT_BINBCSR_KERNEL_AUTO) {
         a->kernel       = (MatBinBCSRKernel)c.kernel;
         a->kernel_tuned = PETSC_TRUE;
@@ -508,7 +497,7 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
   a->bw       = best.bw;
   a->streams  = best.K;
   a->prefetch = best.pf;
-  if (!a->xload_set) PetscCall(MatSeqBinBCSRSetXLoad(A, (MatBinBCSRXLoad)best.xg));
+  if (!a->xload_set) a->xload = (MatBinBCSRXLoad)best.xg;
   if (body_free && best.kernel != (PetscInt)MAT_BINBCSR_KERNEL_AUTO) {
     a->kernel       = (MatBinBCSRKernel)best.kernel;
     a->kernel_tuned = PETSC_TRUE;

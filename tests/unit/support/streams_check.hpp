@@ -102,7 +102,7 @@ inline void check_xload(Mat A, const Pattern &p)
     const Products loads = products(A, p);
     REQUIRE(MatBinBCSRSetXLoad(A, MAT_BINBCSR_XLOAD_GATHER) == 0);
     check_same_bits(products(A, p), loads);
-    REQUIRE(MatBinBCSRSetXLoad(A, MAT_BINBCSR_XLOAD_LOADS) == 0); // back: the hint made again
+    REQUIRE(MatBinBCSRSetXLoad(A, MAT_BINBCSR_XLOAD_LOADS) == 0); // and back
     check_same_bits(products(A, p), loads);
   }
 }
