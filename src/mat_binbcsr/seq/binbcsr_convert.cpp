@@ -296,81 +296,127 @@ PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat A, MatType type, MatReuse reuse, Ma
   PetscFunctionReturn(0);
 }
 
-/* MATSEQBINBCSR -> seqaij (bs 1 rows) or seqbaij (bs x bs blocks). */
+/* The blocks of full block row br in ascending column: with symmetric storage the stored blocks (c, br),
+   c < br, transposed, then the row's own; f(bc, vb, transposed) with vb the value index of the block's
+   entry 0 (entry e at vb + e * bw). A slot's lane is its row's place in the bin: no division per block. */
+template <class F> static inline void ForEachFullRowBlock(const Mat_SeqBinBCSR *a, PetscInt br, F &&f)
+{
+  const PetscInt bw = a->bw, bs2 = a->bs2, l = br % bw;
+  if (a->sym) {
+    for (PetscInt p = a->lower_off[br]; p < a->lower_off[br + 1]; p++) {
+      const PetscInt s = a->lower_slot[2 * p], c = a->lower_slot[2 * p + 1], lc = c % bw;
+      f(c, (s - lc) * bs2 + lc, true);
+    }
+    for (PetscInt k = 0; k < a->row_nz[br]; k++) {
+      const PetscInt s = a->real_slot[a->row_off[br] + k];
+      f(a->col[s], (s - l) * bs2 + l, false);
+    }
+    return;
+  }
+  const PetscInt s0 = a->bin_start[br / bw] + l;
+  for (PetscInt k = 0; k < a->row_nz[br]; k++) {
+    const PetscInt s = s0 + k * bw;
+    f(a->col[s], (s - l) * bs2 + l, false);
+  }
+}
+
+/* v <- the values of A's full rows in the order of B's value array (seqbaij: blocks column-major). */
+template <typename V>
+static void FullRowValues(const Mat_SeqBinBCSR *a, const V *val, PetscBool blocked, PetscScalar *v)
+{
+  const PetscInt bs = a->bs, bw = a->bw;
+  size_t         n = 0;
+  /* entry (i, j) of the block at vb: (i, j) of a stored block, (j, i) of a transposed one */
+  const auto entry = [&](PetscInt vb, bool t, PetscInt i, PetscInt j) {
+    return (PetscScalar)val[vb + (t ? j * bs + i : i * bs + j) * bw];
+  };
+  for (PetscInt br = 0; br < a->mbs; br++) {
+    if (blocked)
+      ForEachFullRowBlock(a, br, [&](PetscInt, PetscInt vb, bool t) {
+        for (PetscInt j = 0; j < bs; j++)
+          for (PetscInt i = 0; i < bs; i++) v[n++] = entry(vb, t, i, j);
+      });
+    else
+      for (PetscInt i = 0; i < bs; i++)
+        ForEachFullRowBlock(a, br, [&](PetscInt, PetscInt vb, bool t) {
+          for (PetscInt j = 0; j < bs; j++) v[n++] = entry(vb, t, i, j);
+        });
+  }
+}
+
+/* MATSEQBINBCSR -> a new seqaij (bs 1 rows) or seqbaij (bs x bs blocks). The rows come out sorted and
+   the pattern is known, so B is preallocated exactly, handed all its column indices at once
+   (MatSeq[B]AIJSetColumnIndices) and its value array filled in place: inserting the rows through
+   MatSetValues searched every entry's place (PCGAMG's graph of the 40K-unknown FE matrix starts from
+   this conversion). */
+static PetscErrorCode MatConvert_SeqBinBCSR_XAIJ_New(Mat A, MatType newtype, PetscBool blocked, Mat *newmat)
+{
+  Mat_SeqBinBCSR *a  = (Mat_SeqBinBCSR *)A->data;
+  const PetscInt  bs = a->bs, bs2 = a->bs2, mbs = a->mbs;
+  Mat             B;
+  PetscInt       *nnz, *idx;
+  PetscScalar    *v;
+  size_t          nblocks = 0, n = 0;
+
+  PetscFunctionBegin;
+  if (a->sym) PetscCall(MatSeqBinBCSRBuildLowerIndex(a));
+  PetscCall(MatBinBCSRCreateLike_Private(A, newtype, &B));
+  PetscCall(PetscMalloc1(blocked ? mbs : A->rmap->n, &nnz));
+  for (PetscInt br = 0; br < mbs; br++) {
+    const PetscInt nb = a->row_nz[br] + (a->sym ? a->lower_off[br + 1] - a->lower_off[br] : 0);
+    nblocks += (size_t)nb;
+    if (blocked) nnz[br] = nb;
+    else
+      for (PetscInt i = 0; i < bs; i++) nnz[br * bs + i] = nb * bs;
+  }
+  PetscCheck(nblocks * bs2 <= (size_t)PETSC_MAX_INT, PETSC_COMM_SELF, PETSC_ERR_SUP,
+             "MatConvert: %zu entries exceed PETSc's index range", nblocks * bs2);
+  if (blocked) PetscCall(MatSeqBAIJSetPreallocation(B, bs, 0, nnz));
+  else PetscCall(MatSeqAIJSetPreallocation(B, 0, nnz));
+  PetscCall(PetscFree(nnz));
+  PetscCall(PetscMalloc1(blocked ? nblocks : nblocks * bs2, &idx));
+  for (PetscInt br = 0; br < mbs; br++) {
+    if (blocked) ForEachFullRowBlock(a, br, [&](PetscInt bc, PetscInt, bool) { idx[n++] = bc; });
+    else
+      for (PetscInt i = 0; i < bs; i++)
+        ForEachFullRowBlock(a, br, [&](PetscInt bc, PetscInt, bool) {
+          for (PetscInt j = 0; j < bs; j++) idx[n++] = bc * bs + j;
+        });
+  }
+  if (blocked) PetscCall(MatSeqBAIJSetColumnIndices(B, idx));
+  else PetscCall(MatSeqAIJSetColumnIndices(B, idx));
+  PetscCall(PetscFree(idx));
+  if (blocked) PetscCall(MatSeqBAIJGetArray(B, &v));
+  else PetscCall(MatSeqAIJGetArray(B, &v));
+  if (a->val) FullRowValues(a, a->val, blocked, v);
+  else FullRowValues(a, a->valf, blocked, v);
+  if (blocked) PetscCall(MatSeqBAIJRestoreArray(B, &v));
+  else PetscCall(MatSeqAIJRestoreArray(B, &v));
+  PetscCall(MatAssemblyBegin(B, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(B, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatPropagateSymmetryOptions(A, B));
+  *newmat = B;
+  PetscFunctionReturn(0);
+}
+
+/* MATSEQBINBCSR -> seqaij (bs 1 rows) or seqbaij (bs x bs blocks): a new matrix by its arrays, into a
+   reused one (whose pattern may differ) row by row. */
 static PetscErrorCode MatConvert_SeqBinBCSR_XAIJ(Mat A, MatType newtype, MatReuse reuse, Mat *newmat,
                                                  PetscBool blocked)
 {
-  Mat_SeqBinBCSR *a  = (Mat_SeqBinBCSR *)A->data;
-  const PetscInt  bs = a->bs, bs2 = a->bs2;
+  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
   Mat             B;
-  PetscInt       *nnz, *cols;
-  PetscScalar    *vals;
 
   PetscFunctionBegin;
   PetscCheck(a->built, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
              "MatConvert needs an assembled MATSEQBINBCSR matrix");
-  if (a->sym) { /* both triangles, through the full rows */
-    if (reuse == MAT_REUSE_MATRIX) {
-      B = *newmat;
-      PetscCall(MatZeroEntries(B));
-    } else {
-      PetscCall(MatBinBCSRCreateLike_Private(A, newtype, &B));
-      PetscCall(MatSeqBinBCSRBuildLowerIndex(a));
-      PetscCall(PetscMalloc1(A->rmap->n, &nnz));
-      for (PetscInt r = 0; r < A->rmap->n; r++)
-        nnz[r] = (a->row_nz[r / bs] + a->lower_off[r / bs + 1] - a->lower_off[r / bs]) * (blocked ? 1 : bs);
-      if (blocked) {
-        PetscInt *bnnz;
-        PetscCall(PetscMalloc1(a->mbs, &bnnz));
-        for (PetscInt r = 0; r < a->mbs; r++) bnnz[r] = nnz[r * bs];
-        PetscCall(MatSeqBAIJSetPreallocation(B, bs, 0, bnnz));
-        PetscCall(PetscFree(bnnz));
-      } else PetscCall(MatSeqAIJSetPreallocation(B, 0, nnz));
-      PetscCall(PetscFree(nnz));
-    }
-    PetscCall(MatBinBCSRInsertRows_Private(A, B));
-    PetscCall(MatPropagateSymmetryOptions(A, B));
-    if (reuse == MAT_INPLACE_MATRIX) PetscCall(MatHeaderReplace(A, &B));
-    else *newmat = B;
-    PetscFunctionReturn(0);
-  }
   if (reuse == MAT_REUSE_MATRIX) {
     B = *newmat;
     PetscCall(MatZeroEntries(B));
-  } else {
-    PetscCall(MatBinBCSRCreateLike_Private(A, newtype, &B));
-    if (blocked) PetscCall(MatSeqBAIJSetPreallocation(B, bs, 0, a->row_nz));
-    else {
-      PetscCall(PetscMalloc1(A->rmap->n, &nnz));
-      for (PetscInt r = 0; r < A->rmap->n; r++) nnz[r] = a->row_nz[r / bs] * bs;
-      PetscCall(MatSeqAIJSetPreallocation(B, 0, nnz));
-      PetscCall(PetscFree(nnz));
-    }
+    PetscCall(MatBinBCSRInsertRows_Private(A, B));
+    PetscFunctionReturn(0);
   }
-  PetscCall(PetscMalloc2((size_t)a->max_row_nz * bs, &cols, (size_t)a->max_row_nz * bs2, &vals));
-  for (PetscInt br = 0; br < a->mbs; br++) {
-    const PetscInt n = a->row_nz[br];
-    for (PetscInt k = 0; k < n; k++) cols[k] = a->col[BinBCSRSlot(a, br, k)];
-    /* the block row as a row-major (bs) x (n*bs) array */
-    for (PetscInt k = 0; k < n; k++) {
-      const PetscInt s = BinBCSRSlot(a, br, k);
-      for (PetscInt i = 0; i < bs; i++)
-        for (PetscInt j = 0; j < bs; j++)
-          vals[i * n * bs + k * bs + j] = BinBCSRGetValue(a, BinBCSRValueIndex(s, i * bs + j, a->bw, bs2));
-    }
-    if (blocked) PetscCall(MatSetValuesBlocked(B, 1, &br, n, cols, vals, INSERT_VALUES));
-    else {
-      for (PetscInt k = n - 1; k >= 0; k--) /* expand block columns in place, back to front */
-        for (PetscInt j = bs - 1; j >= 0; j--) cols[k * bs + j] = cols[k] * bs + j;
-      for (PetscInt i = 0; i < bs; i++) {
-        const PetscInt r = br * bs + i;
-        PetscCall(MatSetValues(B, 1, &r, n * bs, cols, vals + i * n * bs, INSERT_VALUES));
-      }
-    }
-  }
-  PetscCall(PetscFree2(cols, vals));
-  PetscCall(MatAssemblyBegin(B, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(B, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatConvert_SeqBinBCSR_XAIJ_New(A, newtype, blocked, &B));
   if (reuse == MAT_INPLACE_MATRIX) PetscCall(MatHeaderReplace(A, &B));
   else *newmat = B;
   PetscFunctionReturn(0);

@@ -150,6 +150,31 @@ TEST_CASE("MatConvert to and from seqaij and seqbaij", "[mat_core][convert]")
     PetscInt bbs;
     REQUIRE(MatGetBlockSize(B, &bbs) == 0);
     CHECK(bbs == bs);
+    {
+      // the new matrix is a whole one: its own product, and new values through a reuse
+      Vec x, y, yr;
+      REQUIRE(MatCreateVecs(A, &x, &y) == 0);
+      REQUIRE(VecDuplicate(y, &yr) == 0);
+      REQUIRE(VecSetRandom(x, nullptr) == 0);
+      REQUIRE(MatMult(A, x, yr) == 0);
+      REQUIRE(MatMult(B, x, y) == 0);
+      PetscReal err, norm;
+      REQUIRE(VecAXPY(y, -1.0, yr) == 0);
+      REQUIRE(VecNorm(y, NORM_INFINITY, &err) == 0);
+      REQUIRE(VecNorm(yr, NORM_INFINITY, &norm) == 0);
+      CHECK(err <= 1e-14 * norm);
+      Mat A3;
+      REQUIRE(MatDuplicate(A, MAT_COPY_VALUES, &A3) == 0);
+      REQUIRE(MatScale(A3, 3.0) == 0);
+      REQUIRE(MatConvert(A3, t, MAT_REUSE_MATRIX, &B) == 0);
+      auto ref3 = ref;
+      for (auto &v : ref3) v *= 3;
+      check_dense(dense(B), ref3, 0);
+      REQUIRE(MatConvert(A, t, MAT_REUSE_MATRIX, &B) == 0);
+      check_dense(dense(B), ref, 0);
+      for (Vec *v : {&x, &y, &yr}) VecDestroy(v);
+      MatDestroy(&A3);
+    }
     // and back, through the target's convertfrom
     Mat C;
     REQUIRE(MatConvert(B, MATBINBCSR, MAT_INITIAL_MATRIX, &C) == 0);
