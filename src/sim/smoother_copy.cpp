@@ -172,9 +172,10 @@ PetscErrorCode SmootherCopyRefill(Mat A, Mat *copy)
   PetscCall(IsBinBCSR(A, &binbcsr));
   if (binbcsr) {
     if (*copy) PetscCall(MatCopy(A, *copy, SAME_NONZERO_PATTERN));
-    else {
-      PetscCall(MatDuplicate(A, MAT_COPY_VALUES, copy));
+    else { // the layout without A's values (a fresh mapping, not touched), then the values in single
+      PetscCall(MatDuplicate(A, MAT_DO_NOT_COPY_VALUES, copy));
       PetscCall(MatBinBCSRSetPrecision(*copy, MAT_BINBCSR_PRECISION_SINGLE));
+      PetscCall(MatCopy(A, *copy, SAME_NONZERO_PATTERN));
     }
     PetscFunctionReturn(0);
   }
