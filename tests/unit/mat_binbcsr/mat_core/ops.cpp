@@ -198,6 +198,22 @@ TEST_CASE("MatConvert to and from seqaij and seqbaij", "[mat_core][convert]")
     check_dense(dense(B), ref2, 0);
     MatDestroy(&B);
   }
+  {
+    // single storage: the rounded values, converted exactly
+    Mat S;
+    REQUIRE(MatDuplicate(A, MAT_COPY_VALUES, &S) == 0);
+    REQUIRE(MatBinBCSRSetPrecision(S, MAT_BINBCSR_PRECISION_SINGLE) == 0);
+    auto rounded = ref;
+    for (auto &v : rounded) v = (double)(float)v;
+    for (MatType t : {MATSEQAIJ, MATSEQBAIJ}) {
+      Mat B;
+      CAPTURE(t);
+      REQUIRE(MatConvert(S, t, MAT_INITIAL_MATRIX, &B) == 0);
+      check_dense(dense(B), rounded, 0);
+      MatDestroy(&B);
+    }
+    MatDestroy(&S);
+  }
   Mat B = nullptr;
   REQUIRE(MatDuplicate(A, MAT_COPY_VALUES, &B) == 0);
   REQUIRE(MatConvert(B, MATSEQAIJ, MAT_INPLACE_MATRIX, &B) == 0);
