@@ -155,8 +155,13 @@ static inline PetscInt BinBCSRDefaultBinWidth(PetscInt bs) { return bs == 1 ? 16
 
 /* The product body for a's shape and body set (binbcsr_mult.cpp; the choice is select_body's). */
 binbcsr::Body MatSeqBinBCSRSelectBody(const Mat_SeqBinBCSR *a);
-/* Whether a's products read the x load (MatBinBCSRSetXLoad): whole storage, 3x3 blocks, width 8, the
-   AVX-512 body */
+/* Whether products of this shape read the x load (MatBinBCSRSetXLoad): whole storage, 3x3 blocks,
+   width 8, the AVX-512 body */
+static inline bool BinBCSRShapeReadsXLoad(PetscBool sym, PetscInt bs, PetscInt bw, binbcsr::BodySet set)
+{
+  return !sym && bs == 3 && bw == 8 && set == binbcsr::BodySet::AVX512;
+}
+/* The same for a's products with the body it selects now */
 PETSC_INTERN PetscBool MatSeqBinBCSRReadsXLoad(const Mat_SeqBinBCSR *a);
 /* the bins' hint, made now if the body uses one (the tuner: not in a timed product) */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRXLoadHint(Mat);

@@ -32,7 +32,7 @@ static binbcsr::BinMatrix BinMatrixOf(const Mat_SeqBinBCSR *a)
 
 static bool ReadsXLoad(const Mat_SeqBinBCSR *a, binbcsr::BodySet set)
 {
-  return !a->sym && a->bs == 3 && a->bw == 8 && set == binbcsr::BodySet::AVX512;
+  return BinBCSRShapeReadsXLoad(a->sym, a->bs, a->bw, set);
 }
 
 PetscBool MatSeqBinBCSRReadsXLoad(const Mat_SeqBinBCSR *a)

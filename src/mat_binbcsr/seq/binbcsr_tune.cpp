@@ -471,9 +471,11 @@ PetscErrorCode MatSeqBinBCSRTune(Mat A, const PetscInt bi[], const PetscInt bj[]
   /* 4b. x by gathers in every slot group against loads where the bins allow, where the best runs the
         AVX-512 whole product of 3x3 blocks at width 8: on a Zen 5 VM gathers ran the 48^3 stencil in
         double about 10% faster and in single 1.4x slower (MatBinBCSRSetXLoad) */
-  if (!a->xload_set && bs == 3 && best.bw == 8 && !a->sym) {
-    const binbcsr::Shape sh = {3, 8, (int)best.K, a->precision == MAT_BINBCSR_PRECISION_SINGLE, false};
-    if (binbcsr::select_body(sh, (binbcsr::BodySet)best.kernel).set == binbcsr::BodySet::AVX512) {
+  if (!a->xload_set) {
+    const binbcsr::Shape sh = {(int)bs, (int)best.bw, (int)best.K,
+                               a->precision == MAT_BINBCSR_PRECISION_SINGLE, a->sym ? true : false};
+    if (BinBCSRShapeReadsXLoad(a->sym, bs, best.bw,
+                               binbcsr::select_body(sh, (binbcsr::BodySet)best.kernel).set)) {
       Tried g = best;
       g.xg    = 1 - best.xg;
       g.sec   = 1e30;
