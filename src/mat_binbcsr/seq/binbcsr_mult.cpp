@@ -130,7 +130,8 @@ static PetscErrorCode MatMultKernel_SeqBinBCSR(Mat A, Vec xx, Vec zz, Vec yy, Pe
              "MATSEQBINBCSR matrix has no layout: assemble it first");
   body = MatSeqBinBCSRSelectBody(a);
   PetscCall(MatSeqBinBCSRXLoadBins(a, body));
-  const bool trial = a->xload_trial > 0 && a->bin_xload && !a->sym;
+  /* only products that read the x load can time it (a body set after the tuner's may not) */
+  const bool trial = a->xload_trial > 0 && a->bin_xload && ReadsXLoad(a, body.set);
   if (trial) PetscCall(MatSeqBinBCSRXLoadTrialMode(a));
   m = BinMatrixOf(a);
   if (a->bs > 8) PetscCall(PetscMalloc1(a->bs, &acc)); /* the lane-by-lane bodies' accumulators */

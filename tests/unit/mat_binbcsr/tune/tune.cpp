@@ -328,6 +328,16 @@ TEST_CASE("tuning: the first products decide the x load", "[tune][xload]")
   REQUIRE(MatBinBCSRGetXLoad(A, &x) == 0);
   CHECK((x == MAT_BINBCSR_XLOAD_LOADS || x == MAT_BINBCSR_XLOAD_GATHER));
   MatDestroy(&A);
+  // a body that does not read the x load, set after the tuner's: its products do not count
+  A = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO, 8);
+  check_same(A, R, p); // the trial's untimed first product, with the AVX-512 body
+  REQUIRE(MatBinBCSRSetKernel(A, MAT_BINBCSR_KERNEL_PORTABLE) == 0);
+  for (int k = 0; k < BINBCSR_XLOAD_TRIAL; k++) check_same(A, R, p);
+  CHECK(info_view(A).find("the first products") == std::string::npos);
+  REQUIRE(MatBinBCSRSetKernel(A, MAT_BINBCSR_KERNEL_AVX512) == 0);
+  for (int k = 0; k < BINBCSR_XLOAD_TRIAL - 1; k++) check_same(A, R, p);
+  CHECK(info_view(A).find("the first products: loads ") != std::string::npos);
+  MatDestroy(&A);
   // an x load set explicitly: no trial
   o.set("-mat_binbcsr_xload", "gather");
   A = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO, 8);
