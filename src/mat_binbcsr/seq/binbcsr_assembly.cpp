@@ -41,8 +41,15 @@ static PetscErrorCode MatSeqBinBCSRFreeLayout(Mat_SeqBinBCSR *a)
 PetscErrorCode MatSeqBinBCSRDestroyCOO(Mat_SeqBinBCSR *a)
 {
   PetscFunctionBegin;
-  PetscCall(PetscFree(a->coo_jmap));
-  PetscCall(PetscFree(a->coo_perm));
+  if (a->coo_shared && --a->coo_shared->refs > 0) { /* another matrix still holds them */
+    a->coo_jmap = nullptr;
+    a->coo_perm = nullptr;
+  } else {
+    delete a->coo_shared;
+    PetscCall(PetscFree(a->coo_jmap));
+    PetscCall(PetscFree(a->coo_perm));
+  }
+  a->coo_shared = nullptr;
   PetscCall(PetscFree(a->coo_perm_src));
   PetscCall(PetscFree(a->coo_slot_ptr));
   PetscCall(PetscFree(a->coo_slot_src));

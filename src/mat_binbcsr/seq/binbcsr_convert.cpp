@@ -121,13 +121,13 @@ static PetscErrorCode MatSeqBinBCSRCopyLayout(Mat A, Mat B, PetscBool copyvalues
       const size_t nrow = (size_t)(a->sym ? PetscMax(a->nbs, 1) : a->max_row_nz) * a->bs;
       PetscCall(PetscMalloc2(nrow, &b->rowbuf_cols, nrow, &b->rowbuf_vals));
     }
-    if (a->coo_jmap) { /* the copy can be refilled with MatSetValuesCOO too */
-      const size_t nq = (size_t)a->nz * a->bs2;
-      b->coo_n        = a->coo_n;
-      PetscCall(PetscMalloc1(nq + 1, &b->coo_jmap));
-      PetscCall(PetscArraycpy(b->coo_jmap, a->coo_jmap, nq + 1));
-      PetscCall(PetscMalloc1(a->coo_jmap[nq], &b->coo_perm));
-      PetscCall(PetscArraycpy(b->coo_perm, a->coo_perm, a->coo_jmap[nq]));
+    if (a->coo_jmap) { /* the copy can be refilled with MatSetValuesCOO too: the same maps, shared */
+      if (!a->coo_shared) a->coo_shared = new BinBCSRSharedCOO{1};
+      a->coo_shared->refs++;
+      b->coo_shared = a->coo_shared;
+      b->coo_n      = a->coo_n;
+      b->coo_jmap   = a->coo_jmap;
+      b->coo_perm   = a->coo_perm;
     }
     b->built = PETSC_TRUE;
   } else PetscCall(MatSeqBinBCSRDuplicateStaging(A, B, copyvalues));

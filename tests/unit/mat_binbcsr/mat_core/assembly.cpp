@@ -230,13 +230,38 @@ TEST_CASE("COO: duplicates summed, negative indices dropped, INSERT and ADD refi
         bad++;
     CHECK(bad == 0);
   }
-  // a matrix filled by COO multiplies like the reference, and a duplicate refills too
-  Mat D;
+  // a matrix filled by COO multiplies like the reference, and a duplicate refills too (the two share
+  // their COO maps: each keeps refilling after the other took a new pattern or was destroyed)
+  Mat D, D2;
   REQUIRE(MatDuplicate(A, MAT_DO_NOT_COPY_VALUES, &D) == 0);
   REQUIRE(MatSetValuesCOO(D, v.data(), INSERT_VALUES) == 0);
   check_dense(dense(D), dense(A), 0);
-  MatDestroy(&D);
+  REQUIRE(MatDuplicate(D, MAT_COPY_VALUES, &D2) == 0);
+  {
+    std::vector<PetscInt> i1 = {0, 1}, j1 = {0, 1}; // A takes another pattern: D's maps stay
+    REQUIRE(MatSetPreallocationCOO(A, 2, i1.data(), j1.data()) == 0);
+    const PetscScalar two[2] = {5, 7};
+    REQUIRE(MatSetValuesCOO(A, two, INSERT_VALUES) == 0);
+    PetscScalar a00;
+    PetscInt    zero = 0;
+    REQUIRE(MatGetValues(A, 1, &zero, 1, &zero, &a00) == 0);
+    CHECK(a00 == 5);
+  }
   MatDestroy(&A);
+  for (PetscCount k = 0; k < ncoo; k++) v[k] = std::cos(2.0 + k);
+  REQUIRE(MatSetValuesCOO(ref, v.data(), INSERT_VALUES) == 0);
+  const auto refills_like_ref = [&](Mat M) {
+    REQUIRE(MatSetValuesCOO(M, v.data(), INSERT_VALUES) == 0);
+    auto   got = dense(M), want = dense(ref);
+    size_t bad = 0;
+    for (size_t k = 0; k < got.size(); k++)
+      if (!(std::fabs(got[k] - want[k]) <= unit * std::fabs(want[k]) * 16.0 + 1e-13)) bad++;
+    CHECK(bad == 0);
+  };
+  refills_like_ref(D);
+  MatDestroy(&D);
+  refills_like_ref(D2); // the last holder of the maps
+  MatDestroy(&D2);
   MatDestroy(&ref);
 }
 
