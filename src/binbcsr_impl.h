@@ -47,6 +47,10 @@ PETSC_INTERN PetscErrorCode MatFDColoringCreate_BinBCSR(Mat, ISColoring, MatFDCo
 PETSC_INTERN PetscErrorCode MatFDColoringSetUp_BinBCSR(Mat, ISColoring, MatFDColoring);
 PETSC_INTERN PetscErrorCode MatFDColoringApply_BinBCSR(Mat, MatFDColoring, Vec, void *);
 /* PCGAMG's needs through that shadow (MatCreateGraph, matrix products with binbcsr operands): common/binbcsr_shadow_ops.cpp */
+/* C = P^T A P of a MATSEQBINBCSR A and a SeqAIJ P, A P made from the blocks (seq/binbcsr_ptap.cpp) */
+PETSC_INTERN PetscErrorCode MatProductSymbolic_PtAP_SeqBinBCSR_SeqAIJ(Mat);
+/* MATSEQBINBCSR's block graph (seq/binbcsr_graph.cpp): block size 1, one weight per stored block */
+PETSC_INTERN PetscErrorCode MatSeqBinBCSRBlockGraph(Mat, Mat *);
 PETSC_INTERN PetscErrorCode MatCreateGraph_BinBCSR(Mat, PetscBool, PetscBool,
                                                    PetscReal BINBCSR_CREATEGRAPH_TYPES, Mat *);
 PETSC_INTERN PetscErrorCode

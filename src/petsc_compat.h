@@ -11,13 +11,17 @@
 
 /* MatCreateGraph and its MatOps slot: 3.21 added the index set of the diagonal entries to filter
    by (num_idx, index[]). BINBCSR_CREATEGRAPH_ARGS declares the parameters after `filter`,
-   BINBCSR_CREATEGRAPH_PASS hands them on, BINBCSR_CREATEGRAPH_NO_INDEX passes none. */
+   BINBCSR_CREATEGRAPH_PASS hands them on, BINBCSR_CREATEGRAPH_NO_INDEX passes none,
+   BINBCSR_CREATEGRAPH_WHOLE_BLOCKS continues a condition with "no index set given". */
 #if PETSC_VERSION_GE(3, 21, 0)
   #define BINBCSR_CREATEGRAPH_ARGS     , PetscInt num_idx, PetscInt index[]
   #define BINBCSR_CREATEGRAPH_PASS     , num_idx, index
   #define BINBCSR_CREATEGRAPH_TYPES    , PetscInt, PetscInt[]
   #define BINBCSR_CREATEGRAPH_NO_INDEX , 0, nullptr
+  /* the block graph sums whole blocks: only without an index set */
+  #define BINBCSR_CREATEGRAPH_WHOLE_BLOCKS &&num_idx <= 0
 #else
+  #define BINBCSR_CREATEGRAPH_WHOLE_BLOCKS
   #define BINBCSR_CREATEGRAPH_ARGS
   #define BINBCSR_CREATEGRAPH_PASS
   #define BINBCSR_CREATEGRAPH_TYPES

@@ -2,10 +2,12 @@
    AIJ shadow of binbcsr_submat.cpp (MatBinBCSRGetAIJShadow_Private: one copy, refreshed only when the
    matrix changed):
 
-   - MatCreateGraph (the strength graph GAMG coarsens): the shadow's own, PETSc's AIJ code.
+   - MatCreateGraph (the strength graph GAMG coarsens): the shadow's own, PETSc's AIJ code; of a
+     sequential matrix of blocks the same graph made from the blocks (seq/binbcsr_graph.cpp).
    - Matrix products (MatProduct AB, AtB, ABt, PtAP, RARt, ABC: GAMG's prolongator smoothing A P and
      its coarse operators P^T A P) where any operand is binbcsr: PETSc's AIJ product of the operands with
-     each binbcsr one replaced by its shadow. The result is AIJ (so are GAMG's coarse levels); the fine
+     each binbcsr one replaced by its shadow. Except P^T A P of a sequential binbcsr and a SeqAIJ P
+     (GAMG's Galerkin products on one rank): A P from the blocks, no shadow (seq/binbcsr_ptap.cpp). The result is AIJ (so are GAMG's coarse levels); the fine
      level keeps the binbcsr operator and its fast MatMult for the smoothers.
 
    A product is routed once, at its symbolic phase: the operands in the product are swapped for their
@@ -146,6 +148,15 @@ PetscErrorCode MatProductSetFromOptions_BinBCSR(Mat C)
   /* binbcsr times a dense block of vectors: PETSc's column-by-column product (MatProductSymbolic_X_Dense)
      with binbcsr's own MatMult / MatMultTranspose, no copy */
   if (dense) PetscFunctionReturn(0);
+  if (C->product->type == MATPRODUCT_PtAP) { /* A P from the blocks, no shadow: binbcsr_ptap.cpp */
+    PetscBool seqA, aijP;
+    PetscCall(PetscObjectTypeCompare((PetscObject)C->product->A, MATSEQBINBCSR, &seqA));
+    PetscCall(PetscObjectTypeCompare((PetscObject)C->product->B, MATSEQAIJ, &aijP));
+    if (seqA && aijP) {
+      C->ops->productsymbolic = MatProductSymbolic_PtAP_SeqBinBCSR_SeqAIJ;
+      PetscFunctionReturn(0);
+    }
+  }
   switch (C->product->type) {
   case MATPRODUCT_AB:
   case MATPRODUCT_AtB:
@@ -161,13 +172,27 @@ PetscErrorCode MatProductSetFromOptions_BinBCSR(Mat C)
   PetscFunctionReturn(0);
 }
 
-/* ops->creategraph: the shadow's graph (GAMG's aggregation). */
+/* ops->creategraph (GAMG's aggregation): of a sequential matrix of blocks, MatCreateGraph of its block
+   graph (MatSeqBinBCSRBlockGraph: what PETSc's AIJ code reduces the matrix to first, made from the
+   blocks without a copy of the values); otherwise the shadow's graph. */
 PetscErrorCode MatCreateGraph_BinBCSR(Mat A, PetscBool sym, PetscBool scale,
                                       PetscReal filter BINBCSR_CREATEGRAPH_ARGS, Mat *graph)
 {
-  Mat S;
+  Mat       S;
+  PetscBool seq;
+  PetscInt  bs;
 
   PetscFunctionBegin;
+  PetscCall(PetscObjectTypeCompare((PetscObject)A, MATSEQBINBCSR, &seq));
+  PetscCall(MatGetBlockSize(A, &bs));
+  if (seq && bs > 1 BINBCSR_CREATEGRAPH_WHOLE_BLOCKS) {
+    Mat G0;
+    PetscCall(MatSeqBinBCSRBlockGraph(A, &G0));
+    PetscErrorCode ierr = MatCreateGraph(G0, sym, scale, filter BINBCSR_CREATEGRAPH_NO_INDEX, graph);
+    PetscCall(MatDestroy(&G0));
+    PetscCall(ierr);
+    PetscFunctionReturn(0);
+  }
   PetscCall(MatBinBCSRGetAIJShadow_Private(A, &S));
   PetscCall(MatCreateGraph(S, sym, scale, filter BINBCSR_CREATEGRAPH_PASS, graph));
   PetscFunctionReturn(0);

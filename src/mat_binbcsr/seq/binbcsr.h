@@ -223,6 +223,31 @@ PetscInt MatSeqBinBCSRColourBin(PetscInt bw, PetscInt r0, PetscInt mbs, const Pe
 
 /* Symmetric storage: builds lower_off/lower_slot if missing (pattern is frozen, so once). */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRBuildLowerIndex(Mat_SeqBinBCSR *);
+/* The blocks of full block row br in ascending column: with symmetric storage the stored blocks (c, br),
+   c < br, transposed, then the row's own; f(bc, vb, transposed) with vb the value index of the block's
+   entry 0 (entry e at vb + e * bw). A slot's lane is its row's place in the bin: no division per block.
+   Symmetric storage needs MatSeqBinBCSRBuildLowerIndex first. */
+template <class F> static inline void ForEachFullRowBlock(const Mat_SeqBinBCSR *a, PetscInt br, F &&f)
+{
+  const PetscInt bw = a->bw, bs2 = a->bs2, l = br % bw;
+  if (a->sym) {
+    for (PetscInt p = a->lower_off[br]; p < a->lower_off[br + 1]; p++) {
+      const PetscInt s = a->lower_slot[2 * p], c = a->lower_slot[2 * p + 1], lc = c % bw;
+      f(c, (s - lc) * bs2 + lc, true);
+    }
+    for (PetscInt k = 0; k < a->row_nz[br]; k++) {
+      const PetscInt s = a->real_slot[a->row_off[br] + k];
+      f(a->col[s], (s - l) * bs2 + l, false);
+    }
+    return;
+  }
+  const PetscInt s0 = a->bin_start[br / bw] + l;
+  for (PetscInt k = 0; k < a->row_nz[br]; k++) {
+    const PetscInt s = s0 + k * bw;
+    f(a->col[s], (s - l) * bs2 + l, false);
+  }
+}
+
 /* Refuses an operation that symmetric storage does not provide. */
 #define BinBCSRCheckNotSym(a, opname)                                                                                     \
   PetscCheck(                                                                                                             \

@@ -296,30 +296,6 @@ PetscErrorCode MatConvertFrom_SeqBinBCSR(Mat A, MatType type, MatReuse reuse, Ma
   PetscFunctionReturn(0);
 }
 
-/* The blocks of full block row br in ascending column: with symmetric storage the stored blocks (c, br),
-   c < br, transposed, then the row's own; f(bc, vb, transposed) with vb the value index of the block's
-   entry 0 (entry e at vb + e * bw). A slot's lane is its row's place in the bin: no division per block. */
-template <class F> static inline void ForEachFullRowBlock(const Mat_SeqBinBCSR *a, PetscInt br, F &&f)
-{
-  const PetscInt bw = a->bw, bs2 = a->bs2, l = br % bw;
-  if (a->sym) {
-    for (PetscInt p = a->lower_off[br]; p < a->lower_off[br + 1]; p++) {
-      const PetscInt s = a->lower_slot[2 * p], c = a->lower_slot[2 * p + 1], lc = c % bw;
-      f(c, (s - lc) * bs2 + lc, true);
-    }
-    for (PetscInt k = 0; k < a->row_nz[br]; k++) {
-      const PetscInt s = a->real_slot[a->row_off[br] + k];
-      f(a->col[s], (s - l) * bs2 + l, false);
-    }
-    return;
-  }
-  const PetscInt s0 = a->bin_start[br / bw] + l;
-  for (PetscInt k = 0; k < a->row_nz[br]; k++) {
-    const PetscInt s = s0 + k * bw;
-    f(a->col[s], (s - l) * bs2 + l, false);
-  }
-}
-
 /* v <- the values of A's full rows in the order of B's value array (seqbaij: blocks column-major). */
 template <typename V>
 static void FullRowValues(const Mat_SeqBinBCSR *a, const V *val, PetscBool blocked, PetscScalar *v)

@@ -94,7 +94,7 @@ PetscErrorCode aggregate_prolongator(Mat A, Mat *P)
 } // namespace
 
 TEST_CASE(
-  "Matrix products with binbcsr operands (through the AIJ shadow) equal aij's, also reused after a refill",
+  "Matrix products with binbcsr operands (P^T A P from the blocks on one rank, the others through the AIJ shadow) equal aij's, also reused after a refill",
   "[pc][gamg][product]")
 {
   const FemProblem fem(5, 4, 3, true);
@@ -107,6 +107,14 @@ TEST_CASE(
       Mat ptap_a, ptap_r, ap_a, ap_r, pta_a, pta_r, aa_a, aa_r;
       PCHK(MatPtAP(A, P, MAT_INITIAL_MATRIX, 2.0, &ptap_a));
       PCHK(MatPtAP(R, P, MAT_INITIAL_MATRIX, 2.0, &ptap_r));
+      {
+        // on one rank P^T A P makes A P from the blocks: no AIJ shadow of A (the products below make one)
+        PetscMPIInt size;
+        PetscObject shadow = nullptr;
+        PCHK(MPI_Comm_size(PETSC_COMM_WORLD, &size));
+        PCHK(PetscObjectQuery((PetscObject)A, "MatBinBCSR_AIJShadow", &shadow));
+        CHECK((size == 1) == (shadow == nullptr));
+      }
       PCHK(MatMatMult(A, P, MAT_INITIAL_MATRIX, 2.0, &ap_a));
       PCHK(MatMatMult(R, P, MAT_INITIAL_MATRIX, 2.0, &ap_r));
       PCHK(MatTransposeMatMult(P, A, MAT_INITIAL_MATRIX, 2.0, &pta_a)); // binbcsr as the second operand
