@@ -248,6 +248,12 @@ template <class F> static inline void ForEachFullRowBlock(const Mat_SeqBinBCSR *
   }
 }
 
+/* The value index of entry (i, j) of a block that ForEachFullRowBlock gives at vb: entry (j, i) of the
+   stored block when it is transposed. */
+static inline PetscInt FullRowEntry(PetscInt vb, bool t, PetscInt i, PetscInt j, PetscInt bs, PetscInt bw)
+{
+  return vb + (t ? j * bs + i : i * bs + j) * bw;
+}
 /* Refuses an operation that symmetric storage does not provide. */
 #define BinBCSRCheckNotSym(a, opname)                                                                                     \
   PetscCheck(                                                                                                             \

@@ -304,7 +304,7 @@ static void FullRowValues(const Mat_SeqBinBCSR *a, const V *val, PetscBool block
   size_t         n = 0;
   /* entry (i, j) of the block at vb: (i, j) of a stored block, (j, i) of a transposed one */
   const auto entry = [&](PetscInt vb, bool t, PetscInt i, PetscInt j) {
-    return (PetscScalar)val[vb + (t ? j * bs + i : i * bs + j) * bw];
+    return (PetscScalar)val[FullRowEntry(vb, t, i, j, bs, bw)];
   };
   for (PetscInt br = 0; br < a->mbs; br++) {
     if (blocked)

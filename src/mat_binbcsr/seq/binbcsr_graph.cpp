@@ -15,8 +15,7 @@ template <typename V> double BlockWeight(const V *val, PetscInt vb, bool t, Pets
 {
   double w = 0;
   for (PetscInt i = 0; i < bs; i++)
-    for (PetscInt j = 0; j < bs; j++)
-      w += PetscAbsReal((PetscReal)val[vb + (t ? j * bs + i : i * bs + j) * bw]);
+    for (PetscInt j = 0; j < bs; j++) w += PetscAbsReal((PetscReal)val[FullRowEntry(vb, t, i, j, bs, bw)]);
   return w;
 }
 } // namespace

@@ -110,7 +110,7 @@ void APValues(const Mat_SeqBinBCSR *a, const V *val, const PetscInt *pi, const P
       for (PetscInt i = 0; i < bs; i++) {
         PetscScalar *out = apv + ai[row0 + i];
         for (PetscInt j = 0; j < bs; j++) {
-          const PetscScalar aij = (PetscScalar)val[vb + (t ? j * bs + i : i * bs + j) * bw];
+          const PetscScalar aij = (PetscScalar)val[FullRowEntry(vb, t, i, j, bs, bw)];
           const PetscInt    r   = bc * bs + j;
           for (PetscInt k = pi[r]; k < pi[r + 1]; k++) out[pos[pj[k]]] += aij * pv[k];
         }
