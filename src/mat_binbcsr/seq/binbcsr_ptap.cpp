@@ -96,7 +96,9 @@ PetscErrorCode APSymbolic(Mat A, Mat P, Mat *AP)
   PetscFunctionReturn(0);
 }
 
-/* AP's values = A P, block by block: row i of block (br, bc) times rows bc bs + j of P. */
+/* AP's values = A P, block by block: column j of block (br, bc) times row bc bs + j of P. The rows of
+   block row br are consecutive in AP and of one length, so an entry of P's row lands at the same place
+   q in each: one lookup serves the bs rows. */
 template <typename V>
 void APValues(const Mat_SeqBinBCSR *a, const V *val, const PetscInt *pi, const PetscInt *pj,
               const PetscScalar *pv, const PetscInt *ai, const PetscInt *aj, PetscInt *pos, PetscScalar *apv)
@@ -104,15 +106,17 @@ void APValues(const Mat_SeqBinBCSR *a, const V *val, const PetscInt *pi, const P
   const PetscInt bs = a->bs, bw = a->bw;
   for (PetscInt br = 0; br < a->mbs; br++) {
     const PetscInt row0 = br * bs, len = ai[row0 + 1] - ai[row0];
-    for (PetscInt p = 0; p < len; p++) pos[aj[ai[row0] + p]] = p; /* the same columns in each row of br */
-    for (PetscInt i = 0; i < bs; i++) std::fill(apv + ai[row0 + i], apv + ai[row0 + i] + len, 0.0);
+    PetscScalar   *out = apv + ai[row0]; /* row i of br at out + i len */
+    for (PetscInt p = 0; p < len; p++) pos[aj[ai[row0] + p]] = p;
+    std::fill(out, out + bs * len, 0.0);
     ForEachFullRowBlock(a, br, [&](PetscInt bc, PetscInt vb, bool t) {
-      for (PetscInt i = 0; i < bs; i++) {
-        PetscScalar *out = apv + ai[row0 + i];
-        for (PetscInt j = 0; j < bs; j++) {
-          const PetscScalar aij = (PetscScalar)val[FullRowEntry(vb, t, i, j, bs, bw)];
-          const PetscInt    r   = bc * bs + j;
-          for (PetscInt k = pi[r]; k < pi[r + 1]; k++) out[pos[pj[k]]] += aij * pv[k];
+      for (PetscInt j = 0; j < bs; j++) {
+        const PetscInt r = bc * bs + j;
+        for (PetscInt k = pi[r]; k < pi[r + 1]; k++) {
+          const PetscInt    q  = pos[pj[k]];
+          const PetscScalar pk = pv[k];
+          for (PetscInt i = 0; i < bs; i++)
+            out[i * len + q] += (PetscScalar)val[FullRowEntry(vb, t, i, j, bs, bw)] * pk;
         }
       }
     });
