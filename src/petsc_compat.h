@@ -36,6 +36,12 @@
   #define BinBCSRVecSetInf(v) VecSetInf(v)
 #endif
 
+/* 3.21 renamed PCGetFailedReasonRank (this rank's reason) to PCGetFailedReason, whose old collective
+   form became PCReduceFailedReason + PCGetFailedReason. */
+#if PETSC_VERSION_GE(3, 21, 0)
+  #define PCGetFailedReasonRank PCGetFailedReason
+#endif
+
 /* 3.22 renamed PetscOptionsGetViewer (the viewer is destroyed with PetscViewerDestroy in both). */
 #if PETSC_VERSION_LT(3, 22, 0)
   #define PetscOptionsCreateViewer PetscOptionsGetViewer

@@ -1,6 +1,7 @@
 #include "sim/pc_failure.h"
 
 #include <petsc/private/pcimpl.h> // whether a PC is set up (its blocks exist)
+#include "petsc_compat.h"         // PCGetFailedReasonRank
 
 #include <cstring>
 
