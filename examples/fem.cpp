@@ -104,15 +104,26 @@ PetscErrorCode GetOptions(Options &o)
     if (given) *given = here;
     PetscFunctionReturn(0);
   };
+  // One number. PETSc 3.22's PetscOptionsReal refuses inf and nan ("Newly set value inf. greater than
+  // allowed bound", not naming the option) before the checks below can say which parameter is wrong: a
+  // value that is not finite is taken as given and reaches them.
+  const auto real = [&](const char *name, const char *help, PetscReal *value) -> PetscErrorCode {
+    PetscReal given = *value;
+    PetscBool here;
+    PetscFunctionBeginUser;
+    PetscCall(PetscOptionsGetReal(nullptr, nullptr, name, &given, &here));
+    if (here && !std::isfinite(given)) *value = given;
+    else PetscCall(PetscOptionsReal(name, help, "", *value, value, nullptr));
+    PetscFunctionReturn(0);
+  };
   PetscCall(PetscOptionsString("-mesh", "gmsh mesh (.msh 2.2/4.1 ASCII) or geometry (.geo, meshed by gmsh)",
                                "", o.mesh, o.mesh, sizeof o.mesh, nullptr));
-  PetscCall(PetscOptionsReal("-mesh_size", "gmsh characteristic length for .geo input", "", o.mesh_size,
-                             &o.mesh_size, nullptr));
+  PetscCall(real("-mesh_size", "gmsh characteristic length for .geo input", &o.mesh_size));
   PetscCheck(o.mesh_size >= 0 && std::isfinite(o.mesh_size), PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
              "-mesh_size must be positive and finite (0: the .geo file's own), not %g", (double)o.mesh_size);
-  PetscCall(PetscOptionsReal("-mesh_max_elements",
-                             "a -mesh_size whose mesh would have about more tetrahedra than this is refused",
-                             "", o.mesh_max_elements, &o.mesh_max_elements, nullptr));
+  PetscCall(real("-mesh_max_elements",
+                 "a -mesh_size whose mesh would have about more tetrahedra than this is refused",
+                 &o.mesh_max_elements));
   PetscCheck(o.mesh_max_elements >= 1 && std::isfinite(o.mesh_max_elements), PETSC_COMM_WORLD,
              PETSC_ERR_ARG_OUTOFRANGE, "-mesh_max_elements must be at least 1 and finite, not %g",
              (double)o.mesh_max_elements);
@@ -130,10 +141,10 @@ PetscErrorCode GetOptions(Options &o)
                              o.corotational, &o.corotational, nullptr));
   PetscCall(PetscOptionsBool("-fem_mass_lumped", "P2: HRZ-lumped instead of consistent mass", "", o.lumped,
                              &o.lumped, nullptr));
-  PetscCall(PetscOptionsReal("-young", "Young's modulus (Pa)", "", o.young, &o.young, nullptr));
-  PetscCall(PetscOptionsReal("-poisson", "Poisson's ratio", "", o.poisson, &o.poisson, nullptr));
-  PetscCall(PetscOptionsReal("-density", "density (kg/m^3)", "", o.density, &o.density, nullptr));
-  PetscCall(PetscOptionsReal("-dt", "time step (s)", "", o.dt, &o.dt, nullptr));
+  PetscCall(real("-young", "Young's modulus (Pa)", &o.young));
+  PetscCall(real("-poisson", "Poisson's ratio", &o.poisson));
+  PetscCall(real("-density", "density (kg/m^3)", &o.density));
+  PetscCall(real("-dt", "time step (s)", &o.dt));
   PetscCall(
     PetscOptionsInt("-steps", "time steps (Newton iterations with -static)", "", o.steps, &o.steps, nullptr));
   PetscCall(numbers("-gravity", "gx,gy,gz", o.gravity, 3, nullptr));
@@ -204,8 +215,7 @@ PetscErrorCode GetOptions(Options &o)
                              "", o.is_static, &o.is_static, nullptr));
   PetscCall(numbers("-initial_velocity", "vx,vy,vz", o.v0, 3, nullptr));
   PetscCall(numbers("-initial_spin", "wx,wy,wz", o.spin, 3, nullptr)); // rigid, about the centroid
-  PetscCall(PetscOptionsReal("-initial_stretch", "scale initial positions about the centroid", "", o.stretch,
-                             &o.stretch, nullptr));
+  PetscCall(real("-initial_stretch", "scale initial positions about the centroid", &o.stretch));
   {
     PetscBool perturb;
     PetscCall(
