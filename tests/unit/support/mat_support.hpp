@@ -110,10 +110,11 @@ inline Pattern wild_pattern(PetscInt mbs, PetscInt bs, PetscInt longrow)
   return p;
 }
 
-// Creates and assembles `type` from the pattern through MatSetValues (one entry at a time, a
-// shuffled order so staging sees unsorted input). bw/precision are applied to binbcsr matrices.
-inline Mat build(const Pattern &p, MatType type, PetscInt bw = 0,
-                 MatBinBCSRPrecision prec = MAT_BINBCSR_PRECISION_DOUBLE)
+// An empty `type` of the pattern's sizes and block size, not yet set up; bin width (0: the default),
+// precision and storage are applied to binbcsr matrices (the setters do nothing to other types).
+inline Mat create_unfilled(const Pattern &p, MatType type, PetscInt bw = 0,
+                           MatBinBCSRPrecision prec = MAT_BINBCSR_PRECISION_DOUBLE,
+                           PetscBool           sym  = PETSC_FALSE)
 {
   Mat A = nullptr;
   REQUIRE(MatCreate(PETSC_COMM_SELF, &A) == 0);
@@ -122,6 +123,16 @@ inline Mat build(const Pattern &p, MatType type, PetscInt bw = 0,
   REQUIRE(MatSetType(A, type) == 0);
   if (bw) REQUIRE(MatBinBCSRSetBinWidth(A, bw) == 0);
   REQUIRE(MatBinBCSRSetPrecision(A, prec) == 0);
+  if (sym) REQUIRE(MatBinBCSRSetSymmetricStorage(A, sym) == 0);
+  return A;
+}
+
+// Creates and assembles `type` from the pattern through MatSetValues (one entry at a time, a
+// shuffled order so staging sees unsorted input). bw/precision are applied to binbcsr matrices.
+inline Mat build(const Pattern &p, MatType type, PetscInt bw = 0,
+                 MatBinBCSRPrecision prec = MAT_BINBCSR_PRECISION_DOUBLE)
+{
+  Mat A = create_unfilled(p, type, bw, prec);
   REQUIRE(MatSetUp(A) == 0);
   std::vector<size_t> order(p.entries.size());
   for (size_t k = 0; k < order.size(); k++) order[k] = (k * 7919) % order.size();

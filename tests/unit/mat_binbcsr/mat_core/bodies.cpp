@@ -33,14 +33,7 @@ TEST_CASE("every body set gives the portable product up to rounding", "[mat_core
     fem_pattern(49, 3, 2, bs),                // unit-stride and gathered groups
   };
   for (const Pattern &p : patterns) {
-    Mat A = nullptr;
-    REQUIRE(MatCreate(PETSC_COMM_SELF, &A) == 0);
-    REQUIRE(MatSetSizes(A, p.m, p.n, p.m, p.n) == 0);
-    REQUIRE(MatSetBlockSize(A, p.bs) == 0);
-    REQUIRE(MatSetType(A, MATSEQBINBCSR) == 0);
-    REQUIRE(MatBinBCSRSetBinWidth(A, bw) == 0);
-    REQUIRE(MatBinBCSRSetPrecision(A, prec) == 0);
-    REQUIRE(MatBinBCSRSetSymmetricStorage(A, sym) == 0);
+    Mat A = create_unfilled(p, MATSEQBINBCSR, bw, prec, sym);
     REQUIRE(MatSetUp(A) == 0);
     for (const Entry &e : p.entries) REQUIRE(MatSetValue(A, e.i, e.j, e.v, INSERT_VALUES) == 0);
     REQUIRE(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY) == 0);

@@ -14,14 +14,7 @@ Mat build_coo(const Pattern &p, PetscInt bw, MatBinBCSRPrecision prec, PetscBool
   std::vector<PetscInt>    ci, cj;
   std::vector<PetscScalar> cv;
   for (const Entry &e : p.entries) ci.push_back(e.i), cj.push_back(e.j), cv.push_back(e.v);
-  Mat A;
-  REQUIRE(MatCreate(PETSC_COMM_SELF, &A) == 0);
-  REQUIRE(MatSetSizes(A, p.m, p.n, p.m, p.n) == 0);
-  REQUIRE(MatSetBlockSize(A, p.bs) == 0);
-  REQUIRE(MatSetType(A, MATSEQBINBCSR) == 0);
-  REQUIRE(MatBinBCSRSetBinWidth(A, bw) == 0);
-  REQUIRE(MatBinBCSRSetPrecision(A, prec) == 0);
-  REQUIRE(MatBinBCSRSetSymmetricStorage(A, sym) == 0);
+  Mat A = create_unfilled(p, MATSEQBINBCSR, bw, prec, sym);
   REQUIRE(MatSetPreallocationCOO(A, (PetscCount)ci.size(), ci.data(), cj.data()) == 0);
   REQUIRE(MatSetValuesCOO(A, cv.data(), INSERT_VALUES) == 0);
   return A;
