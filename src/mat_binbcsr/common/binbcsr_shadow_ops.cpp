@@ -7,8 +7,9 @@
    - Matrix products (MatProduct AB, AtB, ABt, PtAP, RARt, ABC: GAMG's prolongator smoothing A P and
      its coarse operators P^T A P) where any operand is binbcsr: PETSc's AIJ product of the operands with
      each binbcsr one replaced by its shadow. Except P^T A P of a sequential binbcsr and a SeqAIJ P
-     (GAMG's Galerkin products on one rank): A P from the blocks, no shadow (seq/binbcsr_ptap.cpp). The result is AIJ (so are GAMG's coarse levels); the fine
-     level keeps the binbcsr operator and its fast MatMult for the smoothers.
+     (GAMG's Galerkin products on one rank): A P from the blocks, no shadow (seq/binbcsr_ptap.cpp).
+     The result is AIJ (so are GAMG's coarse levels); the fine level keeps the binbcsr operator and its
+     fast MatMult for the smoothers.
 
    A product is routed once, at its symbolic phase: the operands in the product are swapped for their
    shadows, PETSc's AIJ dispatch (MatProductSetFromOptions) picks the AIJ symbolic routine and runs it
