@@ -60,8 +60,9 @@ struct FemSimulation {
   std::vector<double>       f_gravity;
   double                    dt = 0, rhs_gravity_scale = 0;
   bool                      is_static = false;
-  bool                      cpu_timer = false; // FemStepInfo times in process CPU time instead of wall time
-  physics::ElementKernel    element_kernel = physics::ElementKernel::Batched; // Scalar: the reference loop
+  bool rigid_body_modes = false; // the near null space is the rigid body modes (given again at a set-up)
+  bool cpu_timer        = false; // FemStepInfo times in process CPU time instead of wall time
+  physics::ElementKernel element_kernel = physics::ElementKernel::Batched; // Scalar: the reference loop
   binbcsr::BodySet element_body = binbcsr::BodySet::Auto; // the batched loop's body set (element_batch.hpp)
   // The solve's initial guess (with a nonzero-guess KSP): the last dv (0), or extrapolated from the last
   // two (1, linear) or three (2, quadratic) dv: under smooth motion the next dv is close to that, and

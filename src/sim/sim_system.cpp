@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstring>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -287,6 +288,18 @@ PetscErrorCode BlockSystemSetRigidBodyModes(BlockSystem *sys, const PetscScalar 
   PetscCall(MatSetNearNullSpace(sys->A, modes));
   PetscCall(MatNullSpaceDestroy(&modes));
   PetscCall(VecDestroy(&coords));
+  { // PCGAMG reads a near null space at its first set-up only; coordinates, at each set-up that builds
+    // its coarse space
+    PC        pc;
+    PetscBool gamg, set;
+    PetscCall(KSPGetPC(sys->ksp, &pc));
+    PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &gamg));
+    PetscCall(PCGetOperatorsSet(pc, nullptr, &set));
+    if (gamg && set) {
+      std::vector<PetscReal> xyz(coords_local, coords_local + (sys->row_end - sys->row_begin));
+      PetscCall(PCSetCoordinates(pc, 3, (sys->row_end - sys->row_begin) / 3, xyz.data()));
+    }
+  }
   PetscFunctionReturn(0);
 }
 
@@ -369,9 +382,20 @@ PetscErrorCode BlockSystemSolve(BlockSystem *sys, const PetscScalar *rhs_local, 
   if (nonzero_guess && sys->guess_scaled) PetscCall(ScaleGuess(sys, stats));
   PetscBool reuse, rebuild = PETSC_FALSE;
   PetscCall(KSPGetReusePreconditioner(sys->ksp, &reuse));
-  if (reuse && sys->rebuild_next) { // this solve sets the preconditioner up again (before the copies look)
+  if (reuse && sys->rebuild_next) { // the preconditioner set up again on this matrix, before the solve
+    PC        pc;
+    PetscBool gamg;
+    PetscCall(KSPGetPC(sys->ksp, &pc));
+    PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &gamg));
+    // GAMG: a new coarse space, not only new Galerkin products of the old interpolation
+    if (gamg) PetscCall(PCGAMGSetReuseInterpolation(pc, PETSC_FALSE));
     PetscCall(KSPSetReusePreconditioner(sys->ksp, PETSC_FALSE));
+    PetscCall(GAMGSmootherCopiesUpdate(sys->ksp, &sys->gamg_copies)); // (hands GAMG its own levels back)
+    PetscCall(PCSetUp(pc));
+    // reused again before KSPSolve, which would otherwise reset the initial guess's history
+    PetscCall(KSPSetReusePreconditioner(sys->ksp, PETSC_TRUE));
     rebuild = PETSC_TRUE;
+    sys->pc_rebuilds++;
   }
   PetscCall(GAMGSmootherCopiesUpdate(sys->ksp, &sys->gamg_copies));
   PetscCall(KSPSolve(sys->ksp, sys->b, sys->x));
@@ -379,13 +403,9 @@ PetscErrorCode BlockSystemSolve(BlockSystem *sys, const PetscScalar *rhs_local, 
   PetscInt     its;
   PetscCall(KSPGetIterationNumber(sys->ksp, &its));
   if (reuse) {
-    if (rebuild) {
-      PetscCall(KSPSetReusePreconditioner(sys->ksp, PETSC_TRUE));
-      sys->pc_rebuilds++;
-    }
-    if (rebuild || sys->its_after_setup < 0) sys->its_after_setup = its;
+    if (rebuild || sys->fewest_its < 0 || its < sys->fewest_its) sys->fewest_its = its;
     // the same on every rank: the iteration count is the KSP's, collective
-    sys->rebuild_next = sys->reuse_growth > 0 && its > sys->reuse_growth * PetscMax(sys->its_after_setup, 1)
+    sys->rebuild_next = sys->reuse_growth > 0 && its > sys->reuse_growth * PetscMax(sys->fewest_its, 1)
                           ? PETSC_TRUE
                           : PETSC_FALSE;
   }

@@ -51,14 +51,16 @@ struct BlockSystem {
   PetscBool guess_scaled = PETSC_FALSE;
   Vec       r            = nullptr;
   // -reuse_preconditioner_growth G (with -ksp_reuse_preconditioner): once a solve takes more than G
-  // times the iterations of the first solve after the last set-up, the next solve sets the
+  // times the fewest iterations of a solve since the last set-up, the next solve sets the
   // preconditioner up again on the current matrix (0: never). A reused set-up goes stale as the
-  // corotational matrix turns: linear_38k's GAMG needed 14 iterations per solve over 20 steps and 48 on
-  // average over 100 (docs/fem.md).
-  PetscReal reuse_growth    = 0;
-  PetscInt  its_after_setup = -1; // iterations of the first solve after the last set-up (-1: none yet)
-  PetscBool rebuild_next    = PETSC_FALSE;
-  PetscInt  pc_rebuilds     = 0; // set-ups forced by reuse_growth
+  // corotational matrix turns: GAMG's coarse space holds the rigid body modes of the shape it was built
+  // on (docs/fem_timings.md). Such a set-up builds GAMG's interpolation again (from the near null space
+  // or coordinates given since, BlockSystemSetRigidBodyModes) and keeps the KSP's initial guess history
+  // (PETSc resets it at a solve that sets its preconditioner up).
+  PetscReal reuse_growth = 0;
+  PetscInt  fewest_its   = -1; // fewest iterations of a solve since the last set-up (-1: none yet)
+  PetscBool rebuild_next = PETSC_FALSE;
+  PetscInt  pc_rebuilds  = 0; // set-ups forced by reuse_growth
 };
 
 struct SolveStats {
@@ -88,7 +90,9 @@ PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, P
 
 // The rigid body modes (3 translations, 3 rotations) of this rank's nodes (coords_local: 3 per block
 // row, in the rows' order) as the matrix's near null space, from which PCGAMG (and ML) build their
-// coarse spaces for elasticity; other preconditioners ignore it.
+// coarse spaces for elasticity; other preconditioners ignore it. Once the KSP has its operators the
+// coordinates also go to PCGAMG, which builds its next coarse space from them (collective): call it
+// again with the current shape before a set-up.
 PetscErrorCode BlockSystemSetRigidBodyModes(BlockSystem *sys, const PetscScalar *coords_local);
 
 // block_values: 9 * n_coo_blocks values, block k row-major at [9k, 9k+9). Summed over duplicates,
