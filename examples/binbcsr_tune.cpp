@@ -30,6 +30,7 @@
 #include <petscbinbcsr.h>
 #include "sim/stencil.h"
 #include "sim/bench_util.h"
+#include "sim/matrix_file.h"
 #include "sim/tune_sweep.h"
 #include <ctime>
 #include <string>
@@ -158,8 +159,11 @@ int main(int argc, char **argv)
   }
 
   {
-    PetscBool sweep = PETSC_FALSE;
+    PetscBool sweep = PETSC_FALSE, files;
     PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-sweep", &sweep, nullptr));
+    PetscCall(PetscOptionsHasName(nullptr, nullptr, "-f", &files));
+    PetscCheck(sweep || !files, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG,
+               "binbcsr_tune: -f FILE is swept with -sweep; the table without it is for the stencil only");
     if (sweep) {
       SweepSettings s;
       char          buf[4096] = "";
@@ -201,13 +205,7 @@ int main(int argc, char **argv)
       }
       PetscCall(PetscOptionsGetString(nullptr, nullptr, "-f", buf, sizeof buf, &flg));
       for (const std::string &f : flg ? SplitList(buf) : std::vector<std::string>{}) {
-        PetscViewer v;
-        PetscCall(PetscViewerBinaryOpen(PETSC_COMM_SELF, f.c_str(), FILE_MODE_READ, &v));
-        PetscCall(MatCreate(PETSC_COMM_SELF, &aij));
-        PetscCall(MatSetType(aij, MATSEQAIJ));
-        PetscCall(MatSetBlockSize(aij, bs));
-        PetscCall(MatLoad(aij, v));
-        PetscCall(PetscViewerDestroy(&v));
+        PetscCall(LoadMatrixFile(PETSC_COMM_SELF, f, bs, &aij));
         PetscCall(TuneSweep(f.substr(f.find_last_of('/') == std::string::npos ? 0 : f.find_last_of('/') + 1),
                             aij, s));
         PetscCall(MatDestroy(&aij));

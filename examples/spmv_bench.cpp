@@ -34,9 +34,9 @@
 //            slots / upper blocks - 1
 //   + 8 N (x) + 8 N (y)
 #include <petscbinbcsr.h>
-#include <sys/stat.h>
 
 #include "sim/bench_util.h"
+#include "sim/matrix_file.h"
 #include "sim/stencil.h"
 #include "sim/read_bw.h"
 #include "sim/stream.h"
@@ -83,73 +83,6 @@ struct Candidate {
   double              bytes = 0, padding = -1, padding_info = -1, rel_err = 0;
   PetscInt            bin_width = 0;
 };
-
-// Checks a PETSc binary matrix file's row lengths (none negative, their sum the stored count) and column
-// indices (in [0, N)) on rank 0, before MatLoad: PETSc 3.18's MatLoad of AIJ takes a file with a negative
-// row length whose lengths still sum to the count, and the matrix then crashed MatIsSymmetric, and one
-// with a column past N gave seqaij products that the other formats refused.
-PetscErrorCode CheckMatrixFile(MPI_Comm comm, const std::string &path)
-{
-  PetscMPIInt rank;
-  char        why[256] = "";
-
-  PetscFunctionBegin;
-  PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  if (!rank) {
-    int fd;
-    PetscCall(PetscBinaryOpen(path.c_str(), FILE_MODE_READ, &fd));
-    PetscInt header[4];
-    PetscCall(PetscBinaryRead(fd, header, 4, nullptr, PETSC_INT));
-    const PetscInt M = header[1], N = header[2], nz = header[3];
-    if (header[0] != MAT_FILE_CLASSID) std::snprintf(why, sizeof why, "not a PETSc matrix (class id %d)", (int)header[0]);
-    else if (M < 0 || N < 0 || nz < 0) std::snprintf(why, sizeof why, "negative sizes %d x %d, %d entries", (int)M, (int)N, (int)nz);
-    else { // sizes the file cannot hold are not allocated: 4 bytes per row length, 12 per entry
-      struct stat st;
-      if (stat(path.c_str(), &st) == 0 && 16.0 + 4.0 * M + 12.0 * nz > (double)st.st_size)
-        std::snprintf(why, sizeof why, "%d rows and %d entries do not fit its %lld bytes", (int)M, (int)nz,
-                      (long long)st.st_size);
-    }
-    if (!why[0]) {
-      std::vector<PetscInt> lengths(M), cols(nz);
-      PetscInt              read = 0;
-      PetscCall(PetscBinaryRead(fd, lengths.data(), M, &read, PETSC_INT));
-      long long sum = 0;
-      for (PetscInt r = 0; r < M && !why[0]; ++r) {
-        if (lengths[r] < 0 || lengths[r] > N)
-          std::snprintf(why, sizeof why, "row %d has length %d (N = %d)", (int)r, (int)lengths[r], (int)N);
-        sum += lengths[r];
-      }
-      if (!why[0] && (read != M || sum != nz))
-        std::snprintf(why, sizeof why, "the row lengths sum to %lld, not the %d entries stored", sum, (int)nz);
-      if (!why[0]) {
-        PetscCall(PetscBinaryRead(fd, cols.data(), nz, &read, PETSC_INT));
-        if (read != nz) std::snprintf(why, sizeof why, "%lld of %d column indices present", (long long)read, (int)nz);
-        for (PetscInt k = 0; k < nz && !why[0]; ++k)
-          if (cols[k] < 0 || cols[k] >= N)
-            std::snprintf(why, sizeof why, "entry %d has column %d, outside [0, %d)", (int)k, (int)cols[k], (int)N);
-      }
-    }
-    PetscCall(PetscBinaryClose(fd));
-  }
-  PetscCallMPI(MPI_Bcast(why, sizeof why, MPI_CHAR, 0, comm));
-  PetscCheck(!why[0], comm, PETSC_ERR_FILE_UNEXPECTED, "%s: %s", path.c_str(), why);
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode LoadAIJ(MPI_Comm comm, const std::string &path, PetscInt bs, Mat *A)
-{
-  PetscViewer viewer;
-
-  PetscFunctionBegin;
-  PetscCall(CheckMatrixFile(comm, path));
-  PetscCall(PetscViewerBinaryOpen(comm, path.c_str(), FILE_MODE_READ, &viewer));
-  PetscCall(MatCreate(comm, A));
-  PetscCall(MatSetType(*A, MATAIJ));
-  if (bs > 0) PetscCall(MatSetBlockSize(*A, bs));
-  PetscCall(MatLoad(*A, viewer));
-  PetscCall(PetscViewerDestroy(&viewer));
-  PetscFunctionReturn(0);
-}
 
 // One pass over the aij rows: scalar row lengths, SELL slots, block row lengths, upper blocks.
 PetscErrorCode MeasureStats(Mat aij, MatrixStats *st)
@@ -305,7 +238,7 @@ PetscErrorCode BenchMatrix(MPI_Comm comm, const MatrixSource &src, const Setting
 
   PetscFunctionBegin;
   if (src.is_file) {
-    PetscCall(LoadAIJ(comm, src.path, set.file_bs, &aij_file));
+    PetscCall(LoadMatrixFile(comm, src.path, set.file_bs, &aij_file));
     // Assembled FE matrices are symmetric only up to the rounding of their sums: tolerance relative
     // to the largest entry.
     PetscBool symmetric = PETSC_FALSE;
@@ -556,8 +489,8 @@ int main(int argc, char **argv)
   { /* -bs: the files' block size, or not given (0: the file's own); 0 and negatives were taken silently */
     PetscBool bs_set;
     PetscCall(PetscOptionsHasName(nullptr, nullptr, "-bs", &bs_set));
-    PetscCheck(!bs_set || set.file_bs >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-bs must be >= 1, not %" PetscInt_FMT,
-               set.file_bs);
+    PetscCheck(!bs_set || set.file_bs >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE,
+               "-bs must be >= 1, not %" PetscInt_FMT, set.file_bs);
   }
 
   std::vector<MatrixSource> sources;

@@ -32,7 +32,9 @@ foreach(case
     "spmv_bs0|-bs must be >= 1|spmv_bench|-stencil_sizes 0 -bs 0"
     "tune_streams_list|-streams takes at most 4 stream counts|binbcsr_tune|-stencil_n 8 -streams 1,2,4,8,1"
     "tune_sweep_confirm|-sweep_confirm must be >= 0|binbcsr_tune|-sweep -stencil_sizes 4 -sweep_confirm -1"
-    "spmv_sizes_list|-stencil_sizes takes at most 16 sizes|spmv_bench|-stencil_sizes 1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17")
+    "spmv_sizes_list|-stencil_sizes takes at most 16 sizes|spmv_bench|-stencil_sizes 1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17"
+    "tune_file_without_sweep|-f FILE is swept with -sweep|binbcsr_tune|-stencil_n 4 -f no_such_file.bin"
+    "solve_rtol_nan|-rtol must be in .0, 1., not nan|solve_bench|-stencil_n 4 -rtol nan")
   string(REPLACE "|" ";" parts "${case}")
   list(GET parts 0 name)
   list(GET parts 1 regex)
@@ -48,6 +50,16 @@ add_test(NAME bench_bad_matrix_file
          COMMAND ${EXPECT_RUN} nonzero "corrupt_matrix.bin: row 0 has length -3"
                  -- sh -c "cp ${PETSC_DATAFILES_DIR}/matrices/spd-real-int32-float64 corrupt_matrix.bin && chmod u+w corrupt_matrix.bin && printf '\\377\\377\\377\\375' | dd of=corrupt_matrix.bin bs=1 seek=16 conv=notrunc 2>/dev/null && $<TARGET_FILE:spmv_bench> -stencil_sizes 0 -f corrupt_matrix.bin -repeats 1")
 set_tests_properties(bench_bad_matrix_file PROPERTIES LABELS "bench" TIMEOUT 60)
+# The same file with its first value NaN (spmv_bench printed NaN errors for every format), and with its
+# first column -7 for binbcsr_tune -sweep (PETSc's MatLoad dropped the entry and the sweep timed another
+# matrix): both benchmarks check files through src/sim/matrix_file.h.
+add_test(NAME bench_bad_matrix_file_nan
+         COMMAND ${EXPECT_RUN} nonzero "nan_matrix.bin: entry 0 is not finite"
+                 -- sh -c "cp ${PETSC_DATAFILES_DIR}/matrices/spd-real-int32-float64 nan_matrix.bin && chmod u+w nan_matrix.bin && printf '\\177\\370\\000\\000\\000\\000\\000\\000' | dd of=nan_matrix.bin bs=1 seek=248 conv=notrunc 2>/dev/null && $<TARGET_FILE:spmv_bench> -stencil_sizes 0 -f nan_matrix.bin -repeats 1")
+add_test(NAME bench_bad_matrix_file_sweep
+         COMMAND ${EXPECT_RUN} nonzero "column_matrix.bin: entry 0 has column -7"
+                 -- sh -c "cp ${PETSC_DATAFILES_DIR}/matrices/spd-real-int32-float64 column_matrix.bin && chmod u+w column_matrix.bin && printf '\\377\\377\\377\\371' | dd of=column_matrix.bin bs=1 seek=64 conv=notrunc 2>/dev/null && $<TARGET_FILE:binbcsr_tune> -sweep -stencil_sizes 0 -repeats 1 -f column_matrix.bin")
+set_tests_properties(bench_bad_matrix_file_nan bench_bad_matrix_file_sweep PROPERTIES LABELS "bench" TIMEOUT 60)
 # An overflowing shift: every solve meets Inf (DIVERGED_NANORINF). Those are not timed, and the targets
 # say they were not measured (the speed-up column printed NaN beside the reason).
 add_test(NAME bench_solve_overflow_not_timed
