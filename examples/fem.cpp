@@ -246,6 +246,11 @@ PetscErrorCode GetOptions(Options &o)
                "-gravity, -initial_velocity and -initial_spin must be finite");
   PetscCheck(std::isfinite(o.rayleigh[0]) && std::isfinite(o.rayleigh[1]) && std::isfinite(o.stretch),
              PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-rayleigh and -initial_stretch must be finite");
+  // 0 puts every node on the centroid: no element has a shape, and so none a rotation to start from
+  // (negative values invert the body, the inversion demo)
+  PetscCheck(
+    o.stretch != 0, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+    "-initial_stretch 0 collapses every element to a point; give a nonzero scale (negative inverts)");
   // D = alpha M + beta K: a negative coefficient feeds energy in instead of taking it out.
   PetscCheck(o.rayleigh[0] >= 0 && o.rayleigh[1] >= 0, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
              "-rayleigh alpha,beta must be >= 0 (negative damping adds energy), got %g,%g",

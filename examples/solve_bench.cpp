@@ -252,6 +252,9 @@ int main(int argc, char **argv)
   PetscCheck(repeats >= 1 && timed_its >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE,
              "-repeats and -timed_its must be >= 1 (got %" PetscInt_FMT " and %" PetscInt_FMT ")", repeats,
              timed_its);
+  /* KSPSetTolerances refuses it for every pair alike: one message before the matrices are built */
+  PetscCheck(rtol >= 0 && rtol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-rtol must be in [0, 1), not %g",
+             (double)rtol);
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-history_its", &history_its, nullptr));
   PetscCall(MPI_Comm_size(comm, &size));
 
@@ -387,8 +390,9 @@ int main(int argc, char **argv)
   for (const Run &r : runs) {
     if (r.solver.label != "mcg" || r.format.type != MATBINBCSR) continue;
     if (!r.ksp || !cg_baij) {
-      PetscCall(PetscPrintf(comm, "target: mcg+%s per iteration vs cg+baij: not measured (%s has no timing, above)\n",
-                            r.format.label.c_str(), !r.ksp ? ("mcg+" + r.format.label).c_str() : "cg+baij"));
+      PetscCall(
+        PetscPrintf(comm, "target: mcg+%s per iteration vs cg+baij: not measured (%s has no timing, above)\n",
+                    r.format.label.c_str(), !r.ksp ? ("mcg+" + r.format.label).c_str() : "cg+baij"));
       continue;
     }
     const double target              = r.format.single ? 1.8 : 1.15,

@@ -31,6 +31,11 @@ fem_test(fem_bad_mesh_error nonzero "cannot open mesh file" ${FEM} -mesh /nonexi
 fem_test(fem_bad_option_error nonzero "-fix .*expected none" ${FEM} ${FEM_SMALL} -fix middle)
 fem_test(fem_bad_material_error nonzero "Poisson" ${FEM} ${FEM_SMALL} -poisson 0.5)
 fem_test(fem_bad_infinite_young nonzero "need a finite Young's modulus" ${FEM} ${FEM_SMALL} -young inf)
+fem_test(fem_bad_zero_stretch nonzero "-initial_stretch 0 collapses every element to a point" ${FEM} ${FEM_SMALL}
+         -initial_stretch 0)
+# -ksp_rtol nan reached the KSP unchecked (KSPSetFromOptions stores it without KSPSetTolerances' test):
+# CG ran to its iteration limit and the step was called converged
+fem_test(fem_bad_rtol_nan nonzero "the solver's tolerances: -ksp_rtol nan" ${FEM} ${FEM_SMALL} -ksp_rtol nan)
 fem_test(fem_bad_fix_fraction nonzero "-fix xmin:nan: the fraction after ':' must be a number in" ${FEM} ${FEM_SMALL} -fix xmin:nan)
 fem_test(fem_bad_box_counts nonzero "cell counts nx,ny,nz must be whole numbers" ${FEM} -mesh_box 1,1,1,1e300,2,2 -steps 1)
 fem_test(fem_bad_box_too_many nonzero "6e\\+15 tetrahedra, more than 32-bit" ${FEM} -mesh_box 1,1,1,100000,100000,100000 -steps 1)

@@ -113,6 +113,14 @@ PetscErrorCode KSPSolve_MCG(KSP ksp)
   PetscCall(PCGetDiagonalScale(ksp->pc, &diagonalscale));
   PetscCheck(!diagonalscale, PetscObjectComm((PetscObject)ksp), PETSC_ERR_SUP,
              "Krylov method %s does not support diagonal scaling", ((PetscObject)ksp)->type_name);
+  /* -ksp_rtol and friends reach ksp->rtol without KSPSetTolerances' checks: a NaN compared false in
+     every test below, and the solve ran to its maximum and reported the matrix indefinite */
+  PetscCheck(
+    !PetscIsNanReal(ksp->rtol) && !PetscIsNanReal(ksp->abstol) && !PetscIsNanReal(ksp->divtol),
+    PetscObjectComm((PetscObject)ksp), PETSC_ERR_ARG_OUTOFRANGE,
+    "KSPMCG: tolerances rtol %g, abstol %g, divtol %g: NaN is not a tolerance (-ksp_rtol, -ksp_atol, "
+    "-ksp_divtol)",
+    (double)ksp->rtol, (double)ksp->abstol, (double)ksp->divtol);
   X = ksp->vec_sol;
   B = ksp->vec_rhs;
   R = ksp->work[0];

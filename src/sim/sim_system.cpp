@@ -262,6 +262,16 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
     PetscCall(PCSetType(pc, PCJACOBI)); // what the seed uses; works for every Mat type
   }
   PetscCall(KSPSetFromOptions(sys->ksp));
+  { // KSPSetFromOptions stores -ksp_rtol and friends without KSPSetTolerances' checks; NaN ran CG to its
+    // iteration limit and called the result converged
+    PetscReal rtol, abstol, divtol;
+    PetscInt  max_it;
+    PetscCall(KSPGetTolerances(sys->ksp, &rtol, &abstol, &divtol, &max_it));
+    PetscCheck(rtol >= 0 && rtol < 1 && abstol >= 0 && !PetscIsNanReal(divtol), comm,
+               PETSC_ERR_ARG_OUTOFRANGE,
+               "the solver's tolerances: -ksp_rtol %g (in [0, 1)), -ksp_atol %g (>= 0), -ksp_divtol %g",
+               (double)rtol, (double)abstol, (double)divtol);
+  }
   PetscCall(PetscOptionsGetBool(nullptr, nullptr, "-initial_guess_scaled", &sys->guess_scaled, nullptr));
   if (sys->guess_scaled) PetscCall(VecDuplicate(sys->b, &sys->r));
   PetscCall(

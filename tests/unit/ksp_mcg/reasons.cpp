@@ -139,6 +139,20 @@ TEST_CASE("an unattainable tolerance is not reported as converged", "[ksp_mcg][r
   VecDestroy(&b);
 }
 
+TEST_CASE("a NaN tolerance from the options database is an error, not a breakdown", "[ksp_mcg][reasons]")
+{
+  // -ksp_rtol nan reached the solve unchecked: it ran to max_it and reported DIVERGED_INDEFINITE_MAT
+  Mat A = diagonal({3, 2, 1, 4});
+  Vec b = rhs(A);
+  for (const char *opt : {"-ksp_rtol nan", "-ksp_atol nan", "-ksp_divtol nan"}) {
+    CAPTURE(opt);
+    Result r = solve(A, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_DEFAULT, 1e-10, 1000, 0, opt});
+    CHECK(r.err == PETSC_ERR_ARG_OUTOFRANGE);
+  }
+  MatDestroy(&A);
+  VecDestroy(&b);
+}
+
 TEST_CASE("errors on bad setter input", "[ksp_mcg]")
 {
   KSP ksp;
