@@ -124,13 +124,19 @@ static bool ReadCache(const std::string &path, std::map<std::string, BinBCSRTune
   return true;
 }
 
-static PetscErrorCode WarnCorrupt(const std::string &path, const std::string &why)
+/* not_file: the path is there but is no regular file (a directory, say), which no tuning can replace */
+static PetscErrorCode WarnCorrupt(const std::string &path, const std::string &why, bool not_file)
 {
   static bool warned = false;
 
   PetscFunctionBegin;
   PetscCall(PetscInfo(nullptr, "Ignoring the tuning cache %s: %s\n", path.c_str(), why.c_str()));
-  if (!warned)
+  if (!warned && not_file)
+    PetscCall(PetscFPrintf(PETSC_COMM_SELF, PETSC_STDERR,
+                           "petscbinbcsr: ignoring the tuning cache %s (%s); tuning choices are not kept "
+                           "(-mat_binbcsr_tune_cache 0 stops looking)\n",
+                           path.c_str(), why.c_str()));
+  else if (!warned)
     PetscCall(PetscFPrintf(
       PETSC_COMM_SELF, PETSC_STDERR,
       "petscbinbcsr: ignoring the corrupt tuning cache %s (%s); it is rewritten by the next tuning\n",
@@ -145,7 +151,7 @@ static PetscErrorCode WarnCorrupt(const std::string &path, const std::string &wh
    another version, written by this process or another one. */
 struct CacheMemo {
   std::string                              path;
-  bool                                     valid = false, parsed = false;
+  bool                                     valid = false, parsed = false, not_file = false;
   dev_t                                    dev   = 0;
   ino_t                                    ino   = 0;
   off_t                                    size  = 0;
@@ -163,6 +169,12 @@ static const CacheMemo &CachedFile(const std::string &path)
     memo        = CacheMemo();
     memo.parsed = true;
     return memo; /* no file: nothing cached, and nothing kept for a file that appears later */
+  }
+  if (!S_ISREG(st.st_mode)) {
+    memo          = CacheMemo();
+    memo.not_file = true;
+    memo.why      = "not a regular file";
+    return memo;
   }
   if (memo.valid && memo.path == path && memo.dev == st.st_dev && memo.ino == st.st_ino &&
       memo.size == st.st_size && memo.mtime.tv_sec == st.st_mtim.tv_sec &&
@@ -188,7 +200,7 @@ PetscErrorCode BinBCSRTuneCacheLookup(const std::string &key, BinBCSRTuneChoice 
   if (path.empty()) PetscFunctionReturn(0);
   const CacheMemo &file = CachedFile(path);
   if (!file.parsed) {
-    PetscCall(WarnCorrupt(path, file.why));
+    PetscCall(WarnCorrupt(path, file.why, file.not_file));
     PetscFunctionReturn(0);
   }
   auto it = file.entries.find(key);

@@ -463,6 +463,19 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
     CHECK(ss.str().find(key + "\t") != std::string::npos);    // the new choice
     CHECK(ss.str().find("Another CPU") != std::string::npos); // other machines' entries kept
   }
+  // the cache's path taken by a folder: read as no file, measured, the folder left alone
+  REQUIRE(std::remove(file.c_str()) == 0);
+  REQUIRE(mkdir(file.c_str(), 0755) == 0);
+  {
+    Mat C = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
+    CHECK(info_view(C).find("measured on block rows") != std::string::npos);
+    check_same(C, A, p);
+    MatDestroy(&C);
+    struct stat st;
+    REQUIRE(stat(file.c_str(), &st) == 0);
+    CHECK(S_ISDIR(st.st_mode));
+    REQUIRE(rmdir(file.c_str()) == 0);
+  }
   // an unreadable cache folder: no file written, no error
   setenv("XDG_CACHE_HOME", "/proc/no/such/folder", 1);
   Mat C = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
