@@ -35,7 +35,9 @@ fem_test(fem_bad_zero_stretch nonzero "-initial_stretch 0 collapses every elemen
          -initial_stretch 0)
 # -ksp_rtol nan reached the KSP unchecked (KSPSetFromOptions stores it without KSPSetTolerances' test):
 # CG ran to its iteration limit and the step was called converged
-fem_test(fem_bad_rtol_nan nonzero "the solver's tolerances: -ksp_rtol nan" ${FEM} ${FEM_SMALL} -ksp_rtol nan)
+# (PETSc 3.22's KSPSetFromOptions refuses it itself, with its own message)
+fem_test(fem_bad_rtol_nan nonzero "(the solver's tolerances: -ksp_rtol nan|Newly set value nan)" ${FEM} ${FEM_SMALL}
+         -ksp_rtol nan)
 fem_test(fem_bad_fix_fraction nonzero "-fix xmin:nan: the fraction after ':' must be a number in" ${FEM} ${FEM_SMALL} -fix xmin:nan)
 fem_test(fem_bad_box_counts nonzero "cell counts nx,ny,nz must be whole numbers" ${FEM} -mesh_box 1,1,1,1e300,2,2 -steps 1)
 fem_test(fem_bad_box_too_many nonzero "6e\\+15 tetrahedra, more than 32-bit" ${FEM} -mesh_box 1,1,1,100000,100000,100000 -steps 1)
@@ -88,13 +90,18 @@ fem_test(fem_mpi2_gamg_reuse_growth_rebuilds 0 "ranks=2 .*pc_rebuilds=[1-9][0-9]
          ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_BEAM_GAMG_REUSE})
 set_tests_properties(fem_mpi2_gamg_reuse_growth_rebuilds PROPERTIES LABELS "fem;mpi")
 # Over 150 steps the beam swings and bends: with G = 1.5 the set-ups forced by the rule build GAMG's
-# coarse space from the current shape and keep the projected guess's history, 13.4 CG iterations per
-# solve (5 set-ups); when they kept the rest shape's coarse space the rule never fired: 15.1.
-fem_test(fem_gamg_reuse_growth_current_shape 0
-         "cg_its=(1[0-3]|[0-9])([.][0-9]+)? .*pc_rebuilds=[1-9][0-9]* .*tip_dz=-0.51103[0-9].*status=ok"
-         ${FEM} -mesh_box 1,0.1,0.1,16,3,3 -fix xmin -steps 150 -fem_quiet -mat_type binbcsr -ksp_type cg
-         -pc_type gamg -pc_gamg_agg_nsmooths 0 -ksp_rtol 1e-8 -ksp_reuse_preconditioner -ksp_initial_guess_nonzero
-         -fem_initial_guess projection -reuse_preconditioner_growth 1.5)
+# coarse space from the current shape and keep the projected guess's history. PETSc 3.18: 13.4 CG
+# iterations per solve (5 set-ups) against 15.1 for the rest shape's hierarchy kept throughout (G = 0),
+# and 15.1 with G = 1.5 before the set-ups took the current shape (the rule never fired); the
+# change without the coordinates gave 14.8. Asserted: fewer than 0.93 x G = 0's, the same answer.
+set(FEM_BEAM_SWING -mesh_box 1,0.1,0.1,16,3,3 -fix xmin -steps 150 -fem_quiet -mat_type binbcsr -ksp_type cg
+    -pc_type gamg -pc_gamg_agg_nsmooths 0 -ksp_rtol 1e-8 -ksp_reuse_preconditioner -ksp_initial_guess_nonzero
+    -fem_initial_guess projection)
+string(REPLACE ";" " " FEM_BEAM_SWING_STR "${FEM_BEAM_SWING}")
+add_test(NAME fem_gamg_reuse_growth_current_shape
+         COMMAND sh -c "${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_less.sh cg_its 0.93 '${FEM} ${FEM_BEAM_SWING_STR} -reuse_preconditioner_growth 1.5' '${FEM} ${FEM_BEAM_SWING_STR} -reuse_preconditioner_growth 0' && ${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_same.sh 'tip_dz:1e-7' 1e-5 '${FEM} ${FEM_BEAM_SWING_STR} -reuse_preconditioner_growth 1.5' '${FEM} ${FEM_BEAM_SWING_STR} -reuse_preconditioner_growth 0'")
+set_tests_properties(fem_gamg_reuse_growth_current_shape PROPERTIES LABELS "fem" TIMEOUT 60
+                     WORKING_DIRECTORY ${FEM_SRC})
 fem_test(fem_gamg_reuse_no_growth_no_rebuild 0 "pc_rebuilds=0 .*tip_dz=-0.27744[89].*status=ok"
          ${FEM} ${FEM_BEAM_GAMG_REUSE} -reuse_preconditioner_growth 0)
 fem_test(fem_bad_reuse_growth nonzero "-reuse_preconditioner_growth 0.5: 0 .never set up again. or >= 1"
