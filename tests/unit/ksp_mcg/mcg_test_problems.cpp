@@ -117,8 +117,8 @@ Result solve(Mat A, Vec b, const Solve &s, Vec x0)
   KSPSetResidualHistory(ksp, hist, 4096, PETSC_TRUE);
   if (s.fixed_its) KSPMCGSetFixedIterations(ksp, s.fixed_its);
   PetscOptionsInsertString(nullptr, s.options);
-  KSPSetFromOptions(ksp);
-  r.err = KSPSolve(ksp, b, x);
+  r.err = KSPSetFromOptions(ksp); // an option PETSc refuses is the result too (3.22 refuses -ksp_rtol nan)
+  if (!r.err) r.err = KSPSolve(ksp, b, x);
   KSPGetConvergedReason(ksp, &r.reason);
   KSPGetIterationNumber(ksp, &r.its);
   KSPGetResidualNorm(ksp, &r.rnorm);

@@ -34,7 +34,8 @@ struct Result {
   std::vector<PetscReal>   history;
   std::vector<PetscScalar> x; // gathered on every rank
 };
-// Solves A x = b from x0 (zero when x0 is null) with the given settings.
+// Solves A x = b from x0 (zero when x0 is null) with the given settings; err: the error of
+// KSPSetFromOptions (then no solve) or of KSPSolve.
 Result solve(Mat A, Vec b, const Solve &s, Vec x0 = nullptr);
 // All entries of a parallel vector, on every rank.
 std::vector<PetscScalar> gather(Vec x);
