@@ -5,6 +5,7 @@
 # the key's own absolute floor (what counts as zero for that quantity, e.g. 1e-12 m for a joint error of
 # 1e-10 m) and defaults to RELTOL (values of order 1). A key missing or not a number fails.
 set -u
+. "$(dirname "$0")/summary_lib.sh"
 keys=$1; tol=$2; shift 2
 names="" floors=""
 for kf in $keys; do
@@ -13,15 +14,7 @@ for kf in $keys; do
 done
 ref=""
 for variant in "$@"; do
-  out=$($variant 2>&1); rc=$?
-  line=$(printf '%s\n' "$out" | grep '^summary ' | tail -n 1)
-  if [ $rc -ne 0 ] || [ -z "$line" ]; then printf '%s\n' "$out" | tail -n 20; echo "FAIL: '$variant' exited with $rc / no summary"; exit 1; fi
-  vals=""
-  for k in $names; do
-    v=$(printf '%s\n' "$line" | tr ' ' '\n' | grep "^$k=" | cut -d= -f2)
-    [[ $v =~ ^[-+]?[0-9.]+([eE][-+]?[0-9]+)?$ ]] || { echo "FAIL: '$variant': $k is '${v}', not a number"; exit 1; }
-    vals="$vals $v"
-  done
+  vals=$(summary_values "$variant" $names) || { printf '%s\n' "$vals"; exit 1; }
   echo "$variant:$vals"
   if [ -z "$ref" ]; then ref=$vals; continue; fi
   awk -v a="$ref" -v b="$vals" -v tol="$tol" -v keys="$names" -v floors="$floors" 'BEGIN { n = split(a, x, " "); split(b, y, " "); split(keys, k, " "); split(floors, f, " ");
