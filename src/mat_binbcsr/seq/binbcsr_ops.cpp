@@ -202,8 +202,10 @@ PetscErrorCode AXPYUnion(Mat Y, PetscScalar a, Mat X)
 PetscBool MatSeqBinBCSRSameLayout(const Mat_SeqBinBCSR *y, const Mat_SeqBinBCSR *x)
 {
   if (!y->built || !x->built) return PETSC_FALSE;
+  /* nz too, before real_slot ([nz]) is compared: two patterns can have as many slots (the same bin
+     widths) and differ in the padding, and real_slot of the smaller would be read past its end */
   if (y->bs != x->bs || y->bw != x->bw || y->mbs != x->mbs || y->nbs != x->nbs || y->nslots != x->nslots ||
-      y->sym != x->sym)
+      y->nz != x->nz || y->sym != x->sym)
     return PETSC_FALSE;
   if (y->bin_start == x->bin_start && y->col == x->col) return PETSC_TRUE;
   if (y->sym && !std::equal(y->real_slot, y->real_slot + y->nz, x->real_slot)) return PETSC_FALSE;
