@@ -5,7 +5,6 @@
 #include <petscbinbcsr.h>
 
 #include <algorithm>
-#include <cstring>
 #include <string>
 #include <vector>
 
@@ -378,13 +377,15 @@ PetscErrorCode BlockSystemSolve(BlockSystem *sys, const PetscScalar *rhs_local, 
   const size_t n = (size_t)(sys->row_end - sys->row_begin);
 
   PetscFunctionBegin;
+  // std::copy_n, not memcpy: a rank without rows has null arrays (PETSc allocates nothing for an
+  // empty Vec, std::vector nothing for an empty one), and memcpy of null is undefined even for 0 bytes
   PetscCall(VecGetArrayWrite(sys->b, &a));
-  std::memcpy(a, rhs_local, n * sizeof(PetscScalar));
+  std::copy_n(rhs_local, n, a);
   PetscCall(VecRestoreArrayWrite(sys->b, &a));
   PetscCall(KSPGetInitialGuessNonzero(sys->ksp, &nonzero_guess));
   if (nonzero_guess) {
     PetscCall(VecGetArrayWrite(sys->x, &a));
-    std::memcpy(a, sol_local, n * sizeof(PetscScalar));
+    std::copy_n(sol_local, n, a);
     PetscCall(VecRestoreArrayWrite(sys->x, &a));
   }
   const double t0 = MPI_Wtime();
@@ -421,7 +422,7 @@ PetscErrorCode BlockSystemSolve(BlockSystem *sys, const PetscScalar *rhs_local, 
   }
   const PetscScalar *xa;
   PetscCall(VecGetArrayRead(sys->x, &xa));
-  std::memcpy(sol_local, xa, n * sizeof(PetscScalar));
+  std::copy_n(xa, n, sol_local);
   PetscCall(VecRestoreArrayRead(sys->x, &xa));
   if (stats) {
     stats->iterations = its;
