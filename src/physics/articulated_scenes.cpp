@@ -54,7 +54,8 @@ ArticulatedScene make_bridge(const BridgeOptions &opt)
 {
   if (opt.chains < 1 || opt.links < 2 || opt.tie_every < 1)
     throw std::invalid_argument("a bridge needs chains >= 1, links >= 2, tie_every >= 1");
-  if ((double)opt.chains * opt.links > 1000000) throw std::invalid_argument("a bridge has at most 1,000,000 planks");
+  if ((double)opt.chains * opt.links > 1000000)
+    throw std::invalid_argument("a bridge has at most 1,000,000 planks");
   // the arc's sag (0, negative or NaN gave a singular joint matrix and a failed solve, with no word
   // about the sag); a sag past the arc's half circle is reached at its bound
   if (!(opt.sag > 0) || !std::isfinite(opt.sag))

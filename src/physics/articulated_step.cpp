@@ -148,7 +148,8 @@ double velocity_errors(const ArticulatedScene &scene, ArticulatedSolver &s, cons
 
 // The initial guess for a solve: `guess` if warm starting with one of the right size, otherwise zero.
 // Returns whether the guess was taken.
-bool set_initial_guess(const ArticulatedParams &params, const std::vector<double> &guess, std::vector<double> &x)
+bool set_initial_guess(const ArticulatedParams &params, const std::vector<double> &guess,
+                       std::vector<double> &x)
 {
   const bool warm = params.warm_start && guess.size() == x.size();
   if (warm) std::copy(guess.begin(), guess.end(), x.begin());

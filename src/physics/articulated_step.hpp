@@ -49,7 +49,7 @@ struct ArticulatedStepReport {
   // failed solves the step recovered from by solving again: the breakdown that switched it to the
   // regularised matrix, and warm starts that broke down (a guess far worse than zero: DIVERGED_DTOL at
   // iteration 0) and were solved again from zero
-  int    recovered_solves = 0;
+  int recovered_solves = 0;
 };
 
 // How the work of a step is split over processes that each hold the whole scene (the PETSc drivers with

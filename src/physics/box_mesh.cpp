@@ -11,14 +11,15 @@ namespace physics {
 
 TetMesh make_box_mesh(double lx, double ly, double lz, int nx, int ny, int nz)
 {
-  if (!(lx > 0 && ly > 0 && lz > 0) || !std::isfinite(lx) || !std::isfinite(ly) || !std::isfinite(lz) || nx < 1 ||
-      ny < 1 || nz < 1)
+  if (!(lx > 0 && ly > 0 && lz > 0) || !std::isfinite(lx) || !std::isfinite(ly) || !std::isfinite(lz) ||
+      nx < 1 || ny < 1 || nz < 1)
     throw std::invalid_argument("box mesh: sizes must be positive and finite, counts >= 1");
   // 6 tetrahedra per cell, their node indices in int: a count past that ran on for hours filling memory
   if ((double)nx * ny * nz * 6 > 2e9) {
     char count[32];
     std::snprintf(count, sizeof count, "%.3g", (double)nx * ny * nz * 6);
-    throw std::invalid_argument(std::string("box mesh: ") + count + " tetrahedra, more than 32-bit indices hold");
+    throw std::invalid_argument(std::string("box mesh: ") + count +
+                                " tetrahedra, more than 32-bit indices hold");
   }
   TetMesh m;
   m.order = 1;

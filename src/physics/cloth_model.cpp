@@ -79,7 +79,8 @@ std::string validate_cloth(const Cloth &c)
              ": rest length must be positive, stiffness non-negative, both finite";
   }
   if (!(c.damping >= 0) || !std::isfinite(c.damping)) return "damping must be non-negative and finite";
-  if (c.sphere.enabled && (!c.sphere.centre.allFinite() || !(c.sphere.radius > 0) || !std::isfinite(c.sphere.radius)))
+  if (c.sphere.enabled &&
+      (!c.sphere.centre.allFinite() || !(c.sphere.radius > 0) || !std::isfinite(c.sphere.radius)))
     return "the sphere needs a finite centre and a positive finite radius";
   return "";
 }

@@ -355,10 +355,7 @@ PetscErrorCode EmptyNumeric(Mat F, Mat, const MatFactorInfo *)
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode EmptySolve(Mat, Vec, Vec)
-{
-  return 0;
-}
+PetscErrorCode EmptySolve(Mat, Vec, Vec) { return 0; }
 
 PetscErrorCode EmptyFactor(Mat F)
 {

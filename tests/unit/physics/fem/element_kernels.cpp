@@ -382,13 +382,13 @@ TEST_CASE("polar kernel in pieces: strains of ~1% pass after kPolarEarlySteps, a
   // Starts near a rotation (det of the normalised start > kPolarNearDet): the unscaled steps the batch
   // takes there pass at the same R; strains of 0.3% always start near and pass.
   int near = 0, near_early = 0;
-  worst    = 0;
+  worst = 0;
   for (int k = 0; k < 4000; ++k) {
     Eigen::Vector3d sv;
     const double    spread = k % 2 ? 0.003 : 0.03;
     for (int d = 0; d < 3; ++d) sv[d] = 1.0 + spread * normal(rng);
     const Eigen::Matrix3d F = random_rotation(rng) * sv.asDiagonal() * random_rotation(rng);
-    double X[9], C[9], det, ok, change, R[9], Rfull[9];
+    double                X[9], C[9], det, ok, change, R[9], Rfull[9];
     kernels::polar_start<1, 1>(F.data(), X, C, &det, &ok);
     REQUIRE(ok != 0);
     if (k % 2) REQUIRE(det > kernels::kPolarNearDet);
