@@ -350,6 +350,69 @@ TEST_CASE("symmetric storage: value operations against seqaij", "[mat_sym][ops]"
   MatDestroy(&R);
 }
 
+// Two symmetric layouts can hold as many slots (the same bin width, the same longest upper row per bin)
+// with other patterns, so other counts of stored blocks. MatEqual and MatAXPY compare layouts before
+// going slot by slot, and that comparison read the slot map of one over the other's block count, past
+// its end (found by AddressSanitizer on 2 ranks). The answers must be seqaij's either way.
+TEST_CASE("symmetric storage: equal slot counts, different patterns", "[mat_sym][ops]")
+{
+  // 16 rows of bs 1, bin width 8: row 0 holds columns 0..9, rows 1..14 their diagonal (of the upper
+  // triangle); `wide`: rows 1..7 also the next 9 columns; `last_diagonal`: row 15 its diagonal
+  auto pattern = [](bool wide, bool last_diagonal) {
+    Pattern p;
+    p.m = p.n = 16;
+    p.bs      = 1;
+    for (PetscInt r = 0; r < 16; r++)
+      for (PetscInt c = r; c < 16; c++) {
+        const bool keep =
+          (c == r && (r < 15 || last_diagonal)) || (r == 0 && c <= 9) || (wide && r < 8 && c <= r + 9);
+        if (!keep) continue;
+        const PetscScalar v = c == r ? 20.0 + r : -0.5 - 0.01 * (r + 2 * c);
+        p.entries.push_back({r, c, v});
+        if (c != r) p.entries.push_back({c, r, v});
+      }
+    return p;
+  };
+  // W holds N's blocks and more, in as many slots (8 x 10 + 8 x 1): 87 blocks against 24 (the slot
+  // maps differ early), and 25 against 24 (N's slot map is the first 24 entries of W's, so even a
+  // comparison that stops at the first difference, as valgrind's memcmp does, reads past N's)
+  const bool wide = GENERATE(true, false);
+  CAPTURE(wide);
+  const Pattern pw = pattern(wide, true), pn = pattern(false, false);
+  Mat W = build_sym(pw, 8, MAT_BINBCSR_PRECISION_DOUBLE), N = build_sym(pn, 8, MAT_BINBCSR_PRECISION_DOUBLE);
+  Mat RW = build_ref(pw, MATSEQAIJ), RN = build_ref(pn, MATSEQAIJ);
+  {
+    const Mat_SeqBinBCSR *w = (const Mat_SeqBinBCSR *)W->data, *n = (const Mat_SeqBinBCSR *)N->data;
+    REQUIRE(w->nslots == n->nslots); // the case this test is about
+    REQUIRE(w->nz == (wide ? 87 : 25));
+    REQUIRE(n->nz == 24);
+    if (!wide) CHECK(std::equal(n->real_slot, n->real_slot + n->nz, w->real_slot));
+  }
+  PetscBool eq;
+  REQUIRE(MatEqual(W, N, &eq) == 0);
+  CHECK(!eq);
+  REQUIRE(MatEqual(N, W, &eq) == 0);
+  CHECK(!eq);
+  Mat W2, RW2;
+  REQUIRE(MatDuplicate(W, MAT_COPY_VALUES, &W2) == 0);
+  REQUIRE(MatEqual(W2, W, &eq) == 0);
+  CHECK(eq);
+  // W2 += -0.5 N (a subset) and N += 2 W (a superset): as seqaij
+  REQUIRE(MatDuplicate(RW, MAT_COPY_VALUES, &RW2) == 0);
+  REQUIRE(MatAXPY(W2, -0.5, N, SUBSET_NONZERO_PATTERN) == 0);
+  REQUIRE(MatAXPY(RW2, -0.5, RN, SUBSET_NONZERO_PATTERN) == 0);
+  check_dense(dense(W2), dense(RW2), 4 * DBL_EPSILON);
+  REQUIRE(MatAXPY(N, 2.0, W, DIFFERENT_NONZERO_PATTERN) == 0);
+  REQUIRE(MatAXPY(RN, 2.0, RW, DIFFERENT_NONZERO_PATTERN) == 0);
+  check_dense(dense(N), dense(RN), 4 * DBL_EPSILON);
+  MatDestroy(&W2);
+  MatDestroy(&RW2);
+  MatDestroy(&W);
+  MatDestroy(&N);
+  MatDestroy(&RW);
+  MatDestroy(&RN);
+}
+
 TEST_CASE("symmetric storage: COO with both triangles and duplicates", "[mat_sym][coo]")
 {
   const MatBinBCSRPrecision prec = GENERATE(MAT_BINBCSR_PRECISION_DOUBLE, MAT_BINBCSR_PRECISION_SINGLE);
