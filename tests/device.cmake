@@ -42,11 +42,19 @@ add_test(NAME device_stock_ex4_reference
          COMMAND ${DEV_COMPARE} 1 -- $<TARGET_FILE:stock_ksp_ex4> -bs 3 -m 20 -n 20 -mat_type binbcsr -mat_binbcsr_device reference -pc_type jacobi -dll_append ${PLUGIN})
 add_test(NAME device_stock_ex72_reference
          COMMAND ${DEV_COMPARE} 1 -- $<TARGET_FILE:stock_ksp_ex72> -f0 ${DEV_SPD} -matload_block_size 3 -mat_convert_type binbcsr -mat_binbcsr_device reference -pc_type jacobi -dll_append ${PLUGIN})
-add_test(NAME device_cuda_not_built
-         COMMAND $<TARGET_FILE:stock_ksp_ex4> -bs 3 -mat_type binbcsr -mat_binbcsr_device cuda -ksp_type mcg -dll_append ${PLUGIN})
-set_tests_properties(device_cuda_not_built PROPERTIES PASS_REGULAR_EXPRESSION "-mat_binbcsr_device cuda: the cuda executor is not built")
+if(BINBCSR_CUDA) # the cuda executor linked in (cmake/device.cmake): on the GPU, or a clear error without one
+  add_test(NAME device_cuda_plugin
+           COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/device/cuda_plugin.sh ${DEV_COMPARE} $<TARGET_FILE:stock_ksp_ex4> ${PLUGIN})
+  set(DEV_CUDA_TEST device_cuda_plugin)
+else()
+  add_test(NAME device_cuda_not_built
+           COMMAND $<TARGET_FILE:stock_ksp_ex4> -bs 3 -mat_type binbcsr -mat_binbcsr_device cuda -ksp_type mcg -dll_append ${PLUGIN})
+  set_tests_properties(device_cuda_not_built PROPERTIES PASS_REGULAR_EXPRESSION
+                       "-mat_binbcsr_device cuda: the cuda executor is not built.*-DBINBCSR_CUDA=ON")
+  set(DEV_CUDA_TEST device_cuda_not_built)
+endif()
 add_test(NAME device_mpi_refused
          COMMAND ${MPIEXEC_CMD} -n 2 $<TARGET_FILE:stock_ksp_ex4> -bs 3 -mat_type binbcsr -mat_binbcsr_device reference -ksp_type mcg -dll_append ${PLUGIN})
 set_tests_properties(device_mpi_refused PROPERTIES PASS_REGULAR_EXPRESSION "MATMPIBINBCSR \\(2 processes\\) has no device copy" PROCESSORS 2)
 set_tests_properties(device_cloth_reference device_fem_reference device_articulated_reference device_stock_ex4_reference
-                     device_stock_ex72_reference device_cuda_not_built device_mpi_refused PROPERTIES LABELS "device" TIMEOUT 120)
+                     device_stock_ex72_reference ${DEV_CUDA_TEST} device_mpi_refused PROPERTIES LABELS "device" TIMEOUT 120)

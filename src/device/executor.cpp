@@ -1,5 +1,5 @@
 /* make_executor: the executor by name. BINBCSR_DEVICE_HAVE_CUDA is defined where the cuda executor is
-   compiled into the library (CMake: nvcc found and the CUDA language enabled). */
+   compiled into the library (CMake's BINBCSR_CUDA=ON, cmake/device.cmake; scripts/gpu_check). */
 #include "reference.h"
 
 namespace binbcsr {
@@ -24,7 +24,7 @@ std::unique_ptr<Executor> make_executor(const std::string &name, std::string *wh
     return make_cuda_executor(why);
 #else
     *why =
-      "the cuda executor is not built into this library (the PETSc plug-in links the reference executor only; scripts/gpu_check builds the cuda one, docs/gpu.md)";
+      "the cuda executor is not built into this library (configure with -DBINBCSR_CUDA=ON to link it into the plug-in; docs/gpu.md)";
     return nullptr;
 #endif
   }
