@@ -13,10 +13,10 @@
 // -sweep: every (bin width 4/8/16(/32 for bs 1), streams 1/2/4/8, body set the CPU has, prefetch distance
 // 0/1024/4096 bytes or those of -sweep_prefetch) against the autotuned default
 // (nothing set, -mat_binbcsr_tune auto) for whole and symmetric storage in double and single precision,
-// on the stencils of -stencil_sizes (default 32,48) and on every PETSc binary file of -f (comma list,
-// block size from -bs, default 3; the drivers write them with -dump_matrix FILE). Per matrix and
-// case one line: the sweep's best bw/K/body and ms, the tuned bw/K/body and ms, tuned / best, the reference
-// (seqbaij; seqaij for bs 1) and what the tuning cost. The best is then timed again against the tuned
+// on the stencils of -stencil_sizes (default 32,48; or the one of -stencil_n) and on every PETSc binary
+// file of -f (comma list, block size from -bs, default 3; the drivers write them with -dump_matrix FILE).
+// Per matrix and case one line: the sweep's best bw/K/body and ms, the tuned bw/K/body and ms, tuned /
+// best, the reference (seqbaij; seqaij for bs 1) and what the tuning cost. The best is then timed again against the tuned
 // matrix alone, alternating, -sweep_confirm N rounds (default 9; 0: not), since the lowest of ~100
 // medians is biased low by the rounds that chose it. -sweep_verbose prints every variant;
 // -tune_cache 1 lets the tuned matrix use the cache file (default: it measures).
@@ -187,6 +187,22 @@ int main(int argc, char **argv)
       PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-stencil_sizes", sizes, &nsizes, &flg));
       PetscCheck(nsizes <= 8, PETSC_COMM_WORLD, PETSC_ERR_ARG_SIZ, "-stencil_sizes takes at most 8 sizes");
       if (!flg) nsizes = 2;
+      { // the sweep's stencils are cubes: -stencil_n N alone means that one (it was ignored), the table's
+        // other grid options are refused rather than dropped
+        PetscBool n_set, other = PETSC_FALSE, o;
+        PetscCall(PetscOptionsHasName(nullptr, nullptr, "-stencil_n", &n_set));
+        for (const char *name : {"-stencil_nx", "-stencil_ny", "-stencil_nz", "-stencil_shift"}) {
+          PetscCall(PetscOptionsHasName(nullptr, nullptr, name, &o));
+          other = (PetscBool)(other || o);
+        }
+        PetscCheck(
+          !other, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG,
+          "binbcsr_tune -sweep: its stencils are cubes given by -stencil_sizes N,M,...; -stencil_nx, "
+          "-stencil_ny, -stencil_nz and -stencil_shift are for the table without -sweep");
+        PetscCheck(!(n_set && flg), PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG,
+                   "binbcsr_tune -sweep: give the stencils by -stencil_sizes or -stencil_n, not both");
+        if (n_set) sizes[0] = grid.nx, nsizes = 1;
+      }
       PetscCall(PetscPrintf(PETSC_COMM_SELF,
                             "binbcsr_tune -sweep: ms per MatMult, median of %" PetscInt_FMT
                             " rounds of %" PetscInt_FMT

@@ -32,6 +32,8 @@ foreach(case
     "spmv_bs0|-bs must be >= 1|spmv_bench|-stencil_sizes 0 -bs 0"
     "tune_streams_list|-streams takes at most 4 stream counts|binbcsr_tune|-stencil_n 8 -streams 1,2,4,8,1"
     "tune_sweep_confirm|-sweep_confirm must be >= 0|binbcsr_tune|-sweep -stencil_sizes 4 -sweep_confirm -1"
+    "tune_sweep_n_and_sizes|give the stencils by -stencil_sizes or -stencil_n, not both|binbcsr_tune|-sweep -stencil_n 4 -stencil_sizes 6"
+    "tune_sweep_nx|its stencils are cubes given by -stencil_sizes|binbcsr_tune|-sweep -stencil_nx 4"
     "spmv_sizes_list|-stencil_sizes takes at most 16 sizes|spmv_bench|-stencil_sizes 1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17"
     "tune_file_without_sweep|-f FILE is swept with -sweep|binbcsr_tune|-stencil_n 4 -f no_such_file.bin"
     "solve_rtol_nan|-rtol must be in .0, 1., not nan|solve_bench|-stencil_n 4 -rtol nan")
@@ -66,3 +68,9 @@ add_test(NAME bench_solve_overflow_not_timed
          COMMAND ${EXPECT_RUN} 0 "mcg +binbcsr +n/a +\\(not timed: the solve ended DIVERGED_NANORINF\\).*target: mcg\\+binbcsr per iteration vs cg\\+baij: not measured"
                  -- $<TARGET_FILE:solve_bench> -stencil_n 6 -stencil_shift 1e300 -repeats 1)
 set_tests_properties(bench_solve_overflow_not_timed PROPERTIES LABELS "bench" TIMEOUT 60)
+
+# -sweep with -stencil_n N sweeps that one stencil (it was ignored for the default 32 and 48)
+add_test(NAME bench_tune_sweep_stencil_n
+         COMMAND ${EXPECT_RUN} 0 "\\nstencil5 +whole +double best" "\\nstencil5 +symmetric +single best"
+                 -- $<TARGET_FILE:binbcsr_tune> -sweep -stencil_n 5 -repeats 1 -batch 1 -sweep_confirm 0)
+set_tests_properties(bench_tune_sweep_stencil_n PROPERTIES LABELS "bench" TIMEOUT 120)
