@@ -168,7 +168,6 @@ int main(int argc, char **argv)
       SweepSettings s;
       char          buf[4096] = "";
       PetscBool     flg;
-      PetscInt      sizes[9] = {32, 48}, nsizes = 9;
       s.now = Now;
       PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-repeats", &s.repeats, nullptr));
       PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-batch", &s.batch, nullptr));
@@ -184,25 +183,8 @@ int main(int argc, char **argv)
         PetscCheck(!flg || npf > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
                    "-sweep_prefetch: give at least one distance");
       }
-      PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-stencil_sizes", sizes, &nsizes, &flg));
-      PetscCheck(nsizes <= 8, PETSC_COMM_WORLD, PETSC_ERR_ARG_SIZ, "-stencil_sizes takes at most 8 sizes");
-      if (!flg) nsizes = 2;
-      { // the sweep's stencils are cubes: -stencil_n N alone means that one (it was ignored), the table's
-        // other grid options are refused rather than dropped
-        PetscBool n_set, other = PETSC_FALSE, o;
-        PetscCall(PetscOptionsHasName(nullptr, nullptr, "-stencil_n", &n_set));
-        for (const char *name : {"-stencil_nx", "-stencil_ny", "-stencil_nz", "-stencil_shift"}) {
-          PetscCall(PetscOptionsHasName(nullptr, nullptr, name, &o));
-          other = (PetscBool)(other || o);
-        }
-        PetscCheck(
-          !other, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG,
-          "binbcsr_tune -sweep: its stencils are cubes given by -stencil_sizes N,M,...; -stencil_nx, "
-          "-stencil_ny, -stencil_nz and -stencil_shift are for the table without -sweep");
-        PetscCheck(!(n_set && flg), PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG,
-                   "binbcsr_tune -sweep: give the stencils by -stencil_sizes or -stencil_n, not both");
-        if (n_set) sizes[0] = grid.nx, nsizes = 1;
-      }
+      std::vector<PetscInt> sizes;
+      PetscCall(StencilSizesFromOptions(PETSC_COMM_WORLD, "binbcsr_tune -sweep", {32, 48}, 8, &sizes));
       PetscCall(PetscPrintf(PETSC_COMM_SELF,
                             "binbcsr_tune -sweep: ms per MatMult, median of %" PetscInt_FMT
                             " rounds of %" PetscInt_FMT
@@ -210,13 +192,13 @@ int main(int argc, char **argv)
                             " of the rounds' ratios (min: the ratio of the minima); confirmed: the"
                             " same from %" PetscInt_FMT " fresh rounds of tuned against best alone\n",
                             s.repeats, s.batch, use_wall ? "wall" : "thread CPU", s.confirm));
-      for (PetscInt i = 0; i < nsizes; i++) {
-        if (sizes[i] <= 0) continue;
+      for (PetscInt n : sizes) {
+        if (n == 0) continue;
         StencilGrid g;
-        g.nx = g.ny = g.nz = sizes[i];
+        g.nx = g.ny = g.nz = n;
         PetscCall(CreateStencilMatrix(PETSC_COMM_SELF, g, MATSEQAIJ, nullptr, &aij));
         if (bs == 1) PetscCall(MatSetBlockSize(aij, 1));
-        PetscCall(TuneSweep("stencil" + std::to_string(sizes[i]), aij, s));
+        PetscCall(TuneSweep("stencil" + std::to_string(n), aij, s));
         PetscCall(MatDestroy(&aij));
       }
       PetscCall(PetscOptionsGetString(nullptr, nullptr, "-f", buf, sizeof buf, &flg));

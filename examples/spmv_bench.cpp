@@ -1,14 +1,14 @@
 // spmv_bench: MatMult timed for PETSc's built-in formats and MATBINBCSR (double and single storage) on
 // the same matrices in the same run, against a STREAM-triad bandwidth measured in the same run.
 //
-//   spmv_bench [-stencil_sizes 16,32,48] [-f FILE]... [-formats aij,baij,sbaij,sell,binbcsr,binbcsr_single,
+//   spmv_bench [-stencil_sizes 16,32,48 | -stencil_n N] [-f FILE]... [-formats aij,baij,sbaij,sell,binbcsr,binbcsr_single,
 //              binbcsr_sym,binbcsr_sym_single]
 //              [-repeats 7] [-min_batch_ms 20] [-csv FILE] [-stats_only] [-stream_elements N]
 //              [-save_dir DIR] (also write each stencil matrix to DIR/stencilN.bin, PETSc binary)
 //              [-timer wall|cpu] (cpu: process CPU time, for a machine shared with other work)
 //
 // Matrices: the 27-point 3x3-block stencil (src/sim/stencil.h) on an n^3 node grid for each
-// n of -stencil_sizes (0 = none), and every PETSc binary file given with -f (repeatable, or a comma
+// n of -stencil_sizes (0 = none; or the one n of -stencil_n), and every PETSc binary file given with -f (repeatable, or a comma
 // list; the block size comes from the file's .info, -matload_block_size, or -bs).
 // Under mpiexec the same types are used in their mpi forms (rows split by PETSc's default layout).
 //
@@ -494,22 +494,13 @@ int main(int argc, char **argv)
   }
 
   std::vector<MatrixSource> sources;
-  PetscInt                  sizes[17], nsizes = 17; // one more than it takes: PETSc drops extras silently
-  PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-stencil_sizes", sizes, &nsizes, &flg));
-  PetscCheck(nsizes <= 16, PETSC_COMM_WORLD, PETSC_ERR_ARG_SIZ, "-stencil_sizes takes at most 16 sizes");
-  if (!flg) {
-    nsizes   = 3;
-    sizes[0] = 16;
-    sizes[1] = 32;
-    sizes[2] = 48;
-  }
-  for (PetscInt i = 0; i < nsizes; ++i) {
-    PetscCheck(sizes[i] >= 0, comm, PETSC_ERR_ARG_OUTOFRANGE,
-               "-stencil_sizes: %" PetscInt_FMT " is no grid size (0: no stencil)", sizes[i]);
-    if (sizes[i] == 0) continue;
+  std::vector<PetscInt>     sizes;
+  PetscCall(StencilSizesFromOptions(comm, "spmv_bench", {16, 32, 48}, 16, &sizes));
+  for (PetscInt n : sizes) {
+    if (n == 0) continue;
     MatrixSource s;
-    s.grid.nx = s.grid.ny = s.grid.nz = sizes[i];
-    s.name                            = "stencil" + std::to_string(sizes[i]);
+    s.grid.nx = s.grid.ny = s.grid.nz = n;
+    s.name                            = "stencil" + std::to_string(n);
     sources.push_back(s);
   }
   for (const std::string &p : files) {

@@ -34,6 +34,8 @@ foreach(case
     "tune_sweep_confirm|-sweep_confirm must be >= 0|binbcsr_tune|-sweep -stencil_sizes 4 -sweep_confirm -1"
     "tune_sweep_n_and_sizes|give the stencils by -stencil_sizes or -stencil_n, not both|binbcsr_tune|-sweep -stencil_n 4 -stencil_sizes 6"
     "tune_sweep_nx|its stencils are cubes given by -stencil_sizes|binbcsr_tune|-sweep -stencil_nx 4"
+    "spmv_n_and_sizes|give the stencils by -stencil_sizes or -stencil_n, not both|spmv_bench|-stencil_n 4 -stencil_sizes 6"
+    "spmv_shift|its stencils are cubes given by -stencil_sizes|spmv_bench|-stencil_shift 2"
     "spmv_sizes_list|-stencil_sizes takes at most 16 sizes|spmv_bench|-stencil_sizes 1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17"
     "tune_file_without_sweep|-f FILE is swept with -sweep|binbcsr_tune|-stencil_n 4 -f no_such_file.bin"
     "solve_rtol_nan|-rtol must be in .0, 1., not nan|solve_bench|-stencil_n 4 -rtol nan")
@@ -69,7 +71,11 @@ add_test(NAME bench_solve_overflow_not_timed
                  -- $<TARGET_FILE:solve_bench> -stencil_n 6 -stencil_shift 1e300 -repeats 1)
 set_tests_properties(bench_solve_overflow_not_timed PROPERTIES LABELS "bench" TIMEOUT 60)
 
-# -sweep with -stencil_n N sweeps that one stencil (it was ignored for the default 32 and 48)
+# -stencil_n N is the one stencil both benchmarks time (they ignored it for their default sizes)
+add_test(NAME bench_spmv_stencil_n
+         COMMAND ${EXPECT_RUN} 0 "== stencil5: 375 rows" "\\A(?!.*== stencil(16|32|48))"
+                 -- $<TARGET_FILE:spmv_bench> -stencil_n 5 -repeats 1)
+set_tests_properties(bench_spmv_stencil_n PROPERTIES LABELS "bench" TIMEOUT 120)
 add_test(NAME bench_tune_sweep_stencil_n
          COMMAND ${EXPECT_RUN} 0 "\\nstencil5 +whole +double best" "\\nstencil5 +symmetric +single best"
                  -- $<TARGET_FILE:binbcsr_tune> -sweep -stencil_n 5 -repeats 1 -batch 1 -sweep_confirm 0)

@@ -164,3 +164,35 @@ PetscErrorCode StencilGridFromOptions(const char *prefix, StencilGrid *grid)
   PetscCall(PetscOptionsGetReal(nullptr, prefix, "-stencil_shift", &grid->shift, nullptr));
   PetscFunctionReturn(0);
 }
+
+PetscErrorCode StencilSizesFromOptions(MPI_Comm comm, const char *program,
+                                       const std::vector<PetscInt> &defaults, PetscInt max_sizes,
+                                       std::vector<PetscInt> *sizes)
+{
+  std::vector<PetscInt> buf(max_sizes + 1); // one more than it takes: PETSc drops extras silently
+  PetscInt              n = max_sizes + 1, one;
+  PetscBool             listed, single, other = PETSC_FALSE, o;
+
+  PetscFunctionBegin;
+  PetscCall(PetscOptionsGetIntArray(nullptr, nullptr, "-stencil_sizes", buf.data(), &n, &listed));
+  PetscCheck(n <= max_sizes, comm, PETSC_ERR_ARG_SIZ,
+             "%s: -stencil_sizes takes at most %" PetscInt_FMT " sizes", program, max_sizes);
+  PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-stencil_n", &one, &single));
+  PetscCheck(!(listed && single), comm, PETSC_ERR_ARG_WRONG,
+             "%s: give the stencils by -stencil_sizes or -stencil_n, not both", program);
+  for (const char *name : {"-stencil_nx", "-stencil_ny", "-stencil_nz", "-stencil_shift"}) {
+    PetscCall(PetscOptionsHasName(nullptr, nullptr, name, &o));
+    other = (PetscBool)(other || o);
+  }
+  PetscCheck(!other, comm, PETSC_ERR_ARG_WRONG,
+             "%s: its stencils are cubes given by -stencil_sizes N,M,... or -stencil_n N; -stencil_nx, "
+             "-stencil_ny, -stencil_nz and -stencil_shift are not read here",
+             program);
+  if (listed) sizes->assign(buf.begin(), buf.begin() + n);
+  else if (single) sizes->assign(1, one);
+  else *sizes = defaults;
+  for (PetscInt s : *sizes)
+    PetscCheck(s >= 0, comm, PETSC_ERR_ARG_OUTOFRANGE,
+               "%s: %" PetscInt_FMT " is no grid size (0: no stencil)", program, s);
+  PetscFunctionReturn(0);
+}

@@ -13,6 +13,8 @@
 #pragma once
 #include <petscmat.h>
 
+#include <vector>
+
 struct StencilGrid {
   PetscInt  nx = 10, ny = 10, nz = 10;
   PetscReal shift = 1e-2; // diagonal margin relative to the coupling: smaller = worse conditioned
@@ -35,3 +37,11 @@ PetscErrorCode CreateStencilMatrix(MPI_Comm comm, const StencilGrid &grid, MatTy
 
 // Reads -stencil_n N (all three) or -stencil_nx/-stencil_ny/-stencil_nz and -stencil_shift.
 PetscErrorCode StencilGridFromOptions(const char *prefix, StencilGrid *grid);
+
+// The cube stencils of a benchmark that times several: -stencil_sizes N,M,... (at most max_sizes;
+// 0: none; negative sizes refused), or the one of -stencil_n N, else the defaults. -stencil_n with
+// -stencil_sizes, and -stencil_nx/-stencil_ny/-stencil_nz/-stencil_shift (one grid's options), are
+// errors naming `program`: they would otherwise go unread.
+PetscErrorCode StencilSizesFromOptions(MPI_Comm comm, const char *program,
+                                       const std::vector<PetscInt> &defaults, PetscInt max_sizes,
+                                       std::vector<PetscInt> *sizes);
