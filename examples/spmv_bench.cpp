@@ -1,15 +1,15 @@
 // spmv_bench: MatMult timed for PETSc's built-in formats and MATBINBCSR (double and single storage) on
 // the same matrices in the same run, against a STREAM-triad bandwidth measured in the same run.
 //
-//   spmv_bench [-stencil_sizes 16,32,48 | -stencil_n N] [-f FILE]... [-formats aij,baij,sbaij,sell,binbcsr,binbcsr_single,
-//              binbcsr_sym,binbcsr_sym_single]
+//   spmv_bench [-stencil_sizes 16,32,48 | -stencil_n N] [-f FILE]...
+//              [-formats aij,baij,sbaij,sell,binbcsr,binbcsr_single,binbcsr_sym,binbcsr_sym_single]
 //              [-repeats 7] [-min_batch_ms 20] [-csv FILE] [-stats_only] [-stream_elements N]
 //              [-save_dir DIR] (also write each stencil matrix to DIR/stencilN.bin, PETSc binary)
 //              [-timer wall|cpu] (cpu: process CPU time, for a machine shared with other work)
 //
-// Matrices: the 27-point 3x3-block stencil (src/sim/stencil.h) on an n^3 node grid for each
-// n of -stencil_sizes (0 = none; or the one n of -stencil_n), and every PETSc binary file given with -f (repeatable, or a comma
-// list; the block size comes from the file's .info, -matload_block_size, or -bs).
+// Matrices: the 27-point 3x3-block stencil (src/sim/stencil.h) on an n^3 node grid for each n of
+// -stencil_sizes (0 = none; or the one n of -stencil_n), and every PETSc binary file given with -f
+// (repeatable, or a comma list; the block size comes from the file's .info, -matload_block_size, or -bs).
 // Under mpiexec the same types are used in their mpi forms (rows split by PETSc's default layout).
 //
 // Timing: the formats are timed round-robin (one batch of MatMults per format per round, -repeats
