@@ -18,10 +18,10 @@ if(BINBCSR_CUDA)
   endif()
   enable_language(CUDA)
   find_package(CUDAToolkit REQUIRED)
-  set(CMAKE_CUDA_STANDARD 17)
-  set(CMAKE_CUDA_STANDARD_REQUIRED ON)
   target_sources(binbcsr_device PRIVATE src/device/cuda_executor.cu)
-  set_target_properties(binbcsr_device PROPERTIES CUDA_ARCHITECTURES "${CMAKE_CUDA_ARCHITECTURES}")
+  # (the target exists already, so its CUDA properties are set here, not through CMAKE_CUDA_*)
+  set_target_properties(binbcsr_device PROPERTIES CUDA_ARCHITECTURES "${CMAKE_CUDA_ARCHITECTURES}"
+                        CUDA_STANDARD 17 CUDA_STANDARD_REQUIRED ON)
   target_compile_definitions(binbcsr_device PRIVATE BINBCSR_DEVICE_HAVE_CUDA)
   # the host compiler's warnings are errors in the cuda executor, as in scripts/gpu_check
   set_source_files_properties(src/device/cuda_executor.cu PROPERTIES COMPILE_OPTIONS
