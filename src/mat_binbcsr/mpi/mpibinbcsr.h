@@ -138,7 +138,27 @@ struct LocalView {
    parts) given to another, empty one (mpibinbcsr_convert.cpp): MatDuplicate, MatAXPY, MatTranspose. */
 PETSC_INTERN PetscErrorCode MatMPIBinBCSRCopyConfig(Mat from, Mat to);
 
-/* mpibinbcsr_parts.cpp: creating the parts, compressing B, the ghost scatter */
+/* mpibinbcsr_config.cpp: the settings, kept for later parts and forwarded to the existing ones */
+PETSC_INTERN PetscErrorCode MatBinBCSRSetBinWidth_MPIBinBCSR(Mat mat, PetscInt bw);
+PETSC_INTERN PetscErrorCode MatBinBCSRGetBinWidth_MPIBinBCSR(Mat mat, PetscInt *bw);
+PETSC_INTERN PetscErrorCode MatBinBCSRSetStreams_MPIBinBCSR(Mat mat, PetscInt streams);
+PETSC_INTERN PetscErrorCode MatBinBCSRGetStreams_MPIBinBCSR(Mat mat, PetscInt *streams);
+PETSC_INTERN PetscErrorCode MatBinBCSRSetPrefetch_MPIBinBCSR(Mat mat, PetscInt bytes);
+PETSC_INTERN PetscErrorCode MatBinBCSRSetXLoad_MPIBinBCSR(Mat mat, MatBinBCSRXLoad xload);
+PETSC_INTERN PetscErrorCode MatBinBCSRGetXLoad_MPIBinBCSR(Mat mat, MatBinBCSRXLoad *xload);
+PETSC_INTERN PetscErrorCode MatBinBCSRGetPrefetch_MPIBinBCSR(Mat mat, PetscInt *bytes);
+PETSC_INTERN PetscErrorCode MatBinBCSRSetTune_MPIBinBCSR(Mat mat, MatBinBCSRTune t);
+PETSC_INTERN PetscErrorCode MatBinBCSRGetTune_MPIBinBCSR(Mat mat, MatBinBCSRTune *t);
+PETSC_INTERN PetscErrorCode MatBinBCSRSetTuneCache_MPIBinBCSR(Mat mat, PetscBool flg);
+PETSC_INTERN PetscErrorCode MatBinBCSRGetTuneCache_MPIBinBCSR(Mat mat, PetscBool *flg);
+PETSC_INTERN PetscErrorCode MatBinBCSRSetPrecision_MPIBinBCSR(Mat mat, MatBinBCSRPrecision p);
+PETSC_INTERN PetscErrorCode MatBinBCSRGetPrecision_MPIBinBCSR(Mat mat, MatBinBCSRPrecision *p);
+PETSC_INTERN PetscErrorCode MatBinBCSRSetSymmetricStorage_MPIBinBCSR(Mat mat, PetscBool flg);
+PETSC_INTERN PetscErrorCode MatBinBCSRGetSymmetricStorage_MPIBinBCSR(Mat mat, PetscBool *flg);
+PETSC_INTERN PetscErrorCode MatBinBCSRSetCOOMirror_MPIBinBCSR(Mat mat, PetscBool flg);
+PETSC_INTERN PetscErrorCode MatBinBCSRGetCOOMirror_MPIBinBCSR(Mat mat, PetscBool *flg);
+
+/* mpibinbcsr.cpp: creating the parts, compressing B, the ghost scatter */
 PETSC_INTERN PetscErrorCode MatMPIBinBCSRCreatePart(Mat, PetscInt m, PetscInt n, Mat *);
 /* Layouts set up, an unset block size (-1: the program never gave one) made 1: every preallocation
    path starts here, so that the parts and the ghost columns may read mat->rmap/cmap->bs. */
