@@ -16,9 +16,9 @@
 // on the stencils of -stencil_sizes (default 32,48; or the one of -stencil_n) and on every PETSc binary
 // file of -f (comma list, block size from -bs, default 3; the drivers write them with -dump_matrix FILE).
 // Per matrix and case one line: the sweep's best bw/K/body and ms, the tuned bw/K/body and ms, tuned /
-// best, the reference (seqbaij; seqaij for bs 1) and what the tuning cost. The best is then timed again against the tuned
-// matrix alone, alternating, -sweep_confirm N rounds (default 9; 0: not), since the lowest of ~100
-// medians is biased low by the rounds that chose it. -sweep_verbose prints every variant;
+// best, the reference (seqbaij; seqaij for bs 1) and what the tuning cost. The best is then timed again
+// against the tuned matrix alone, alternating, -sweep_confirm N rounds (default 9; 0: not), since the
+// lowest of ~100 medians is biased low by the rounds that chose it. -sweep_verbose prints every variant;
 // -tune_cache 1 lets the tuned matrix use the cache file (default: it measures).
 //
 // The fixed variants are built with -mat_binbcsr_tune off semantics (MatBinBCSRSetTune).

@@ -221,6 +221,10 @@ void FromLanes(const SlabGS &gs, const std::vector<double> &lv, double *v)
     }
 }
 
+} // namespace slab_gs_detail
+
+namespace {
+
 // One pass in the lane layout, lane by lane: the definition.
 void PassLanes(const SlabGS &gs, const double *b, double *x, double *lower, double *r, PassMode mode)
 {
@@ -273,7 +277,7 @@ void PassLanes(const SlabGS &gs, const double *b, double *x, double *lower, doub
   }
 }
 
-} // namespace slab_gs_detail
+} // namespace
 
 #if defined(__GNUC__) && defined(__x86_64__)
   #include <immintrin.h>
@@ -398,6 +402,10 @@ PassBody BestBody()
   return PassLanes;
 }
 
+} // namespace slab_gs_detail
+
+namespace {
+
 // one sweep from x, row by row in and out (a backward one first takes L x for the x it starts from)
 void SweepWith(PassBody body, SlabGS &gs, const double *b, double *x, bool forward)
 {
@@ -409,7 +417,7 @@ void SweepWith(PassBody body, SlabGS &gs, const double *b, double *x, bool forwa
   FromLanes(gs, gs.xl, x);
 }
 
-} // namespace slab_gs_detail
+} // namespace
 
 void SlabGSSweep(SlabGS &gs, const double *b, double *x, bool forward)
 {

@@ -33,11 +33,10 @@ enum PassMode {
   kLower        // lower = L x only (before a backward sweep that has no forward one before it)
 };
 
-// One pass in the lane layout: PassLanes is the definition (lane by lane), BestBody the fastest this
-// CPU runs (AVX-512 where it has it).
+// One pass in the lane layout: the fastest body this CPU runs (AVX-512 where it has it, else the
+// lane-by-lane definition, slab_gs.cpp's PassLanes).
 using PassBody = void (*)(const SlabGS &, const double *b, double *x, double *lower, double *r,
                           PassMode mode);
-void     PassLanes(const SlabGS &gs, const double *b, double *x, double *lower, double *r, PassMode mode);
 PassBody BestBody();
 
 } // namespace slab_gs_detail
