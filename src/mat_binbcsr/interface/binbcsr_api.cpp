@@ -450,10 +450,12 @@ const char *const MatBinBCSRXLoads[] = {"loads", "gather", "MatBinBCSRXLoad", "M
    Notes:
    Applies to the whole-storage product of 3x3 blocks at bin width 8 with the AVX-512 body; other
    shapes and bodies ignore it. With loads, the bins where at least half of the slot groups read
-   consecutive block columns load x for those groups (three vector loads, six permutes) and gather
-   for the others; with gather every group gathers. Both read the same x, so the results are the same.
-   Which is faster depends on the machine and the matrix: on a Zen 5 core the 48^3 stencil's product
-   in double ran about 10% faster gathering and in single 1.4x slower. Where it is not set, the tuner
+   consecutive block columns load x for those groups (three vector loads, six permutes) and every other
+   group reads it lane by lane (one masked load per lane and a transpose); with gather every group
+   gathers (three gather instructions). Both read the same x, so the results are the same. Which is
+   faster depends on the machine and the matrix: on a Zen 5 core the 48^3 stencil's product in double
+   ran about 10% faster gathering and in single 1.4x slower, and its gathers lost to the lane loads
+   on FE matrices. Where it is not set, the tuner
    (`MatBinBCSRSetTune()`) times both on a sample and the matrix's first products (after an untimed one,
    eight alternating) decide again; setting it ends that. It may change at any time. A no-op on
    matrices of other types.

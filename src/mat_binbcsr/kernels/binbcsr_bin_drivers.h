@@ -11,6 +11,7 @@
 
 #include "binbcsr_dispatch.h"
 #include "binbcsr_kernels.h"
+#include "binbcsr_layout.h"
 #if defined(BINBCSR_HAND_AVX512)
   #include "avx512/binbcsr_avx512.h"
 #endif
@@ -144,8 +145,8 @@ inline void bins_sweep(const BinMatrix &m, const int *bins, const double *x, con
   if constexpr (BS == 3 && BW == 8) {
     double(*accq[K])[8];
     for (int q = 0; q < K; q++) accq[q] = acc[q];
-    bool xload[K];
-    for (int q = 0; q < K; q++) xload[q] = !m.bin_xload || m.bin_xload[bins[q]];
+    unsigned char xload[K];
+    for (int q = 0; q < K; q++) xload[q] = m.bin_xload ? m.bin_xload[bins[q]] : XC_NEAR_UNIT;
     avx512::bins_mult_3x8<K>(s.t, s.c, s.len, nz, x, m.nbs, accq, m.prefetch, xload);
   } else
 #endif

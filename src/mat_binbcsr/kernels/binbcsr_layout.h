@@ -88,9 +88,20 @@ template <typename I> inline bool near_unit_group(const I *c, unsigned real, int
   return false;
 }
 
-/* xload[b] = 1 where at least half of bin b's slot groups pass near_unit_group, else 0: the hint that
-   lets a body gather x_c in the other bins without testing each group (on FE matrices most groups fail
-   the test, and its branches cost more than the loads save; a grid's bins pass it). Whole storage. */
+/* How the AVX-512 whole-storage body reads a bin's x_c (BinMatrix::bin_xload): XC_NEAR_UNIT tests each
+   slot group for consecutive columns and loads them as a block, lane by lane where the test fails;
+   XC_LANES goes lane by lane without the test; XC_GATHER gathers (MAT_BINBCSR_XLOAD_GATHER, for a CPU
+   whose gathers beat the lane loads). */
+enum : unsigned char {
+  XC_LANES     = 0,
+  XC_NEAR_UNIT = 1,
+  XC_GATHER    = 2
+};
+
+/* xload[b] = XC_NEAR_UNIT where at least half of bin b's slot groups pass near_unit_group, else
+   XC_LANES: the hint that lets a body read x_c lane by lane in the other bins without testing each
+   group (on FE matrices most groups fail the test, and its branches cost more than the loads save; a
+   grid's bins pass it). Whole storage. */
 template <typename I>
 inline void xload_bins(const I *bin_start, const I *col, const I *row_nz, I mbs, I nbins, int bw, I ncols,
                        unsigned char *xload)
@@ -106,7 +117,7 @@ inline void xload_bins(const I *bin_start, const I *col, const I *row_nz, I mbs,
       }
       pass += near_unit_group(col + bin_start[b] + k * bw, real, bw, ncols);
     }
-    xload[b] = 2 * pass >= len;
+    xload[b] = 2 * pass >= len ? XC_NEAR_UNIT : XC_LANES;
   }
 }
 

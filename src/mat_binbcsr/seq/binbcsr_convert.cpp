@@ -474,9 +474,10 @@ PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
         a->prefetch, a->prefetch ? "" : " (no software prefetch)"));
       if (MatSeqBinBCSRReadsXLoad(a))
         PetscCall(PetscViewerASCIIPrintf(
-          viewer, "product: x for consecutive columns by %s (-mat_binbcsr_xload %s)\n",
-          a->xload == MAT_BINBCSR_XLOAD_GATHER ? "gathers in every slot group"
-                                               : "loads where the bin's groups mostly allow",
+          viewer, "product: x read by %s (-mat_binbcsr_xload %s)\n",
+          a->xload == MAT_BINBCSR_XLOAD_GATHER
+            ? "gathers in every slot group"
+            : "block loads in the bins of mostly consecutive columns, lane by lane elsewhere",
           MatBinBCSRXLoads[a->xload]));
     }
     PetscCall(PetscViewerASCIIPrintf(viewer, "product body: %s (-mat_binbcsr_kernel %s)\n",

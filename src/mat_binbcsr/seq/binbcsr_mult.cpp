@@ -42,20 +42,20 @@ PetscBool MatSeqBinBCSRReadsXLoad(const Mat_SeqBinBCSR *a)
 
 /* The AVX-512 whole-storage body's per-bin hint (BinMatrix::bin_xload), made at the first product that
    runs that body and kept with the layout: one pass over the column indices. Two halves: the hint
-   (MAT_BINBCSR_XLOAD_LOADS) and zeros (MAT_BINBCSR_XLOAD_GATHER, gather everywhere), so that the x load
-   can change from one product to the next without a pass. */
+   (MAT_BINBCSR_XLOAD_LOADS) and XC_GATHER (MAT_BINBCSR_XLOAD_GATHER, gather everywhere), so that the x
+   load can change from one product to the next without a pass. */
 static PetscErrorCode MatSeqBinBCSRXLoadBins(Mat_SeqBinBCSR *a, const binbcsr::Body &body)
 {
   PetscFunctionBegin;
   if (a->bin_xload || !a->nbins || !ReadsXLoad(a, body.set)) PetscFunctionReturn(0);
   PetscCall(PetscMalloc1(2 * a->nbins, &a->bin_xload));
   binbcsr::xload_bins<PetscInt>(a->bin_start, a->col, a->row_nz, a->mbs, a->nbins, 8, a->nbs, a->bin_xload);
-  std::fill(a->bin_xload + a->nbins, a->bin_xload + 2 * a->nbins, (unsigned char)0);
+  std::fill(a->bin_xload + a->nbins, a->bin_xload + 2 * a->nbins, binbcsr::XC_GATHER);
   PetscInt n = 0;
-  for (PetscInt b = 0; b < a->nbins; b++) n += a->bin_xload[b];
-  PetscCall(PetscInfo(NULL,
-                      "x_c by loads in %" PetscInt_FMT " of %" PetscInt_FMT " bins, gathered in the others\n",
-                      n, a->nbins));
+  for (PetscInt b = 0; b < a->nbins; b++) n += a->bin_xload[b] == binbcsr::XC_NEAR_UNIT;
+  PetscCall(PetscInfo(
+    NULL, "x_c by block loads in %" PetscInt_FMT " of %" PetscInt_FMT " bins, lane by lane in the others\n",
+    n, a->nbins));
   PetscFunctionReturn(0);
 }
 

@@ -103,24 +103,73 @@ BINBCSR_AVX512_INLINE void patch_xyz(const I *c, const double *x, __mmask8 off, 
   }
 }
 
-/* x_c of a slot group's lanes as one register per component, zero in the lanes outside real: a
-   unit-stride or near-unit group (near_unit_3x8) loads it, any other gathers it with 32-bit offsets
-   (a masked gather reads nothing for the lanes outside real; try_loads false: the bin's hint says its
-   groups mostly gather, so gather without the test). Zero, not x: a padding slot's zero
-   value times a NaN or Inf of x would be a NaN the row does not have. */
+/* x_c of a slot group's real lanes, lane by lane: one masked load of x, y and z per lane (the fourth
+   element masked off, so the last column never reads past x; a lane outside real loads nothing and
+   reads as zero), then an 8x4 transpose (4 inserts, 4 unpacks, 3 two-source permutes) into one
+   register per component. Why not a gather: a zmm gather of 8 doubles runs slowly on Zen 4 and Zen 5;
+   with single-precision values in cache (an FE operator's size, random columns) three gathers took 1.8x
+   the time of these loads and the transpose (docs/mat_binbcsr.md, lane by lane). */
+template <typename I>
+BINBCSR_AVX512_INLINE void lanes_xyz_3x8(const I *c, __mmask8 real, const double *x, __m512d &x0, __m512d &x1,
+                                         __m512d &x2)
+{
+  const auto lane = [&](int l) __attribute__((always_inline))
+  {
+    return _mm256_maskz_loadu_pd((__mmask8)(-(int)(real >> l & 1u) & 7), x + (long)c[l] * 3);
+  };
+  const auto pair = [&](int l) __attribute__((always_inline))
+  {
+    return _mm512_insertf64x4(_mm512_castpd256_pd512(lane(l)), lane(l + 4), 1);
+  };
+  const __m512d a04 = pair(0), a15 = pair(1), a26 = pair(2), a37 = pair(3);
+  /* [x0 x1 z0 z1 | x4 x5 z4 z5], [y0 y1 - - | y4 y5 - -] and the same for lanes 2, 3, 6, 7 */
+  const __m512d lo01 = _mm512_unpacklo_pd(a04, a15), hi01 = _mm512_unpackhi_pd(a04, a15);
+  const __m512d lo23 = _mm512_unpacklo_pd(a26, a37), hi23 = _mm512_unpackhi_pd(a26, a37);
+  const __m512i first  = _mm512_setr_epi64(0, 1, 8, 9, 4, 5, 12, 13),
+                second = _mm512_setr_epi64(2, 3, 10, 11, 6, 7, 14, 15);
+  x0                   = _mm512_permutex2var_pd(lo01, first, lo23);
+  x1                   = _mm512_permutex2var_pd(hi01, first, hi23);
+  x2                   = _mm512_permutex2var_pd(lo01, second, lo23);
+}
+
+/* y_c[lane l] += (s0, s1, s2)[l] for the lanes in m (lanes_xyz_3x8 inverted; the lanes' columns differ,
+   so the read-add-writes do not overlap): the symmetric product's transposed blocks where a slot
+   group's columns are not consecutive. A lane outside m reads and writes nothing. */
+template <typename I>
+BINBCSR_AVX512_INLINE void lanes_add_xyz_3x8(const I *c, __mmask8 m, double *y, __m512d s0, __m512d s1,
+                                             __m512d s2)
+{
+  const __m512d lo01 = _mm512_permutex2var_pd(s0, _mm512_setr_epi64(0, 1, 8, 9, 4, 5, 12, 13), s2);
+  const __m512d lo23 = _mm512_permutex2var_pd(s0, _mm512_setr_epi64(2, 3, 10, 11, 6, 7, 14, 15), s2);
+  const __m512d hi23 = _mm512_permutex_pd(s1, 0xEE);
+  /* lane l's (s0, s1, s2, -) in the low half of a[l % 4] for l < 4, the high half for l >= 4 */
+  const __m512d a[4] = {_mm512_unpacklo_pd(lo01, s1), _mm512_unpackhi_pd(lo01, s1),
+                        _mm512_unpacklo_pd(lo23, hi23), _mm512_unpackhi_pd(lo23, hi23)};
+  for (int l = 0; l < 8; l++) {
+    const __mmask8 k = (__mmask8)(-(int)(m >> l & 1u) & 7);
+    double        *p = y + (long)c[l] * 3;
+    const __m256d  v = l < 4 ? _mm512_castpd512_pd256(a[l]) : _mm512_extractf64x4_pd(a[l - 4], 1);
+    _mm256_mask_storeu_pd(p, k, _mm256_add_pd(_mm256_maskz_loadu_pd(k, p), v));
+  }
+}
+
+/* x_c of a slot group's lanes as one register per component, zero in the lanes outside real (zero, not
+   x: a padding slot's zero value times a NaN or Inf of x would be a NaN the row does not have); mode:
+   the bin's XC_* (binbcsr_layout.h). A masked gather reads nothing for the lanes outside real. */
 template <typename I>
 BINBCSR_AVX512_INLINE void load_xc_3x8(const I *c, __m256i ci, __mmask8 real, const double *x, int ncols,
-                                       __m512d &x0, __m512d &x1, __m512d &x2, bool try_loads)
+                                       __m512d &x0, __m512d &x1, __m512d &x2, unsigned char mode)
 {
   int      base;
   __mmask8 off;
-  if (try_loads && near_unit_3x8(c, ci, real, ncols, base, off)) {
+  if (mode == XC_NEAR_UNIT && near_unit_3x8(c, ci, real, ncols, base, off)) {
     split_xyz(x + (long)base * 3, x0, x1, x2);
     if (off) patch_xyz(c, x, off, x0, x1, x2);
     x0 = _mm512_maskz_mov_pd(real, x0);
     x1 = _mm512_maskz_mov_pd(real, x1);
     x2 = _mm512_maskz_mov_pd(real, x2);
-  } else {
+  } else if (mode != XC_GATHER) lanes_xyz_3x8(c, real, x, x0, x1, x2);
+  else {
     const __m256i o = _mm256_add_epi32(ci, _mm256_add_epi32(ci, ci)); /* 3 c */
     x0              = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), real, o, x, 8);
     x1              = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), real, o, x + 1, 8);
@@ -133,13 +182,13 @@ BINBCSR_AVX512_INLINE void load_xc_3x8(const I *c, __m256i ci, __mmask8 real, co
    columns of x. */
 template <typename V, typename I>
 BINBCSR_AVX512_INLINE void group_mult_3x8(const V *t, const I *c, const double *x, int ncols, __m512d *a,
-                                          __mmask8 real, int pf, bool try_loads)
+                                          __mmask8 real, int pf, unsigned char mode)
 {
   static_assert(sizeof(I) == 4, "32-bit column indices");
   prefetch_values(t, 72 * (int)sizeof(V), pf);
   const __m256i ci = _mm256_loadu_si256((const __m256i *)c);
   __m512d       x0, x1, x2;
-  load_xc_3x8(c, ci, real, x, ncols, x0, x1, x2, try_loads);
+  load_xc_3x8(c, ci, real, x, ncols, x0, x1, x2, mode);
   a[0] = _mm512_fmadd_pd(load8(t + 16), x2,
                          _mm512_fmadd_pd(load8(t + 8), x1, _mm512_fmadd_pd(load8(t), x0, a[0])));
   a[1] = _mm512_fmadd_pd(load8(t + 40), x2,
@@ -155,7 +204,7 @@ BINBCSR_AVX512_INLINE void group_mult_3x8(const V *t, const I *c, const double *
 template <int K, typename V, typename I>
 BINBCSR_AVX512_INLINE void bins_mult_3x8(const V *const *bin_val, const I *const *bin_col, const int *len,
                                          const int (*nz)[8], const double *x, int ncols,
-                                         double (*const *acc)[8], int pf, const bool *xload)
+                                         double (*const *acc)[8], int pf, const unsigned char *xload)
 {
   __m512d a[K][3];
   __m256i n[K]; /* the lanes' real blocks: slot group k of lane l is real when k < n[l] */
@@ -242,10 +291,7 @@ BINBCSR_AVX512_INLINE void sym_bin_group_3x8(SymBin3x8<V, I> &b, const double *x
     split_xyz(x + (long)base * 3, xc[0], xc[1], xc[2]);
     if (off) patch_xyz(c, x, off, xc[0], xc[1], xc[2]);
     for (int j = 0; j < 3; j++) xc[j] = _mm512_maskz_mov_pd(real, xc[j]);
-  } else {
-    const __m256i o = _mm256_add_epi32(ci, _mm256_add_epi32(ci, ci)); /* 3 c */
-    for (int j = 0; j < 3; j++) xc[j] = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), real, o, x + j, 8);
-  }
+  } else lanes_xyz_3x8(c, real, x, xc[0], xc[1], xc[2]);
   for (int i = 0; i < 3; i++)
     b.a[i] = _mm512_fmadd_pd(v[3 * i + 2], xc[2],
                              _mm512_fmadd_pd(v[3 * i + 1], xc[1], _mm512_fmadd_pd(v[3 * i], xc[0], b.a[i])));
@@ -269,13 +315,7 @@ BINBCSR_AVX512_INLINE void sym_bin_group_3x8(SymBin3x8<V, I> &b, const double *x
     else
       add_xyz(y + (long)base * 3, _mm512_maskz_mov_pd(keep, s[0]), _mm512_maskz_mov_pd(keep, s[1]),
               _mm512_maskz_mov_pd(keep, s[2]));
-  } else {
-    const __m256i o = _mm256_add_epi32(ci, _mm256_add_epi32(ci, ci));
-    for (int j = 0; j < 3; j++) {
-      const __m512d yc = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), scatter, o, y + j, 8);
-      _mm512_mask_i32scatter_pd(y + j, scatter, o, _mm512_add_pd(yc, s[j]), 8);
-    }
-  }
+  } else lanes_add_xyz_3x8(c, scatter, y, s[0], s[1], s[2]);
 }
 
 template <typename V, typename I>
