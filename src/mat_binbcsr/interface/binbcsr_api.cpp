@@ -455,10 +455,9 @@ const char *const MatBinBCSRXLoads[] = {"loads", "gather", "MatBinBCSRXLoad", "M
    gathers (three gather instructions). Both read the same x, so the results are the same. Which is
    faster depends on the machine and the matrix: on a Zen 5 core the 48^3 stencil's product in double
    ran about 10% faster gathering and in single 1.4x slower, and its gathers lost to the lane loads
-   on FE matrices. Where it is not set, the tuner
-   (`MatBinBCSRSetTune()`) times both on a sample and the matrix's first products (after an untimed one,
-   eight alternating) decide again; setting it ends that. It may change at any time. A no-op on
-   matrices of other types.
+   on FE matrices. Where it is not set, the tuner (`MatBinBCSRSetTune()`) times both on a sample and
+   the matrix's first products (after an untimed one, eight alternating) decide again; setting it ends
+   that. It may change at any time. A no-op on matrices of other types.
 
 .seealso: `MATBINBCSR`, `MatBinBCSRGetXLoad()`, `MatBinBCSRSetTune()`
 @*/

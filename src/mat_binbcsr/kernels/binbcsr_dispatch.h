@@ -30,10 +30,10 @@ struct BinMatrix {
   int           nbins, mbs, nbs, bs, bw, streams; /* nbs: block columns (x has nbs * bs entries) */
   int           prefetch; /* bytes the products prefetch the values ahead (0: none; prefetch_values) */
   bool          sym;
-  /* [nbins] or NULL, whole storage, 3x3 blocks, width 8 (the AVX-512 body): each bin's XC_* (binbcsr_layout.h),
-     XC_LANES where its slot groups mostly cannot load x_c as consecutive columns (near_unit_group), so
-     that the body reads it lane by lane there without testing each group; NULL: test every group. A
-     hint: every way reads the same x_c. */
+  /* [nbins] or NULL, whole storage, 3x3 blocks, width 8 (the AVX-512 body): each bin's XC_*
+     (binbcsr_layout.h), XC_LANES where its slot groups mostly cannot load x_c as consecutive columns
+     (near_unit_group), so that the body reads it lane by lane there without testing each group; NULL:
+     test every group. A hint: every way reads the same x_c. */
   const unsigned char *bin_xload;
 };
 

@@ -59,11 +59,12 @@ BINBCSR_AVX512_INLINE void add_xyz(double *ys, __m512d s0, __m512d s1, __m512d s
 
 /* Where the real lanes of a slot group read consecutive block columns but for at most two: the
    first or last row of a grid line lacks the neighbour on that side, so in a bin that holds it the
-   row's k-th block is another column than its neighbours' in every group. Those groups would go
-   lane by lane (a third of the 48^3 stencil's groups at width 8; a Zen 4 core ran them, gathered then,
-   at half the speed of the loaded ones). Instead: base, the column of lane 0 were the group unit-stride (from the first real
-   lane, or the last where the first is the odd one), and off, the real lanes that do not follow it.
-   Returns false where more lanes are off or the 8 columns from base leave [0, ncols). */
+   row's k-th block is another column than its neighbours' in every group. Those groups would go lane
+   by lane (a third of the 48^3 stencil's groups at width 8; a Zen 4 core ran them, gathered then, at
+   half the speed of the loaded ones). Instead: base, the column of lane 0 were the group unit-stride
+   (from the first real lane, or the last where the first is the odd one), and off, the real lanes
+   that do not follow it. Returns false where more lanes are off or the 8 columns from base leave
+   [0, ncols). */
 template <typename I>
 BINBCSR_AVX512_INLINE bool near_unit_3x8(const I *c, __m256i ci, __mmask8 real, int ncols, int &base,
                                          __mmask8 &off)
@@ -232,11 +233,10 @@ BINBCSR_AVX512_INLINE void bins_mult_3x8(const V *const *bin_val, const I *const
 /* sym_bins_mult (binbcsr_kernels.h) for 3x3 blocks and 8 lanes, each bin in registers: the lanes'
    accumulators and x_r stay in zmm registers from the first slot group to the last (a per-group body
    kept them in memory, a store and a reload per group on the critical path: the cloth's product took
-   1.02 ms instead of 0.84, docs/mat_binbcsr.md). Consecutive-column
-   groups load x and update y contiguously; the others read x and add into y lane by lane
-   (lanes_xyz_3x8, lanes_add_xyz_3x8) for the lanes whose column is not their own row (conflict-free
-   within a group: the colouring). Same semantics as
-   the portable sym_bins_mult: on exit y_r += acc for the real lanes of every bin. */
+   1.02 ms instead of 0.84, docs/mat_binbcsr.md). Consecutive-column groups load x and update y
+   contiguously; the others read x and add into y lane by lane (lanes_xyz_3x8, lanes_add_xyz_3x8) for
+   the lanes whose column is not their own row (conflict-free within a group: the colouring). Same
+   semantics as the portable sym_bins_mult: on exit y_r += acc for the real lanes of every bin. */
 template <typename V, typename I> struct SymBin3x8 {
   const V *t;
   const I *c;
