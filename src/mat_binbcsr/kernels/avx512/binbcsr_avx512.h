@@ -104,6 +104,14 @@ BINBCSR_AVX512_INLINE void patch_xyz(const I *c, const double *x, __mmask8 off, 
   }
 }
 
+/* The two-source permutes of the 8x4 transpose (lanes_xyz_3x8) and of its inverse (lanes_add_xyz_3x8):
+   the 128-bit pairs 0 and 2 of each 256-bit half of a and b, or pairs 1 and 3. */
+BINBCSR_AVX512_INLINE __m512i pairs_even() { return _mm512_setr_epi64(0, 1, 8, 9, 4, 5, 12, 13); }
+BINBCSR_AVX512_INLINE __m512i pairs_odd() { return _mm512_setr_epi64(2, 3, 10, 11, 6, 7, 14, 15); }
+
+/* x, y and z of lane l (not the fourth element) where lane l is in m, nothing elsewhere */
+BINBCSR_AVX512_INLINE __mmask8 xyz_mask(__mmask8 m, int l) { return (__mmask8)(-(int)(m >> l & 1u) & 7); }
+
 /* x_c of a slot group's real lanes, lane by lane: one masked load of x, y and z per lane (the fourth
    element masked off, so the last column never reads past x; a lane outside real loads nothing and
    reads as zero), then an 8x4 transpose (4 inserts, 4 unpacks, 3 two-source permutes) into one
@@ -116,7 +124,7 @@ BINBCSR_AVX512_INLINE void lanes_xyz_3x8(const I *c, __mmask8 real, const double
 {
   const auto lane = [&](int l) __attribute__((always_inline))
   {
-    return _mm256_maskz_loadu_pd((__mmask8)(-(int)(real >> l & 1u) & 7), x + (long)c[l] * 3);
+    return _mm256_maskz_loadu_pd(xyz_mask(real, l), x + (long)c[l] * 3);
   };
   const auto pair = [&](int l) __attribute__((always_inline))
   {
@@ -126,11 +134,9 @@ BINBCSR_AVX512_INLINE void lanes_xyz_3x8(const I *c, __mmask8 real, const double
   /* [x0 x1 z0 z1 | x4 x5 z4 z5], [y0 y1 - - | y4 y5 - -] and the same for lanes 2, 3, 6, 7 */
   const __m512d lo01 = _mm512_unpacklo_pd(a04, a15), hi01 = _mm512_unpackhi_pd(a04, a15);
   const __m512d lo23 = _mm512_unpacklo_pd(a26, a37), hi23 = _mm512_unpackhi_pd(a26, a37);
-  const __m512i first  = _mm512_setr_epi64(0, 1, 8, 9, 4, 5, 12, 13),
-                second = _mm512_setr_epi64(2, 3, 10, 11, 6, 7, 14, 15);
-  x0                   = _mm512_permutex2var_pd(lo01, first, lo23);
-  x1                   = _mm512_permutex2var_pd(hi01, first, hi23);
-  x2                   = _mm512_permutex2var_pd(lo01, second, lo23);
+  x0 = _mm512_permutex2var_pd(lo01, pairs_even(), lo23);
+  x1 = _mm512_permutex2var_pd(hi01, pairs_even(), hi23);
+  x2 = _mm512_permutex2var_pd(lo01, pairs_odd(), lo23);
 }
 
 /* y_c[lane l] += (s0, s1, s2)[l] for the lanes in m (lanes_xyz_3x8 inverted; the lanes' columns differ,
@@ -140,14 +146,14 @@ template <typename I>
 BINBCSR_AVX512_INLINE void lanes_add_xyz_3x8(const I *c, __mmask8 m, double *y, __m512d s0, __m512d s1,
                                              __m512d s2)
 {
-  const __m512d lo01 = _mm512_permutex2var_pd(s0, _mm512_setr_epi64(0, 1, 8, 9, 4, 5, 12, 13), s2);
-  const __m512d lo23 = _mm512_permutex2var_pd(s0, _mm512_setr_epi64(2, 3, 10, 11, 6, 7, 14, 15), s2);
+  const __m512d lo01 = _mm512_permutex2var_pd(s0, pairs_even(), s2);
+  const __m512d lo23 = _mm512_permutex2var_pd(s0, pairs_odd(), s2);
   const __m512d hi23 = _mm512_permutex_pd(s1, 0xEE);
   /* lane l's (s0, s1, s2, -) in the low half of a[l % 4] for l < 4, the high half for l >= 4 */
   const __m512d a[4] = {_mm512_unpacklo_pd(lo01, s1), _mm512_unpackhi_pd(lo01, s1),
                         _mm512_unpacklo_pd(lo23, hi23), _mm512_unpackhi_pd(lo23, hi23)};
   for (int l = 0; l < 8; l++) {
-    const __mmask8 k = (__mmask8)(-(int)(m >> l & 1u) & 7);
+    const __mmask8 k = xyz_mask(m, l);
     double        *p = y + (long)c[l] * 3;
     const __m256d  v = l < 4 ? _mm512_castpd512_pd256(a[l]) : _mm512_extractf64x4_pd(a[l - 4], 1);
     _mm256_mask_storeu_pd(p, k, _mm256_add_pd(_mm256_maskz_loadu_pd(k, p), v));
