@@ -47,4 +47,16 @@
   #define PetscOptionsCreateViewer PetscOptionsGetViewer
 #endif
 
+/* 3.22 renamed PetscOptionsPushGetViewerOff and PetscOptionsPopGetViewerOff (the -xxx_view options
+   switched off for internal objects). */
+#if PETSC_VERSION_LT(3, 22, 0)
+  #define PetscOptionsPushCreateViewerOff PetscOptionsPushGetViewerOff
+  #define PetscOptionsPopCreateViewerOff  PetscOptionsPopGetViewerOff
+#endif
+
+/* 3.20 replaced PetscValidPointer (argument checks, petsc/private/petscimpl.h) by PetscAssertPointer. */
+#if PETSC_VERSION_LT(3, 20, 0)
+  #define PetscAssertPointer(h, arg) PetscValidPointer(h, arg)
+#endif
+
 #endif

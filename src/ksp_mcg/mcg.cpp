@@ -325,4 +325,4 @@ BINBCSR_TRY_SETTER(KSPMCGSetFixedIterations, KSP, KSP_CLASSID, PetscInt, PetscVa
 
 .seealso: `KSPMCG`, `KSPMCGSetFixedIterations()`
 @*/
-BINBCSR_TRY_GETTER(KSPMCGGetFixedIterations, KSP, KSP_CLASSID, PetscInt, PetscValidIntPointer, 0)
+BINBCSR_TRY_GETTER(KSPMCGGetFixedIterations, KSP, KSP_CLASSID, PetscInt, PetscAssertPointer, 0)

@@ -39,9 +39,9 @@ PetscErrorCode MatFDColoringApply_BinBCSR(Mat A, MatFDColoring c, Vec x, void *s
 
   PetscFunctionBegin;
   PetscCall(MatBinBCSRGetAIJShadow_Private(A, &S));
-  PetscCall(PetscOptionsPushGetViewerOff(PETSC_TRUE));  /* S's assembly is internal: no -mat_view of it */
-  PetscCall((*S->ops->fdcoloringapply)(S, c, x, sctx)); /* zeroes S, fills it, assembles it */
-  PetscCall(PetscOptionsPopGetViewerOff());
+  PetscCall(PetscOptionsPushCreateViewerOff(PETSC_TRUE)); /* S's assembly is internal: no -mat_view of it */
+  PetscCall((*S->ops->fdcoloringapply)(S, c, x, sctx));   /* zeroes S, fills it, assembles it */
+  PetscCall(PetscOptionsPopCreateViewerOff());
   PetscCall(MatBinBCSRSetValuesFromAIJShadow_Private(A));
   /* an AIJ Jacobian is viewed by -mat_view each time the colouring assembles it: so is this one */
   PetscCall(MatViewFromOptions(A, nullptr, "-mat_view"));

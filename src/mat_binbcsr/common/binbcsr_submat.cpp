@@ -138,7 +138,7 @@ PetscErrorCode MatBinBCSRGetAIJShadow_Private(Mat A, Mat *S)
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIBINBCSR, &mpi));
   /* The shadow is internal: its assemblies must not answer the user's -mat_view (on several ranks the
      parts' views are per rank and unsynchronised, and interleave with rank 0's output). */
-  PetscCall(PetscOptionsPushGetViewerOff(PETSC_TRUE));
+  PetscCall(PetscOptionsPushCreateViewerOff(PETSC_TRUE));
   if (todo[0]) {
     PetscCall(ClearParts(sh));
     PetscCall(MatDestroy(&sh->S));
@@ -149,7 +149,7 @@ PetscErrorCode MatBinBCSRGetAIJShadow_Private(Mat A, Mat *S)
     PetscCall(PetscObjectStateIncrease((PetscObject)sh->S));
   } else if (todo[1]) PetscCall(MatConvert(A, mpi ? MATMPIAIJ : MATSEQAIJ, MAT_REUSE_MATRIX, &sh->S));
   if (todo[1]) PetscCall(MatPropagateSymmetryOptions(A, sh->S)); /* external factors read them (MUMPS: SPD) */
-  PetscCall(PetscOptionsPopGetViewerOff());
+  PetscCall(PetscOptionsPopCreateViewerOff());
   sh->state   = state;
   sh->nzstate = A->nonzerostate;
   *S          = sh->S;

@@ -141,7 +141,7 @@ BINBCSR_TRY_SETTER(MatBinBCSRSetBinWidth, Mat, MAT_CLASSID, PetscInt, PetscValid
 
 .seealso: `MATBINBCSR`, `MatBinBCSRSetBinWidth()`
 @*/
-BINBCSR_TRY_GETTER(MatBinBCSRGetBinWidth, Mat, MAT_CLASSID, PetscInt, PetscValidIntPointer, 0)
+BINBCSR_TRY_GETTER(MatBinBCSRGetBinWidth, Mat, MAT_CLASSID, PetscInt, PetscAssertPointer, 0)
 
 /*@
    MatBinBCSRSetPrecision - Sets the storage precision of the values of a `MATBINBCSR` matrix
@@ -182,7 +182,7 @@ BINBCSR_TRY_SETTER(MatBinBCSRSetPrecision, Mat, MAT_CLASSID, MatBinBCSRPrecision
 
 .seealso: `MATBINBCSR`, `MatBinBCSRSetPrecision()`
 @*/
-BINBCSR_TRY_GETTER(MatBinBCSRGetPrecision, Mat, MAT_CLASSID, MatBinBCSRPrecision, PetscValidPointer,
+BINBCSR_TRY_GETTER(MatBinBCSRGetPrecision, Mat, MAT_CLASSID, MatBinBCSRPrecision, PetscAssertPointer,
                    MAT_BINBCSR_PRECISION_DOUBLE)
 
 /*@
@@ -228,7 +228,7 @@ BINBCSR_TRY_SETTER(MatBinBCSRSetSymmetricStorage, Mat, MAT_CLASSID, PetscBool,
 
 .seealso: `MATBINBCSR`, `MatBinBCSRSetSymmetricStorage()`
 @*/
-BINBCSR_TRY_GETTER(MatBinBCSRGetSymmetricStorage, Mat, MAT_CLASSID, PetscBool, PetscValidBoolPointer,
+BINBCSR_TRY_GETTER(MatBinBCSRGetSymmetricStorage, Mat, MAT_CLASSID, PetscBool, PetscAssertPointer,
                    PETSC_FALSE)
 
 /*@
@@ -271,7 +271,7 @@ BINBCSR_TRY_SETTER(MatBinBCSRSetCOOMirror, Mat, MAT_CLASSID, PetscBool, PetscVal
 
 .seealso: `MATBINBCSR`, `MatBinBCSRSetCOOMirror()`
 @*/
-BINBCSR_TRY_GETTER(MatBinBCSRGetCOOMirror, Mat, MAT_CLASSID, PetscBool, PetscValidBoolPointer, PETSC_FALSE)
+BINBCSR_TRY_GETTER(MatBinBCSRGetCOOMirror, Mat, MAT_CLASSID, PetscBool, PetscAssertPointer, PETSC_FALSE)
 
 /*@
    MatBinBCSRSetValuesCOOSingle - `MatSetValuesCOO()` with the values in single precision
@@ -372,7 +372,7 @@ PetscErrorCode MatBinBCSRSetStreams(Mat A, PetscInt streams)
 
 .seealso: `MATBINBCSR`, `MatBinBCSRSetStreams()`
 @*/
-BINBCSR_TRY_GETTER(MatBinBCSRGetStreams, Mat, MAT_CLASSID, PetscInt, PetscValidIntPointer, 1)
+BINBCSR_TRY_GETTER(MatBinBCSRGetStreams, Mat, MAT_CLASSID, PetscInt, PetscAssertPointer, 1)
 
 /*@
    MatBinBCSRSetPrefetch - Sets how many bytes ahead of the values being multiplied the products of a
@@ -428,7 +428,7 @@ PetscErrorCode MatBinBCSRSetPrefetch(Mat A, PetscInt bytes)
 
 .seealso: `MATBINBCSR`, `MatBinBCSRSetPrefetch()`
 @*/
-BINBCSR_TRY_GETTER(MatBinBCSRGetPrefetch, Mat, MAT_CLASSID, PetscInt, PetscValidIntPointer, 0)
+BINBCSR_TRY_GETTER(MatBinBCSRGetPrefetch, Mat, MAT_CLASSID, PetscInt, PetscAssertPointer, 0)
 
 const char *const MatBinBCSRXLoads[] = {"loads", "gather", "MatBinBCSRXLoad", "MAT_BINBCSR_XLOAD_", nullptr};
 
@@ -489,7 +489,7 @@ PetscErrorCode MatBinBCSRSetXLoad(Mat A, MatBinBCSRXLoad xload)
 
 .seealso: `MATBINBCSR`, `MatBinBCSRSetXLoad()`
 @*/
-BINBCSR_TRY_GETTER(MatBinBCSRGetXLoad, Mat, MAT_CLASSID, MatBinBCSRXLoad, PetscValidPointer,
+BINBCSR_TRY_GETTER(MatBinBCSRGetXLoad, Mat, MAT_CLASSID, MatBinBCSRXLoad, PetscAssertPointer,
                    MAT_BINBCSR_XLOAD_LOADS)
 
 /*@
@@ -528,7 +528,7 @@ PetscErrorCode MatBinBCSRSetTune(Mat A, MatBinBCSRTune t)
 
 .seealso: `MATBINBCSR`, `MatBinBCSRSetTune()`
 @*/
-BINBCSR_TRY_GETTER(MatBinBCSRGetTune, Mat, MAT_CLASSID, MatBinBCSRTune, PetscValidPointer,
+BINBCSR_TRY_GETTER(MatBinBCSRGetTune, Mat, MAT_CLASSID, MatBinBCSRTune, PetscAssertPointer,
                    MAT_BINBCSR_TUNE_OFF)
 
 /*@
@@ -554,7 +554,7 @@ BINBCSR_TRY_SETTER(MatBinBCSRSetTuneCache, Mat, MAT_CLASSID, PetscBool, PetscVal
 
 .seealso: `MATBINBCSR`, `MatBinBCSRSetTuneCache()`
 @*/
-BINBCSR_TRY_GETTER(MatBinBCSRGetTuneCache, Mat, MAT_CLASSID, PetscBool, PetscValidBoolPointer, PETSC_FALSE)
+BINBCSR_TRY_GETTER(MatBinBCSRGetTuneCache, Mat, MAT_CLASSID, PetscBool, PetscAssertPointer, PETSC_FALSE)
 
 /*@
    MatMultDotLocal - Computes y = A x and the local part of the dot product x^T y in one pass over A
@@ -586,7 +586,7 @@ PetscErrorCode MatMultDotLocal(Mat A, Vec x, Vec y, PetscScalar *xdoty)
   PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
   PetscValidHeaderSpecific(x, VEC_CLASSID, 2);
   PetscValidHeaderSpecific(y, VEC_CLASSID, 3);
-  PetscValidScalarPointer(xdoty, 4);
+  PetscAssertPointer(xdoty, 4);
   PetscCall(PetscObjectQueryFunction((PetscObject)A, "MatMultDotLocal_C", &fused));
   if (fused) {
     PetscCall(fused(A, x, y, xdoty));

@@ -9,7 +9,7 @@ const char *const MatBinBCSRKernels[] = {
 PetscErrorCode MatBinBCSRKernelAvailable(MatBinBCSRKernel kernel, PetscBool *avail)
 {
   PetscFunctionBegin;
-  PetscValidBoolPointer(avail, 2);
+  PetscAssertPointer(avail, 2);
   *avail = (kernel >= MAT_BINBCSR_KERNEL_AUTO && kernel <= MAT_BINBCSR_KERNEL_AVX512 &&
             binbcsr::body_set_available((binbcsr::BodySet)kernel))
              ? PETSC_TRUE
@@ -51,7 +51,7 @@ PetscErrorCode MatBinBCSRGetKernel(Mat A, MatBinBCSRKernel *kernel)
 
   PetscFunctionBegin;
   PetscValidHeaderSpecific(A, MAT_CLASSID, 1);
-  PetscValidPointer(kernel, 2);
+  PetscAssertPointer(kernel, 2);
   *kernel = MAT_BINBCSR_KERNEL_PORTABLE;
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATSEQBINBCSR, &seq));
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIBINBCSR, &mpi));

@@ -36,7 +36,7 @@ static PetscErrorCode ConvertByParts(Mat mat, Mat *M)
   PetscFunctionBegin;
   const std::vector<PetscInt> cols = PointGarray(mat);
   /* the parts and the join are internal steps: -mat_view must not see them (per-rank, unsynchronised) */
-  PetscCall(PetscOptionsPushGetViewerOff(PETSC_TRUE));
+  PetscCall(PetscOptionsPushCreateViewerOff(PETSC_TRUE));
   PetscCall(MatConvert(b->A, MATSEQAIJ, MAT_INITIAL_MATRIX, &Ad));
   if (b->B) PetscCall(MatConvert(b->B, MATSEQAIJ, MAT_INITIAL_MATRIX, &Ao));
   else {
@@ -47,7 +47,7 @@ static PetscErrorCode ConvertByParts(Mat mat, Mat *M)
   PetscCheck(Ao->cmap->n == static_cast<PetscInt>(cols.size()), PETSC_COMM_SELF, PETSC_ERR_PLIB,
              "Off-diagonal part has %" PetscInt_FMT " columns, garray %zu", Ao->cmap->n, cols.size());
   PetscCall(MatCreateMPIAIJWithSeqAIJ(PetscObjectComm((PetscObject)mat), Ad, Ao, cols.data(), M));
-  PetscCall(PetscOptionsPopGetViewerOff());
+  PetscCall(PetscOptionsPopCreateViewerOff());
   PetscCall(
     MatSetOption(*M, MAT_NEW_NONZERO_LOCATION_ERR, PETSC_FALSE)); /* as any other conversion's result */
   PetscCall(MatPropagateSymmetryOptions(mat, *M));
