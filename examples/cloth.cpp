@@ -96,6 +96,7 @@ int main(int argc, char **argv)
     PetscCall(PetscOptionsGetEList(nullptr, nullptr, "-cloth_timer", timers, 2, &t, nullptr));
     cpu_timer = t == 1;
   }
+  params.clock = cpu_timer ? ProcessCpuTime : WallTime; // the strain limiting's share of physics_ms
   PetscCall(DriverOutputFromOptions(comm, &out));
   params.choi_ko = !exact;
   opt.n          = (int)n;
@@ -225,7 +226,8 @@ int main(int argc, char **argv)
   }
   const auto now           = cpu_timer ? ProcessCpuTime : WallTime;
   double     step_ms_total = 0, max_stretch = 0;
-  long long  nan_steps = 0, unconverged = 0, contacts = 0, done = 0;
+  long long  nan_steps = 0, unconverged = 0, contacts = 0, done = 0, limit_sweeps = 0, limit_capped = 0;
+  double     limit_s = 0;
   for (PetscInt step = 1; step <= out.steps; ++step) {
     const long long                its0   = rs.iterations;
     const double                   solve0 = rs.solve_ms, t0 = now();
@@ -240,6 +242,9 @@ int main(int argc, char **argv)
     nan_steps += !finite;
     unconverged += !r.converged;
     contacts += r.contacts;
+    limit_sweeps += r.strain_sweeps;
+    limit_capped += r.strain_capped;
+    limit_s += r.strain_seconds;
     max_stretch = std::max(max_stretch, r.max_stretch); // this rank's springs: reduced where printed
     if (step % out.progress_every == 0 || step == out.steps) {
       double stretch = r.max_stretch;
@@ -284,6 +289,12 @@ int main(int argc, char **argv)
   s.add("steps_per_s", step_ms_total > 0 ? 1e3 * done / step_ms_total : 0.0);
   s.add("unconverged_steps", unconverged);
   s.add("max_stretch", max_stretch);
+  // the strain limiting (every rank limits the whole replicated cloth): its time per step (part of
+  // physics_ms), sweeps per step, and the steps whose sweeps ran out before every stretch spring was
+  // within the bound (then max_stretch exceeds 1 + -cloth_strain_limit)
+  s.add("limit_ms", done ? 1e3 * limit_s / done : 0.0);
+  s.add("limit_sweeps", done ? (double)limit_sweeps / done : 0.0);
+  s.add("limit_capped_steps", limit_capped);
   s.add("contacts", contacts);
   s.add("energy_initial", e0);
   s.add("energy_final", physics::cloth_energy(cloth));

@@ -197,8 +197,11 @@ ClothStepReport cloth_step(Cloth &cloth, ClothSystem &sys, const ClothParams &pa
       }
     }
   }
+  const double            t0      = params.clock ? params.clock() : 0.0;
   const StrainLimitReport limited = limit_strain(cloth, sys.strain_limiter, params.strain_limit, h);
+  report.strain_seconds           = params.clock ? params.clock() - t0 : 0.0;
   report.strain_sweeps            = limited.sweeps;
+  report.strain_capped            = limited.capped;
   // the limit's report holds the same maximum over every stretch spring: where this process assembles
   // them all (one process), that is the answer
   const bool all_stretch = sys.stretch_springs.size() == sys.strain_limiter.stretch_all.size();

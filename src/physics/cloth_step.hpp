@@ -19,6 +19,8 @@ struct ClothParams {
   double      dt      = 1.0 / 60.0;
   bool        choi_ko = true; // false keeps the exact (possibly indefinite) Jacobian of compressed springs
   StrainLimit strain_limit;   // off by default: applied after the position update and the sphere
+  // A clock in seconds (the driver's wall or CPU timer) to time the strain limiting with; null: untimed.
+  double (*clock)() = nullptr;
 };
 
 // The blocks one process assembles. On one process: every row and both triangles. With replicated state
@@ -43,6 +45,9 @@ struct ClothStepReport {
   int    contacts      = 0; // particles projected out of the sphere
   double max_stretch   = 0; // over the stretch springs this process assembles (all of them on one process)
   int    strain_sweeps = 0; // strain-limiting sweeps made (0 when off)
+  // the limiting used all its sweeps and the last one still corrected springs: the bound is not met
+  bool   strain_capped  = false;
+  double strain_seconds = 0; // the limiting's time, by ClothParams::clock
 };
 
 // Every row, both triangles.

@@ -179,6 +179,7 @@ StrainLimitReport limit_strain(Cloth &cloth, StrainLimiter &limiter, const Strai
     }
     report.sweeps = sweep + 1;
     if (!over) break;
+    report.capped = sweep + 1 == limit.max_sweeps;
     std::fill(next.begin(), next.end(), 0);
     for (int p : moved) mark(next, p);
     visit.swap(next);

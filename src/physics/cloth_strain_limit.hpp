@@ -30,9 +30,10 @@ struct StrainLimit {
 };
 
 struct StrainLimitReport {
-  int    sweeps    = 0; // sweeps made
-  int    corrected = 0; // spring corrections made, over all sweeps
-  double max_ratio = 0; // largest length / rest length after the last sweep
+  int    sweeps    = 0;     // sweeps made
+  int    corrected = 0;     // spring corrections made, over all sweeps
+  double max_ratio = 0;     // largest length / rest length after the last sweep
+  bool   capped    = false; // the sweeps ran out while the last one still corrected springs
 };
 
 std::string validate_strain_limit(const StrainLimit &limit);

@@ -179,6 +179,40 @@ TEST_CASE("over-relaxed strain limiting brings a stretched chain within the boun
   CHECK(shortest19 >= 0.5);        // over-relaxed: below the bound, never below half the rest length
 }
 
+TEST_CASE("strain limiting says when its sweeps ran out before the bound", "[cloth][strain]")
+{
+  // the over-stretched chain of the case above, limited with too few sweeps and with enough
+  const auto limited = [](int max_sweeps) {
+    const int n = 30;
+    Cloth     c;
+    for (int p = 0; p < n; ++p) c.position.emplace_back(1.2 * p, 0, 0);
+    c.velocity.assign(n, Eigen::Vector3d::Zero());
+    c.mass.assign(n, 1.0);
+    c.fixed.assign(n, 0);
+    c.fixed[0] = 1;
+    for (int p = 0; p + 1 < n; ++p) c.springs.push_back(Spring{p, p + 1, 1.0, 1.0, SpringKind::Stretch});
+    StrainLimit limit;
+    limit.max_strain = 0.05, limit.max_sweeps = max_sweeps;
+    return limit_strain(c, limit, 0.01);
+  };
+  const StrainLimitReport few = limited(3), enough = limited(5000);
+  CHECK(few.sweeps == 3);
+  CHECK(few.capped);
+  CHECK(few.max_ratio > 1.05 * (1 + 1e-3)); // the bound not met: what capped reports
+  CHECK(enough.sweeps < 5000);
+  CHECK(!enough.capped);
+  CHECK(enough.max_ratio <= 1.05 * (1 + 1e-4));
+  // one sweep allowed and nothing to correct: that sweep was the last, but nothing ran out
+  ClothOptions opt;
+  opt.n            = 6;
+  Cloth       rest = make_cloth(opt);
+  StrainLimit one;
+  one.max_strain = 0.05, one.max_sweeps = 1;
+  const StrainLimitReport calm = limit_strain(rest, one, 0.01);
+  CHECK(calm.sweeps == 1);
+  CHECK(!calm.capped);
+}
+
 TEST_CASE("bad strain limits are refused", "[cloth][strain]")
 {
   ClothParams p;
