@@ -290,8 +290,8 @@ int main(int argc, char **argv)
   s.add("unconverged_steps", unconverged);
   s.add("max_stretch", max_stretch);
   // the strain limiting (every rank limits the whole replicated cloth): its time per step (part of
-  // physics_ms), sweeps per step, and the steps whose sweeps ran out before every stretch spring was
-  // within the bound (then max_stretch exceeds 1 + -cloth_strain_limit)
+  // physics_ms), sweeps per step, and the steps whose sweeps ran out while the last one still corrected
+  // springs (then max_stretch may exceed 1 + -cloth_strain_limit)
   s.add("limit_ms", done ? 1e3 * limit_s / done : 0.0);
   s.add("limit_sweeps", done ? (double)limit_sweeps / done : 0.0);
   s.add("limit_capped_steps", limit_capped);

@@ -45,7 +45,7 @@ struct ClothStepReport {
   int    contacts      = 0; // particles projected out of the sphere
   double max_stretch   = 0; // over the stretch springs this process assembles (all of them on one process)
   int    strain_sweeps = 0; // strain-limiting sweeps made (0 when off)
-  // the limiting used all its sweeps and the last one still corrected springs: the bound is not met
+  // the limiting used all its sweeps and the last one still corrected springs: the bound may not hold
   bool   strain_capped  = false;
   double strain_seconds = 0; // the limiting's time, by ClothParams::clock
 };
