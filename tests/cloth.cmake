@@ -12,8 +12,18 @@ add_test(NAME cloth_drape_sphere
 # spring stays within a few percent of its rest length over 30 steps that hang it from its corners and
 # drop it on the sphere (the thesis's setting, options/cloth_thesis.opts, stretches the corners far).
 add_test(NAME cloth_scene_stretch_bounded
-         COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && max_stretch<1.08 && contacts>0 && diverged_solves==0"
+         COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && max_stretch<1.08 && contacts>0 && diverged_solves==0 && limit_sweeps>=1 && limit_capped_steps==0 && limit_ms>0"
                  -- ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 40 -steps 30 -progress_every 1000)
+# The summary says when the limiting ran out of sweeps (one allowed: in most steps, and the bound is
+# exceeded) and reports none without a limit.
+add_test(NAME cloth_strain_limit_capped_reported
+         COMMAND ${SUMMARY_CHECK} "nan==0 && limit_sweeps==1 && limit_capped_steps>=10 && max_stretch>1.1"
+                 -- ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 40 -steps 30 -progress_every 1000
+                    -cloth_strain_limit_sweeps 1)
+add_test(NAME cloth_strain_limit_off_reported
+         COMMAND ${SUMMARY_CHECK} "nan==0 && limit_sweeps==0 && limit_capped_steps==0"
+                 -- ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 40 -steps 30 -progress_every 1000
+                    -cloth_strain_limit 0)
 # At 80 x 80 a region of springs lands on the sphere over the bound at once: the scene's over-relaxed
 # sweeps (omega 1.9, 150 at most) keep every stretch spring within 6% over 40 steps (1.058 measured),
 # where Provot's plain sweeps reach their cap of 200 at 1.114.
@@ -128,7 +138,7 @@ add_test(NAME cloth_bad_sphere_centre COMMAND ${EXPECT_RUN} nonzero "sphere need
 # PETSc reads at most as many numbers as the array holds and drops the rest without a word
 add_test(NAME cloth_bad_sphere_centre_count COMMAND ${EXPECT_RUN} nonzero "-sphere_centre needs 3 numbers, got 4"
                                                    -- ${CLOTH} -cloth_n 4 -sphere -sphere_centre 0,-0.5,0,7)
-set_tests_properties(cloth_drape_sphere cloth_scene_stretch_bounded cloth_scene_stretch_bounded_80 cloth_stiff_dt30 cloth_same_result_mat_types cloth_bad_dt cloth_bad_n cloth_bad_pins
+set_tests_properties(cloth_drape_sphere cloth_scene_stretch_bounded cloth_strain_limit_capped_reported cloth_strain_limit_off_reported cloth_scene_stretch_bounded_80 cloth_stiff_dt30 cloth_same_result_mat_types cloth_bad_dt cloth_bad_n cloth_bad_pins
                      cloth_bad_stiffness cloth_bad_strain_limit_omega cloth_bad_huge_n cloth_bad_infinite_stiffness
                      cloth_bad_sphere_centre cloth_bad_sphere_centre_count PROPERTIES LABELS "cloth" TIMEOUT 60)
 
