@@ -41,6 +41,23 @@ double worst_stretch(int n, double max_strain, int steps, bool sphere)
   return worst;
 }
 
+// A zigzag chain of 30 particles pinned at its first, every spring 20% over its rest length: the excess
+// has to leave through the free end, which Gauss-Seidel sweeps do a spring at a time.
+Cloth stretched_chain()
+{
+  const int n = 30;
+  Cloth     c;
+  for (int p = 0; p < n; ++p) c.position.emplace_back(1.2 * p, 0.3 * (p % 2), 0);
+  c.velocity.assign(n, Eigen::Vector3d::Zero());
+  c.mass.assign(n, 1.0);
+  c.fixed.assign(n, 0);
+  c.fixed[0] = 1;
+  for (int p = 0; p + 1 < n; ++p)
+    c.springs.push_back(
+      Spring{p, p + 1, (c.position[p + 1] - c.position[p]).norm() / 1.2, 1.0, SpringKind::Stretch});
+  return c;
+}
+
 // The limiting as its definition reads: every sweep visits every stretch spring (alternating the
 // direction) and ends by projecting every particle out of the sphere; then the velocities take the
 // change. limit_strain visits only the springs and particles that can change, and must make exactly
@@ -146,19 +163,8 @@ TEST_CASE("strain limiting moves the free end of an overstretched spring and its
 TEST_CASE("over-relaxed strain limiting brings a stretched chain within the bound in fewer sweeps",
           "[cloth][strain]")
 {
-  // a chain pinned at one end, every spring 20% over its rest length: the excess has to leave through
-  // the free end, which Gauss-Seidel sweeps do a spring at a time
   const auto sweeps_to_bound = [](double omega, double &max_ratio, double &shortest) {
-    const int n = 30;
-    Cloth     c;
-    for (int p = 0; p < n; ++p) c.position.emplace_back(1.2 * p, 0.3 * (p % 2), 0);
-    c.velocity.assign(n, Eigen::Vector3d::Zero());
-    c.mass.assign(n, 1.0);
-    c.fixed.assign(n, 0);
-    c.fixed[0] = 1;
-    for (int p = 0; p + 1 < n; ++p)
-      c.springs.push_back(
-        Spring{p, p + 1, (c.position[p + 1] - c.position[p]).norm() / 1.2, 1.0, SpringKind::Stretch});
+    Cloth       c = stretched_chain();
     StrainLimit limit;
     limit.max_strain = 0.05, limit.max_sweeps = 5000, limit.omega = omega;
     const StrainLimitReport r = limit_strain(c, limit, 0.01);
@@ -181,16 +187,9 @@ TEST_CASE("over-relaxed strain limiting brings a stretched chain within the boun
 
 TEST_CASE("strain limiting says when its sweeps ran out before the bound", "[cloth][strain]")
 {
-  // the over-stretched chain of the case above, limited with too few sweeps and with enough
+  // the stretched chain, limited with too few sweeps and with enough
   const auto limited = [](int max_sweeps) {
-    const int n = 30;
-    Cloth     c;
-    for (int p = 0; p < n; ++p) c.position.emplace_back(1.2 * p, 0, 0);
-    c.velocity.assign(n, Eigen::Vector3d::Zero());
-    c.mass.assign(n, 1.0);
-    c.fixed.assign(n, 0);
-    c.fixed[0] = 1;
-    for (int p = 0; p + 1 < n; ++p) c.springs.push_back(Spring{p, p + 1, 1.0, 1.0, SpringKind::Stretch});
+    Cloth       c = stretched_chain();
     StrainLimit limit;
     limit.max_strain = 0.05, limit.max_sweeps = max_sweeps;
     return limit_strain(c, limit, 0.01);
