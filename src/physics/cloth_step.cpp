@@ -202,11 +202,9 @@ ClothStepReport cloth_step(Cloth &cloth, ClothSystem &sys, const ClothParams &pa
   report.strain_seconds           = params.clock ? params.clock() - t0 : 0.0;
   report.strain_sweeps            = limited.sweeps;
   report.strain_capped            = limited.capped;
-  // the limit's report holds the same maximum over every stretch spring: where this process assembles
-  // them all (one process), that is the answer
-  const bool all_stretch = sys.stretch_springs.size() == sys.strain_limiter.stretch_all.size();
-  report.max_stretch =
-    limited.sweeps > 0 && all_stretch ? limited.max_ratio : max_stretch_ratio(cloth, sys.stretch_springs);
+  // the limiting measured the largest stretch over every stretch spring (every process holds the
+  // whole cloth): no second pass, on any number of processes; without it, this process's own springs
+  report.max_stretch = limited.sweeps > 0 ? limited.max_ratio : max_stretch_ratio(cloth, sys.stretch_springs);
   return report;
 }
 

@@ -39,11 +39,13 @@ struct ClothSystem {
   StrainLimiter       strain_limiter;        // over every stretch spring: each process limits the whole state
 };
 struct ClothStepReport {
-  int    iterations    = 0;
-  bool   converged     = true;
-  bool   breakdown     = false;
-  int    contacts      = 0; // particles projected out of the sphere
-  double max_stretch   = 0; // over the stretch springs this process assembles (all of them on one process)
+  int  iterations = 0;
+  bool converged  = true;
+  bool breakdown  = false;
+  int  contacts   = 0; // particles projected out of the sphere
+  // the largest stretch ratio: over every stretch spring where the strain limit ran, else over those
+  // this process assembles (all of them on one process); the driver takes the maximum over processes
+  double max_stretch   = 0;
   int    strain_sweeps = 0; // strain-limiting sweeps made (0 when off)
   // the limiting used all its sweeps and the last one still corrected springs: the bound may not hold
   bool   strain_capped  = false;
