@@ -27,6 +27,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fcntl.h>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -72,13 +73,48 @@ std::string BinBCSRTuneCachePath(void)
   return dir + "/petscbinbcsr/tune.txt";
 }
 
-/* Every entry of the file; false when the file exists but does not parse (why says where). */
+/* A file of this size is none the tuner wrote (a line per matrix class and machine, under 200 bytes) */
+static const off_t cache_max_bytes = 1 << 20;
+
+/* The whole file, read without blocking: a FIFO at the path would block an open for reading until a
+   writer came, and a device (a link to /dev/zero) would never end. Returns 0 (text holds the file), 1
+   when there is nothing to read (no file, or unreadable), -1 when the path is no regular file or one
+   too large (why says which). */
+static int ReadCacheText(const std::string &path, std::string &text, std::string &why)
+{
+  const int fd = open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return 1;
+  struct stat st;
+  int         status = 0;
+  if (fstat(fd, &st) != 0) status = 1;
+  else if (!S_ISREG(st.st_mode)) why = "not a regular file", status = -1;
+  else if (st.st_size > cache_max_bytes)
+    why = "larger than " + std::to_string((long)cache_max_bytes) + " bytes", status = -1;
+  else {
+    text.resize((size_t)st.st_size);
+    size_t got = 0;
+    while (got < text.size()) {
+      const ssize_t n = read(fd, &text[got], text.size() - got);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;
+      got += (size_t)n;
+    }
+    text.resize(got); /* a file cut short while read: what was there (the parse judges it) */
+  }
+  close(fd);
+  return status;
+}
+
+/* Every entry of the file; false when the file exists but does not parse, or is no regular file of a
+   cache's size (why says where). */
 static bool ReadCache(const std::string &path, std::map<std::string, BinBCSRTuneChoice> &entries,
                       std::string &why)
 {
-  std::ifstream in(path);
-  std::string   line;
-  if (!in) return true; /* no file yet (or unreadable): nothing cached */
+  std::string text, line;
+  const int   status = ReadCacheText(path, text, why);
+  if (status > 0) return true; /* no file yet (or unreadable): nothing cached */
+  if (status < 0) return false;
+  std::istringstream in(text);
   if (std::getline(in, line) && line != cache_header && line.rfind(cache_header_stem, 0) == 0) {
     PetscCallAbort(PETSC_COMM_SELF, PetscInfo(nullptr,
                                               "Tuning cache %s is from another tuner version (\"%s\"): "
@@ -124,7 +160,8 @@ static bool ReadCache(const std::string &path, std::map<std::string, BinBCSRTune
   return true;
 }
 
-/* not_file: the path is there but is no regular file (a directory, say), which no tuning can replace */
+/* not_file: the path is there but is no regular file (a directory, a FIFO, a device) or one far larger
+   than a cache, which a store leaves alone */
 static PetscErrorCode WarnCorrupt(const std::string &path, const std::string &why, bool not_file)
 {
   static bool warned = false;
@@ -170,10 +207,11 @@ static const CacheMemo &CachedFile(const std::string &path)
     memo.parsed = true;
     return memo; /* no file: nothing cached, and nothing kept for a file that appears later */
   }
-  if (!S_ISREG(st.st_mode)) {
+  if (!S_ISREG(st.st_mode) || st.st_size > cache_max_bytes) {
     memo          = CacheMemo();
     memo.not_file = true;
-    memo.why      = "not a regular file";
+    memo.why      = S_ISREG(st.st_mode) ? "larger than " + std::to_string((long)cache_max_bytes) + " bytes"
+                                        : "not a regular file";
     return memo;
   }
   if (memo.valid && memo.path == path && memo.dev == st.st_dev && memo.ino == st.st_ino &&
@@ -228,6 +266,13 @@ PetscErrorCode BinBCSRTuneCacheStore(const std::string &key, const BinBCSRTuneCh
 
   PetscFunctionBegin;
   if (path.empty()) PetscFunctionReturn(0);
+  struct stat st;
+  /* no regular file (a folder, a FIFO, a device) or one far larger than a cache: someone else's, left
+     alone (the lookup warned that choices are not kept) */
+  if (stat(path.c_str(), &st) == 0 && (!S_ISREG(st.st_mode) || st.st_size > cache_max_bytes)) {
+    PetscCall(PetscInfo(nullptr, "Not storing in %s: no regular file of a cache's size\n", path.c_str()));
+    PetscFunctionReturn(0);
+  }
   if (!ReadCache(path, entries, why)) entries.clear();  /* a corrupt file is replaced (the lookup warned) */
   for (auto it = entries.begin(); it != entries.end();) /* other kernels' choices for this machine */
     it = StaleForThisMachine(it->first) ? entries.erase(it) : std::next(it);

@@ -476,6 +476,31 @@ TEST_CASE("tuning cache: round trip, corrupt files ignored", "[tune][cache]")
     CHECK(S_ISDIR(st.st_mode));
     REQUIRE(rmdir(file.c_str()) == 0);
   }
+  // a FIFO (an open for reading would wait for a writer), a link to an endless device, a regular file
+  // far larger than a cache: measured, never blocking or reading without end, and left alone. The
+  // alarm turns a hang into a failure of this test.
+  for (const std::string kind : {"fifo", "device", "large"}) {
+    CAPTURE(kind);
+    if (kind == "fifo") REQUIRE(mkfifo(file.c_str(), 0644) == 0);
+    else if (kind == "device") REQUIRE(symlink("/dev/zero", file.c_str()) == 0);
+    else {
+      std::ofstream out(file, std::ios::trunc);
+      out << "# petscbinbcsr tune cache v5\n" << std::string(2 << 20, '#') << "\n";
+    }
+    alarm(120);
+    Mat C = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
+    alarm(0);
+    CHECK(info_view(C).find("measured on block rows") != std::string::npos);
+    check_same(C, A, p);
+    MatDestroy(&C);
+    struct stat st;
+    REQUIRE(lstat(file.c_str(), &st) == 0);
+    CHECK((kind == "fifo"     ? S_ISFIFO(st.st_mode)
+           : kind == "device" ? S_ISLNK(st.st_mode)
+                              : S_ISREG(st.st_mode)));
+    if (kind == "large") CHECK(st.st_size > (1 << 20));
+    REQUIRE(std::remove(file.c_str()) == 0);
+  }
   // an unreadable cache folder: no file written, no error
   setenv("XDG_CACHE_HOME", "/proc/no/such/folder", 1);
   Mat C = build_tuned(p, MAT_BINBCSR_PRECISION_DOUBLE, false, MAT_BINBCSR_TUNE_AUTO);
