@@ -16,6 +16,16 @@ PetscErrorCode MatMPIBinBCSRSetUpLayouts(Mat mat)
   PetscCall(PetscLayoutSetUp(mat->cmap));
   if (mat->rmap->bs < 1) PetscCall(PetscLayoutSetBlockSize(mat->rmap, 1));
   if (mat->cmap->bs < 1) PetscCall(PetscLayoutSetBlockSize(mat->cmap, 1));
+  /* symmetric storage decided on the global layouts, so that every rank stops here, not only those
+     whose diagonal part is not square (the others would wait in the next collective) */
+  if (MPIBinBCSR(mat)->sym) {
+    PetscBool congruent;
+    PetscCall(PetscLayoutCompare(mat->rmap, mat->cmap, &congruent));
+    PetscCheck(congruent, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_SIZ,
+               "Symmetric storage needs a square matrix with equal row and column layouts, this one is "
+               "%" PetscInt_FMT " x %" PetscInt_FMT,
+               mat->rmap->N, mat->cmap->N);
+  }
   PetscFunctionReturn(0);
 }
 

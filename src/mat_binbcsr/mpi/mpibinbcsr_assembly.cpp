@@ -241,7 +241,9 @@ PETSC_INTERN PetscErrorCode MatSetPreallocationCOO_MPIBinBCSR(Mat mat, PetscCoun
      it is routed like any other (its row may be another rank's). */
   std::vector<PetscCount> mirror_of;
   if (b->coo_mirror) {
-    PetscCheck(M == N && mat->rmap->n == mat->cmap->n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+    PetscBool congruent; /* the same answer on every rank */
+    PetscCall(PetscLayoutCompare(mat->rmap, mat->cmap, &congruent));
+    PetscCheck(congruent, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_SIZ,
                "The COO mirror needs a square matrix with equal row and column layouts");
     for (PetscCount k = 0; k < ncoo; k++)
       if (coo_i[k] >= 0 && coo_j[k] >= 0 && coo_i[k] / bs != coo_j[k] / bs) mirror_of.push_back(k);

@@ -190,3 +190,33 @@ TEST_CASE("mpibinbcsr: a COO refill with values reaches a PC set up before it (b
       PCHK(MatDestroy(&F));
     }
 }
+
+TEST_CASE("mpibinbcsr: symmetric storage and the COO mirror refuse unequal row and column layouts on every "
+          "rank",
+          "[mpi][sym]")
+{
+  PetscMPIInt rank, size;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  MPI_Comm_size(PETSC_COMM_WORLD, &size);
+  // square overall, but rank r's diagonal part has 3 (r + 1) rows and 3 (size - r) columns: square on
+  // none or one rank, so an error on the others only would leave that one waiting in a collective
+  const PetscInt m = 3 * (rank + 1), n = 3 * (size - rank), M = 3 * size * (size + 1) / 2;
+  PetscInt       ci[] = {3 * rank, 3 * rank}, cj[] = {0, M - 1}; // non-const: PETSc 3.18's prototype
+  // modes: symmetric storage at MatSetUp, at the COO preallocation; the COO mirror; symmetric storage of
+  // a matrix 3 columns wider than high, given by local sizes only (the setter cannot tell yet)
+  for (int mode = 0; mode < 4; ++mode) {
+    INFO("mode " << mode);
+    Mat A;
+    PCHK(MatCreate(PETSC_COMM_WORLD, &A));
+    if (mode == 3) PCHK(MatSetSizes(A, m, m + (rank == size - 1 ? 3 : 0), PETSC_DETERMINE, PETSC_DETERMINE));
+    else PCHK(MatSetSizes(A, m, n, M, M));
+    PCHK(MatSetBlockSize(A, 3));
+    PCHK(MatSetType(A, MATMPIBINBCSR));
+    if (mode == 2) PCHK(MatBinBCSRSetCOOMirror(A, PETSC_TRUE));
+    else PCHK(MatBinBCSRSetSymmetricStorage(A, PETSC_TRUE));
+    const PetscErrorCode ierr = mode == 0 || mode == 3 ? MatSetUp(A) : MatSetPreallocationCOO(A, 2, ci, cj);
+    if (size > 1 || mode == 3) CHECK(all_ranks(ierr == PETSC_ERR_ARG_SIZ));
+    else CHECK(ierr == 0);
+    PCHK(MatDestroy(&A));
+  }
+}
