@@ -197,4 +197,9 @@ PETSC_EXTERN PetscErrorCode    MatBinBCSRGetDevice(Mat, MatBinBCSRDevice *);
 PETSC_EXTERN PetscErrorCode KSPMCGSetFixedIterations(KSP, PetscInt);
 PETSC_EXTERN PetscErrorCode KSPMCGGetFixedIterations(KSP, PetscInt *);
 
+/* KSPMCG: the last solve's precision floor u ||A|| ||x|| (2-norm of b - A x; 0: none, the operator's
+   products are not rounded below double) and whether the solve stopped there before its tolerance
+   (KSP_DIVERGED_BREAKDOWN). 0 and PETSC_FALSE on solvers of other types. */
+PETSC_EXTERN PetscErrorCode KSPMCGGetPrecisionFloor(KSP, PetscReal *, PetscBool *);
+
 #endif

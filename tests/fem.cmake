@@ -34,6 +34,10 @@ fem_test(fem_scene_linear_38k 0
          "levels=3 cycles=v.*\\n      maximum iterations=1, nonzero initial guess.*ksp_reason=CONVERGED_RTOL .*status=ok"
          ${FEM} -options_file options/linear_38k.opts -steps 2 -ksp_view)
 fem_test(fem_aijcusparse_error nonzero "needs a PETSc configured with CUDA" ${FEM} ${FEM_SMALL} -options_file options/compare_aijcusparse.opts)
+# a tolerance below what single storage resolves: the run stops and says so, and what helps
+fem_test(fem_single_storage_floor 2
+         "failed \\(DIVERGED_BREAKDOWN, stopped at the precision floor u \\|\\|A\\|\\| \\|\\|x\\|\\| = [^ ]+ of the rounded operator before the tolerance: loosen -ksp_rtol or store double values\\).*status=solver_failed"
+         ${FEM} ${FEM_SMALL} -mat_type binbcsr -mat_binbcsr_precision single -ksp_type mcg -ksp_rtol 1e-10)
 fem_test(fem_bad_mesh_error nonzero "cannot open mesh file" ${FEM} -mesh /nonexistent/mesh.msh)
 fem_test(fem_bad_option_error nonzero "-fix .*expected none" ${FEM} ${FEM_SMALL} -fix middle)
 fem_test(fem_bad_material_error nonzero "Poisson" ${FEM} ${FEM_SMALL} -poisson 0.5)

@@ -33,6 +33,7 @@ static PetscErrorCode KSPDestroy_MCG(KSP ksp)
   PetscCall(KSPDestroyDefault(ksp));
   PetscCall(PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGSetFixedIterations_C", nullptr));
   PetscCall(PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGGetFixedIterations_C", nullptr));
+  PetscCall(PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGGetPrecisionFloor_C", nullptr));
   PetscFunctionReturn(0);
 }
 
@@ -138,6 +139,16 @@ static PetscErrorCode KSPMCGGetFixedIterations_MCG(KSP ksp, PetscInt *n)
 {
   PetscFunctionBegin;
   *n = ((KSP_MCG *)ksp->data)->fixed_its;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode KSPMCGGetPrecisionFloor_MCG(KSP ksp, PetscReal *floor, PetscBool *stopped)
+{
+  const KSP_MCG *mcg = (const KSP_MCG *)ksp->data;
+
+  PetscFunctionBegin;
+  if (floor) *floor = mcg->floor;
+  if (stopped) *stopped = mcg->floor_hit && ksp->reason == KSP_DIVERGED_BREAKDOWN ? PETSC_TRUE : PETSC_FALSE;
   PetscFunctionReturn(0);
 }
 
@@ -279,6 +290,8 @@ PetscErrorCode KSPCreate_MCG(KSP ksp)
     PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGSetFixedIterations_C", KSPMCGSetFixedIterations_MCG));
   PetscCall(
     PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGGetFixedIterations_C", KSPMCGGetFixedIterations_MCG));
+  PetscCall(
+    PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGGetPrecisionFloor_C", KSPMCGGetPrecisionFloor_MCG));
   {
     PetscBool registered = PETSC_FALSE;
     for (PetscInt k = 0; k < ksp->numberreasonviews; k++)
@@ -326,3 +339,38 @@ BINBCSR_TRY_SETTER(KSPMCGSetFixedIterations, KSP, KSP_CLASSID, PetscInt, PetscVa
 .seealso: `KSPMCG`, `KSPMCGSetFixedIterations()`
 @*/
 BINBCSR_TRY_GETTER(KSPMCGGetFixedIterations, KSP, KSP_CLASSID, PetscInt, PetscAssertPointer, 0)
+
+/*@
+   KSPMCGGetPrecisionFloor - Gets the precision floor of the last `KSPMCG` solve and whether the solve
+   stopped at it
+
+   Not Collective
+
+   Input Parameter:
+.  ksp - the solver
+
+   Output Parameters:
++  floor   - u ||A|| ||x||, the 2-norm of b - A x below which the operator's rounded products (single
+             precision storage, or `-ksp_mcg_precision_floor`) cannot resolve the residual; 0 when there
+             is none (pass NULL if not wanted)
+-  stopped - `PETSC_TRUE` when the solve reached the floor before its tolerance and stopped there with
+             `KSP_DIVERGED_BREAKDOWN` (pass NULL if not wanted)
+
+   Level: intermediate
+
+   Note:
+   Tells a caller why a solve ended in `KSP_DIVERGED_BREAKDOWN`: a tolerance below what single storage
+   resolves, not a breakdown of the iteration; a looser tolerance or double storage
+   (`MatBinBCSRSetPrecision()`) converges. 0 and `PETSC_FALSE` on solvers of other types.
+
+.seealso: `KSPMCG`, `MatBinBCSRSetPrecision()`, `KSPGetConvergedReason()`
+@*/
+PetscErrorCode KSPMCGGetPrecisionFloor(KSP ksp, PetscReal *floor, PetscBool *stopped)
+{
+  PetscFunctionBegin;
+  PetscValidHeaderSpecific(ksp, KSP_CLASSID, 1);
+  if (floor) *floor = 0;
+  if (stopped) *stopped = PETSC_FALSE;
+  PetscTryMethod(ksp, "KSPMCGGetPrecisionFloor_C", (KSP, PetscReal *, PetscBool *), (ksp, floor, stopped));
+  PetscFunctionReturn(0);
+}

@@ -430,6 +430,19 @@ PetscErrorCode BlockSystemSolve(BlockSystem *sys, const PetscScalar *rhs_local, 
     PetscCall(KSPGetConvergedReason(sys->ksp, &stats->reason));
     stats->pc_failure.clear();
     if (stats->reason == KSP_DIVERGED_PC_FAILED) PetscCall(DescribePCFailure(sys->ksp, &stats->pc_failure));
+    if (stats->reason == KSP_DIVERGED_BREAKDOWN) { /* KSPMCG's precision floor: say so, and what helps */
+      PetscReal floor;
+      PetscBool stopped;
+      PetscCall(KSPMCGGetPrecisionFloor(sys->ksp, &floor, &stopped));
+      if (stopped) {
+        char detail[200];
+        PetscCall(PetscSNPrintf(detail, sizeof detail,
+                                "stopped at the precision floor u ||A|| ||x|| = %.3g of the rounded operator "
+                                "before the tolerance: loosen -ksp_rtol or store double values",
+                                (double)floor));
+        stats->pc_failure = detail;
+      }
+    }
     stats->ms = 1e3 * (t1 - t0);
   }
   PetscFunctionReturn(0);

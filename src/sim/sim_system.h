@@ -69,7 +69,9 @@ struct SolveStats {
   PetscReal          residual_norm = 0; // as the KSP reports it (0 when the KSP computes none)
   KSPConvergedReason reason        = KSP_CONVERGED_ITERATING;
   double             ms            = 0; // wall-clock milliseconds of KSPSolve
-  std::string        pc_failure;        // with KSP_DIVERGED_PC_FAILED: what failed (pc_failure.h)
+  // what failed: the PC (KSP_DIVERGED_PC_FAILED, pc_failure.h), or KSPMCG stopped at its precision
+  // floor (KSP_DIVERGED_BREAKDOWN); empty otherwise
+  std::string pc_failure;
 };
 
 // n_block_rows_local may be PETSC_DECIDE. Call after PetscInitialize and plug-in registration.

@@ -122,6 +122,7 @@ Result solve(Mat A, Vec b, const Solve &s, Vec x0)
   KSPGetConvergedReason(ksp, &r.reason);
   KSPGetIterationNumber(ksp, &r.its);
   KSPGetResidualNorm(ksp, &r.rnorm);
+  KSPMCGGetPrecisionFloor(ksp, &r.floor, &r.floor_stopped);
   KSPGetResidualHistory(ksp, &h, &nhist);
   r.history.assign(h, h + nhist);
   r.x = gather(x);

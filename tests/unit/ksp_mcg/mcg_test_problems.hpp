@@ -32,7 +32,9 @@ struct Result {
   PetscInt                 its    = -1;
   PetscReal                rnorm  = -1;
   std::vector<PetscReal>   history;
-  std::vector<PetscScalar> x; // gathered on every rank
+  std::vector<PetscScalar> x;                  // gathered on every rank
+  PetscReal                floor         = -1; // KSPMCGGetPrecisionFloor
+  PetscBool                floor_stopped = PETSC_FALSE;
 };
 // Solves A x = b from x0 (zero when x0 is null) with the given settings; err: the error of
 // KSPSetFromOptions (then no solve) or of KSPSolve.

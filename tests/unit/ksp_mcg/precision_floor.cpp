@@ -32,6 +32,8 @@ TEST_CASE("precision floor: double products have none, any operator can be given
   // aij and binbcsr double: no floor, rtol 1e-12 is claimed as before
   Result r = solve(A, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-12});
   CHECK(r.reason == KSP_CONVERGED_RTOL);
+  CHECK(r.floor == 0);
+  CHECK(!r.floor_stopped);
   CHECK(view_after_solve(A, b, "-ksp_rtol 1e-12")
           .find("precision floor: none (operator products in double precision)") != std::string::npos);
   if (Mat B = to_binbcsr(A, MAT_BINBCSR_PRECISION_DOUBLE)) {
@@ -102,11 +104,19 @@ TEST_CASE("precision floor: single storage, every norm type, error if not conver
       const Result mcg = solve(B, b, Solve{KSPMCG, PCJACOBI, nt, rtol});
       CHECK(mcg.reason == KSP_CONVERGED_RTOL);
       CHECK(std::abs(mcg.its - cg.its) <= 1);
+      // the getter: a floor (single storage), not stopped at it; another KSP type: none
+      CHECK(mcg.floor > 0);
+      CHECK(!mcg.floor_stopped);
+      CHECK(cg.floor == 0);
+      CHECK(!cg.floor_stopped);
     }
-    // rtol 1e-12 is below the floor: no claim
+    // rtol 1e-12 is below the floor: no claim, and the getter says why
     const Result r = solve(B, b, Solve{KSPMCG, PCJACOBI, nt, 1e-12});
     CHECK(r.reason == KSP_DIVERGED_BREAKDOWN);
     CHECK(r.its < 100);
+    CHECK(r.floor_stopped);
+    CHECK(r.floor > 0);
+    CHECK(r.floor < 1e-3 * norm(b));
   }
   const Result e = solve(
     B, b, Solve{KSPMCG, PCJACOBI, KSP_NORM_UNPRECONDITIONED, 1e-12, 1000, 0, "-ksp_error_if_not_converged"});
