@@ -156,6 +156,30 @@ PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, P
   PetscFunctionReturn(0);
 }
 
+/* A scene's fixed iteration count (-ksp_mcg_fixed_iterations N, N > 0) carried over to another
+   -ksp_type: N iterations with no norm and no convergence test, as KSPMCG's fixed mode. So a scene
+   file and a comparison file giving only -mat_type and -ksp_type (options/compare_aij_cg.opts) run
+   the same iterations as the scene where it fixes them, and the scene's tolerance where it has one
+   (a comparison file that skipped the test itself ran a converged scene's -ksp_max_it 5000
+   untested iterations into a blow-up). */
+static PetscErrorCode CarryFixedIterations(KSP ksp)
+{
+  PetscBool   mcg, set;
+  PetscInt    n      = 0;
+  const char *prefix = nullptr;
+
+  PetscFunctionBegin;
+  PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPMCG, &mcg));
+  if (mcg) PetscFunctionReturn(0);
+  PetscCall(KSPGetOptionsPrefix(ksp, &prefix));
+  PetscCall(PetscOptionsGetInt(nullptr, prefix, "-ksp_mcg_fixed_iterations", &n, &set));
+  if (!set || n <= 0) PetscFunctionReturn(0);
+  PetscCall(KSPSetTolerances(ksp, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT, n));
+  PetscCall(KSPSetNormType(ksp, KSP_NORM_NONE));
+  PetscCall(KSPSetConvergenceTest(ksp, KSPConvergedSkip, nullptr, nullptr));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, PetscInt n_block_rows_local,
                                  const std::vector<PetscInt> &coo_block_row,
                                  const std::vector<PetscInt> &coo_block_col, BlockSystem *sys)
@@ -261,6 +285,7 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
     PetscCall(PCSetType(pc, PCJACOBI)); // what the seed uses; works for every Mat type
   }
   PetscCall(KSPSetFromOptions(sys->ksp));
+  PetscCall(CarryFixedIterations(sys->ksp));
   { // KSPSetFromOptions stores -ksp_rtol and friends without KSPSetTolerances' checks; NaN ran CG to its
     // iteration limit and called the result converged
     PetscReal rtol, abstol, divtol;
