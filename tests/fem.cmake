@@ -44,6 +44,24 @@ fem_test(fem_single_storage_floor 2
          ${FEM} ${FEM_SMALL} -mat_type binbcsr -mat_binbcsr_precision single -ksp_type mcg -ksp_rtol 1e-10)
 fem_test(fem_bad_mesh_error nonzero "cannot open mesh file" ${FEM} -mesh /nonexistent/mesh.msh)
 fem_test(fem_bad_option_error nonzero "-fix .*expected none" ${FEM} ${FEM_SMALL} -fix middle)
+# -mesh without a file, a box beyond the range of element volumes, a NaN or inverted -fix_box, a NaN
+# health bound: each refused by name (they ran the default box, called sound elements degenerate,
+# fixed nothing, or turned the check off)
+fem_test(fem_bad_mesh_no_value nonzero "-mesh needs a file name" ${FEM} -steps 1 -mesh)
+fem_test(fem_bad_box_huge nonzero "has coordinate 1e\\+300, outside \\[-1e100, 1e100\\]" ${FEM} -mesh_box 1e300,1,1,2,2,2
+         -fix xmin -steps 1)
+fem_test(fem_bad_fix_box_nan nonzero "-fix_box x0,y0,z0,x1,y1,z1: the corners must be finite .*axis x: nan" ${FEM}
+         ${FEM_SMALL} -fix_box nan,0,0,1,1,1)
+fem_test(fem_bad_fix_box_inverted nonzero "-fix_box .*axis y: 1., 0." ${FEM} ${FEM_SMALL} -fix_box 0,1,0,1,0,1)
+fem_test(fem_bad_health_nan nonzero "-health_inverted_fraction nan: give a bound" ${FEM} ${FEM_SMALL}
+         -health_inverted_fraction nan)
+# a .geo gmsh refuses: gmsh's own error in the message; one it meshes into nothing: said, and not cached
+file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/fem_geo_input/garbage.geo "garbage here;\n")
+file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/fem_geo_input/empty.geo "")
+fem_test(fem_bad_geo_garbage nonzero "gmsh could not mesh .*garbage.geo: Error.*garbage.geo" ${FEM}
+         -mesh ${CMAKE_CURRENT_BINARY_DIR}/fem_geo_input/garbage.geo -steps 1)
+fem_test(fem_bad_geo_empty nonzero "gmsh could not mesh .*empty.geo: gmsh made no usable mesh of it: .*no \\$Nodes section" ${FEM}
+         -mesh ${CMAKE_CURRENT_BINARY_DIR}/fem_geo_input/empty.geo -steps 1)
 fem_test(fem_bad_material_error nonzero "Poisson" ${FEM} ${FEM_SMALL} -poisson 0.5)
 fem_test(fem_bad_infinite_young nonzero "need a finite Young's modulus" ${FEM} ${FEM_SMALL} -young inf)
 fem_test(fem_bad_zero_stretch nonzero "-initial_stretch 0 collapses every element to a point" ${FEM} ${FEM_SMALL}

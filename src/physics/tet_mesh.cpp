@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <unordered_map>
@@ -144,6 +145,16 @@ void validate_mesh(const TetMesh &mesh, const std::string &what, const std::vect
   if (mesh.element_count() == 0) throw std::runtime_error(what + ": mesh has no tetrahedra");
   if (mesh.elements.size() % npe)
     throw std::runtime_error(what + ": element list length is not a multiple of the element size");
+  // an element's volume is a product of three coordinate differences: beyond this it overflows, and the
+  // check below would call a sound element degenerate
+  constexpr double coordinate_limit = 1e100;
+  for (size_t k = 0; k < mesh.nodes.size(); ++k)
+    if (!(std::fabs(mesh.nodes[k]) <= coordinate_limit)) {
+      char text[96];
+      std::snprintf(text, sizeof text, ": node %zu has coordinate %.6g, outside [-1e100, 1e100]", k / 3,
+                    mesh.nodes[k]);
+      throw std::runtime_error(what + text);
+    }
   std::vector<char> used(n, 0);
   for (size_t k = 0; k < mesh.elements.size(); ++k) {
     const int v = mesh.elements[k];
@@ -177,10 +188,13 @@ void validate_mesh(const TetMesh &mesh, const std::string &what, const std::vect
       ++bad;
     }
   }
-  if (bad)
+  if (bad) {
+    char volume[32];
+    std::snprintf(volume, sizeof volume, "%.6g", first_volume);
     throw std::runtime_error(what + ": " + std::to_string(bad) +
                              " element(s) inverted or of zero volume; first: " + name(first_bad) +
-                             " with signed volume " + std::to_string(first_volume));
+                             " with signed volume " + volume);
+  }
 }
 
 std::vector<int> nodes_in_box(const TetMesh &mesh, const std::array<double, 3> &lo,

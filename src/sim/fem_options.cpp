@@ -45,8 +45,11 @@ PetscErrorCode FemGetOptions(FemOptions &o)
     else PetscCall(PetscOptionsReal(name, help, "", *value, value, nullptr));
     PetscFunctionReturn(0);
   };
+  PetscBool mesh_given;
   PetscCall(PetscOptionsString("-mesh", "gmsh mesh (.msh 2.2/4.1 ASCII) or geometry (.geo, meshed by gmsh)",
-                               "", o.mesh, o.mesh, sizeof o.mesh, nullptr));
+                               "", o.mesh, o.mesh, sizeof o.mesh, &mesh_given));
+  PetscCheck(!mesh_given || o.mesh[0], PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG,
+             "-mesh needs a file name (.msh or .geo); without -mesh the driver meshes a box (-mesh_box)");
   PetscCall(real("-mesh_size", "gmsh characteristic length for .geo input", &o.mesh_size));
   PetscCheck(o.mesh_size >= 0 && std::isfinite(o.mesh_size), PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
              "-mesh_size must be positive and finite (0: the .geo file's own), not %g", (double)o.mesh_size);
@@ -82,6 +85,13 @@ PetscErrorCode FemGetOptions(FemOptions &o)
                                "none | xmin|xmax|ymin|ymax|zmin|zmax[:fraction of the extent, default 0.01]",
                                "", o.fix, o.fix, sizeof o.fix, nullptr));
   PetscCall(numbers("-fix_box", "x0,y0,z0,x1,y1,z1", o.fix_box, 6, &o.fix_box_set)); // fix the nodes inside
+  for (int d = 0; o.fix_box_set && d < 3; ++d) // a NaN or a lower corner above the upper fixed nothing
+    PetscCheck(
+      std::isfinite(o.fix_box[d]) && std::isfinite(o.fix_box[d + 3]) && o.fix_box[d] <= o.fix_box[d + 3],
+      PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+      "-fix_box x0,y0,z0,x1,y1,z1: the corners must be finite with x0 <= x1, y0 <= y1, z0 <= z1 (axis %c: "
+      "%g, %g)",
+      "xyz"[d], (double)o.fix_box[d], (double)o.fix_box[d + 3]);
   PetscCall(PetscOptionsString("-vtk", "write PREFIX_NNNN.vtu frames and PREFIX.pvd", "", o.vtk, o.vtk,
                                sizeof o.vtk, nullptr));
   PetscCall(

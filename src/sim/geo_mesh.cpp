@@ -10,6 +10,7 @@
 #include <iterator>
 #include <string>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 static PetscErrorCode EstimateGeoTets(MPI_Comm comm, const std::string &geo, double size, double *volume,
@@ -68,16 +69,42 @@ PetscErrorCode GeoMesh(MPI_Comm comm, std::string geo, double size, double max_t
                "%.3g: choose a larger -mesh_size (%.3g gives about that many)",
                size, geo.c_str(), volume, tets, max_tets, size * std::cbrt(tets / max_tets));
   }
+  char why[512] = ""; // gmsh's own words, or what the reader found wrong with what gmsh wrote
   if (make) {
     mkdir(dir.c_str(), 0755);
-    const std::string tmp = *msh + ".tmp." + std::to_string(getpid()) + ".msh";
-    std::string       cmd = "gmsh " + options + "'" + geo + "' -o '" + tmp + "' > /dev/null 2>&1";
-    failed                = std::system(cmd.c_str()) != 0 || std::rename(tmp.c_str(), msh->c_str()) != 0;
+    const std::string tmp = *msh + ".tmp." + std::to_string(getpid()) + ".msh", log = tmp + ".log";
+    std::string       cmd    = "gmsh " + options + "'" + geo + "' -o '" + tmp + "' > '" + log + "' 2>&1";
+    const int         status = std::system(cmd.c_str());
+    if (status != 0) {
+      failed = 1;
+      std::ifstream in(log);
+      std::string   line, last;
+      while (std::getline(in, line)) // gmsh's first error says what is wrong with the file
+        if (line.find("Error") != std::string::npos && !why[0])
+          std::snprintf(why, sizeof why, "%s", line.c_str());
+        else if (!line.empty()) last = line;
+      if (!why[0]) std::snprintf(why, sizeof why, "%s", last.empty() ? "gmsh printed nothing" : last.c_str());
+      if (status == 127 || (WIFEXITED(status) && WEXITSTATUS(status) == 127))
+        std::snprintf(why, sizeof why, "gmsh not found (scripts/setup installs it)");
+    } else {
+      try { // a .geo gmsh meshes without complaint may still give no tetrahedra (an empty file does)
+        physics::read_msh_file(tmp);
+      } catch (const std::exception &e) {
+        failed = 1;
+        std::snprintf(why, sizeof why, "gmsh made no usable mesh of it: %s", e.what());
+      }
+    }
+    if (!failed && std::rename(tmp.c_str(), msh->c_str()) != 0) {
+      failed = 1;
+      std::snprintf(why, sizeof why, "cannot put the mesh in the cache folder %s", dir.c_str());
+    }
     if (failed) std::remove(tmp.c_str()); // what gmsh left of a failed mesh stays out of the cache
+    std::remove(log.c_str());
   }
   PetscCallMPI(MPI_Bcast(&failed, 1, MPI_INT, 0, comm));
-  PetscCheck(!failed, comm, PETSC_ERR_LIB,
-             "gmsh could not mesh %s (is gmsh installed? scripts/setup installs it)", geo.c_str());
+  PetscCallMPI(MPI_Bcast(why, sizeof why, MPI_CHAR, 0, comm));
+  PetscCheck(!failed, comm, PETSC_ERR_LIB, "gmsh could not mesh %s: %s", geo.c_str(),
+             why[0] ? why : "cannot read it");
   PetscFunctionReturn(0);
 }
 

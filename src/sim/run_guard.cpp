@@ -5,12 +5,15 @@
 namespace {
 
 // -NAME VALUE overrides *bound; a negative value turns the check off (NaN).
-PetscErrorCode OverrideBound(const char *name, double *bound)
+PetscErrorCode OverrideBound(MPI_Comm comm, const char *name, double *bound)
 {
   PetscReal v;
   PetscBool set;
   PetscFunctionBegin;
   PetscCall(PetscOptionsGetReal(nullptr, nullptr, name, &v, &set));
+  // NaN would turn the check off as a negative value does, without saying so
+  PetscCheck(!set || !PetscIsNanReal(v), comm, PETSC_ERR_ARG_OUTOFRANGE,
+             "%s nan: give a bound, or a negative number to turn the check off", name);
   if (set) *bound = v < 0 ? NAN : (double)v;
   PetscFunctionReturn(0);
 }
@@ -44,10 +47,10 @@ PetscErrorCode RunGuardFromOptions(MPI_Comm comm, const HealthBounds &scene, Run
   g->bounds = scene;
   PetscCall(GetChoice(comm, "-on_solver_failure", "stop", "continue", &g->stop_on_solver_failure));
   PetscCall(GetChoice(comm, "-on_unstable", "stop", "warn", &g->stop_on_unstable));
-  PetscCall(OverrideBound("-health_energy_growth", &g->bounds.energy_growth));
-  PetscCall(OverrideBound("-health_inverted_fraction", &g->bounds.inverted_fraction));
-  PetscCall(OverrideBound("-health_joint_error", &g->bounds.joint_error));
-  PetscCall(OverrideBound("-health_max_stretch", &g->bounds.max_stretch));
+  PetscCall(OverrideBound(comm, "-health_energy_growth", &g->bounds.energy_growth));
+  PetscCall(OverrideBound(comm, "-health_inverted_fraction", &g->bounds.inverted_fraction));
+  PetscCall(OverrideBound(comm, "-health_joint_error", &g->bounds.joint_error));
+  PetscCall(OverrideBound(comm, "-health_max_stretch", &g->bounds.max_stretch));
   PetscFunctionReturn(0);
 }
 
