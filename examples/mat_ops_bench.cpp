@@ -52,6 +52,17 @@ int main(int argc, char **argv)
   grid.nx = grid.ny = grid.nz = 24;
   PetscCall(StencilGridFromOptions(nullptr, &grid));
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-repeats", &repeats, nullptr));
+  /* -repeats 0 printed the unset minimum (inf) for every operation */
+  PetscCheck(repeats >= 1, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+             "-repeats must be >= 1, not %" PetscInt_FMT, repeats);
+  /* the types timed are the sequential ones, on PETSC_COMM_SELF: under mpiexec every rank ran its own copy
+     and the tables came out interleaved */
+  PetscMPIInt size;
+  PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
+  PetscCheck(
+    size == 1, PETSC_COMM_WORLD, PETSC_ERR_SUP,
+    "mat_ops_bench times the sequential matrix types on one process: run it without mpiexec, not on %d ranks",
+    size);
 
   const Flavour flavours[] = {
     {"seqaij", MATSEQAIJ, MAT_BINBCSR_PRECISION_DOUBLE},

@@ -62,7 +62,7 @@ PetscErrorCode time_setups(Mat A, const std::string &pc, PetscInt refills, doubl
     PetscCall(PCSetUp(p));
   }
   PetscCallMPI(MPI_Barrier(PetscObjectComm((PetscObject)A)));
-  *refill_ms = 1e3 * (MPI_Wtime() - t0) / std::max<PetscInt>(refills, 1);
+  *refill_ms = 1e3 * (MPI_Wtime() - t0) / refills;
   PetscCall(KSPDestroy(&ksp));
   PetscFunctionReturn(0);
 }
@@ -83,6 +83,14 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-repeats", &repeats, nullptr));
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-formats", formats, sizeof formats, nullptr));
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-pcs", pcs, sizeof pcs, nullptr));
+  /* -repeats 0 printed the unset minimum (1e300, 300 digits); the refill column is a time per refill */
+  PetscCheck(repeats >= 1, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+             "-repeats must be >= 1, not %" PetscInt_FMT, repeats);
+  PetscCheck(refills >= 1, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE,
+             "-refills must be >= 1, not %" PetscInt_FMT, refills);
+  std::vector<std::string> pc_list, format_list;
+  PetscCall(SplitOptionList(PETSC_COMM_WORLD, "-pcs", pcs, &pc_list));
+  PetscCall(SplitOptionList(PETSC_COMM_WORLD, "-formats", formats, &format_list));
   PetscMPIInt size;
   PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
   PetscCall(PetscPrintf(PETSC_COMM_WORLD,
@@ -91,8 +99,8 @@ int main(int argc, char **argv)
                         grid.nx, 3 * grid.nodes(), size, repeats));
   PetscCall(PetscPrintf(PETSC_COMM_WORLD, "%-12s %-10s %14s %20s\n", "pc", "format", "first (ms)",
                         "after refill (ms)"));
-  for (const std::string &pc : SplitList(pcs)) {
-    for (const std::string &fmt : SplitList(formats)) {
+  for (const std::string &pc : pc_list) {
+    for (const std::string &fmt : format_list) {
       Mat    A;
       double first = 1e300, refill = 1e300;
       PetscCall(CreateStencilMatrix(PETSC_COMM_WORLD, grid, fmt.c_str(), nullptr, &A));

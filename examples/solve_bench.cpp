@@ -258,8 +258,11 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetInt(nullptr, nullptr, "-history_its", &history_its, nullptr));
   PetscCall(MPI_Comm_size(comm, &size));
 
+  std::vector<std::string> solver_list, format_list;
+  PetscCall(SplitOptionList(comm, "-solvers", solvers_opt, &solver_list));
+  PetscCall(SplitOptionList(comm, "-formats", formats_opt, &format_list));
   std::vector<Solver> solvers;
-  for (const std::string &s : SplitList(solvers_opt)) {
+  for (const std::string &s : solver_list) {
     if (s == "cg") solvers.push_back({s, KSPCG, false});
     else if (s == "cg_sr") solvers.push_back({s, KSPCG, true});
     else if (s == "pipecg") solvers.push_back({s, KSPPIPECG, false});
@@ -267,7 +270,7 @@ int main(int argc, char **argv)
     else SETERRQ(comm, PETSC_ERR_ARG_WRONG, "unknown solver %s (cg, cg_sr, pipecg, mcg)", s.c_str());
   }
   std::vector<Format> formats;
-  for (const std::string &f : SplitList(formats_opt)) {
+  for (const std::string &f : format_list) {
     if (f == "binbcsr_single") formats.push_back({f, MATBINBCSR, true});
     else if (f == "binbcsr_sym") formats.push_back({f, MATBINBCSR, false, true});
     else if (f == "binbcsr_sym_single") formats.push_back({f, MATBINBCSR, true, true});

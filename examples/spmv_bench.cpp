@@ -258,6 +258,22 @@ PetscErrorCode BenchMatrix(MPI_Comm comm, const MatrixSource &src, const Setting
       PetscCall(PetscPrintf(comm, "wrote %s\n", path.c_str()));
     }
   }
+  { /* a 0 x 0 (or M x 0) file has no product to time: every format printed a NaN error, the CSV a
+       minimum row length of PETSC_MAX_INT and a NaN average */
+    PetscInt M, N;
+    PetscCall(MatGetSize(reference, &M, &N));
+    if (M == 0 || N == 0) {
+      PetscCall(PetscPrintf(
+        comm, "\n== %s: %" PetscInt_FMT " x %" PetscInt_FMT " matrix, nothing to multiply: skipped\n",
+        src.name.c_str(), M, N));
+      if (set.csv)
+        for (const FormatSpec &f : set.formats)
+          PetscCall(PetscFPrintf(comm, set.csv, "%s,%s,%" PetscInt_FMT ",0,,,,,,,,,,,,,,,,,,,,,skipped\n",
+                                 src.name.c_str(), f.label.c_str(), M));
+      PetscCall(MatDestroy(&reference));
+      PetscFunctionReturn(0);
+    }
+  }
   PetscCall(MeasureStats(reference, &st));
 
   std::vector<Candidate> cands;
@@ -316,13 +332,15 @@ PetscErrorCode BenchMatrix(MPI_Comm comm, const MatrixSource &src, const Setting
         PetscCall(VecAXPY(y, -1.0, y_ref));
         PetscReal d;
         PetscCall(VecNorm(y, NORM_INFINITY, &d));
-        c.rel_err = d / ref_norm;
+        c.rel_err = ref_norm > 0 ? d / ref_norm : d; /* a zero matrix: the absolute difference */
         PetscCallMPI(MPI_Barrier(comm));
         double t0 = Clock(set);
         PetscCall(MatMult(c.A, x, y));
         double t = Clock(set) - t0;
         PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &t, 1, MPI_DOUBLE, MPI_MAX, comm));
-        c.inner = std::max<PetscInt>(1, (PetscInt)std::ceil(set.min_batch_ms * 1e-3 / std::max(t, 1e-9)));
+        /* in double, clamped before the cast: a long -min_batch_ms over a fast product passed PETSC_MAX_INT */
+        c.inner =
+          (PetscInt)std::min(1e9, std::max(1.0, std::ceil(set.min_batch_ms * 1e-3 / std::max(t, 1e-9))));
         return 0;
       },
       &c.note));
@@ -442,13 +460,24 @@ int main(int argc, char **argv)
 {
   // -f may be repeated: PETSc's options database keeps only the last one, so collect them first.
   std::vector<std::string> files;
-  for (int i = 1; i + 1 < argc; ++i)
-    if (!std::strcmp(argv[i], "-f"))
-      for (const std::string &p : SplitList(argv[i + 1])) files.push_back(p);
+  std::string              empty_f; // the value of a -f that lists no file ("," or none): refused below
+  bool                     has_empty_f = false;
+  for (int i = 1; i < argc; ++i)
+    if (!std::strcmp(argv[i], "-f")) {
+      const std::string              value = i + 1 < argc ? argv[i + 1] : "";
+      const std::vector<std::string> list  = SplitList(value);
+      if (list.empty() && !has_empty_f) {
+        empty_f     = value;
+        has_empty_f = true;
+      }
+      files.insert(files.end(), list.begin(), list.end());
+    }
 
   PetscCall(PetscInitialize(&argc, &argv, nullptr, "MatMult benchmark: PETSc formats and MATBINBCSR.\n"));
   PetscCall(PetscBinBCSRRegisterAll());
   MPI_Comm comm = PETSC_COMM_WORLD;
+  PetscCheck(!has_empty_f, comm, PETSC_ERR_ARG_WRONG, "-f \"%s\" is an empty list: give at least one entry",
+             empty_f.c_str());
 
   Settings  set;
   char      buf[PETSC_MAX_PATH_LEN] = "";
@@ -456,7 +485,9 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-formats", buf, sizeof buf, &flg));
   const std::string formats =
     flg ? buf : "aij,baij,sbaij,sell,binbcsr,binbcsr_single,binbcsr_sym,binbcsr_sym_single";
-  for (const std::string &f : SplitList(formats)) {
+  std::vector<std::string> format_list;
+  PetscCall(SplitOptionList(comm, "-formats", formats, &format_list));
+  for (const std::string &f : format_list) {
     FormatSpec spec;
     spec.label = f;
     spec.type  = f;
@@ -486,6 +517,19 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetString(nullptr, nullptr, "-save_dir", buf, sizeof buf, &flg));
   if (flg) set.save_dir = buf;
   PetscCheck(set.repeats > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-repeats must be positive");
+  /* a NaN -min_batch_ms made the batch size NaN (cast to an integer: undefined), 0 and negatives
+     timed single products */
+  PetscCheck(set.min_batch_ms > 0 && std::isfinite((double)set.min_batch_ms), comm, PETSC_ERR_ARG_OUTOFRANGE,
+             "-min_batch_ms must be positive and finite, not %g", (double)set.min_batch_ms);
+  { /* read by MeasureStreamTriadFromOptions, where 0 and negatives silently meant the default */
+    PetscInt  v;
+    PetscBool given;
+    for (const char *name : {"-stream_elements", "-stream_repeats"}) {
+      PetscCall(PetscOptionsGetInt(nullptr, nullptr, name, &v, &given));
+      PetscCheck(!given || v >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s must be >= 1, not %" PetscInt_FMT,
+                 name, v);
+    }
+  }
   { /* -bs: the files' block size, or not given (0: the file's own); 0 and negatives were taken silently */
     PetscBool bs_set;
     PetscCall(PetscOptionsHasName(nullptr, nullptr, "-bs", &bs_set));

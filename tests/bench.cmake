@@ -38,7 +38,25 @@ foreach(case
     "spmv_shift|its stencils are cubes given by -stencil_sizes|spmv_bench|-stencil_shift 2"
     "spmv_sizes_list|-stencil_sizes takes at most 16 sizes|spmv_bench|-stencil_sizes 1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17"
     "tune_file_without_sweep|-f FILE is swept with -sweep|binbcsr_tune|-stencil_n 4 -f no_such_file.bin"
-    "solve_rtol_nan|-rtol must be in .0, 1., not nan|solve_bench|-stencil_n 4 -rtol nan")
+    "solve_rtol_nan|-rtol must be in .0, 1., not nan|solve_bench|-stencil_n 4 -rtol nan"
+    "reorder_min_batch_nan|-min_batch_ms must be positive and finite, not nan|reorder_bench|-n 4 -repeats 1 -min_batch_ms nan"
+    "reorder_min_batch0|-min_batch_ms must be positive and finite, not 0|reorder_bench|-n 4 -repeats 1 -min_batch_ms 0"
+    "reorder_n_negative|-n must be >= 1 .nodes a side., not -1|reorder_bench|-n -1 -repeats 1 -min_batch_ms 1"
+    "reorder_n0|-n must be >= 1 .nodes a side., not 0|reorder_bench|-n 0 -repeats 1 -min_batch_ms 1"
+    "reorder_repeats0|-repeats must be >= 1, not 0|reorder_bench|-n 4 -repeats 0 -min_batch_ms 1"
+    "spmv_min_batch_nan|-min_batch_ms must be positive and finite, not nan|spmv_bench|-stencil_sizes 2 -min_batch_ms nan"
+    "spmv_stream_elements0|-stream_elements must be >= 1, not 0|spmv_bench|-stencil_sizes 2 -stream_elements 0"
+    "spmv_stream_elements_negative|-stream_elements must be >= 1, not -5|spmv_bench|-stencil_sizes 2 -stream_elements -5"
+    "spmv_formats_empty|-formats .,. is an empty list|spmv_bench|-stencil_sizes 2 -formats ,"
+    "spmv_files_empty|-f .,. is an empty list|spmv_bench|-stencil_sizes 2 -f ,"
+    "pc_setup_repeats0|-repeats must be >= 1, not 0|pc_setup_bench|-stencil_n 3 -repeats 0"
+    "pc_setup_refills_negative|-refills must be >= 1, not -1|pc_setup_bench|-stencil_n 3 -refills -1"
+    "pc_setup_pcs_empty|-pcs .,. is an empty list|pc_setup_bench|-stencil_n 3 -pcs ,"
+    "mat_ops_repeats0|-repeats must be >= 1, not 0|mat_ops_bench|-stencil_n 3 -repeats 0"
+    "solve_formats_empty|-formats .,. is an empty list|solve_bench|-stencil_n 4 -formats ,"
+    "solve_solvers_empty|-solvers .,. is an empty list|solve_bench|-stencil_n 4 -solvers ,"
+    "tune_timer|-timer cpu.wall, not foo|binbcsr_tune|-stencil_n 4 -timer foo"
+    "tune_sweep_files_empty|-f .,. is an empty list|binbcsr_tune|-sweep -stencil_sizes 0 -f ,")
   string(REPLACE "|" ";" parts "${case}")
   list(GET parts 0 name)
   list(GET parts 1 regex)
@@ -80,3 +98,35 @@ add_test(NAME bench_tune_sweep_stencil_n
          COMMAND ${EXPECT_RUN} 0 "\\nstencil5 +whole +double best" "\\nstencil5 +symmetric +single best"
                  -- $<TARGET_FILE:binbcsr_tune> -sweep -stencil_n 5 -repeats 1 -batch 1 -sweep_confirm 0)
 set_tests_properties(bench_tune_sweep_stencil_n PROPERTIES LABELS "bench" TIMEOUT 120)
+
+# mat_ops_bench times the sequential types on PETSC_COMM_SELF: under mpiexec every rank printed its
+# own table, interleaved; it refuses more than one rank.
+add_test(NAME bench_bad_mat_ops_mpi
+         COMMAND ${EXPECT_RUN} nonzero "mat_ops_bench times the sequential matrix types on one process"
+                 -- ${MPIEXEC_CMD} -n 2 $<TARGET_FILE:mat_ops_bench> -stencil_n 3 -repeats 1)
+set_tests_properties(bench_bad_mat_ops_mpi PROPERTIES LABELS "bench;mpi" PROCESSORS 2 TIMEOUT 60)
+# reorder_bench preallocated 27 blocks per row, which PETSc refuses where a rank holds fewer block
+# columns: grids of 1 node a side on one rank and 3 a side on two failed.
+add_test(NAME bench_reorder_small_grid
+         COMMAND ${EXPECT_RUN} 0 "shuffled\\+ND +0 +0 +[0-9.]+ +[0-9.]+ +[0-9.]+"
+                 -- $<TARGET_FILE:reorder_bench> -n 1 -repeats 1 -min_batch_ms 1)
+set_tests_properties(bench_reorder_small_grid PROPERTIES LABELS "bench" TIMEOUT 60)
+add_test(NAME bench_reorder_small_grid_mpi
+         COMMAND ${EXPECT_RUN} 0 "shuffled\\+METIS\\+RCM +[0-9]+ +[0-9]+ +[0-9.]+"
+                 -- ${MPIEXEC_CMD} -n 2 $<TARGET_FILE:reorder_bench> -n 3 -repeats 1 -min_batch_ms 1)
+set_tests_properties(bench_reorder_small_grid_mpi PROPERTIES LABELS "bench;mpi" PROCESSORS 2 TIMEOUT 60)
+# A 0 x 0 matrix file: spmv_bench printed a NaN error for every format (and a NaN average row length
+# in the CSV) with status ok; it skips the matrix with a line.
+add_test(NAME bench_spmv_empty_matrix
+         COMMAND ${EXPECT_RUN} 0 "== empty_matrix.bin: 0 x 0 matrix, nothing to multiply: skipped" "\\A(?!.*nan)"
+                 -- sh -c "printf '\\000\\022\\173\\120\\000\\000\\000\\000\\000\\000\\000\\000\\000\\000\\000\\000' > empty_matrix.bin && $<TARGET_FILE:spmv_bench> -stencil_sizes 0 -f empty_matrix.bin -stats_only")
+# binbcsr_tune -sweep on files: a size that is not whole blocks of -bs is named with the file (MatLoad's
+# message named neither), a rectangular matrix is skipped (its symmetric storage case aborted the run),
+# and so is a 0 x 0 one.
+add_test(NAME bench_bad_tune_sweep_block_size
+         COMMAND ${EXPECT_RUN} nonzero "one_matrix.bin is 1 x 1, not whole 3x3 blocks"
+                 -- sh -c "printf '\\000\\022\\173\\120\\000\\000\\000\\001\\000\\000\\000\\001\\000\\000\\000\\001\\000\\000\\000\\001\\000\\000\\000\\000\\100\\000\\000\\000\\000\\000\\000\\000' > one_matrix.bin && $<TARGET_FILE:binbcsr_tune> -sweep -stencil_sizes 0 -repeats 1 -batch 1 -f one_matrix.bin")
+add_test(NAME bench_tune_sweep_skips
+         COMMAND ${EXPECT_RUN} 0 "rect_matrix.bin +symmetric double +skipped: 3 x 6 is not square" "empty_matrix0.bin +skipped: 0 x 0 matrix"
+                 -- sh -c "printf '\\000\\022\\173\\120\\000\\000\\000\\003\\000\\000\\000\\006\\000\\000\\000\\000\\000\\000\\000\\000\\000\\000\\000\\000\\000\\000\\000\\000' > rect_matrix.bin && printf '\\000\\022\\173\\120\\000\\000\\000\\000\\000\\000\\000\\000\\000\\000\\000\\000' > empty_matrix0.bin && $<TARGET_FILE:binbcsr_tune> -sweep -stencil_sizes 0 -repeats 1 -batch 1 -sweep_confirm 0 -f rect_matrix.bin,empty_matrix0.bin")
+set_tests_properties(bench_spmv_empty_matrix bench_bad_tune_sweep_block_size bench_tune_sweep_skips PROPERTIES LABELS "bench" TIMEOUT 60)

@@ -59,6 +59,16 @@ std::vector<std::string> SplitList(const std::string &s)
   return out;
 }
 
+PetscErrorCode SplitOptionList(MPI_Comm comm, const char *option, const std::string &value,
+                               std::vector<std::string> *list)
+{
+  PetscFunctionBegin;
+  *list = SplitList(value);
+  PetscCheck(!list->empty(), comm, PETSC_ERR_ARG_WRONG, "%s \"%s\" is an empty list: give at least one entry",
+             option, value.c_str());
+  PetscFunctionReturn(0);
+}
+
 std::string LastErrorText()
 {
   const char *text     = nullptr;

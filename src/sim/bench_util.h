@@ -18,6 +18,11 @@ PetscErrorCode ReplaceWithBinBCSR(Mat *A, PetscBool symmetric, MatBinBCSRPrecisi
 // "a,b,,c" -> {"a", "b", "c"}: comma lists given as options.
 std::vector<std::string> SplitList(const std::string &s);
 
+// SplitList of the value of option (named in the message); a list with no entry (",", "") is an
+// error on comm: a benchmark given one printed an empty table and exited 0.
+PetscErrorCode SplitOptionList(MPI_Comm comm, const char *option, const std::string &value,
+                               std::vector<std::string> *list);
+
 // The message of the last PETSc error, without trailing blanks.
 std::string LastErrorText();
 

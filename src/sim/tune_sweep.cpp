@@ -130,12 +130,21 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
   PetscCall(VecSet(x, 1.0));
   std::vector<PetscInt> widths = {4, 8, 16};
   if (bs == 1) widths.push_back(32);
+  PetscInt M, N;
+  PetscCall(MatGetSize(aij, &M, &N));
   for (int g = 0; g < 4; g++) {
     const PetscBool           sym  = g >= 2 ? PETSC_TRUE : PETSC_FALSE;
     const MatBinBCSRPrecision prec = g % 2 ? MAT_BINBCSR_PRECISION_SINGLE : MAT_BINBCSR_PRECISION_DOUBLE;
-    std::vector<Variant>      vars;
-    Variant                   tuned, base;
-    PetscLogDouble            t0, t1;
+    if (sym && M != N) { /* the whole-storage cases above still hold for a rectangular matrix */
+      PetscCall(PetscPrintf(PETSC_COMM_SELF,
+                            "%-14s symmetric %-6s skipped: %" PetscInt_FMT " x %" PetscInt_FMT
+                            " is not square\n",
+                            name.c_str(), g % 2 ? "single" : "double", M, N));
+      continue;
+    }
+    std::vector<Variant> vars;
+    Variant              tuned, base;
+    PetscLogDouble       t0, t1;
     PetscCall(PetscOptionsSetValue(nullptr, "-mat_binbcsr_tune_cache", s.tune_cache ? "1" : "0"));
     PetscCall(PetscTime(&t0));
     PetscCall(MakeBinBCSR(aij, bs, 0, 0, prec, sym, PETSC_TRUE, &tuned.A));
@@ -218,6 +227,10 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
     double      cost;
     std::string line;
     PetscCall(TuneCost(tuned.A, &cost, &line));
+    /* no cost in the tuner's line: it did not run (too small a matrix, say), and its line says why */
+    char tuning[160];
+    if (cost >= 0) snprintf(tuning, sizeof tuning, "tuning %6.1f ms", cost);
+    else snprintf(tuning, sizeof tuning, "not tuned (%s)", line.empty() ? "no tuner line" : line.c_str());
     const char *storage = sym ? "symmetric" : "whole",
                *p       = prec == MAT_BINBCSR_PRECISION_SINGLE ? "single" : "double";
     if (s.verbose) {
@@ -229,18 +242,18 @@ PetscErrorCode TuneSweep(const std::string &name, Mat aij, const SweepSettings &
                               v.prefetch, MatBinBCSRXLoads[v.xload], 1e3 * v.median()));
       PetscCall(PetscPrintf(PETSC_COMM_SELF, "  tuner: %s\n", line.c_str()));
     }
-    PetscCall(PetscPrintf(
-      PETSC_COMM_SELF,
-      "%-14s %-9s %-6s best %2" PetscInt_FMT "/%" PetscInt_FMT "/%s/%" PetscInt_FMT "%-7s"
-      " %8.4f   tuned %2" PetscInt_FMT "/%" PetscInt_FMT "/%s/%" PetscInt_FMT "%-7s"
-      " %8.4f   tuned/best %5.3f (min %5.3f)%s   %s %8.4f  tuned x %s %5.2f   tuning %6.1f ms "
-      "(build %.0f ms)\n",
-      name.c_str(), storage, p, best->bw, best->streams, MatBinBCSRKernels[best->kernel], best->prefetch,
-      best->xload == MAT_BINBCSR_XLOAD_GATHER ? "/gather" : "", 1e3 * best->median(), tuned.bw, tuned.streams,
-      MatBinBCSRKernels[tuned.kernel], tuned.prefetch,
-      tuned.xload == MAT_BINBCSR_XLOAD_GATHER ? "/gather" : "", 1e3 * tuned.median(),
-      PairedRatio(tuned, *best), tuned.best / best->best, confirmed, bs > 1 ? "baij" : "aij",
-      1e3 * base.median(), bs > 1 ? "baij" : "aij", PairedRatio(base, tuned), cost, 1e3 * (t1 - t0)));
+    PetscCall(PetscPrintf(PETSC_COMM_SELF,
+                          "%-14s %-9s %-6s best %2" PetscInt_FMT "/%" PetscInt_FMT "/%s/%" PetscInt_FMT "%-7s"
+                          " %8.4f   tuned %2" PetscInt_FMT "/%" PetscInt_FMT "/%s/%" PetscInt_FMT "%-7s"
+                          " %8.4f   tuned/best %5.3f (min %5.3f)%s   %s %8.4f  tuned x %s %5.2f   %s "
+                          "(build %.0f ms)\n",
+                          name.c_str(), storage, p, best->bw, best->streams, MatBinBCSRKernels[best->kernel],
+                          best->prefetch, best->xload == MAT_BINBCSR_XLOAD_GATHER ? "/gather" : "",
+                          1e3 * best->median(), tuned.bw, tuned.streams, MatBinBCSRKernels[tuned.kernel],
+                          tuned.prefetch, tuned.xload == MAT_BINBCSR_XLOAD_GATHER ? "/gather" : "",
+                          1e3 * tuned.median(), PairedRatio(tuned, *best), tuned.best / best->best, confirmed,
+                          bs > 1 ? "baij" : "aij", 1e3 * base.median(), bs > 1 ? "baij" : "aij",
+                          PairedRatio(base, tuned), tuning, 1e3 * (t1 - t0)));
     for (Variant &v : vars)
       if (v.owner) PetscCall(MatDestroy(&v.A));
     PetscCall(MatDestroy(&tuned.A));
