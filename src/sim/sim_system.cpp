@@ -147,7 +147,9 @@ PetscErrorCode BlockSystemStoredTriangle(MPI_Comm comm, PetscBool *upper_only, P
   PetscCall(MatCreate(comm, &probe));
   PetscCall(MatSetSizes(probe, 3, 3, PETSC_DETERMINE, PETSC_DETERMINE));
   PetscCall(MatSetBlockSize(probe, 3));
-  PetscCall(MatSetType(probe, MATAIJ));
+  // no MatSetType(MATAIJ) first: MatSetFromOptions takes aij by default, and an aij made first printed
+  // its own "Matrix (Mat) options" under -help, after which PETSc printed that block no more, so the
+  // -mat_type and -mat_binbcsr_* lines never showed
   PetscCall(MatSetFromOptions(probe));
   PetscCall(MatStoredTriangle(probe, upper_only, offrank_full, &mirrored));
   if (lower_mirrored) *lower_mirrored = mirrored;
@@ -216,8 +218,7 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
   PetscCall(MatCreate(comm, &sys->A));
   PetscCall(MatSetSizes(sys->A, 3 * n_local, 3 * n_local, 3 * n_block_rows_global, 3 * n_block_rows_global));
   PetscCall(MatSetBlockSize(sys->A, 3));
-  PetscCall(MatSetType(sys->A, MATAIJ));
-  PetscCall(MatSetFromOptions(sys->A));
+  PetscCall(MatSetFromOptions(sys->A)); // aij unless -mat_type says otherwise
   {
     PetscBool offrank_full, mirrored;
     PetscCall(MatStoredTriangle(sys->A, &sys->upper_only, &offrank_full, &mirrored));
