@@ -76,6 +76,12 @@ int main(int argc, char **argv)
       error = ex.what();
     }
     PetscCheck(error.empty(), comm, PETSC_ERR_USER_INPUT, "%s", error.c_str());
+    // a free body has no static equilibrium under gravity: its stiffness matrix is singular (the rigid
+    // motions), and the Newton solve diverged (DIVERGED_DTOL) without saying why
+    PetscCheck(!o.is_static || std::count(scene.fixed.begin(), scene.fixed.end(), 1) > 0, comm,
+               PETSC_ERR_USER_INPUT,
+               "-static needs fixed nodes (-fix or -fix_box): a free body has no equilibrium and a singular "
+               "stiffness matrix");
     scene.settings.young        = o.young;
     scene.settings.poisson      = o.poisson;
     scene.settings.density      = o.density;

@@ -158,7 +158,10 @@ add_test(NAME cloth_reference_positions
 set_tests_properties(cloth_reference_positions PROPERTIES LABELS "cloth" TIMEOUT 60)
 add_test(NAME cloth_vtk_dump
          COMMAND sh -c "rm -rf cloth_out && mkdir cloth_out && ${CLOTH} -cloth_n 6 -steps 2 -sphere -vtk cloth_out/c -dump_matrix cloth_out/A.bin -progress_every 10 && grep -q 'NumberOfCells=\"50\"' cloth_out/c_00002.vtu && grep -q c_00001.vtu cloth_out/c.pvd && test -s cloth_out/A.bin")
-set_tests_properties(cloth_vtk_dump PROPERTIES LABELS "cloth" TIMEOUT 60)
+# a -vtk prefix in a folder that does not exist yet: made (as the fem driver makes it)
+add_test(NAME cloth_vtk_new_folder
+         COMMAND sh -c "rm -rf cloth_out_new && ${CLOTH} -cloth_n 6 -steps 1 -vtk cloth_out_new/a/c -progress_every 10 && test -s cloth_out_new/a/c_00001.vtu")
+set_tests_properties(cloth_vtk_dump cloth_vtk_new_folder PROPERTIES LABELS "cloth" TIMEOUT 60)
 
 # When the physics or the solver breaks the run says so (src/sim/run_guard.h). Springs of
 # 1e12 N/m (energy 2.9e8 J from 0 in 5 steps) and a time step of 1 s (a spring at 1108 x its rest

@@ -50,6 +50,7 @@ fem_test(fem_help_lists_binbcsr 0 "-mat_binbcsr_bin_width .*-mat_binbcsr_precisi
 # -mesh without a file, a box beyond the range of element volumes, a NaN or inverted -fix_box, a NaN
 # health bound: each refused by name (they ran the default box, called sound elements degenerate,
 # fixed nothing, or turned the check off)
+fem_test(fem_bad_static_free nonzero "-static needs fixed nodes" ${FEM} -static -fix none -steps 1)
 fem_test(fem_bad_mesh_no_value nonzero "-mesh needs a file name" ${FEM} -steps 1 -mesh)
 fem_test(fem_bad_box_huge nonzero "has coordinate 1e\\+300, outside \\[-1e100, 1e100\\]" ${FEM} -mesh_box 1e300,1,1,2,2,2
          -fix xmin -steps 1)

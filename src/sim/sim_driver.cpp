@@ -4,6 +4,8 @@
 
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <system_error>
 
 PetscErrorCode DriverOutputFromOptions(MPI_Comm comm, DriverOutput *out)
 {
@@ -17,6 +19,13 @@ PetscErrorCode DriverOutputFromOptions(MPI_Comm comm, DriverOutput *out)
                                   &out->dump));
   PetscCheck(out->steps >= 0 && out->progress_every >= 1 && out->vtk_every >= 1, comm,
              PETSC_ERR_ARG_OUTOFRANGE, "-steps must be >= 0, -progress_every and -vtk_every >= 1");
+  int rank;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (out->vtk && !rank) { // a prefix in a new folder: made, as the fem driver does (a folder that cannot
+    std::error_code             ec; // be made shows as the first frame's "cannot write")
+    const std::filesystem::path parent = std::filesystem::path(out->vtk_prefix).parent_path();
+    if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+  }
   PetscFunctionReturn(0);
 }
 
