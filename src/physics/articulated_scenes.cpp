@@ -33,8 +33,12 @@ ArticulatedScene make_chain(const ChainOptions &opt)
   const Eigen::Vector3d down(std::sin(opt.angle), -std::cos(opt.angle), 0);
   Eigen::Vector3d       top = Eigen::Vector3d::Zero();
   for (int i = 0; i < opt.links; ++i) {
-    const double    t    = opt.links > 1 ? double(i) / (opt.links - 1) : 0.0;
-    const double    mass = opt.mass_first * std::pow(opt.mass_last / opt.mass_first, t);
+    const double t = opt.links > 1 ? double(i) / (opt.links - 1) : 0.0;
+    // geometric in between, through the logarithms: the ratio itself (1e-300 / 1e300) underflows to 0;
+    // the end links and equal masses exactly as given
+    const double    mass = opt.mass_first == opt.mass_last || t == 0 ? opt.mass_first
+                           : t == 1                                  ? opt.mass_last
+                                    : std::exp((1 - t) * std::log(opt.mass_first) + t * std::log(opt.mass_last));
     Eigen::Vector3d size;
     scene.bodies.push_back(bar_between(top, top + opt.link_length * down, mass,
                                        Eigen::Vector3d(0, opt.link_width, opt.link_width), size));
