@@ -279,7 +279,7 @@ int main(int argc, char **argv)
       PetscCall(PetscPrintf(
         comm,
         "step %" PetscInt_FMT
-        " t=%.4f corrections=%d solves=%lld cg_its=%lld joint_err=%.3e vel_err=%.3e energy=%.6e ms=%.2f solve_ms=%.2f%s%s\n",
+        " t=%.6g corrections=%d solves=%lld cg_its=%lld joint_err=%.3e vel_err=%.3e energy=%.6e ms=%.2f solve_ms=%.2f%s%s\n",
         n, n * params.dt, r.corrections, rs.solves - solves0, rs.iterations - its0, r.joint_error,
         r.velocity_error, energy, step_ms, rs.solve_ms - solve0, r.converged ? "" : " UNCONVERGED",
         r.singular_detected ? " SINGULAR->regularised" : ""));

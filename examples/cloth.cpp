@@ -114,6 +114,10 @@ int main(int argc, char **argv)
     (double)params.strain_limit.omega);
   PetscCheck(!sphere || radius > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-sphere_radius must be positive, got %g",
              (double)radius);
+  // the springs' squared lengths must stay finite: past this make_cloth refused "spring 0", which named
+  // no option
+  PetscCheck(opt.size > 0 && opt.size <= 1e100, comm, PETSC_ERR_ARG_OUTOFRANGE,
+             "-cloth_size must be positive and at most 1e100 m, got %g", (double)opt.size);
 
   // The matrix holds about 13 blocks of 9 entries per particle, and PETSc's indices here are 32-bit:
   // past that n the allocation failed (std::bad_alloc) or the counts overflowed.
@@ -252,7 +256,7 @@ int main(int argc, char **argv)
       PetscCall(PetscPrintf(
         comm,
         "step %" PetscInt_FMT
-        " t=%.4f cg_its=%lld stretch=%.5f contacts=%d energy=%.6e ms=%.2f solve_ms=%.2f%s\n",
+        " t=%.6g cg_its=%lld stretch=%.5f contacts=%d energy=%.6e ms=%.2f solve_ms=%.2f%s\n",
         step, step * params.dt, rs.iterations - its0, stretch, r.contacts, physics::cloth_energy(cloth),
         step_ms, rs.solve_ms - solve0, r.converged ? "" : " UNCONVERGED"));
     }
