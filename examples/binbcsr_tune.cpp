@@ -32,6 +32,7 @@
 #include "sim/bench_util.h"
 #include "sim/matrix_file.h"
 #include "sim/tune_sweep.h"
+#include <algorithm>
 #include <ctime>
 #include <string>
 #include <vector>
@@ -205,6 +206,13 @@ int main(int argc, char **argv)
       }
       std::vector<PetscInt> sizes;
       PetscCall(StencilSizesFromOptions(PETSC_COMM_WORLD, "binbcsr_tune -sweep", {32, 48}, 8, &sizes));
+      {
+        PetscBool files_given;
+        PetscCall(PetscOptionsHasName(nullptr, nullptr, "-f", &files_given));
+        PetscCheck(files_given || std::any_of(sizes.begin(), sizes.end(), [](PetscInt n) { return n > 0; }),
+                   PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG,
+                   "nothing to sweep: -stencil_sizes 0 and no -f FILE");
+      }
       PetscCall(PetscPrintf(PETSC_COMM_SELF,
                             "binbcsr_tune -sweep: ms per MatMult, median of %" PetscInt_FMT
                             " rounds of %" PetscInt_FMT

@@ -547,6 +547,9 @@ int main(int argc, char **argv)
     s.name                            = "stencil" + std::to_string(n);
     sources.push_back(s);
   }
+  // -stencil_sizes 0 and no -f: nothing to time, and the run exited 0 as if it had measured
+  PetscCheck(!sources.empty() || !files.empty(), comm, PETSC_ERR_ARG_WRONG,
+             "nothing to measure: -stencil_sizes 0 and no -f FILE");
   for (const std::string &p : files) {
     MatrixSource s;
     s.is_file = true;

@@ -56,7 +56,9 @@ foreach(case
     "solve_formats_empty|-formats .,. is an empty list|solve_bench|-stencil_n 4 -formats ,"
     "solve_solvers_empty|-solvers .,. is an empty list|solve_bench|-stencil_n 4 -solvers ,"
     "tune_timer|-timer cpu.wall, not foo|binbcsr_tune|-stencil_n 4 -timer foo"
-    "tune_sweep_files_empty|-f .,. is an empty list|binbcsr_tune|-sweep -stencil_sizes 0 -f ,")
+    "tune_sweep_files_empty|-f .,. is an empty list|binbcsr_tune|-sweep -stencil_sizes 0 -f ,"
+    "spmv_nothing|nothing to measure: -stencil_sizes 0 and no -f FILE|spmv_bench|-stencil_sizes 0"
+    "tune_sweep_nothing|nothing to sweep: -stencil_sizes 0 and no -f FILE|binbcsr_tune|-sweep -stencil_sizes 0")
   string(REPLACE "|" ";" parts "${case}")
   list(GET parts 0 name)
   list(GET parts 1 regex)
