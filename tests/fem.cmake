@@ -45,7 +45,7 @@ fem_test(fem_single_storage_floor 2
 fem_test(fem_bad_mesh_error nonzero "cannot open mesh file" ${FEM} -mesh /nonexistent/mesh.msh)
 fem_test(fem_bad_option_error nonzero "-fix .*expected none" ${FEM} ${FEM_SMALL} -fix middle)
 # -help lists the plug-in's matrix options (an aij made before had taken the Mat block's one printing)
-fem_test(fem_help_lists_binbcsr 0 "-mat_binbcsr_bin_width .*-mat_binbcsr_precision" ${FEM} ${FEM_SMALL} -steps 1
+fem_test(fem_help_lists_binbcsr 0 "-mat_binbcsr_bin_width[: ].*-mat_binbcsr_precision" ${FEM} ${FEM_SMALL} -steps 1
          -mat_type binbcsr -help)
 # -mesh without a file, a box beyond the range of element volumes, a NaN or inverted -fix_box, a NaN
 # health bound: each refused by name (they ran the default box, called sound elements degenerate,
