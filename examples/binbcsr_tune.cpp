@@ -49,23 +49,6 @@ double    Now()
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* The sizes in the header of the PETSc binary matrix file path; *known false where the header is not
-   a matrix's (LoadMatrixFile's check then says what is wrong). */
-PetscErrorCode MatrixFileSizes(const std::string &path, PetscInt *M, PetscInt *N, PetscBool *known)
-{
-  int      fd;
-  PetscInt header[4] = {0, 0, 0, 0}, count = 0;
-
-  PetscFunctionBeginUser;
-  PetscCall(PetscBinaryOpen(path.c_str(), FILE_MODE_READ, &fd));
-  PetscCall(PetscBinaryRead(fd, header, 4, &count, PETSC_INT));
-  PetscCall(PetscBinaryClose(fd));
-  *known = (PetscBool)(count == 4 && header[0] == MAT_FILE_CLASSID && header[1] >= 0 && header[2] >= 0);
-  *M     = header[1];
-  *N     = header[2];
-  PetscFunctionReturn(0);
-}
-
 struct Variant {
   std::string name;
   Mat         A       = nullptr;
@@ -235,24 +218,17 @@ int main(int argc, char **argv)
       for (const std::string &f : file_list) {
         const std::string name =
           f.substr(f.find_last_of('/') == std::string::npos ? 0 : f.find_last_of('/') + 1);
-        PetscInt  M, N;
-        PetscBool known;
-        PetscCall(MatrixFileSizes(f, &M, &N, &known));
-        /* the sizes as the file states them; a file that is no matrix is named by LoadMatrixFile's check */
-        if (known) {
-          /* MatLoad's "Local size 1 must be divisible by blocksize 3" named neither the file nor -bs */
-          PetscCheck(
-            M % bs == 0 && N % bs == 0, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
-            "%s is %" PetscInt_FMT " x %" PetscInt_FMT ", not whole %" PetscInt_FMT "x%" PetscInt_FMT
-            " blocks: -sweep reads files with block size -bs (default 3); give -bs 1 for a scalar matrix",
-            f.c_str(), M, N, bs, bs);
-          if (M == 0) { /* nothing to multiply: its "times" were the calls' overhead */
-            PetscCall(PetscPrintf(PETSC_COMM_SELF, "%-14s skipped: 0 x 0 matrix, nothing to multiply\n",
-                                  name.c_str()));
-            continue;
-          }
-        }
         PetscCall(LoadMatrixFile(PETSC_COMM_SELF, f, bs, &aij));
+        PetscInt M, N;
+        PetscCall(MatGetSize(aij, &M, &N));
+        if (M == 0 || N == 0) { /* nothing to multiply: its "times" were the calls' overhead */
+          PetscCall(PetscPrintf(PETSC_COMM_SELF,
+                                "%-14s skipped: %" PetscInt_FMT " x %" PetscInt_FMT
+                                " matrix, nothing to multiply\n",
+                                name.c_str(), M, N));
+          PetscCall(MatDestroy(&aij));
+          continue;
+        }
         PetscCall(TuneSweep(name, aij, s));
         PetscCall(MatDestroy(&aij));
       }

@@ -5,10 +5,11 @@
 #include <cstdio>
 #include <vector>
 
-PetscErrorCode CheckMatrixFile(MPI_Comm comm, const std::string &path)
+PetscErrorCode CheckMatrixFile(MPI_Comm comm, const std::string &path, PetscInt *rows, PetscInt *cols)
 {
   PetscMPIInt rank;
   char        why[256] = "";
+  PetscInt    sizes[2] = {0, 0};
 
   PetscFunctionBegin;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
@@ -18,6 +19,7 @@ PetscErrorCode CheckMatrixFile(MPI_Comm comm, const std::string &path)
     PetscInt header[4];
     PetscCall(PetscBinaryRead(fd, header, 4, nullptr, PETSC_INT));
     const PetscInt M = header[1], N = header[2], nz = header[3];
+    sizes[0] = M, sizes[1] = N;
     if (header[0] != MAT_FILE_CLASSID)
       std::snprintf(why, sizeof why, "not a PETSc matrix (class id %d)", (int)header[0]);
     else if (M < 0 || N < 0 || nz < 0)
@@ -63,6 +65,9 @@ PetscErrorCode CheckMatrixFile(MPI_Comm comm, const std::string &path)
   }
   PetscCallMPI(MPI_Bcast(why, sizeof why, MPI_CHAR, 0, comm));
   PetscCheck(!why[0], comm, PETSC_ERR_FILE_UNEXPECTED, "%s: %s", path.c_str(), why);
+  PetscCallMPI(MPI_Bcast(sizes, 2, MPIU_INT, 0, comm));
+  if (rows) *rows = sizes[0];
+  if (cols) *cols = sizes[1];
   PetscFunctionReturn(0);
 }
 
@@ -71,7 +76,14 @@ PetscErrorCode LoadMatrixFile(MPI_Comm comm, const std::string &path, PetscInt b
   PetscViewer viewer;
 
   PetscFunctionBegin;
-  PetscCall(CheckMatrixFile(comm, path));
+  PetscInt M, N;
+  PetscCall(CheckMatrixFile(comm, path, &M, &N));
+  // MatLoad's own refusal ("Local size 1 must be divisible by blocksize 3") names neither the file nor
+  // where the block size came from
+  PetscCheck(bs <= 0 || (M % bs == 0 && N % bs == 0), comm, PETSC_ERR_ARG_SIZ,
+             "%s is %" PetscInt_FMT " x %" PetscInt_FMT ", not whole %" PetscInt_FMT "x%" PetscInt_FMT
+             " blocks: give a block size that divides both (-bs; 1 for a scalar matrix)",
+             path.c_str(), M, N, bs, bs);
   PetscCall(PetscViewerBinaryOpen(comm, path.c_str(), FILE_MODE_READ, &viewer));
   PetscCall(MatCreate(comm, A));
   PetscCall(MatSetType(*A, MATAIJ));

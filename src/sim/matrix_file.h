@@ -10,9 +10,11 @@
 // a negative row length whose lengths still sum to the count (the matrix then crashed MatIsSymmetric),
 // drops a negative column index without a word, keeps a column past N (seqaij products then ran where
 // the other formats refused), and loads NaN. PETSC_ERR_FILE_UNEXPECTED naming the file and the first
-// fault.
-PetscErrorCode CheckMatrixFile(MPI_Comm comm, const std::string &path);
+// fault. rows, cols (may be null): the sizes the file states, on every rank.
+PetscErrorCode CheckMatrixFile(MPI_Comm comm, const std::string &path, PetscInt *rows = nullptr,
+                               PetscInt *cols = nullptr);
 
-// The checked file loaded as AIJ on comm (PETSc's default row layout); bs > 0 sets the block size,
-// else it comes from the file's .info or -matload_block_size.
+// The checked file loaded as AIJ on comm (PETSc's default row layout); bs > 0 sets the block size (a
+// clear error naming the file where it does not divide the sizes), else it comes from the file's .info
+// or -matload_block_size.
 PetscErrorCode LoadMatrixFile(MPI_Comm comm, const std::string &path, PetscInt bs, Mat *A);
