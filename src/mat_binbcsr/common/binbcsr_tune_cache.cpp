@@ -76,6 +76,15 @@ std::string BinBCSRTuneCachePath(void)
 /* A file of this size is none the tuner wrote (a line per matrix class and machine, under 200 bytes) */
 static const off_t cache_max_bytes = 1 << 20;
 
+/* Why what st describes is no cache file (no regular file: a folder, a FIFO, a device; or one far
+   larger than a cache), or nullptr when it may be one. */
+static const char *NotCacheFile(const struct stat &st)
+{
+  if (!S_ISREG(st.st_mode)) return "not a regular file";
+  if (st.st_size > cache_max_bytes) return "larger than 1 MiB";
+  return nullptr;
+}
+
 /* The whole file, read without blocking: a FIFO at the path would block an open for reading until a
    writer came, and a device (a link to /dev/zero) would never end. Returns 0 (text holds the file), 1
    when there is nothing to read (no file, or unreadable), -1 when the path is no regular file or one
@@ -87,9 +96,7 @@ static int ReadCacheText(const std::string &path, std::string &text, std::string
   struct stat st;
   int         status = 0;
   if (fstat(fd, &st) != 0) status = 1;
-  else if (!S_ISREG(st.st_mode)) why = "not a regular file", status = -1;
-  else if (st.st_size > cache_max_bytes)
-    why = "larger than " + std::to_string((long)cache_max_bytes) + " bytes", status = -1;
+  else if (const char *no = NotCacheFile(st)) why = no, status = -1;
   else {
     text.resize((size_t)st.st_size);
     size_t got = 0;
@@ -207,11 +214,10 @@ static const CacheMemo &CachedFile(const std::string &path)
     memo.parsed = true;
     return memo; /* no file: nothing cached, and nothing kept for a file that appears later */
   }
-  if (!S_ISREG(st.st_mode) || st.st_size > cache_max_bytes) {
+  if (const char *no = NotCacheFile(st)) {
     memo          = CacheMemo();
     memo.not_file = true;
-    memo.why      = S_ISREG(st.st_mode) ? "larger than " + std::to_string((long)cache_max_bytes) + " bytes"
-                                        : "not a regular file";
+    memo.why      = no;
     return memo;
   }
   if (memo.valid && memo.path == path && memo.dev == st.st_dev && memo.ino == st.st_ino &&
@@ -269,7 +275,7 @@ PetscErrorCode BinBCSRTuneCacheStore(const std::string &key, const BinBCSRTuneCh
   struct stat st;
   /* no regular file (a folder, a FIFO, a device) or one far larger than a cache: someone else's, left
      alone (the lookup warned that choices are not kept) */
-  if (stat(path.c_str(), &st) == 0 && (!S_ISREG(st.st_mode) || st.st_size > cache_max_bytes)) {
+  if (stat(path.c_str(), &st) == 0 && NotCacheFile(st)) {
     PetscCall(PetscInfo(nullptr, "Not storing in %s: no regular file of a cache's size\n", path.c_str()));
     PetscFunctionReturn(0);
   }
