@@ -33,7 +33,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -191,11 +190,7 @@ int main(int argc, char **argv)
     frames.emplace_back(rel, step * o.dt);
     physics::write_pvd(std::string(o.vtk) + ".pvd", frames);
   };
-  if (!rank && o.vtk[0]) {
-    std::error_code ec; // a prefix in a new folder: create it (failure shows up as no frames, reported below)
-    const std::filesystem::path parent = std::filesystem::path(o.vtk).parent_path();
-    if (!parent.empty()) std::filesystem::create_directories(parent, ec);
-  }
+  if (!rank && o.vtk[0]) physics::make_prefix_folder(o.vtk); // failure shows up as no frames, reported below
   write_frame(0);
   PetscCheck(rank || !o.vtk[0] || !frames.empty(), PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN,
              "-vtk %s: cannot write %s_0000.vtu", o.vtk, o.vtk);

@@ -1,6 +1,8 @@
 #include "physics/vtk_writer.hpp"
 
 #include <cstdio>
+#include <filesystem>
+#include <system_error>
 
 namespace physics {
 
@@ -54,6 +56,13 @@ bool write_pvd(const std::string &path, const std::vector<std::pair<std::string,
     std::fprintf(f, "<DataSet timestep=\"%.9g\" file=\"%s\"/>\n", frame.second, frame.first.c_str());
   std::fprintf(f, "</Collection>\n</VTKFile>\n");
   return std::fclose(f) == 0;
+}
+
+void make_prefix_folder(const std::string &prefix)
+{
+  std::error_code             ec;
+  const std::filesystem::path parent = std::filesystem::path(prefix).parent_path();
+  if (!parent.empty()) std::filesystem::create_directories(parent, ec);
 }
 
 } // namespace physics

@@ -35,4 +35,8 @@ bool write_vtu(const std::string &path, const VtkScene &scene);
 // Writes a ParaView collection (.pvd) that lists frames (file, time) so a series plays as animation.
 bool write_pvd(const std::string &path, const std::vector<std::pair<std::string, double>> &frames);
 
+// Makes the folder a frame prefix ("out/run/frame") lies in, with its parents, if missing. Best effort:
+// a folder that cannot be made shows as the first frame's failure to write.
+void make_prefix_folder(const std::string &prefix);
+
 } // namespace physics

@@ -4,8 +4,6 @@
 
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
-#include <system_error>
 
 PetscErrorCode DriverOutputFromOptions(MPI_Comm comm, DriverOutput *out)
 {
@@ -21,11 +19,7 @@ PetscErrorCode DriverOutputFromOptions(MPI_Comm comm, DriverOutput *out)
              PETSC_ERR_ARG_OUTOFRANGE, "-steps must be >= 0, -progress_every and -vtk_every >= 1");
   int rank;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  if (out->vtk && !rank) { // a prefix in a new folder: made, as the fem driver does (a folder that cannot
-    std::error_code             ec; // be made shows as the first frame's "cannot write")
-    const std::filesystem::path parent = std::filesystem::path(out->vtk_prefix).parent_path();
-    if (!parent.empty()) std::filesystem::create_directories(parent, ec);
-  }
+  if (out->vtk && !rank) physics::make_prefix_folder(out->vtk_prefix); // a prefix in a new folder
   PetscFunctionReturn(0);
 }
 
