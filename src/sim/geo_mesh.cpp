@@ -84,7 +84,7 @@ PetscErrorCode GeoMesh(MPI_Comm comm, std::string geo, double size, double max_t
           std::snprintf(why, sizeof why, "%s", line.c_str());
         else if (!line.empty()) last = line;
       if (!why[0]) std::snprintf(why, sizeof why, "%s", last.empty() ? "gmsh printed nothing" : last.c_str());
-      if (status == 127 || (WIFEXITED(status) && WEXITSTATUS(status) == 127))
+      if (WIFEXITED(status) && WEXITSTATUS(status) == 127) // the shell's "command not found"
         std::snprintf(why, sizeof why, "gmsh not found (scripts/setup installs it)");
     } else {
       try { // a .geo gmsh meshes without complaint may still give no tetrahedra (an empty file does)
