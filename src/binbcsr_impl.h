@@ -118,10 +118,11 @@ PETSC_INTERN PetscErrorCode MatBinBCSRReadOptions_Private(Mat, PetscOptionItems 
   }
 
 /* *xdoty = the local part of x.y (no reduction), flops logged: the fallback of MatMultDotLocal and
-   KSPMCG's transposed solve (interface/binbcsr_api.cpp) */
+   KSPMCG's transposed solve (interface/binbcsr_mult_dot.cpp) */
 PETSC_INTERN PetscErrorCode MatBinBCSRVecDotLocal_Private(Vec x, Vec y, PetscScalar *xdoty);
 
-/* A clear error unless v has n local entries (what: the argument's name in the message): interface/binbcsr_api.cpp */
+/* A clear error unless v has n local entries (what: the argument's name in the message):
+   interface/binbcsr_mult_dot.cpp */
 PETSC_INTERN PetscErrorCode MatBinBCSRCheckVecLocalSize(Vec v, PetscInt n, const char *what);
 
 /* Registered once by PetscBinBCSRRegisterAll(). */
