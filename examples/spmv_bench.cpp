@@ -20,22 +20,13 @@
 // best read bandwidth of all those passes: the physical limit of a product that reads its matrix
 // once. %triad is relative to the best triad pass (two reads and a write: not that limit).
 // GFlop/s = 2 nnz / t with nnz the nonzeros of the full matrix (also for sbaij, which stores half).
-// Bytes model (GB/s): the matrix's stored arrays read once (values, column indices, row/bin offsets,
-// padding included) + x read once + y written once; no cache reuse of x beyond that and no halo.
-//   aij:     nnz (8 + 4) + 4 (rows + 1)
-//   baij:    blocks (8 bs^2 + 4) + 4 (block rows + 1)
-//   sbaij:   upper blocks incl. diagonal (8 bs^2 + 4) + 4 (block rows + 1)
-//   sell:    padded slots (8 + 4) + 4 (slices + 1), slices of 8 rows padded to their longest row
-//   binbcsr: slots (s bs^2 + 4) + 4 (bins + 1), s = 8 (double) or 4 (single); slots = sum over bins
-//            of bin_width x the bin's longest (block) row; padding overhead = slots / blocks - 1
-//   binbcsr_sym(_single): symmetric storage (upper blocks incl. diagonal, colour-ordered bins):
-//            slots (s bs^2 + 4) + 4 (bins + 1) with the slots the matrix reports (MatGetInfo), plus
-//            8 N more for y (zeroed first, then read and written by the scatter); padding overhead =
-//            slots / upper blocks - 1
-//   + 8 N (x) + 8 N (y)
+// Bytes model (GB/s): the matrix's stored arrays read once (values, column indices, row or bin
+// offsets, padding included) + x read once + y written once; per format in src/sim/format_bytes.h.
+// Padding overhead of binbcsr = slots / blocks - 1 (upper blocks for symmetric storage).
 #include <petscbinbcsr.h>
 
 #include "sim/bench_util.h"
+#include "sim/format_bytes.h"
 #include "sim/matrix_file.h"
 #include "sim/stencil.h"
 #include "sim/read_bw.h"
@@ -65,15 +56,6 @@ struct MatrixSource {
   std::string path;
 };
 
-// Shape of a matrix, measured once on its aij form (row lengths in scalars; block rows for padding).
-struct MatrixStats {
-  PetscInt              rows = 0, bs = 1;
-  double                nnz = 0, upper_blocks = 0, blocks = 0, sell_slots = 0;
-  PetscInt              max_row = 0, min_row = 0;
-  double                avg_row = 0;
-  std::vector<PetscInt> block_row_len; // local block rows, in blocks (for binbcsr padding)
-};
-
 struct Candidate {
   FormatSpec          spec;
   Mat                 A = nullptr;
@@ -84,101 +66,9 @@ struct Candidate {
   PetscInt            bin_width = 0;
 };
 
-// One pass over the aij rows: scalar row lengths, SELL slots, block row lengths, upper blocks.
-PetscErrorCode MeasureStats(Mat aij, MatrixStats *st)
-{
-  PetscInt rstart, rend;
-  MPI_Comm comm = PetscObjectComm((PetscObject)aij);
-
-  PetscFunctionBegin;
-  PetscCall(MatGetSize(aij, &st->rows, nullptr));
-  PetscCall(MatGetBlockSize(aij, &st->bs));
-  PetscCall(MatGetOwnershipRange(aij, &rstart, &rend));
-  const PetscInt        bs   = st->bs;
-  PetscInt              maxr = 0, minr = PETSC_MAX_INT, slice_max = 0;
-  double                nnz = 0, sell = 0, blocks = 0, upper = 0;
-  std::vector<PetscInt> bcols;
-  st->block_row_len.clear();
-  for (PetscInt r = rstart; r < rend; ++r) {
-    PetscInt        ncols;
-    const PetscInt *cols;
-    PetscCall(MatGetRow(aij, r, &ncols, &cols, nullptr));
-    maxr = std::max(maxr, ncols);
-    minr = std::min(minr, ncols);
-    nnz += ncols;
-    slice_max = std::max(slice_max, ncols);
-    if ((r - rstart) % 8 == 7 || r == rend - 1) {
-      sell += 8.0 * slice_max;
-      slice_max = 0;
-    }
-    for (PetscInt c = 0; c < ncols; ++c) bcols.push_back(cols[c] / bs);
-    PetscCall(MatRestoreRow(aij, r, &ncols, &cols, nullptr));
-    if ((r - rstart) % bs == bs - 1) {
-      std::sort(bcols.begin(), bcols.end());
-      bcols.erase(std::unique(bcols.begin(), bcols.end()), bcols.end());
-      const PetscInt brow = r / bs;
-      st->block_row_len.push_back((PetscInt)bcols.size());
-      blocks += (double)bcols.size();
-      for (PetscInt c : bcols) upper += (c >= brow);
-      bcols.clear();
-    }
-  }
-  double sums[5] = {nnz, sell, blocks, upper, (double)(rend - rstart)};
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, sums, 5, MPI_DOUBLE, MPI_SUM, comm));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &maxr, 1, MPIU_INT, MPI_MAX, comm));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &minr, 1, MPIU_INT, MPI_MIN, comm));
-  st->nnz          = sums[0];
-  st->sell_slots   = sums[1];
-  st->blocks       = sums[2];
-  st->upper_blocks = sums[3];
-  st->max_row      = maxr;
-  st->min_row      = minr;
-  st->avg_row      = sums[0] / (double)st->rows;
-  PetscFunctionReturn(0);
-}
-
-// Stored blocks (slots) of BIN-(B)CSR: bins of bin_width local block rows, each padded to its longest
-// row, the last bin completed with phantom lanes (as src/mat_binbcsr/seq/binbcsr.h lays them out).
-double BinnedBlocks(const MatrixStats &st, PetscInt bin_width, MPI_Comm comm, double *bins)
-{
-  double         slots = 0, nb = 0;
-  const PetscInt n = (PetscInt)st.block_row_len.size();
-  for (PetscInt start = 0; start < n; start += bin_width) {
-    const PetscInt end     = std::min(n, start + bin_width);
-    PetscInt       longest = 0;
-    for (PetscInt r = start; r < end; ++r) longest = std::max(longest, st.block_row_len[r]);
-    slots += (double)longest * (double)bin_width; // the last bin is completed with phantom lanes
-    nb += 1;
-  }
-  double s[2] = {slots, nb};
-  MPI_Allreduce(MPI_IN_PLACE, s, 2, MPI_DOUBLE, MPI_SUM, comm);
-  *bins = s[1];
-  return s[0];
-}
-
 double ModelBytes(const Candidate &c, const MatrixStats &st, MPI_Comm comm, double *padding)
 {
-  const double bs = (double)st.bs, nbrows = (double)st.rows / bs, vec = 16.0 * st.rows;
-  *padding = -1;
-  if (c.spec.type == "aij") return st.nnz * 12 + 4 * (st.rows + 1) + vec;
-  if (c.spec.type == "baij") return st.blocks * (8 * bs * bs + 4) + 4 * (nbrows + 1) + vec;
-  if (c.spec.type == "sbaij") return st.upper_blocks * (8 * bs * bs + 4) + 4 * (nbrows + 1) + vec;
-  if (c.spec.type == "sell") return st.sell_slots * 12 + 4 * (std::ceil(st.rows / 8.0) + 1) + vec;
-  if (c.spec.type == "binbcsr" && c.spec.sym) {
-    MatInfo info;
-    if (MatGetInfo(c.A, MAT_GLOBAL_SUM, &info)) return 0;
-    const double slots = info.nz_allocated / (bs * bs),
-                 bins  = std::ceil(nbrows / std::max<PetscInt>(1, c.bin_width));
-    *padding           = 100.0 * (slots - st.upper_blocks) / st.upper_blocks;
-    return slots * ((c.spec.single ? 4 : 8) * bs * bs + 4) + 4 * (bins + 1) + vec + 8.0 * st.rows;
-  }
-  if (c.spec.type == "binbcsr") {
-    double       bins;
-    const double slots = BinnedBlocks(st, std::max<PetscInt>(1, c.bin_width), comm, &bins);
-    *padding           = 100.0 * (slots - st.blocks) / st.blocks;
-    return slots * ((c.spec.single ? 4 : 8) * bs * bs + 4) + 4 * (bins + 1) + vec;
-  }
-  return 0;
+  return FormatModelBytes(c.spec.type, c.spec.single, c.spec.sym, c.bin_width, c.A, st, comm, padding);
 }
 
 PetscErrorCode BuildCandidate(MPI_Comm comm, const MatrixSource &src, Mat aij_file, Candidate *c)
