@@ -195,6 +195,9 @@ PETSC_INTERN PetscErrorCode MatMPIBinBCSRCreatePart(Mat mat, PetscInt m, PetscIn
 
   PetscFunctionBegin;
   PetscCall(MatCreate(PETSC_COMM_SELF, part));
+  /* the matrix's prefix: the options a part reads itself (the tuner's size threshold, sample and
+     budget) are then the matrix's, as its other -mat_binbcsr_* options are */
+  PetscCall(MatSetOptionsPrefix(*part, ((PetscObject)mat)->prefix));
   PetscCall(MatSetSizes(*part, m, n, m, n));
   PetscCall(MatSetBlockSizes(*part, mat->rmap->bs, mat->cmap->bs));
   PetscCall(MatSetType(*part, b->inner_type));

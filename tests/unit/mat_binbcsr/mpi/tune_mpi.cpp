@@ -127,3 +127,45 @@ TEST_CASE("mpi: each rank tunes its parts; the matrix and its products stay MPIA
   VecDestroy(&y);
   VecDestroy(&yr);
 }
+
+// A matrix with an options prefix: the tuner's knobs read by the parts themselves (the size below
+// which a part is not tuned, the cache) come under that prefix, as the type's other options do; the
+// same knobs without it are another matrix's and change nothing here.
+TEST_CASE("mpi: the parts read the tuner's options under the matrix's prefix", "[mpi][tune]")
+{
+  const FemProblem fem(7, 6, 5, true); // under 512 KiB of values on one rank
+  PCHK(PetscOptionsSetValue(nullptr, "-mat_binbcsr_tune_min_kib", "0")); // not this matrix's
+  PCHK(PetscOptionsSetValue(nullptr, "-sys_mat_binbcsr_tune_cache", "0"));
+  std::vector<PetscInt> ci, cj;
+  const PetscInt        m = local_rows(fem, PETSC_COMM_WORLD, false);
+  rank_coo_entries(fem, ci, cj);
+  const auto cv    = rank_element_values(fem, [](int e) { return 1.0 + 0.01 * (e % 5); });
+  auto       build = [&]() {
+    Mat A;
+    PCHK(MatCreate(PETSC_COMM_WORLD, &A));
+    PCHK(MatSetOptionsPrefix(A, "sys_"));
+    PCHK(MatSetSizes(A, m, m, fem.rows(), fem.rows()));
+    PCHK(MatSetBlockSize(A, 3));
+    PCHK(MatSetType(A, MATMPIBINBCSR));
+    PCHK(MatSetFromOptions(A));
+    PCHK(MatSetPreallocationCOO(A, (PetscCount)ci.size(), ci.data(), cj.data()));
+    PCHK(MatSetValuesCOO(A, cv.data(), ADD_VALUES));
+    return A;
+  };
+  Mat A = build(); // the parts are below the default 512 KiB: not tuned
+  CHECK(all_ranks(info_text(A).find("measured on block rows") == std::string::npos));
+  MatDestroy(&A);
+  PCHK(PetscOptionsSetValue(nullptr, "-sys_mat_binbcsr_tune_min_kib", "0"));
+  A                     = build();
+  const std::string txt = info_text(A);
+  PetscMPIInt       rank;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  if (rank == 0) {
+    CAPTURE(txt);
+    CHECK(txt.find("measured on block rows") != std::string::npos);
+  }
+  MatDestroy(&A);
+  PCHK(PetscOptionsClearValue(nullptr, "-mat_binbcsr_tune_min_kib"));
+  PCHK(PetscOptionsClearValue(nullptr, "-sys_mat_binbcsr_tune_min_kib"));
+  PCHK(PetscOptionsClearValue(nullptr, "-sys_mat_binbcsr_tune_cache"));
+}
