@@ -62,6 +62,10 @@ add_test(NAME cloth_mg_sor_smoothers_converge_like_tight
          COMMAND sh -c "${CLOTH_MG} -pc_type pbjacobi -ksp_rtol 1e-10 -write_positions cloth_mg_ref_sor.txt >/dev/null && ${SUMMARY_CHECK} 'cg_its<=10 && unconverged_steps==0 && diverged_solves==0 && rms_position_diff<5e-4' -- ${CLOTH_MG} -grid_mg_smoother sor -reference_positions cloth_mg_ref_sor.txt")
 add_test(NAME cloth_mg_slab_smoothers_named
          COMMAND ${EXPECT_RUN} 0 "slab Gauss-Seidel sweeps" -- ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 32 -steps 1 -progress_every 1000)
+# -mat_view shows the system matrix only: the block graph, the grid's interpolation and the Galerkin
+# coarse matrices have prefixes of their own (-grid_mg_interp_mat_view, -grid_mg_coarse_mat_view)
+add_test(NAME cloth_mat_view_system_only
+         COMMAND ${EXPECT_RUN} 0 "\\A(?!.*Mat Object.*Mat Object).*Mat Object: 1 MPI process\\n  type: seqbinbcsr" -- ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 20 -steps 1 -progress_every 1000 -mat_view ::ascii_info)
 # With PCMG's products (more ranks) slab Gauss-Seidel smooths each rank's fine rows only; their couplings
 # to the other rank go to the residual Richardson forms on the whole operator. Sweeping from the guess
 # without them made the V-cycle nonsymmetric (DIVERGED_INDEFINITE_MAT at the second step); now the
@@ -114,6 +118,7 @@ add_test(NAME cloth_bad_rows_partition
 set_tests_properties(cloth_mg_converges_like_tight cloth_mg_energy_as_tight cloth_mg_single_level_direct cloth_mg_bad_coarse_nodes cloth_bad_rows_partition
                      cloth_mg_double_smoothers_converge_like_tight cloth_mg_single_smoothers_need_binbcsr
                      cloth_mg_single_smoothers_only_with_blocks cloth_mg_bad_smoother_precision
+                     cloth_mg_sor_smoothers_converge_like_tight cloth_mg_slab_smoothers_named cloth_mat_view_system_only
                      PROPERTIES LABELS "cloth" TIMEOUT 60)
 set_tests_properties(cloth_mg_distributed_blocks_named PROPERTIES LABELS "cloth;mpi" PROCESSORS 2 TIMEOUT 60)
 # A failed preconditioner is named with its reason (src/sim/pc_failure.h; every LU pivot counts as zero).

@@ -47,6 +47,10 @@ fem_test(fem_bad_option_error nonzero "-fix .*expected none" ${FEM} ${FEM_SMALL}
 # -help lists the plug-in's matrix options (an aij made before had taken the Mat block's one printing)
 fem_test(fem_help_lists_binbcsr 0 "-mat_binbcsr_bin_width[: ].*-mat_binbcsr_precision" ${FEM} ${FEM_SMALL} -steps 1
          -mat_type binbcsr -help)
+# -mat_view shows the system matrix only: the block graph that sizes its preallocation has a prefix of
+# its own (it was printed first, a 189 x 189 aij on the default box)
+fem_test(fem_mat_view_system_only 0 "\\A(?!.*Mat Object.*Mat Object).*Mat Object: 1 MPI process\\n  type: seqbinbcsr"
+         ${FEM} ${FEM_SMALL} -steps 1 -mat_type binbcsr -mat_view ::ascii_info)
 # -mesh without a file, a box beyond the range of element volumes, a NaN or inverted -fix_box, a NaN
 # health bound: each refused by name (they ran the default box, called sound elements degenerate,
 # fixed nothing, or turned the check off)

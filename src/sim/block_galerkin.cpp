@@ -63,6 +63,7 @@ PetscErrorCode BlockGalerkinCreate(const std::vector<PetscInt> &row, const std::
     nnz[I] = std::max<PetscInt>(1, (PetscInt)cols[I].size());
   }
   PetscCall(MatCreateSeqBAIJ(PETSC_COMM_SELF, 3, 3 * n_coarse, 3 * n_coarse, 0, nnz.data(), &g->Ac));
+  PetscCall(MatSetOptionsPrefix(g->Ac, "grid_mg_coarse_")); // -mat_view is for the system matrix
   {
     const PetscScalar zero[9] = {0};
     for (PetscInt I = 0; I < n_coarse; ++I) {

@@ -104,6 +104,7 @@ PetscErrorCode Interpolation(MPI_Comm comm, const GridLevel &f, const GridLevel 
   PetscFunctionBegin;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   PetscCall(MatCreate(comm, &W));
+  PetscCall(MatSetOptionsPrefix(W, "grid_mg_interp_")); // -mat_view is for the system matrix
   PetscCall(MatSetSizes(W, dof * (f.offsets[rank + 1] - f.offsets[rank]),
                         dof * (c.offsets[rank + 1] - c.offsets[rank]), dof * nf, dof * c.side * c.side));
   PetscCall(MatSetBlockSizes(W, dof, dof));

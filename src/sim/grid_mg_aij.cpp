@@ -103,6 +103,7 @@ PetscErrorCode GridMGShareTarget(MPI_Comm comm, Mat Ac, const GridMG::Distribute
     }
   const PetscInt local = 3 * (c.offsets[rank + 1] - c.offsets[rank]), global = 3 * c.side * c.side;
   PetscCall(MatCreate(comm, &A));
+  PetscCall(MatSetOptionsPrefix(A, "grid_mg_coarse_")); // -mat_view is for the system matrix
   PetscCall(MatSetSizes(A, local, local, global, global));
   PetscCall(MatSetBlockSize(A, 3));
   PetscCall(MatSetType(A, MATAIJ));

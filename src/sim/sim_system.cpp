@@ -60,6 +60,8 @@ PetscErrorCode PreallocateFromBlockPattern(MPI_Comm comm, PetscInt n_local, Pets
 
   PetscFunctionBegin;
   PetscCall(MatCreate(comm, &graph));
+  // a prefix of its own, so that a user's -mat_view shows the system matrix, not this helper
+  PetscCall(MatSetOptionsPrefix(graph, "sim_block_graph_"));
   PetscCall(MatSetSizes(graph, n_local, n_local, n_global, n_global));
   PetscCall(MatSetType(graph, MATAIJ));
   {
@@ -488,6 +490,7 @@ PetscErrorCode BlockSystemDumpMatrix(BlockSystem *sys, const char *path)
   // Rebuilt as aij from the same COO list, so the dump works for every type (binbcsr has no MatView
   // to binary of its own) and loads anywhere.
   PetscCall(MatCreate(comm, &aij));
+  PetscCall(MatSetOptionsPrefix(aij, "sim_dump_")); // -mat_view is for the system matrix
   PetscCall(MatSetSizes(aij, sys->row_end - sys->row_begin, sys->row_end - sys->row_begin,
                         3 * sys->n_block_rows_global, 3 * sys->n_block_rows_global));
   PetscCall(MatSetBlockSize(aij, 3));
