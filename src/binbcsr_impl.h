@@ -60,7 +60,8 @@ PETSC_INTERN PetscErrorCode MatBinBCSRRegisterExternalFactors(void);
 
 /* MATSEQBINBCSR parts of MATMPIBINBCSR: after MatSetPreallocationCOO, compose the part's COO map with
    from[] (part entry -> source index); the two-source refill then reads source p < n from v and
-   p >= n from recv[p - n]. A plain MatSetValuesCOO on the part keeps its own map. */
+   p >= n from recv[p - n], and leaves the part to be assembled by the caller. A plain MatSetValuesCOO
+   on the part keeps its own map. */
 PETSC_INTERN PetscErrorCode
                             MatSeqBinBCSRComposeCOO(Mat, const PetscCount from[], PetscCount n,
                                                     PetscCount nsrc); /* from[] < n: the caller's values, else received */

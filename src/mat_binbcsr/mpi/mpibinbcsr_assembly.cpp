@@ -186,8 +186,15 @@ PETSC_INTERN PetscErrorCode MatAssemblyEnd_MPIBinBCSR(Mat mat, MatAssemblyType t
   Mat_MPIBinBCSR *b = MPIBinBCSR(mat);
 
   PetscFunctionBegin;
-  if (b->coo_just_assembled) { /* MatSetValuesCOO assembled both parts already */
+  if (b->coo_just_assembled) { /* MatSetValuesCOO refilled both parts; nothing is stashed */
     b->coo_just_assembled = PETSC_FALSE;
+    if (b->coo_parts_refilled) { /* assembled here, inside mat's assembly: -mat_view shows mat, not them */
+      b->coo_parts_refilled = PETSC_FALSE;
+      PetscCall(MatAssemblyBegin(b->A, MAT_FINAL_ASSEMBLY));
+      PetscCall(MatAssemblyEnd(b->A, MAT_FINAL_ASSEMBLY));
+      PetscCall(MatAssemblyBegin(b->B, MAT_FINAL_ASSEMBLY));
+      PetscCall(MatAssemblyEnd(b->B, MAT_FINAL_ASSEMBLY));
+    }
     PetscFunctionReturn(0);
   }
   PetscCheck(b->A, PetscObjectComm((PetscObject)mat), PETSC_ERR_ARG_WRONGSTATE,
@@ -363,6 +370,7 @@ template <typename S> PetscErrorCode SetValuesCOO_MPIBinBCSR(Mat mat, const S v[
       PetscCall(MatSetValuesCOOTwoSources_SeqBinBCSR(b->A, v, n, coo->recvbuf.data(), mode));
       PetscCall(MatSetValuesCOOTwoSources_SeqBinBCSR(b->B, v, n, coo->recvbuf.data(), mode));
     }
+    b->coo_parts_refilled = PETSC_TRUE; /* unassembled until mat's assembly */
   } else {
     /* the local entries are gathered while the others travel */
     for (std::size_t k = 0; k < coo->a_from.size(); k++)

@@ -547,9 +547,9 @@ static PetscErrorCode SetValuesCOOTwoSources(Mat A, const S v[], PetscCount n, c
   PetscCheck(a->built && a->coo_composed, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE,
              "MatSetValuesCOOTwoSources_SeqBinBCSR needs MatSeqBinBCSRComposeCOO first");
   PetscCall(SetValuesCOO(A, a->coo_perm_src, v, (long)n, recv, imode));
-  /* as MatSetValuesCOO() does after the type's refill */
-  PetscCall(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY));
+  /* not assembled here: the MPI matrix assembles its parts inside its own assembly, which
+     MatSetValuesCOO() calls next (assembled here, outside it, a part printed itself under -mat_view) */
+  PetscCall(PetscObjectStateIncrease((PetscObject)A));
   PetscFunctionReturn(0);
 }
 
