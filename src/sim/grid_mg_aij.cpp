@@ -1,4 +1,5 @@
 #include "sim/grid_mg_aij.h"
+#include "petsc_compat.h" // PetscOptionsPushCreateViewerOff
 
 #include <algorithm>
 #include <unordered_map>
@@ -107,7 +108,10 @@ PetscErrorCode GridMGShareTarget(MPI_Comm comm, Mat Ac, const GridMG::Distribute
   PetscCall(MatSetSizes(A, local, local, global, global));
   PetscCall(MatSetBlockSize(A, 3));
   PetscCall(MatSetType(A, MATAIJ));
+  // viewers off: MPIAIJ's COO preallocation assembles its parts on their own (-mat_view printed them)
+  PetscCall(PetscOptionsPushCreateViewerOff(PETSC_TRUE));
   PetscCall(MatSetPreallocationCOO(A, (PetscCount)ci.size(), ci.data(), cj.data()));
+  PetscCall(PetscOptionsPopCreateViewerOff());
   *target = A;
   PetscFunctionReturn(0);
 }

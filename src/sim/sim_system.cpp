@@ -1,6 +1,7 @@
 #include "sim/sim_system.h"
 
 #include "sim/pc_failure.h"
+#include "petsc_compat.h" // PetscOptionsPushCreateViewerOff
 
 #include <petscbinbcsr.h>
 
@@ -64,12 +65,16 @@ PetscErrorCode PreallocateFromBlockPattern(MPI_Comm comm, PetscInt n_local, Pets
   PetscCall(MatSetOptionsPrefix(graph, "sim_block_graph_"));
   PetscCall(MatSetSizes(graph, n_local, n_local, n_global, n_global));
   PetscCall(MatSetType(graph, MATAIJ));
+  // On more ranks MPIAIJ's COO preallocation assembles its diagonal and off-diagonal parts on their
+  // own, which -mat_view then printed (without the graph's prefix): viewers off while it is built.
+  PetscCall(PetscOptionsPushCreateViewerOff(PETSC_TRUE));
   {
     std::vector<PetscInt> ci(rows), cj(cols);
     PetscCall(MatSetPreallocationCOO(graph, (PetscCount)ci.size(), ci.data(), cj.data()));
   }
   std::vector<PetscScalar> ones(rows.size(), 1.0);
   PetscCall(MatSetValuesCOO(graph, ones.data(), INSERT_VALUES));
+  PetscCall(PetscOptionsPopCreateViewerOff());
   PetscCall(MatGetOwnershipRange(graph, &bstart, &bend));
   {
     MatInfo info;
