@@ -202,4 +202,18 @@ PETSC_EXTERN PetscErrorCode KSPMCGGetFixedIterations(KSP, PetscInt *);
    (KSP_DIVERGED_BREAKDOWN). 0 and PETSC_FALSE on solvers of other types. */
 PETSC_EXTERN PetscErrorCode KSPMCGGetPrecisionFloor(KSP, PetscReal *, PetscBool *);
 
+/* KSPMCG's other settings (each a no-op on other solvers; the getters give PETSC_FALSE or 0 there):
+   the fused preconditioner (-ksp_mcg_fused_pc), the check on the true residual before claiming
+   convergence (-ksp_mcg_verify_residual), the factor each restart must shrink it by
+   (-ksp_mcg_stagnation, in (0, 1]) and the relative rounding of the precision floor
+   (-ksp_mcg_precision_floor: -1 from the matrix, 0 off, or in (0, 1)). */
+PETSC_EXTERN PetscErrorCode KSPMCGSetFusedPC(KSP, PetscBool);
+PETSC_EXTERN PetscErrorCode KSPMCGGetFusedPC(KSP, PetscBool *);
+PETSC_EXTERN PetscErrorCode KSPMCGSetVerifyResidual(KSP, PetscBool);
+PETSC_EXTERN PetscErrorCode KSPMCGGetVerifyResidual(KSP, PetscBool *);
+PETSC_EXTERN PetscErrorCode KSPMCGSetStagnation(KSP, PetscReal);
+PETSC_EXTERN PetscErrorCode KSPMCGGetStagnation(KSP, PetscReal *);
+PETSC_EXTERN PetscErrorCode KSPMCGSetPrecisionFloorRounding(KSP, PetscReal);
+PETSC_EXTERN PetscErrorCode KSPMCGGetPrecisionFloorRounding(KSP, PetscReal *);
+
 #endif

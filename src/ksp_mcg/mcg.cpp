@@ -34,6 +34,7 @@ static PetscErrorCode KSPDestroy_MCG(KSP ksp)
   PetscCall(PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGSetFixedIterations_C", nullptr));
   PetscCall(PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGGetFixedIterations_C", nullptr));
   PetscCall(PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGGetPrecisionFloor_C", nullptr));
+  PetscCall(KSPMCGComposeSettings(ksp, PETSC_FALSE));
   PetscFunctionReturn(0);
 }
 
@@ -164,31 +165,26 @@ static PetscErrorCode KSPSetFromOptions_MCG(KSP ksp, PetscOptionItems *PetscOpti
                             "Run exactly this many iterations per solve, no convergence test (0: off)",
                             "KSPMCGSetFixedIterations", n, &n, &flg));
   if (flg) PetscCall(KSPMCGSetFixedIterations(ksp, n));
+  PetscBool fused = mcg->allow_fused, verify = mcg->verify, set;
   PetscCall(PetscOptionsBool("-ksp_mcg_fused_pc",
-                             "Apply PCJACOBI/PCPBJACOBI/PCNONE inside the fused vector pass", "",
-                             mcg->allow_fused, &mcg->allow_fused, nullptr));
+                             "Apply PCJACOBI/PCPBJACOBI/PCNONE inside the fused vector pass",
+                             "KSPMCGSetFusedPC", fused, &fused, &set));
+  if (set) PetscCall(KSPMCGSetFusedPC(ksp, fused));
   PetscCall(PetscOptionsBool("-ksp_mcg_verify_residual",
-                             "Confirm convergence on the true residual b - A x, restarting if it fails", "",
-                             mcg->verify, &mcg->verify, nullptr));
-  /* read into locals and kept only when valid: a refused value must not stay in the KSP */
+                             "Confirm convergence on the true residual b - A x, restarting if it fails",
+                             "KSPMCGSetVerifyResidual", verify, &verify, &set));
+  if (set) PetscCall(KSPMCGSetVerifyResidual(ksp, verify));
+  /* the setters check the values: a refused one never reaches the KSP */
   PetscReal stagnation = mcg->stagnation, floor_set = mcg->floor_set;
   PetscCall(PetscOptionsReal("-ksp_mcg_stagnation",
-                             "Each restart must shrink the true residual by this factor", "", stagnation,
-                             &stagnation, nullptr));
-  /* 0 or NaN stopped at the first restart, above 1 let a restart grow the residual: neither is a factor */
-  PetscCheck(stagnation > 0 && stagnation <= 1, PetscObjectComm((PetscObject)ksp), PETSC_ERR_ARG_OUTOFRANGE,
-             "-ksp_mcg_stagnation must be a factor in (0, 1], not %g", (double)stagnation);
-  mcg->stagnation = stagnation;
+                             "Each restart must shrink the true residual by this factor",
+                             "KSPMCGSetStagnation", stagnation, &stagnation, &set));
+  if (set) PetscCall(KSPMCGSetStagnation(ksp, stagnation));
   PetscCall(PetscOptionsReal(
     "-ksp_mcg_precision_floor",
     "Relative rounding u of the operator's products: stop at u ||A|| ||x|| instead of claiming a tolerance below it (-1: from the matrix, 0: off)",
-    "", floor_set, &floor_set, nullptr));
-  PetscCheck(
-    floor_set == MCG_FLOOR_AUTO || (floor_set >= 0 && floor_set < 1), PetscObjectComm((PetscObject)ksp),
-    PETSC_ERR_ARG_OUTOFRANGE,
-    "-ksp_mcg_precision_floor must be -1 (from the matrix), 0 (off) or a relative rounding in (0, 1), not %g",
-    (double)floor_set);
-  mcg->floor_set = floor_set;
+    "KSPMCGSetPrecisionFloorRounding", floor_set, &floor_set, &set));
+  if (set) PetscCall(KSPMCGSetPrecisionFloorRounding(ksp, floor_set));
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }
@@ -232,13 +228,13 @@ static PetscErrorCode KSPConvergedReasonView_MCGFloor(KSP ksp, void *)
 
    Options Database Keys:
 +  -ksp_mcg_fixed_iterations <n>   - exactly n iterations per solve, no convergence test (0: off), see `KSPMCGSetFixedIterations()`
-.  -ksp_mcg_fused_pc <bool>        - apply `PCJACOBI`, `PCPBJACOBI` (block size 3) or `PCNONE` inside the fused vector pass (default true)
-.  -ksp_mcg_verify_residual <bool> - confirm convergence on the true residual b - A x, restarting if it fails (default true)
-.  -ksp_mcg_stagnation <f>         - each restart from the true residual must shrink it by f (default 0.5)
+.  -ksp_mcg_fused_pc <bool>        - apply `PCJACOBI`, `PCPBJACOBI` (block size 3) or `PCNONE` inside the fused vector pass (default true), see `KSPMCGSetFusedPC()`
+.  -ksp_mcg_verify_residual <bool> - confirm convergence on the true residual b - A x, restarting if it fails (default true), see `KSPMCGSetVerifyResidual()`
+.  -ksp_mcg_stagnation <f>         - each restart from the true residual must shrink it by f (default 0.5), see `KSPMCGSetStagnation()`
 -  -ksp_mcg_precision_floor <u>    - relative rounding of the operator's products: the solve stops with
                                      `KSP_DIVERGED_BREAKDOWN` at u ||A|| ||x|| instead of claiming a tolerance
                                      below it (default -1: from the matrix, 2^-24 for `MATBINBCSR` single
-                                     storage and none otherwise; 0: off)
+                                     storage and none otherwise; 0: off), see `KSPMCGSetPrecisionFloorRounding()`
 
    Level: intermediate
 
@@ -292,6 +288,7 @@ PetscErrorCode KSPCreate_MCG(KSP ksp)
     PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGGetFixedIterations_C", KSPMCGGetFixedIterations_MCG));
   PetscCall(
     PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGGetPrecisionFloor_C", KSPMCGGetPrecisionFloor_MCG));
+  PetscCall(KSPMCGComposeSettings(ksp, PETSC_TRUE));
   {
     PetscBool registered = PETSC_FALSE;
     for (PetscInt k = 0; k < ksp->numberreasonviews; k++)

@@ -63,6 +63,8 @@ typedef struct {
 #define MCG_FLOOR_DEPTH 0.1
 
 PETSC_INTERN PetscErrorCode KSPSolve_MCG(KSP);
+/* composes (or, compose false, removes) the settings' functions of mcg_settings.cpp */
+PETSC_INTERN PetscErrorCode KSPMCGComposeSettings(KSP, PetscBool compose);
 /* The passes of one iteration (mcg_passes.cpp). */
 PETSC_INTERN PetscErrorCode MCGChoosePath(KSP, Mat);
 PETSC_INTERN PetscErrorCode MCGUpdateDiagonal(KSP);

@@ -231,3 +231,70 @@ TEST_CASE("precision floor: a residual that reaches zero below the floor, tolera
   MatDestroy(&A);
   VecDestroy(&b);
 }
+
+// Every option of KSPMCG has its function pair: the values round trip, a call refuses what the option
+// refuses (the same check), -help names the function, and on another solver the calls do nothing.
+TEST_CASE("settings: functions for every option", "[ksp_mcg][settings]")
+{
+  KSP ksp;
+  REQUIRE(KSPCreate(PETSC_COMM_WORLD, &ksp) == 0);
+  REQUIRE(KSPSetType(ksp, KSPMCG) == 0);
+  PetscBool flg;
+  PetscReal r;
+  REQUIRE(KSPMCGGetFusedPC(ksp, &flg) == 0);
+  CHECK(flg == PETSC_TRUE);
+  REQUIRE(KSPMCGSetFusedPC(ksp, PETSC_FALSE) == 0);
+  REQUIRE(KSPMCGGetFusedPC(ksp, &flg) == 0);
+  CHECK(flg == PETSC_FALSE);
+  REQUIRE(KSPMCGGetVerifyResidual(ksp, &flg) == 0);
+  CHECK(flg == PETSC_TRUE);
+  REQUIRE(KSPMCGSetVerifyResidual(ksp, PETSC_FALSE) == 0);
+  REQUIRE(KSPMCGGetVerifyResidual(ksp, &flg) == 0);
+  CHECK(flg == PETSC_FALSE);
+  REQUIRE(KSPMCGGetStagnation(ksp, &r) == 0);
+  CHECK(r == 0.5);
+  REQUIRE(KSPMCGSetStagnation(ksp, 0.25) == 0);
+  REQUIRE(KSPMCGGetStagnation(ksp, &r) == 0);
+  CHECK(r == 0.25);
+  REQUIRE(KSPMCGGetPrecisionFloorRounding(ksp, &r) == 0);
+  CHECK(r == -1);
+  REQUIRE(KSPMCGSetPrecisionFloorRounding(ksp, 1e-7) == 0);
+  REQUIRE(KSPMCGGetPrecisionFloorRounding(ksp, &r) == 0);
+  CHECK(r == 1e-7);
+  // refused, and the setting kept
+  PetscPushErrorHandler(PetscReturnErrorHandler, nullptr);
+  for (PetscReal bad : {0.0, -1.0, 2.0, (PetscReal)NAN}) {
+    CAPTURE(bad);
+    CHECK(KSPMCGSetStagnation(ksp, bad) == PETSC_ERR_ARG_OUTOFRANGE);
+  }
+  for (PetscReal bad : {1.0, -0.5, 5.0, (PetscReal)NAN}) {
+    CAPTURE(bad);
+    CHECK(KSPMCGSetPrecisionFloorRounding(ksp, bad) == PETSC_ERR_ARG_OUTOFRANGE);
+  }
+  PetscPopErrorHandler();
+  REQUIRE(KSPMCGGetStagnation(ksp, &r) == 0);
+  CHECK(r == 0.25);
+  REQUIRE(KSPMCGGetPrecisionFloorRounding(ksp, &r) == 0);
+  CHECK(r == 1e-7);
+  // the options go through the same functions
+  PetscOptionsInsertString(nullptr, "-ksp_mcg_fused_pc 1 -ksp_mcg_verify_residual 1 -ksp_mcg_stagnation 0.75 "
+                                    "-ksp_mcg_precision_floor 0");
+  REQUIRE(KSPSetFromOptions(ksp) == 0);
+  PetscOptionsClear(nullptr);
+  REQUIRE(KSPMCGGetFusedPC(ksp, &flg) == 0);
+  CHECK(flg == PETSC_TRUE);
+  REQUIRE(KSPMCGGetVerifyResidual(ksp, &flg) == 0);
+  CHECK(flg == PETSC_TRUE);
+  REQUIRE(KSPMCGGetStagnation(ksp, &r) == 0);
+  CHECK(r == 0.75);
+  REQUIRE(KSPMCGGetPrecisionFloorRounding(ksp, &r) == 0);
+  CHECK(r == 0);
+  // another solver: the setters do nothing, the getters give their defaults
+  REQUIRE(KSPSetType(ksp, KSPCG) == 0);
+  REQUIRE(KSPMCGSetStagnation(ksp, 0.9) == 0);
+  REQUIRE(KSPMCGGetStagnation(ksp, &r) == 0);
+  CHECK(r == 0);
+  REQUIRE(KSPMCGGetFusedPC(ksp, &flg) == 0);
+  CHECK(flg == PETSC_FALSE);
+  KSPDestroy(&ksp);
+}
