@@ -2,6 +2,7 @@
 // what the rounded products can resolve (u ||A|| ||x||), and must report the residual honestly.
 #include <catch2/catch.hpp>
 #include "mcg_test_problems.hpp"
+#include <cmath>
 #include <cstdio>
 #include <string>
 
