@@ -6,31 +6,18 @@
 
 namespace {
 
-PetscErrorCode KSPMCGSetFusedPC_MCG(KSP ksp, PetscBool flg)
+/* The getter of any setting, and the setter of one that takes every value of its type */
+template <typename T, T KSP_MCG::*field> PetscErrorCode GetField(KSP ksp, T *v)
 {
   PetscFunctionBegin;
-  ((KSP_MCG *)ksp->data)->allow_fused = flg;
+  *v = ((KSP_MCG *)ksp->data)->*field;
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode KSPMCGGetFusedPC_MCG(KSP ksp, PetscBool *flg)
+template <typename T, T KSP_MCG::*field> PetscErrorCode SetField(KSP ksp, T v)
 {
   PetscFunctionBegin;
-  *flg = ((KSP_MCG *)ksp->data)->allow_fused;
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode KSPMCGSetVerifyResidual_MCG(KSP ksp, PetscBool flg)
-{
-  PetscFunctionBegin;
-  ((KSP_MCG *)ksp->data)->verify = flg;
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode KSPMCGGetVerifyResidual_MCG(KSP ksp, PetscBool *flg)
-{
-  PetscFunctionBegin;
-  *flg = ((KSP_MCG *)ksp->data)->verify;
+  ((KSP_MCG *)ksp->data)->*field = v;
   PetscFunctionReturn(0);
 }
 
@@ -40,14 +27,7 @@ PetscErrorCode KSPMCGSetStagnation_MCG(KSP ksp, PetscReal factor)
   /* 0 or NaN stopped at the first restart, above 1 let a restart grow the residual: neither is a factor */
   PetscCheck(factor > 0 && factor <= 1, PetscObjectComm((PetscObject)ksp), PETSC_ERR_ARG_OUTOFRANGE,
              "The stagnation factor (-ksp_mcg_stagnation) must be in (0, 1], not %g", (double)factor);
-  ((KSP_MCG *)ksp->data)->stagnation = factor;
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode KSPMCGGetStagnation_MCG(KSP ksp, PetscReal *factor)
-{
-  PetscFunctionBegin;
-  *factor = ((KSP_MCG *)ksp->data)->stagnation;
+  PetscCall(SetField<PetscReal, &KSP_MCG::stagnation>(ksp, factor));
   PetscFunctionReturn(0);
 }
 
@@ -58,14 +38,7 @@ PetscErrorCode KSPMCGSetPrecisionFloorRounding_MCG(KSP ksp, PetscReal u)
     u == MCG_FLOOR_AUTO || (u >= 0 && u < 1), PetscObjectComm((PetscObject)ksp), PETSC_ERR_ARG_OUTOFRANGE,
     "The precision floor's rounding (-ksp_mcg_precision_floor) must be -1 (from the matrix), 0 (off) or in (0, 1), not %g",
     (double)u);
-  ((KSP_MCG *)ksp->data)->floor_set = u;
-  PetscFunctionReturn(0);
-}
-
-PetscErrorCode KSPMCGGetPrecisionFloorRounding_MCG(KSP ksp, PetscReal *u)
-{
-  PetscFunctionBegin;
-  *u = ((KSP_MCG *)ksp->data)->floor_set;
+  PetscCall(SetField<PetscReal, &KSP_MCG::floor_set>(ksp, u));
   PetscFunctionReturn(0);
 }
 
@@ -74,22 +47,24 @@ PetscErrorCode KSPMCGGetPrecisionFloorRounding_MCG(KSP ksp, PetscReal *u)
 PetscErrorCode KSPMCGComposeSettings(KSP ksp, PetscBool compose)
 {
   PetscObject o = (PetscObject)ksp;
+  const auto  f = [compose](auto fn) { return compose ? fn : nullptr; };
 
   PetscFunctionBegin;
-  PetscCall(PetscObjectComposeFunction(o, "KSPMCGSetFusedPC_C", compose ? KSPMCGSetFusedPC_MCG : nullptr));
-  PetscCall(PetscObjectComposeFunction(o, "KSPMCGGetFusedPC_C", compose ? KSPMCGGetFusedPC_MCG : nullptr));
-  PetscCall(PetscObjectComposeFunction(o, "KSPMCGSetVerifyResidual_C",
-                                       compose ? KSPMCGSetVerifyResidual_MCG : nullptr));
-  PetscCall(PetscObjectComposeFunction(o, "KSPMCGGetVerifyResidual_C",
-                                       compose ? KSPMCGGetVerifyResidual_MCG : nullptr));
   PetscCall(
-    PetscObjectComposeFunction(o, "KSPMCGSetStagnation_C", compose ? KSPMCGSetStagnation_MCG : nullptr));
+    PetscObjectComposeFunction(o, "KSPMCGSetFusedPC_C", f(SetField<PetscBool, &KSP_MCG::allow_fused>)));
   PetscCall(
-    PetscObjectComposeFunction(o, "KSPMCGGetStagnation_C", compose ? KSPMCGGetStagnation_MCG : nullptr));
+    PetscObjectComposeFunction(o, "KSPMCGGetFusedPC_C", f(GetField<PetscBool, &KSP_MCG::allow_fused>)));
+  PetscCall(
+    PetscObjectComposeFunction(o, "KSPMCGSetVerifyResidual_C", f(SetField<PetscBool, &KSP_MCG::verify>)));
+  PetscCall(
+    PetscObjectComposeFunction(o, "KSPMCGGetVerifyResidual_C", f(GetField<PetscBool, &KSP_MCG::verify>)));
+  PetscCall(PetscObjectComposeFunction(o, "KSPMCGSetStagnation_C", f(KSPMCGSetStagnation_MCG)));
+  PetscCall(
+    PetscObjectComposeFunction(o, "KSPMCGGetStagnation_C", f(GetField<PetscReal, &KSP_MCG::stagnation>)));
   PetscCall(PetscObjectComposeFunction(o, "KSPMCGSetPrecisionFloorRounding_C",
-                                       compose ? KSPMCGSetPrecisionFloorRounding_MCG : nullptr));
+                                       f(KSPMCGSetPrecisionFloorRounding_MCG)));
   PetscCall(PetscObjectComposeFunction(o, "KSPMCGGetPrecisionFloorRounding_C",
-                                       compose ? KSPMCGGetPrecisionFloorRounding_MCG : nullptr));
+                                       f(GetField<PetscReal, &KSP_MCG::floor_set>)));
   PetscFunctionReturn(0);
 }
 
