@@ -92,7 +92,6 @@ struct Mat_MPIBinBCSR {
 
   MPIBinBCSRCoo *coo                = nullptr;
   PetscBool      coo_just_assembled = PETSC_FALSE; /* MatSetValuesCOO's own assembly call has nothing to do */
-  PetscBool      coo_parts_refilled = PETSC_FALSE; /* ... but to assemble the binbcsr parts it refilled */
 };
 
 static inline Mat_MPIBinBCSR *MPIBinBCSR(Mat mat) { return static_cast<Mat_MPIBinBCSR *>(mat->data); }

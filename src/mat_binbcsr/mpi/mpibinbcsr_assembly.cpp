@@ -188,8 +188,8 @@ PETSC_INTERN PetscErrorCode MatAssemblyEnd_MPIBinBCSR(Mat mat, MatAssemblyType t
   PetscFunctionBegin;
   if (b->coo_just_assembled) { /* MatSetValuesCOO refilled both parts; nothing is stashed */
     b->coo_just_assembled = PETSC_FALSE;
-    if (b->coo_parts_refilled) { /* assembled here, inside mat's assembly: -mat_view shows mat, not them */
-      b->coo_parts_refilled = PETSC_FALSE;
+    if (b->coo->composed) { /* the two-source refill leaves its parts to be assembled here, inside mat's
+                               assembly: -mat_view shows mat, not them */
       PetscCall(MatAssemblyBegin(b->A, MAT_FINAL_ASSEMBLY));
       PetscCall(MatAssemblyEnd(b->A, MAT_FINAL_ASSEMBLY));
       PetscCall(MatAssemblyBegin(b->B, MAT_FINAL_ASSEMBLY));
@@ -370,7 +370,6 @@ template <typename S> PetscErrorCode SetValuesCOO_MPIBinBCSR(Mat mat, const S v[
       PetscCall(MatSetValuesCOOTwoSources_SeqBinBCSR(b->A, v, n, coo->recvbuf.data(), mode));
       PetscCall(MatSetValuesCOOTwoSources_SeqBinBCSR(b->B, v, n, coo->recvbuf.data(), mode));
     }
-    b->coo_parts_refilled = PETSC_TRUE; /* unassembled until mat's assembly */
   } else {
     /* the local entries are gathered while the others travel */
     for (std::size_t k = 0; k < coo->a_from.size(); k++)

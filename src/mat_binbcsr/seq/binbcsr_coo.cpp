@@ -549,7 +549,6 @@ static PetscErrorCode SetValuesCOOTwoSources(Mat A, const S v[], PetscCount n, c
   PetscCall(SetValuesCOO(A, a->coo_perm_src, v, (long)n, recv, imode));
   /* not assembled here: the MPI matrix assembles its parts inside its own assembly, which
      MatSetValuesCOO() calls next (assembled here, outside it, a part printed itself under -mat_view) */
-  PetscCall(PetscObjectStateIncrease((PetscObject)A));
   PetscFunctionReturn(0);
 }
 
