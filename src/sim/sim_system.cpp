@@ -61,12 +61,11 @@ PetscErrorCode PreallocateFromBlockPattern(MPI_Comm comm, PetscInt n_local, Pets
 
   PetscFunctionBegin;
   PetscCall(MatCreate(comm, &graph));
-  // a prefix of its own, so that a user's -mat_view shows the system matrix, not this helper
-  PetscCall(MatSetOptionsPrefix(graph, "sim_block_graph_"));
   PetscCall(MatSetSizes(graph, n_local, n_local, n_global, n_global));
   PetscCall(MatSetType(graph, MATAIJ));
-  // On more ranks MPIAIJ's COO preallocation assembles its diagonal and off-diagonal parts on their
-  // own, which -mat_view then printed (without the graph's prefix): viewers off while it is built.
+  // Viewers off while the graph is filled, so that a user's -mat_view shows the system matrix only:
+  // the graph's own assembly, and on more ranks those of MPIAIJ's parts, which its COO preallocation
+  // assembles on their own (a prefix on the graph would not reach them).
   PetscCall(PetscOptionsPushCreateViewerOff(PETSC_TRUE));
   {
     std::vector<PetscInt> ci(rows), cj(cols);
