@@ -16,7 +16,8 @@ using namespace mpitest;
 
 namespace {
 
-Mat coo_matrix(const FemProblem &fem, MatType type)
+// prefix: the matrix's options prefix, or null
+Mat coo_matrix(const FemProblem &fem, MatType type, const char *prefix = nullptr)
 {
   Mat                   A;
   std::vector<PetscInt> ci, cj;
@@ -24,6 +25,7 @@ Mat coo_matrix(const FemProblem &fem, MatType type)
   rank_coo_entries(fem, ci, cj);
   const auto cv = rank_element_values(fem, [](int e) { return 1.0 + 0.01 * (e % 5); });
   PCHK(MatCreate(PETSC_COMM_WORLD, &A));
+  PCHK(MatSetOptionsPrefix(A, prefix));
   PCHK(MatSetSizes(A, m, m, fem.rows(), fem.rows()));
   PCHK(MatSetBlockSize(A, 3));
   PCHK(MatSetType(A, type));
@@ -136,27 +138,11 @@ TEST_CASE("mpi: the parts read the tuner's options under the matrix's prefix", "
   const FemProblem fem(7, 6, 5, true); // under 512 KiB of values on one rank
   PCHK(PetscOptionsSetValue(nullptr, "-mat_binbcsr_tune_min_kib", "0")); // not this matrix's
   PCHK(PetscOptionsSetValue(nullptr, "-sys_mat_binbcsr_tune_cache", "0"));
-  std::vector<PetscInt> ci, cj;
-  const PetscInt        m = local_rows(fem, PETSC_COMM_WORLD, false);
-  rank_coo_entries(fem, ci, cj);
-  const auto cv    = rank_element_values(fem, [](int e) { return 1.0 + 0.01 * (e % 5); });
-  auto       build = [&]() {
-    Mat A;
-    PCHK(MatCreate(PETSC_COMM_WORLD, &A));
-    PCHK(MatSetOptionsPrefix(A, "sys_"));
-    PCHK(MatSetSizes(A, m, m, fem.rows(), fem.rows()));
-    PCHK(MatSetBlockSize(A, 3));
-    PCHK(MatSetType(A, MATMPIBINBCSR));
-    PCHK(MatSetFromOptions(A));
-    PCHK(MatSetPreallocationCOO(A, (PetscCount)ci.size(), ci.data(), cj.data()));
-    PCHK(MatSetValuesCOO(A, cv.data(), ADD_VALUES));
-    return A;
-  };
-  Mat A = build(); // the parts are below the default 512 KiB: not tuned
+  Mat A = coo_matrix(fem, MATMPIBINBCSR, "sys_"); // the parts are below the default 512 KiB: not tuned
   CHECK(all_ranks(info_text(A).find("measured on block rows") == std::string::npos));
   MatDestroy(&A);
   PCHK(PetscOptionsSetValue(nullptr, "-sys_mat_binbcsr_tune_min_kib", "0"));
-  A                     = build();
+  A                     = coo_matrix(fem, MATMPIBINBCSR, "sys_");
   const std::string txt = info_text(A);
   PetscMPIInt       rank;
   MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
