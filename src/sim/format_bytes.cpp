@@ -43,8 +43,8 @@ PetscErrorCode MeasureStats(Mat aij, MatrixStats *st)
       bcols.clear();
     }
   }
-  double sums[5] = {nnz, sell, blocks, upper, (double)(rend - rstart)};
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, sums, 5, MPI_DOUBLE, MPI_SUM, comm));
+  double sums[4] = {nnz, sell, blocks, upper};
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, sums, 4, MPI_DOUBLE, MPI_SUM, comm));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &maxr, 1, MPIU_INT, MPI_MAX, comm));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &minr, 1, MPIU_INT, MPI_MIN, comm));
   st->nnz          = sums[0];
