@@ -1,6 +1,6 @@
 /* KSPMCG ("mcg"): merged preconditioned conjugate gradient with one global reduction per iteration
    (Chronopoulos-Gear formulation; the iteration is in mcg_solve.cpp). This file holds the object:
-   creation, options, view, setup and the fixed-iteration setters. */
+   creation, options, view and setup (the settings' functions are in mcg_settings.cpp). */
 #include "mcg_impl.h"
 
 static PetscErrorCode KSPSetUp_MCG(KSP ksp)
@@ -31,8 +31,6 @@ static PetscErrorCode KSPDestroy_MCG(KSP ksp)
   PetscFunctionBegin;
   PetscCall(KSPReset_MCG(ksp));
   PetscCall(KSPDestroyDefault(ksp));
-  PetscCall(PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGSetFixedIterations_C", nullptr));
-  PetscCall(PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGGetFixedIterations_C", nullptr));
   PetscCall(PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGGetPrecisionFloor_C", nullptr));
   PetscCall(KSPMCGComposeSettings(ksp, PETSC_FALSE));
   PetscFunctionReturn(0);
@@ -122,24 +120,6 @@ static PetscErrorCode KSPView_MCG(KSP ksp, PetscViewer viewer)
                                      "  last solve: %" PetscInt_FMT " true-residual checks, %" PetscInt_FMT
                                      " restarts, true residual norm %g\n",
                                      mcg->true_checks, mcg->restarts, (double)mcg->true_rnorm));
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode KSPMCGSetFixedIterations_MCG(KSP ksp, PetscInt n)
-{
-  KSP_MCG *mcg = (KSP_MCG *)ksp->data;
-
-  PetscFunctionBegin;
-  PetscCheck(n >= 0, PetscObjectComm((PetscObject)ksp), PETSC_ERR_ARG_OUTOFRANGE,
-             "Fixed iteration count must be >= 0 (0 turns it off), not %" PetscInt_FMT, n);
-  mcg->fixed_its = n;
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode KSPMCGGetFixedIterations_MCG(KSP ksp, PetscInt *n)
-{
-  PetscFunctionBegin;
-  *n = ((KSP_MCG *)ksp->data)->fixed_its;
   PetscFunctionReturn(0);
 }
 
@@ -283,10 +263,6 @@ PetscErrorCode KSPCreate_MCG(KSP ksp)
   ksp->ops->buildsolution  = KSPBuildSolutionDefault;
   ksp->ops->buildresidual  = KSPBuildResidualDefault;
   PetscCall(
-    PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGSetFixedIterations_C", KSPMCGSetFixedIterations_MCG));
-  PetscCall(
-    PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGGetFixedIterations_C", KSPMCGGetFixedIterations_MCG));
-  PetscCall(
     PetscObjectComposeFunction((PetscObject)ksp, "KSPMCGGetPrecisionFloor_C", KSPMCGGetPrecisionFloor_MCG));
   PetscCall(KSPMCGComposeSettings(ksp, PETSC_TRUE));
   {
@@ -298,44 +274,6 @@ PetscErrorCode KSPCreate_MCG(KSP ksp)
   }
   PetscFunctionReturn(0);
 }
-
-/*@
-   KSPMCGSetFixedIterations - Makes `KSPMCG` run exactly n iterations per solve, with no convergence test
-
-   Logically Collective
-
-   Input Parameters:
-+  ksp - the solver
--  n   - the number of iterations; 0 turns it off (the tolerances decide)
-
-   Options Database Key:
-.  -ksp_mcg_fixed_iterations <n> - sets the number of iterations
-
-   Level: advanced
-
-   Note:
-   No residual norm is computed. A no-op on solvers of other types.
-
-.seealso: `KSPMCG`, `KSPMCGGetFixedIterations()`
-@*/
-BINBCSR_TRY_SETTER(KSPMCGSetFixedIterations, KSP, KSP_CLASSID, PetscInt, PetscValidLogicalCollectiveInt)
-
-/*@
-   KSPMCGGetFixedIterations - Gets the fixed number of iterations per solve of `KSPMCG`
-
-   Not Collective
-
-   Input Parameter:
-.  ksp - the solver
-
-   Output Parameter:
-.  n - the number of iterations; 0 when off and on solvers of other types
-
-   Level: advanced
-
-.seealso: `KSPMCG`, `KSPMCGSetFixedIterations()`
-@*/
-BINBCSR_TRY_GETTER(KSPMCGGetFixedIterations, KSP, KSP_CLASSID, PetscInt, PetscAssertPointer, 0)
 
 /*@
    KSPMCGGetPrecisionFloor - Gets the precision floor of the last `KSPMCG` solve and whether the solve

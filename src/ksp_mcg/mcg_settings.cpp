@@ -1,7 +1,7 @@
 /* KSPMCG's settings as functions (include/petscbinbcsr.h), one pair per option of KSPSetFromOptions_MCG:
-   the fused preconditioner, the true-residual check, its stagnation factor and the precision floor's
-   rounding. The checks of a value live in the type's setter, so an option and a call refuse the same
-   values with the same message. KSPMCGSetFixedIterations is with the type (mcg.cpp). */
+   the fixed iteration count, the fused preconditioner, the true-residual check, its stagnation factor
+   and the precision floor's rounding. The checks of a value live in the type's setter, so an option
+   and a call refuse the same values with the same message. */
 #include "mcg_impl.h"
 
 namespace {
@@ -18,6 +18,15 @@ template <typename T, T KSP_MCG::*field> PetscErrorCode SetField(KSP ksp, T v)
 {
   PetscFunctionBegin;
   ((KSP_MCG *)ksp->data)->*field = v;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode KSPMCGSetFixedIterations_MCG(KSP ksp, PetscInt n)
+{
+  PetscFunctionBegin;
+  PetscCheck(n >= 0, PetscObjectComm((PetscObject)ksp), PETSC_ERR_ARG_OUTOFRANGE,
+             "Fixed iteration count must be >= 0 (0 turns it off), not %" PetscInt_FMT, n);
+  PetscCall(SetField<PetscInt, &KSP_MCG::fixed_its>(ksp, n));
   PetscFunctionReturn(0);
 }
 
@@ -50,6 +59,9 @@ PetscErrorCode KSPMCGComposeSettings(KSP ksp, PetscBool compose)
   const auto  f = [compose](auto fn) { return compose ? fn : nullptr; };
 
   PetscFunctionBegin;
+  PetscCall(PetscObjectComposeFunction(o, "KSPMCGSetFixedIterations_C", f(KSPMCGSetFixedIterations_MCG)));
+  PetscCall(
+    PetscObjectComposeFunction(o, "KSPMCGGetFixedIterations_C", f(GetField<PetscInt, &KSP_MCG::fixed_its>)));
   PetscCall(
     PetscObjectComposeFunction(o, "KSPMCGSetFusedPC_C", f(SetField<PetscBool, &KSP_MCG::allow_fused>)));
   PetscCall(
@@ -67,6 +79,44 @@ PetscErrorCode KSPMCGComposeSettings(KSP ksp, PetscBool compose)
                                        f(GetField<PetscReal, &KSP_MCG::floor_set>)));
   PetscFunctionReturn(0);
 }
+
+/*@
+   KSPMCGSetFixedIterations - Makes `KSPMCG` run exactly n iterations per solve, with no convergence test
+
+   Logically Collective
+
+   Input Parameters:
++  ksp - the solver
+-  n   - the number of iterations; 0 turns it off (the tolerances decide)
+
+   Options Database Key:
+.  -ksp_mcg_fixed_iterations <n> - sets the number of iterations
+
+   Level: advanced
+
+   Note:
+   No residual norm is computed. A no-op on solvers of other types.
+
+.seealso: `KSPMCG`, `KSPMCGGetFixedIterations()`
+@*/
+BINBCSR_TRY_SETTER(KSPMCGSetFixedIterations, KSP, KSP_CLASSID, PetscInt, PetscValidLogicalCollectiveInt)
+
+/*@
+   KSPMCGGetFixedIterations - Gets the fixed number of iterations per solve of `KSPMCG`
+
+   Not Collective
+
+   Input Parameter:
+.  ksp - the solver
+
+   Output Parameter:
+.  n - the number of iterations; 0 when off and on solvers of other types
+
+   Level: advanced
+
+.seealso: `KSPMCG`, `KSPMCGSetFixedIterations()`
+@*/
+BINBCSR_TRY_GETTER(KSPMCGGetFixedIterations, KSP, KSP_CLASSID, PetscInt, PetscAssertPointer, 0)
 
 /*@
    KSPMCGSetFusedPC - Sets whether `KSPMCG` applies `PCJACOBI`, `PCPBJACOBI` (block size 3) or `PCNONE`
