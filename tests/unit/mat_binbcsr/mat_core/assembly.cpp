@@ -152,6 +152,76 @@ TEST_CASE("the preallocation calls of stock programs give a working matrix", "[m
     check_dense(dense(A), ref, 0);
     MatDestroy(&A);
   }
+  SECTION("MatXAIJSetPreallocation, blocks set twice (INSERT then ADD), scalars in between")
+  {
+    // the staging finds a block once per MatSetValuesBlocked block; scalars go one by one
+    Mat                   A = create(p.m, p.n, 3);
+    std::vector<PetscInt> dnnz(p.m / 3, 27);
+    REQUIRE(MatXAIJSetPreallocation(A, 3, dnnz.data(), nullptr, nullptr, nullptr) == 0);
+    std::vector<PetscScalar> ref2(ref.size());
+    for (size_t k = 0; k < ref.size(); k++) ref2[k] = 2 * ref[k];
+    for (const Entry &e : p.entries) { // the block of each entry, whole, with the entry's value in place
+      const PetscInt br = e.i / 3, bc = e.j / 3;
+      PetscScalar    blk[9];
+      for (PetscInt ii = 0; ii < 3; ii++)
+        for (PetscInt jj = 0; jj < 3; jj++)
+          blk[3 * ii + jj] = ref[(size_t)((3 * br + ii) * p.n + 3 * bc + jj)];
+      REQUIRE(MatSetValuesBlocked(A, 1, &br, 1, &bc, blk, INSERT_VALUES) == 0);
+    }
+    REQUIRE(MatAssemblyBegin(A, MAT_FLUSH_ASSEMBLY) == 0); // INSERT and ADD are not mixed without one
+    REQUIRE(MatAssemblyEnd(A, MAT_FLUSH_ASSEMBLY) == 0);
+    for (const Entry &e : p.entries)
+      REQUIRE(MatSetValue(A, e.i, e.j, 0.5 * ref[(size_t)(e.i * p.n + e.j)], ADD_VALUES) == 0);
+    for (const Entry &e : p.entries)
+      REQUIRE(MatSetValue(A, e.i, e.j, 0.5 * ref[(size_t)(e.i * p.n + e.j)], ADD_VALUES) == 0);
+    assemble(A);
+    check_dense(dense(A), ref2, 4 * DBL_EPSILON);
+    MatDestroy(&A);
+  }
+  SECTION(
+    "MatSeqAIJSetPreallocation bounds a block row by its largest point row, and rows grow past what they reserved")
+  {
+    // 3 scalars per point row: at most 3 blocks per block row (each could hold one of them); the
+    // staging reserves one full block and grows to three
+    Mat A = create(12, 12, 3);
+    REQUIRE(MatSeqAIJSetPreallocation(A, 3, nullptr) == 0);
+    REQUIRE(MatSetOption(A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE) == 0);
+    for (PetscInt bc = 0; bc < 3; bc++) {
+      const PetscInt br = 0;
+      PetscScalar    blk[9];
+      for (int k = 0; k < 9; k++) blk[k] = 1 + k + 10 * bc;
+      REQUIRE(MatSetValuesBlocked(A, 1, &br, 1, &bc, blk, INSERT_VALUES) == 0);
+    }
+    CHECK(MatSetValue(A, 0, 9, 1.0, INSERT_VALUES) == PETSC_ERR_ARG_OUTOFRANGE); // a fourth block
+    assemble(A);
+    PetscScalar    v;
+    const PetscInt r = 2, c = 7; // block (0, 2), entry (2, 1)
+    REQUIRE(MatGetValues(A, 1, &r, 1, &c, &v) == 0);
+    CHECK(v == 1 + 7 + 20);
+    MatDestroy(&A);
+  }
+  SECTION("new blocks ignored (MAT_NEW_NONZERO_LOCATIONS false) before the first assembly")
+  {
+    Mat A = create(9, 9, 3);
+    REQUIRE(MatSeqBAIJSetPreallocation(A, 3, 2, nullptr) == 0);
+    const PetscInt br = 1, bc0 = 1, bc1 = 2;
+    PetscScalar    blk[9] = {1, 2, 3, 4, 5, 6, 7, 8, 9};
+    REQUIRE(MatSetValuesBlocked(A, 1, &br, 1, &bc0, blk, INSERT_VALUES) == 0);
+    REQUIRE(MatSetOption(A, MAT_NEW_NONZERO_LOCATIONS, PETSC_FALSE) == 0);
+    REQUIRE(MatSetValuesBlocked(A, 1, &br, 1, &bc1, blk, INSERT_VALUES) == 0); // ignored
+    REQUIRE(MatAssemblyBegin(A, MAT_FLUSH_ASSEMBLY) == 0);
+    REQUIRE(MatAssemblyEnd(A, MAT_FLUSH_ASSEMBLY) == 0);
+    REQUIRE(MatSetValuesBlocked(A, 1, &br, 1, &bc0, blk, ADD_VALUES) == 0); // an existing block
+    assemble(A);
+    MatInfo info;
+    REQUIRE(MatGetInfo(A, MAT_LOCAL, &info) == 0);
+    CHECK(info.nz_used == 9);
+    PetscScalar    v;
+    const PetscInt r = 5, c = 4; // block (1, 1), entry (2, 1)
+    REQUIRE(MatGetValues(A, 1, &r, 1, &c, &v) == 0);
+    CHECK(v == 16);
+    MatDestroy(&A);
+  }
   SECTION("MatSeqBAIJSetPreallocation, then MAT_NEW_NONZERO_ALLOCATION_ERR beyond it")
   {
     Mat A = create(9, 9, 3);
