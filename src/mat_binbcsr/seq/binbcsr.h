@@ -187,6 +187,13 @@ PETSC_INTERN PetscErrorCode MatSeqBinBCSRAllocValues_Private(Mat_SeqBinBCSR *, M
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRFreeValues_Private(Mat_SeqBinBCSR *);
 /* Frees a val_mem of map bytes (0: PetscMalloc'd), when the caller took it out of the matrix. */
 PETSC_INTERN PetscErrorCode MatSeqBinBCSRReleaseValues_Private(void *mem, size_t map);
+/* An array of `bytes` (4 MiB and more) in a mapping of its own, its start 2 MiB-aligned and marked for
+   transparent huge pages before any page is touched; reads as zero. NULL where the size is smaller, the
+   system has no such hint or the mapping fails (then *base is NULL). *base and *length: what
+   MatSeqBinBCSRUnmapHuge (or the value arrays' release) takes back. Why huge pages: see
+   MatSeqBinBCSRAllocValues_Private (binbcsr_build.cpp). */
+PETSC_INTERN void *MatSeqBinBCSRMapHuge(size_t bytes, void **base, size_t *length);
+PETSC_INTERN void  MatSeqBinBCSRUnmapHuge(void *base, size_t length);
 
 /* Lane of slot s, and the index into val/valf of entry e of slot s. */
 static inline PetscInt BinBCSRLane(PetscInt s, PetscInt bw) { return s % bw; }

@@ -2,18 +2,16 @@
    build itself: binbcsr_build.cpp; the type, its ops table and options: binbcsr.cpp). */
 #include "binbcsr.h"
 #include <algorithm>
-#include <cstdint>
 #include <memory_resource>
 #include <new>
-#include <sys/mman.h>
 #include <vector>
 
 namespace {
 
-/* Where the staging arena gets its buffers: those of 4 MiB and more from a mapping of their own,
-   marked for transparent huge pages before the first touch, as the value arrays are
-   (binbcsr_build.cpp); smaller ones from the heap. Filling the 48^3 stencil touches ~250 MB of
-   staging; with 4 KiB pages that is 60,000 page faults, about 10 us each on a virtual machine. */
+/* Where the staging arena gets its buffers: those of 4 MiB and more from a mapping of their own on
+   transparent huge pages, as the value arrays (MatSeqBinBCSRMapHuge); smaller ones from the heap.
+   Filling the 48^3 stencil touches ~250 MB of staging; with 4 KiB pages that is 60,000 page faults,
+   about 10 us each on a virtual machine. */
 class HugePageUpstream final : public std::pmr::memory_resource {
   struct Mapping {
     void  *start, *base;
@@ -23,26 +21,19 @@ class HugePageUpstream final : public std::pmr::memory_resource {
 
   void *do_allocate(size_t bytes, size_t align) override
   {
-#if defined(MADV_HUGEPAGE)
-    constexpr size_t huge = (size_t)2 << 20;
-    if (bytes >= 2 * huge && align <= huge) {
-      const size_t length = (bytes + huge - 1) / huge * huge + huge; /* room to align the start */
-      void        *base   = mmap(nullptr, length, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-      if (base != MAP_FAILED) {
-        char *start = (char *)(((uintptr_t)base + huge - 1) & ~(uintptr_t)(huge - 1));
-        (void)madvise(start, length - (size_t)(start - (char *)base), MADV_HUGEPAGE);
-        maps.push_back({start, base, length});
-        return start;
-      }
+    void  *base;
+    size_t length;
+    if (void *start = align <= ((size_t)2 << 20) ? MatSeqBinBCSRMapHuge(bytes, &base, &length) : nullptr) {
+      maps.push_back({start, base, length});
+      return start;
     }
-#endif
     return ::operator new(bytes, std::align_val_t(align));
   }
   void do_deallocate(void *p, size_t bytes, size_t align) override
   {
     for (size_t k = 0; k < maps.size(); k++)
       if (maps[k].start == p) {
-        (void)munmap(maps[k].base, maps[k].length);
+        MatSeqBinBCSRUnmapHuge(maps[k].base, maps[k].length);
         maps.erase(maps.begin() + (long)k);
         return;
       }

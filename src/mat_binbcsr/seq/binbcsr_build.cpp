@@ -59,6 +59,33 @@ static void HugePages(void *p, size_t bytes)
 #endif
 }
 
+void *MatSeqBinBCSRMapHuge(size_t bytes, void **base, size_t *length)
+{
+#if defined(MADV_HUGEPAGE)
+  constexpr size_t huge = (size_t)2 << 20;
+  if (bytes >= 2 * huge) {
+    const size_t map = (bytes + huge - 1) / huge * huge + huge; /* room to align the start */
+    void        *m   = mmap(nullptr, map, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (m != MAP_FAILED) {
+      char *start = (char *)(((uintptr_t)m + huge - 1) & ~(uintptr_t)(huge - 1));
+      (void)madvise(start, map - (size_t)(start - (char *)m), MADV_HUGEPAGE);
+      *base   = m;
+      *length = map;
+      return start;
+    }
+  }
+#endif
+  (void)bytes;
+  *base   = nullptr;
+  *length = 0;
+  return nullptr;
+}
+
+void MatSeqBinBCSRUnmapHuge(void *base, size_t length)
+{
+  if (base) (void)munmap(base, length);
+}
+
 /* The value arrays (binbcsr.h: 64-byte aligned inside val_mem). Of 4 MiB and more they get a mapping
    of their own (val_map bytes), 2 MiB-aligned and marked for huge pages before any page is touched:
    from malloc they often reused heap pages a freed matrix had faulted in with 4 KiB pages, which the
@@ -98,20 +125,16 @@ PetscErrorCode MatSeqBinBCSRAllocValues_Private(Mat_SeqBinBCSR *a, MatBinBCSRPre
 
   PetscFunctionBegin;
   PetscCall(MatSeqBinBCSRFreeValues_Private(a));
-#if defined(MADV_HUGEPAGE)
-  constexpr size_t huge = (size_t)2 << 20;
-  if (bytes >= 2 * huge) {
-    const size_t map = (bytes + huge - 1) / huge * huge + huge; /* room to align the start */
-    void        *m   = mmap(nullptr, map, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (m != MAP_FAILED) { /* else malloc below */
-      mem        = (char *)m;
-      v          = (char *)(((uintptr_t)m + huge - 1) & ~(uintptr_t)(huge - 1));
-      a->val_map = map;
-      (void)madvise(v, map - (size_t)(v - mem), MADV_HUGEPAGE);
-      zero = PETSC_FALSE; /* a fresh mapping reads as zero */
+  {
+    void  *base;
+    size_t length;
+    v = (char *)MatSeqBinBCSRMapHuge(bytes, &base, &length);
+    if (v) { /* else malloc below */
+      mem        = (char *)base;
+      a->val_map = length;
+      zero       = PETSC_FALSE; /* a fresh mapping reads as zero */
     }
   }
-#endif
   if (!mem) {
     PetscCall(PetscMalloc1(bytes + line, &mem));
     v = mem + (line - (size_t)((uintptr_t)mem % line)) % line;
