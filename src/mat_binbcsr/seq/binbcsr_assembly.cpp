@@ -189,37 +189,37 @@ PetscErrorCode MatSeqBinBCSRResetLayout(Mat A)
 static PetscErrorCode MatSeqBinBCSRResetStaging(Mat A, const PetscInt *block_nnz, PetscInt block_nz,
                                                 PetscInt fill)
 {
-  Mat_SeqBinBCSR *a = (Mat_SeqBinBCSR *)A->data;
+  Mat_SeqBinBCSR *a      = (Mat_SeqBinBCSR *)A->data;
+  const bool      given  = block_nnz || block_nz > 0;
+  const auto      bound  = [&](PetscInt r) { return PetscMin(block_nnz ? block_nnz[r] : block_nz, a->nbs); };
+  const auto      blocks = [fill](PetscInt n) { return (n + fill - 1) / fill; }; /* what a row reserves */
+  size_t          expect = 0; /* what the rows reserve, plus a little for the vectors' rounding */
 
   PetscFunctionBegin;
   PetscCall(MatSeqBinBCSRSetSizes(A));
+  if (given) /* checked before anything is dropped */
+    for (PetscInt r = 0; r < a->mbs; r++) {
+      const PetscInt n = bound(r);
+      PetscCheck(n >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
+                 "Negative preallocation %" PetscInt_FMT " for block row %" PetscInt_FMT, n, r);
+      expect += (size_t)blocks(n) * (sizeof(PetscInt) + (size_t)a->bs2 * sizeof(MatScalar)) + 64;
+    }
   PetscCall(MatSeqBinBCSRFreeLayout(a));
   if (a->staging && (PetscInt)a->staging->cols.size() == a->mbs) {
     for (auto &c : a->staging->cols) c.clear();
     for (auto &v : a->staging->vals) v.clear();
     a->staging->prealloc.clear();
   } else {
-    size_t expect = 0; /* what the rows will reserve below, plus a little for the vectors' rounding */
-    if (block_nnz || block_nz > 0) {
-      for (PetscInt r = 0; r < a->mbs; r++) {
-        const PetscInt n = PetscMax(PetscMin(block_nnz ? block_nnz[r] : block_nz, a->nbs), 0);
-        expect +=
-          (size_t)((n + fill - 1) / fill) * (sizeof(PetscInt) + (size_t)a->bs2 * sizeof(MatScalar)) + 64;
-      }
-    }
     delete a->staging;
     a->staging = new BinBCSRStaging(a->mbs, expect);
   }
-  if (block_nnz || block_nz > 0) {
+  if (given) {
     a->staging->prealloc.resize(a->mbs);
     for (PetscInt r = 0; r < a->mbs; r++) {
-      const PetscInt n = PetscMin(block_nnz ? block_nnz[r] : block_nz, a->nbs);
-      PetscCheck(n >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE,
-                 "Negative preallocation %" PetscInt_FMT " for block row %" PetscInt_FMT, n, r);
-      const PetscInt reserve  = (n + fill - 1) / fill;
+      const PetscInt n        = bound(r);
       a->staging->prealloc[r] = n;
-      a->staging->cols[r].reserve(reserve);
-      a->staging->vals[r].reserve(reserve * a->bs2);
+      a->staging->cols[r].reserve(blocks(n));
+      a->staging->vals[r].reserve(blocks(n) * a->bs2);
     }
   }
   A->preallocated  = PETSC_TRUE;

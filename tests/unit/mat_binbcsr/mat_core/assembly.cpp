@@ -222,6 +222,20 @@ TEST_CASE("the preallocation calls of stock programs give a working matrix", "[m
     CHECK(v == 16);
     MatDestroy(&A);
   }
+  SECTION("a negative preallocation is refused, the matrix still usable")
+  {
+    Mat                   A   = create(9, 9, 3);
+    std::vector<PetscInt> bad = {1, -2, 1};
+    CHECK(MatSeqBAIJSetPreallocation(A, 3, 0, bad.data()) == PETSC_ERR_ARG_OUTOFRANGE);
+    REQUIRE(MatSeqBAIJSetPreallocation(A, 3, 1, nullptr) == 0);
+    REQUIRE(MatSetValue(A, 4, 4, 2.0, INSERT_VALUES) == 0);
+    assemble(A);
+    PetscScalar    v;
+    const PetscInt r = 4;
+    REQUIRE(MatGetValues(A, 1, &r, 1, &r, &v) == 0);
+    CHECK(v == 2.0);
+    MatDestroy(&A);
+  }
   SECTION("MatSeqBAIJSetPreallocation, then MAT_NEW_NONZERO_ALLOCATION_ERR beyond it")
   {
     Mat A = create(9, 9, 3);
