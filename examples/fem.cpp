@@ -328,6 +328,7 @@ int main(int argc, char **argv)
     s.add("transfer_copies", (long long)transfers);
   }
   s.add("pc_rebuilds", (long long)sim.sys.pc_rebuilds); // -reuse_preconditioner_growth's set-ups
+  s.add("pc_refits", (long long)sim.sys.pc_refits);     // of them, GAMG's coarse space refitted in place
   s.add("tip_dx", x[3 * tip] - X[3 * tip]);
   s.add("tip_dy", x[3 * tip + 1] - X[3 * tip + 1]);
   s.add("tip_dz", x[3 * tip + 2] - X[3 * tip + 2]);

@@ -1,4 +1,5 @@
 #include "sim/sim_system.h"
+#include "sim/gamg_coarse_space.h"
 
 #include "sim/pc_failure.h"
 #include "petsc_compat.h" // PetscOptionsPushCreateViewerOff
@@ -310,6 +311,8 @@ PetscErrorCode BlockSystemCreate(MPI_Comm comm, PetscInt n_block_rows_global, Pe
   PetscCheck(sys->reuse_growth == 0 || sys->reuse_growth >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE,
              "-reuse_preconditioner_growth %g: 0 (never set up again) or >= 1", (double)sys->reuse_growth);
   PetscCall(GAMGSmootherCopiesFromOptions(comm, &sys->gamg_copies));
+  PetscCall(
+    PetscOptionsGetBool(nullptr, nullptr, "-gamg_refit_coarse_space", &sys->refit_coarse_space, nullptr));
   PetscFunctionReturn(0);
 }
 
@@ -329,6 +332,7 @@ PetscErrorCode BlockSystemSetRigidBodyModes(BlockSystem *sys, const PetscScalar 
   PetscCall(MatSetNearNullSpace(sys->A, modes));
   PetscCall(MatNullSpaceDestroy(&modes));
   PetscCall(VecDestroy(&coords));
+  sys->mode_coords.assign(coords_local, coords_local + (sys->row_end - sys->row_begin));
   { // PCGAMG reads a near null space at its first set-up only; coordinates, at each set-up that builds
     // its coarse space
     PC        pc;
@@ -430,8 +434,19 @@ PetscErrorCode BlockSystemSolve(BlockSystem *sys, const PetscScalar *rhs_local, 
     PetscBool gamg;
     PetscCall(KSPGetPC(sys->ksp, &pc));
     PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &gamg));
-    // GAMG: a new coarse space, not only new Galerkin products of the old interpolation
-    if (gamg) PetscCall(PCGAMGSetReuseInterpolation(pc, PETSC_FALSE));
+    // GAMG: a new coarse space, not only new Galerkin products of the old interpolation: refitted on
+    // its aggregates where it can be (then GAMG reuses the refitted interpolation), else built anew
+    if (gamg) {
+      PetscBool refit = PETSC_FALSE;
+      if (sys->refit_coarse_space && !sys->mode_coords.empty()) {
+        std::vector<Mat> interp;
+        PetscCall(GAMGSmootherCopiesOwnInterpolations(pc, &sys->gamg_copies, &interp));
+        PetscCall(GAMGRefitCoarseSpace(PetscObjectComm((PetscObject)pc), interp, sys->mode_coords.data(),
+                                       (PetscInt)sys->mode_coords.size() / 3, &refit));
+      }
+      PetscCall(PCGAMGSetReuseInterpolation(pc, refit));
+      sys->pc_refits += refit;
+    }
     PetscCall(KSPSetReusePreconditioner(sys->ksp, PETSC_FALSE));
     PetscCall(GAMGSmootherCopiesUpdate(sys->ksp, &sys->gamg_copies)); // (hands GAMG its own levels back)
     PetscCall(PCSetUp(pc));

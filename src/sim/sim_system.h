@@ -61,6 +61,13 @@ struct BlockSystem {
   PetscInt  fewest_its   = -1; // fewest iterations of a solve since the last set-up (-1: none yet)
   PetscBool rebuild_next = PETSC_FALSE;
   PetscInt  pc_rebuilds  = 0; // set-ups forced by reuse_growth
+  // -gamg_refit_coarse_space (default on): such a set-up of a plain-aggregation GAMG on one rank refits
+  // its prolongators to the rigid body modes of the last coordinates given (BlockSystemSetRigidBodyModes)
+  // on the aggregates it has and redoes only the Galerkin products (gamg_coarse_space.h), instead of
+  // building the hierarchy again. pc_refits: the set-ups done so.
+  PetscBool              refit_coarse_space = PETSC_TRUE;
+  std::vector<PetscReal> mode_coords; // this rank's node coordinates of the last rigid body modes
+  PetscInt               pc_refits = 0;
 };
 
 struct SolveStats {

@@ -292,9 +292,11 @@ PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
   if ((PetscInt)c->copy.size() != nlev) {
     PetscCall(GAMGSmootherCopiesDestroy(c));
     c->enabled = true;
-    for (std::vector<Mat> *v : {&c->source, &c->copy, &c->interp_source, &c->interp_copy, &c->restrict_copy})
+    for (std::vector<Mat> *v :
+         {&c->source, &c->copy, &c->interp_source, &c->interp_copy, &c->restrict_copy, &c->restrict_source})
       v->assign(nlev, nullptr);
-    for (std::vector<PetscObjectState> *v : {&c->source_state, &c->source_nzstate, &c->interp_state})
+    for (std::vector<PetscObjectState> *v :
+         {&c->source_state, &c->source_nzstate, &c->interp_state, &c->interp_nzstate})
       v->assign(nlev, 0);
   }
   // A level's operator or transfer is copied when it serves its second solve: with the hierarchy reused
@@ -342,23 +344,51 @@ PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
     if (P != c->interp_source[l]) { // a new interpolation: remembered
       PetscCall(MatDestroy(&c->interp_copy[l]));
       PetscCall(MatDestroy(&c->restrict_copy[l]));
+      PetscCall(MatDestroy(&c->restrict_source[l]));
       PetscCall(Hold(P, &c->interp_source[l]));
       c->interp_state[l] = state;
       continue;
     }
-    if (!c->interp_copy[l] || state != c->interp_state[l]) { // made, or made again for new values
-      PetscCall(MatDestroy(&c->interp_copy[l]));
-      PetscCall(MatDestroy(&c->restrict_copy[l]));
-      PetscCall(RefillFromAIJ(P, PETSC_FALSE, &c->interp_copy[l]));
-      PetscCall(MatTranspose(P, MAT_INITIAL_MATRIX, &R)); // restriction by products, not transposed ones
-      PetscCall(RefillFromAIJ(R, PETSC_FALSE, &c->restrict_copy[l]));
-      PetscCall(MatDestroy(&R));
-      c->interp_state[l] = state;
+    if (!c->interp_copy[l] || state != c->interp_state[l]) { // made, or refilled for new values
+      PetscObjectState nz;
+      PetscCall(MatGetNonzeroState(P, &nz));
+      if (c->interp_copy[l] && c->restrict_source[l] && nz == c->interp_nzstate[l]) {
+        // the same pattern (a refitted coarse space, gamg_coarse_space.h): the copies refilled in place
+        PetscCall(RefillFromAIJ(P, PETSC_FALSE, &c->interp_copy[l]));
+        PetscCall(MatTranspose(P, MAT_REUSE_MATRIX, &c->restrict_source[l]));
+        PetscCall(RefillFromAIJ(c->restrict_source[l], PETSC_FALSE, &c->restrict_copy[l]));
+      } else {
+        PetscCall(MatDestroy(&c->interp_copy[l]));
+        PetscCall(MatDestroy(&c->restrict_copy[l]));
+        PetscCall(MatDestroy(&c->restrict_source[l]));
+        PetscCall(RefillFromAIJ(P, PETSC_FALSE, &c->interp_copy[l]));
+        PetscCall(MatTranspose(P, MAT_INITIAL_MATRIX, &R)); // restriction by products, not transposed ones
+        PetscCall(RefillFromAIJ(R, PETSC_FALSE, &c->restrict_copy[l]));
+        c->restrict_source[l] = R;
+      }
+      c->interp_state[l]   = state;
+      c->interp_nzstate[l] = nz;
     }
     PetscCall(PCMGSetInterpolation(pc, l, c->interp_copy[l]));
     PetscCall(PCMGSetRestriction(pc, l, c->restrict_copy[l]));
   }
   PetscCall(PetscLogEventEnd(COPIES_Update, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode GAMGSmootherCopiesOwnInterpolations(PC pc, const GAMGSmootherCopies *c,
+                                                   std::vector<Mat> *interp)
+{
+  PetscInt nlev;
+
+  PetscFunctionBegin;
+  PetscCall(PCMGGetLevels(pc, &nlev));
+  interp->assign(nlev, nullptr);
+  for (PetscInt l = 1; l < nlev; ++l) {
+    PetscCall(PCMGGetInterpolation(pc, l, &(*interp)[l]));
+    if (c && (size_t)l < c->interp_copy.size() && c->interp_copy[l] && (*interp)[l] == c->interp_copy[l])
+      (*interp)[l] = c->interp_source[l];
+  }
   PetscFunctionReturn(0);
 }
 
@@ -377,6 +407,7 @@ PetscErrorCode GAMGSmootherCopiesDestroy(GAMGSmootherCopies *c)
   for (Mat &m : c->interp_copy) PetscCall(MatDestroy(&m));
   for (Mat &m : c->interp_source) PetscCall(MatDestroy(&m));
   for (Mat &m : c->restrict_copy) PetscCall(MatDestroy(&m));
+  for (Mat &m : c->restrict_source) PetscCall(MatDestroy(&m));
   *c = GAMGSmootherCopies{};
   PetscFunctionReturn(0);
 }

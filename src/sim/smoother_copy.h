@@ -39,6 +39,10 @@ struct GAMGSmootherCopies {
   // rebuilds the hierarchy (as the levels' own operators are), which reuses it
   std::vector<Mat>              interp_copy, restrict_copy, interp_source;
   std::vector<PetscObjectState> interp_state; // interp_source's state when its copies were made
+  // R = P^T in AIJ (the restriction copy's source, transposed again in place when P's values change
+  // and its pattern does not) and P's nonzero state when its copies were made
+  std::vector<Mat>              restrict_source;
+  std::vector<PetscObjectState> interp_nzstate;
 };
 
 // Reads -gamg_smoother_precision (double, the default, or single).
@@ -46,6 +50,10 @@ PetscErrorCode GAMGSmootherCopiesFromOptions(MPI_Comm comm, GAMGSmootherCopies *
 // Call before each solve, after the operator's new values: sets the KSP up (so PCGAMG builds or
 // reuses its hierarchy) and brings the copies up to date. A no-op unless enabled and the PC is GAMG.
 PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c);
+// PCGAMG's own prolongators into PCMG levels 1 .. levels - 1 (*interp[0] null): what PCMG holds, or,
+// where a copy is installed, the prolongator it copies. (c may be disabled.)
+PetscErrorCode GAMGSmootherCopiesOwnInterpolations(PC pc, const GAMGSmootherCopies *c,
+                                                   std::vector<Mat> *interp);
 // The levels smoothing on copies and the levels whose transfers are copies (on this rank).
 void           GAMGSmootherCopiesCount(const GAMGSmootherCopies &c, int *levels, int *transfers);
 PetscErrorCode GAMGSmootherCopiesDestroy(GAMGSmootherCopies *c);

@@ -1,0 +1,23 @@
+// A new coarse space for PCGAMG's plain-aggregation hierarchy without a new hierarchy.
+//
+// When the FE driver sets GAMG up again (-reuse_preconditioner_growth), the reason is the coarse space:
+// GAMG's tentative prolongator holds, per aggregate, an orthonormal basis of the rigid body modes of the
+// shape it was built on, and a turning body leaves them behind. The aggregates themselves depend only on
+// the matrix graph, which a fixed pattern keeps. So the prolongators can be refitted in place: per
+// aggregate, the QR factorisation PCGAMG's formProl0 makes (the modes of the current coordinates stacked
+// over the aggregate's nodes, Q into the prolongator's rows, R as the next level's modes), level after
+// level; PCGAMG then needs only its Galerkin products again (-pc_gamg_reuse_interpolation). That is the
+// coarse space a full set-up builds on the same aggregates, for a fraction of its cost (docs/fem.md).
+#pragma once
+#include <petscksp.h>
+
+#include <vector>
+
+// interp[l], l = 1 .. levels - 1: PCGAMG's own prolongator into PCMG level l (SeqAIJ; the finest level
+// is levels - 1), refitted in place to the rigid body modes of `coords` (x, y, z per node of the finest
+// level, `nodes` of them). *refit is PETSC_FALSE, with nothing changed, where the hierarchy is not one
+// this can refit: more than one rank, a prolongator that is not SeqAIJ or not plain aggregation (a row
+// reaching into two aggregates: smoothed aggregation), a block size other than 3 on the finest level, or
+// a refitted entry the prolongator's pattern lacks. Then the caller sets GAMG up from scratch.
+PetscErrorCode GAMGRefitCoarseSpace(MPI_Comm comm, const std::vector<Mat> &interp, const PetscReal *coords,
+                                    PetscInt nodes, PetscBool *refit);
