@@ -172,6 +172,8 @@ PetscErrorCode GAMGRefitCoarseSpace(MPI_Comm comm, const std::vector<Mat> &inter
   *refit = PETSC_FALSE;
   PetscCallMPI(MPI_Comm_size(comm, &size));
   if (size > 1 || interp.size() < 2) PetscFunctionReturn(0);
+  for (PetscInt k = 0; k < 3 * nodes; ++k)
+    if (!std::isfinite(coords[k])) PetscFunctionReturn(0); // (a set-up from scratch says what breaks)
   for (size_t l = 1; l < interp.size(); ++l) {
     PetscBool aij;
     if (!interp[l]) PetscFunctionReturn(0);

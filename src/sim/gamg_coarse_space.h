@@ -18,6 +18,7 @@
 // level, `nodes` of them). *refit is PETSC_FALSE, with nothing changed, where the hierarchy is not one
 // this can refit: more than one rank, a prolongator that is not SeqAIJ or not plain aggregation (a row
 // reaching into two aggregates: smoothed aggregation), a block size other than 3 on the finest level, or
-// a refitted entry the prolongator's pattern lacks. Then the caller sets GAMG up from scratch.
+// a refitted entry the prolongator's pattern lacks, or a coordinate that is not finite. Then the caller
+// sets GAMG up from scratch.
 PetscErrorCode GAMGRefitCoarseSpace(MPI_Comm comm, const std::vector<Mat> &interp, const PetscReal *coords,
                                     PetscInt nodes, PetscBool *refit);

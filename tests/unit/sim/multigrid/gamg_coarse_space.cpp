@@ -192,12 +192,19 @@ TEST_CASE("a smoothed-aggregation hierarchy is not refitted and keeps its prolon
   CHECK(Values(h.interp.back()) == before);
 }
 
-TEST_CASE("coordinates of another node count are not refitted", "[gamg]")
+TEST_CASE("coordinates of another node count, or not finite, are not refitted", "[gamg]")
 {
   Hierarchy h;
   REQUIRE(SetUpGAMG(6, 0, &h) == 0);
-  PetscBool refit = PETSC_TRUE;
+  const std::vector<PetscScalar> before = Values(h.interp.back());
+  PetscBool                      refit  = PETSC_TRUE;
   REQUIRE(GAMGRefitCoarseSpace(PETSC_COMM_SELF, h.interp, h.coords.data(), (PetscInt)h.coords.size() / 3 - 1,
                                &refit) == 0);
   CHECK(!refit);
+  h.coords[7] = NAN;
+  refit       = PETSC_TRUE;
+  REQUIRE(GAMGRefitCoarseSpace(PETSC_COMM_SELF, h.interp, h.coords.data(), (PetscInt)h.coords.size() / 3,
+                               &refit) == 0);
+  CHECK(!refit);
+  CHECK(Values(h.interp.back()) == before);
 }
