@@ -159,6 +159,11 @@ fem_test(fem_gamg_refit_coarse_space 0 "pc_rebuilds=([1-9][0-9]*) pc_refits=\\1 
 add_test(NAME fem_gamg_refit_same_as_rebuild
          COMMAND sh -c "${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_less.sh cg_its 1.02 '${FEM} ${FEM_BEAM_SWING_STR} -reuse_preconditioner_growth 1.5' '${FEM} ${FEM_BEAM_SWING_STR} -reuse_preconditioner_growth 1.5 -gamg_refit_coarse_space 0' && ${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_same.sh 'tip_dz:1e-7' 1e-5 '${FEM} ${FEM_BEAM_SWING_STR} -reuse_preconditioner_growth 1.5' '${FEM} ${FEM_BEAM_SWING_STR} -reuse_preconditioner_growth 1.5 -gamg_refit_coarse_space 0'")
 set_tests_properties(fem_gamg_refit_same_as_rebuild PROPERTIES LABELS "fem" TIMEOUT 60 WORKING_DIRECTORY ${FEM_SRC})
+# With the single-precision copies the refit refills the transfers' copies in place (the same pattern).
+add_test(NAME fem_gamg_refit_single_copies_same_as_rebuild
+         COMMAND sh -c "${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_less.sh cg_its 1.02 '${FEM} ${FEM_BEAM_SWING_STR} -reuse_preconditioner_growth 1.5 -gamg_smoother_precision single' '${FEM} ${FEM_BEAM_SWING_STR} -reuse_preconditioner_growth 1.5 -gamg_smoother_precision single -gamg_refit_coarse_space 0' && ${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_same.sh 'tip_dz:1e-7' 1e-5 '${FEM} ${FEM_BEAM_SWING_STR} -reuse_preconditioner_growth 1.5 -gamg_smoother_precision single' '${FEM} ${FEM_BEAM_SWING_STR} -reuse_preconditioner_growth 1.5 -gamg_smoother_precision single -gamg_refit_coarse_space 0'")
+set_tests_properties(fem_gamg_refit_single_copies_same_as_rebuild PROPERTIES LABELS "fem" TIMEOUT 60
+                     WORKING_DIRECTORY ${FEM_SRC})
 fem_test(fem_gamg_smoothed_not_refit 0 "pc_rebuilds=[1-9][0-9]* pc_refits=0 .*status=ok" ${FEM} ${FEM_BEAM_GAMG_REUSE})
 fem_test(fem_mpi2_gamg_not_refit 0 "ranks=2 .*pc_rebuilds=[1-9][0-9]* pc_refits=0 .*status=ok"
          ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_BEAM_SWING} -steps 60 -reuse_preconditioner_growth 1.1)
