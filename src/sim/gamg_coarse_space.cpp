@@ -1,7 +1,5 @@
 #include "sim/gamg_coarse_space.h"
 
-#include <petsc/private/petscimpl.h> // PetscObjectStateIncrease: the values were written through the array
-
 #include <algorithm>
 #include <cmath>
 
@@ -80,58 +78,91 @@ std::vector<PetscReal> RigidBodyModes(const PetscReal *coords, PetscInt nodes)
   return modes;
 }
 
-// One prolongator P (SeqAIJ, bs fine rows per node, kModes columns per aggregate): the refitted values
-// in P's value order (into *values) and the next level's modes (per aggregate a kModes x kModes block,
-// row-major), from this level's modes (per node a bs x kModes block). False where P is not plain
-// aggregation or lacks an entry of the refit.
-PetscErrorCode RefitLevel(Mat P, PetscInt bs, const std::vector<PetscReal> &modes,
-                          std::vector<PetscScalar> *values, std::vector<PetscReal> *coarse_modes, bool *ok)
+// This rank's rows r0 + k of one prolongator and what the refit writes into them: row r0 + k gets
+// vals[i] at cols[i], i in [offsets[k], offsets[k + 1]) (its pattern, ascending).
+struct LocalRows {
+  PetscInt                 r0 = 0;
+  std::vector<PetscInt>    offsets, cols;
+  std::vector<PetscScalar> vals;
+};
+
+// All ranks' entries of `mine` (this rank's share, in rank order): the level's arrays over all its nodes.
+template <typename T>
+PetscErrorCode AllGather(MPI_Comm comm, const std::vector<T> &mine, MPI_Datatype type, std::vector<T> *all)
 {
-  PetscInt           m, n, nrows, nz;
-  const PetscInt    *ia, *ja;
-  const PetscScalar *a;
-  PetscBool          done;
+  PetscMPIInt size, count = (PetscMPIInt)mine.size();
+
+  PetscFunctionBegin;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  std::vector<PetscMPIInt> counts(size), displs(size, 0);
+  PetscCallMPI(MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm));
+  for (PetscMPIInt r = 1; r < size; ++r) displs[r] = displs[r - 1] + counts[r - 1];
+  all->resize((size_t)displs[size - 1] + counts[size - 1]);
+  PetscCallMPI(
+    MPI_Allgatherv(mine.data(), count, type, all->data(), counts.data(), displs.data(), type, comm));
+  PetscFunctionReturn(0);
+}
+
+// One prolongator P (AIJ, bs rows per node of its fine level, kModes columns per aggregate), from the
+// modes of every node of its fine level (per node a bs x kModes block, row-major, the same on every
+// rank): this rank's rows refitted (*mine) and the modes of every node of its coarse level (per
+// aggregate a kModes x kModes block). Every rank factors every aggregate, in the same order on the same
+// data, so all hold the same coarse modes without sending them. *ok false (the same on every rank)
+// where P is not plain aggregation or lacks an entry of the refit.
+PetscErrorCode RefitLevel(Mat P, PetscInt bs, const std::vector<PetscReal> &modes, LocalRows *mine,
+                          std::vector<PetscReal> *coarse_modes, bool *ok)
+{
+  MPI_Comm comm;
+  PetscInt m, n, r0, r1;
+  int      fits = 1, all_fit;
 
   PetscFunctionBegin;
   *ok = false;
+  PetscCall(PetscObjectGetComm((PetscObject)P, &comm));
   PetscCall(MatGetSize(P, &m, &n));
-  if (m % bs || n % kModes || (size_t)m * kModes != modes.size()) PetscFunctionReturn(0);
+  PetscCall(MatGetOwnershipRange(P, &r0, &r1));
+  fits = m % bs == 0 && n % kModes == 0 && r0 % bs == 0 && r1 % bs == 0 && (size_t)m * kModes == modes.size();
+  PetscCallMPI(MPI_Allreduce(&fits, &all_fit, 1, MPI_INT, MPI_LAND, comm));
+  if (!all_fit) PetscFunctionReturn(0);
   const PetscInt nodes = m / bs, aggregates = n / kModes;
-  PetscCall(MatGetRowIJ(P, 0, PETSC_FALSE, PETSC_FALSE, &nrows, &ia, &ja, &done));
-  if (!done) PetscFunctionReturn(0);
-  nz = ia[nrows];
-  // each node's aggregate: the column block of its rows' entries, which must all lie in one block
-  std::vector<PetscInt> first(aggregates + 1, 0), members(nodes), aggregate_of(nodes, -1);
-  bool                  plain = true;
-  for (PetscInt i = 0; i < nodes && plain; ++i)
-    for (PetscInt r = bs * i; r < bs * (i + 1) && plain; ++r)
-      for (PetscInt k = ia[r]; k < ia[r + 1]; ++k) {
-        const PetscInt g = ja[k] / kModes;
-        if (aggregate_of[i] < 0) aggregate_of[i] = g;
-        plain = plain && g == aggregate_of[i];
-      }
-  if (plain) {
-    for (PetscInt i = 0; i < nodes; ++i)
-      if (aggregate_of[i] >= 0) first[aggregate_of[i] + 1]++;
-    for (PetscInt g = 0; g < aggregates; ++g) {
-      plain = plain && first[g + 1] > 0; // every column block is an aggregate of some nodes
-      first[g + 1] += first[g];
+  // this rank's nodes' aggregates: the column block of their rows' entries, all in one block
+  std::vector<PetscInt> local_aggregate((r1 - r0) / bs, -1), aggregate_of;
+  mine->r0 = r0;
+  mine->offsets.assign(1, 0);
+  mine->cols.clear();
+  for (PetscInt r = r0; r < r1; ++r) {
+    PetscInt        ncols;
+    const PetscInt *cols;
+    PetscCall(MatGetRow(P, r, &ncols, &cols, nullptr));
+    PetscInt &g = local_aggregate[(r - r0) / bs];
+    for (PetscInt k = 0; k < ncols; ++k) {
+      if (g < 0) g = cols[k] / kModes;
+      fits = fits && cols[k] / kModes == g;
     }
+    mine->cols.insert(mine->cols.end(), cols, cols + ncols);
+    mine->offsets.push_back((PetscInt)mine->cols.size());
+    PetscCall(MatRestoreRow(P, r, &ncols, &cols, nullptr));
+  }
+  mine->vals.assign(mine->cols.size(), 0.0);
+  PetscCall(AllGather(comm, local_aggregate, MPIU_INT, &aggregate_of));
+  // every node's aggregate known; the aggregates' members, ascending
+  std::vector<PetscInt> first(aggregates + 1, 0), members(nodes);
+  for (PetscInt i = 0; i < nodes; ++i)
+    if (aggregate_of[i] >= 0) first[aggregate_of[i] + 1]++;
+  for (PetscInt g = 0; g < aggregates; ++g) {
+    fits = fits && first[g + 1] > 0; // every column block is an aggregate of some nodes
+    first[g + 1] += first[g];
+  }
+  PetscCallMPI(MPI_Allreduce(&fits, &all_fit, 1, MPI_INT, MPI_LAND, comm));
+  if (!all_fit) PetscFunctionReturn(0);
+  {
     std::vector<PetscInt> fill(first.begin(), first.end() - 1);
     for (PetscInt i = 0; i < nodes; ++i)
-      if (aggregate_of[i] >= 0) members[fill[aggregate_of[i]]++] = i; // ascending within each aggregate
+      if (aggregate_of[i] >= 0) members[fill[aggregate_of[i]]++] = i;
   }
-  if (!plain) {
-    PetscCall(MatRestoreRowIJ(P, 0, PETSC_FALSE, PETSC_FALSE, &nrows, &ia, &ja, &done));
-    PetscFunctionReturn(0);
-  }
-  PetscCall(MatSeqAIJGetArrayRead(P, &a));
-  values->assign(a, a + nz);
-  PetscCall(MatSeqAIJRestoreArrayRead(P, &a));
   coarse_modes->assign((size_t)aggregates * kModes * kModes, 0.0);
   std::vector<PetscReal> qr;
-  bool                   fits = true;
-  for (PetscInt g = 0; g < aggregates && fits; ++g) {
+  for (PetscInt g = 0; g < aggregates; ++g) {
     // formProl0's factorisation: the members' mode blocks stacked (column-major, padded with zero rows
     // to at least kModes), geqrf; R -> the coarse node's modes, orgqr's Q -> the members' rows of P
     const PetscInt rows = (first[g + 1] - first[g]) * bs, ld = std::max(rows, kModes);
@@ -144,20 +175,23 @@ PetscErrorCode RefitLevel(Mat P, PetscInt bs, const std::vector<PetscReal> &mode
     HouseholderQR(qr, ld, r);
     for (PetscInt i = 0; i < kModes; ++i)
       for (PetscInt j = 0; j < kModes; ++j) (*coarse_modes)[((size_t)g * kModes + i) * kModes + j] = r[i][j];
-    for (PetscInt t = first[g]; t < first[g + 1] && fits; ++t)
-      for (PetscInt d = 0; d < bs && fits; ++d) {
+    for (PetscInt t = first[g]; t < first[g + 1]; ++t)
+      for (PetscInt d = 0; d < bs; ++d) {
         const PetscInt row = members[t] * bs + d;
+        if (row < r0 || row >= r1) continue; // another rank's row
+        const PetscInt *begin = mine->cols.data() + mine->offsets[row - r0],
+                       *end   = mine->cols.data() + mine->offsets[row - r0 + 1];
         for (PetscInt j = 0; j < kModes; ++j) {
           const PetscReal q   = qr[(size_t)j * ld + (t - first[g]) * bs + d];
           const PetscInt  col = g * kModes + j;
-          const PetscInt *at  = std::lower_bound(ja + ia[row], ja + ia[row + 1], col);
-          if (at != ja + ia[row + 1] && *at == col) (*values)[at - ja] = q;
+          const PetscInt *at  = std::lower_bound(begin, end, col);
+          if (at != end && *at == col) mine->vals[at - mine->cols.data()] = q;
           else if (q != 0.0) fits = false; // an entry the pattern lacks
         }
       }
   }
-  PetscCall(MatRestoreRowIJ(P, 0, PETSC_FALSE, PETSC_FALSE, &nrows, &ia, &ja, &done));
-  *ok = fits;
+  PetscCallMPI(MPI_Allreduce(&fits, &all_fit, 1, MPI_INT, MPI_LAND, comm));
+  *ok = all_fit != 0;
   PetscFunctionReturn(0);
 }
 
@@ -166,41 +200,50 @@ PetscErrorCode RefitLevel(Mat P, PetscInt bs, const std::vector<PetscReal> &mode
 PetscErrorCode GAMGRefitCoarseSpace(MPI_Comm comm, const std::vector<Mat> &interp, const PetscReal *coords,
                                     PetscInt nodes, PetscBool *refit)
 {
-  PetscMPIInt size;
+  int usable = interp.size() >= 2, all_usable;
 
   PetscFunctionBegin;
   *refit = PETSC_FALSE;
-  PetscCallMPI(MPI_Comm_size(comm, &size));
-  if (size > 1 || interp.size() < 2) PetscFunctionReturn(0);
-  for (PetscInt k = 0; k < 3 * nodes; ++k)
-    if (!std::isfinite(coords[k])) PetscFunctionReturn(0); // (a set-up from scratch says what breaks)
-  for (size_t l = 1; l < interp.size(); ++l) {
-    PetscBool aij;
-    if (!interp[l]) PetscFunctionReturn(0);
-    PetscCall(PetscObjectTypeCompare((PetscObject)interp[l], MATSEQAIJ, &aij));
-    if (!aij) PetscFunctionReturn(0);
+  for (PetscInt k = 0; k < 3 * nodes && usable; ++k)
+    usable = std::isfinite(coords[k]); // (a set-up from scratch says what breaks)
+  for (size_t l = 1; l < interp.size() && usable; ++l) {
+    PetscBool aij = PETSC_FALSE;
+    if (interp[l])
+      PetscCall(PetscObjectTypeCompareAny((PetscObject)interp[l], &aij, MATSEQAIJ, MATMPIAIJ, ""));
+    usable = aij;
   }
-  // every level's values first, then written: a level that cannot be refitted leaves all as they were
+  if (usable) { // the finest level's rows are this rank's nodes
+    PetscInt r0, r1;
+    PetscCall(MatGetOwnershipRange(interp.back(), &r0, &r1));
+    usable = r1 - r0 == 3 * nodes;
+  }
+  PetscCallMPI(MPI_Allreduce(&usable, &all_usable, 1, MPI_INT, MPI_LAND, comm));
+  if (!all_usable) PetscFunctionReturn(0);
+  // every level computed before any is written: a level that cannot be refitted leaves all as they were
   PetscCall(RefitRegisterEvent());
   PetscCall(PetscLogEventBegin(REFIT_Event, 0, 0, 0, 0));
-  std::vector<std::vector<PetscScalar>> values(interp.size());
-  std::vector<PetscReal>                modes = RigidBodyModes(coords, nodes), coarse;
-  PetscInt                              bs    = 3;
-  bool                                  ok    = true;
+  std::vector<LocalRows> mine(interp.size());
+  std::vector<PetscReal> modes, coarse;
+  PetscCall(AllGather(comm, RigidBodyModes(coords, nodes), MPIU_REAL, &modes));
+  PetscInt bs = 3;
+  bool     ok = true;
   for (size_t l = interp.size() - 1; l >= 1 && ok; --l) {
-    PetscCall(RefitLevel(interp[l], bs, modes, &values[l], &coarse, &ok));
+    PetscCall(RefitLevel(interp[l], bs, modes, &mine[l], &coarse, &ok));
     modes.swap(coarse);
     bs = kModes;
   }
+  if (ok)
+    for (size_t l = 1; l < interp.size(); ++l) { // existing entries only: the pattern stays
+      const LocalRows &rows = mine[l];
+      for (size_t k = 0; k + 1 < rows.offsets.size(); ++k) {
+        const PetscInt row = rows.r0 + (PetscInt)k, at = rows.offsets[k];
+        PetscCall(MatSetValues(interp[l], 1, &row, rows.offsets[k + 1] - at, rows.cols.data() + at,
+                               rows.vals.data() + at, INSERT_VALUES));
+      }
+      PetscCall(MatAssemblyBegin(interp[l], MAT_FINAL_ASSEMBLY));
+      PetscCall(MatAssemblyEnd(interp[l], MAT_FINAL_ASSEMBLY));
+    }
   PetscCall(PetscLogEventEnd(REFIT_Event, 0, 0, 0, 0));
-  if (!ok) PetscFunctionReturn(0);
-  for (size_t l = 1; l < interp.size(); ++l) {
-    PetscScalar *a;
-    PetscCall(MatSeqAIJGetArrayWrite(interp[l], &a));
-    std::copy(values[l].begin(), values[l].end(), a);
-    PetscCall(MatSeqAIJRestoreArrayWrite(interp[l], &a));
-    PetscCall(PetscObjectStateIncrease((PetscObject)interp[l]));
-  }
-  *refit = PETSC_TRUE;
+  *refit = ok ? PETSC_TRUE : PETSC_FALSE;
   PetscFunctionReturn(0);
 }

@@ -13,12 +13,14 @@
 
 #include <vector>
 
-// interp[l], l = 1 .. levels - 1: PCGAMG's own prolongator into PCMG level l (SeqAIJ; the finest level
-// is levels - 1), refitted in place to the rigid body modes of `coords` (x, y, z per node of the finest
-// level, `nodes` of them). *refit is PETSC_FALSE, with nothing changed, where the hierarchy is not one
-// this can refit: more than one rank, a prolongator that is not SeqAIJ or not plain aggregation (a row
-// reaching into two aggregates: smoothed aggregation), a block size other than 3 on the finest level, or
-// a refitted entry the prolongator's pattern lacks, or a coordinate that is not finite. Then the caller
-// sets GAMG up from scratch.
+// interp[l], l = 1 .. levels - 1: PCGAMG's own prolongator into PCMG level l (SeqAIJ or MPIAIJ; the
+// finest level is levels - 1), refitted in place to the rigid body modes of `coords` (x, y, z per node
+// of this rank's rows of the finest level, `nodes` of them). Collective on comm. Every rank gathers every
+// node's modes and aggregate, factors every aggregate the same way (an aggregate may hold nodes of
+// several ranks) and writes its own rows, existing entries only: the patterns stay. *refit is
+// PETSC_FALSE, with nothing changed, where the hierarchy is not one this can refit: a prolongator that is
+// not AIJ or not plain aggregation (a row reaching into two aggregates: smoothed aggregation), rows
+// that are not this rank's nodes by three, a refitted entry the prolongator's pattern lacks, or a
+// coordinate that is not finite. Then the caller sets GAMG up from scratch.
 PetscErrorCode GAMGRefitCoarseSpace(MPI_Comm comm, const std::vector<Mat> &interp, const PetscReal *coords,
                                     PetscInt nodes, PetscBool *refit);

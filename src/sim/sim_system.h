@@ -61,7 +61,7 @@ struct BlockSystem {
   PetscInt  fewest_its   = -1; // fewest iterations of a solve since the last set-up (-1: none yet)
   PetscBool rebuild_next = PETSC_FALSE;
   PetscInt  pc_rebuilds  = 0; // set-ups forced by reuse_growth
-  // -gamg_refit_coarse_space (default on): such a set-up of a plain-aggregation GAMG on one rank refits
+  // -gamg_refit_coarse_space (default on): such a set-up of a plain-aggregation GAMG refits
   // its prolongators to the rigid body modes of the last coordinates given (BlockSystemSetRigidBodyModes)
   // on the aggregates it has and redoes only the Galerkin products (gamg_coarse_space.h), instead of
   // building the hierarchy again. pc_refits: the set-ups done so.

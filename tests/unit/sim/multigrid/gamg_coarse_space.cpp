@@ -28,7 +28,7 @@ struct Hierarchy {
 
 // GAMG (plain aggregation unless nsmooths) set up on the 27-point block stencil of an n^3 node grid,
 // with the grid's coordinates.
-PetscErrorCode SetUpGAMG(PetscInt n, PetscInt nsmooths, Hierarchy *h)
+PetscErrorCode SetUpGAMG(PetscInt n, PetscInt nsmooths, Hierarchy *h, MPI_Comm comm = PETSC_COMM_SELF)
 {
   StencilGrid grid;
   PC          pc;
@@ -36,18 +36,19 @@ PetscErrorCode SetUpGAMG(PetscInt n, PetscInt nsmooths, Hierarchy *h)
 
   PetscFunctionBegin;
   grid.nx = grid.ny = grid.nz = n;
-  PetscCall(CreateStencilMatrix(PETSC_COMM_SELF, grid, MATSEQAIJ, nullptr, &h->A));
-  for (PetscInt k = 0; k < n; ++k)
-    for (PetscInt j = 0; j < n; ++j)
-      for (PetscInt i = 0; i < n; ++i) h->coords.insert(h->coords.end(), {0.1 * i, 0.1 * j, 0.1 * k});
-  PetscCall(KSPCreate(PETSC_COMM_SELF, &h->ksp));
+  PetscCall(CreateStencilMatrix(comm, grid, MATAIJ, nullptr, &h->A));
+  PetscInt r0, r1; // this rank's nodes: rows r0 / 3 .. r1 / 3 (node i + n (j + n k) at (i, j, k))
+  PetscCall(MatGetOwnershipRange(h->A, &r0, &r1));
+  for (PetscInt node = r0 / 3; node < r1 / 3; ++node)
+    h->coords.insert(h->coords.end(), {0.1 * (node % n), 0.1 * (node / n % n), 0.1 * (node / (n * n))});
+  PetscCall(KSPCreate(comm, &h->ksp));
   PetscCall(KSPSetOperators(h->ksp, h->A, h->A));
   PetscCall(KSPSetType(h->ksp, KSPCG));
   PetscCall(KSPGetPC(h->ksp, &pc));
   PetscCall(PCSetType(pc, PCGAMG));
   PetscCall(PCGAMGSetNSmooths(pc, nsmooths));
   PetscCall(PCGAMGSetCoarseEqLim(pc, 50));
-  PetscCall(PCSetCoordinates(pc, 3, grid.nodes(), h->coords.data()));
+  PetscCall(PCSetCoordinates(pc, 3, (PetscInt)h->coords.size() / 3, h->coords.data()));
   PetscCall(KSPSetUp(h->ksp));
   PetscCall(PCMGGetLevels(pc, &nlev));
   h->interp.assign(nlev, nullptr);
@@ -76,10 +77,10 @@ double OrthonormalityError(Mat P)
 {
   Mat PtP;
   REQUIRE(MatTransposeMatMult(P, P, MAT_INITIAL_MATRIX, PETSC_DEFAULT, &PtP) == 0);
-  PetscInt n;
-  REQUIRE(MatGetSize(PtP, &n, nullptr) == 0);
+  PetscInt r0, r1;
+  REQUIRE(MatGetOwnershipRange(PtP, &r0, &r1) == 0);
   double worst = 0;
-  for (PetscInt r = 0; r < n; ++r) {
+  for (PetscInt r = r0; r < r1; ++r) {
     PetscInt           ncols;
     const PetscInt    *cols;
     const PetscScalar *vals;
@@ -92,6 +93,8 @@ double OrthonormalityError(Mat P)
         worst = std::max(worst, std::fabs(PetscRealPart(vals[k]) - (cols[k] == r ? 1.0 : 0.0)));
     REQUIRE(MatRestoreRow(PtP, r, &ncols, &cols, &vals) == 0);
   }
+  REQUIRE(MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_DOUBLE, MPI_MAX, PetscObjectComm((PetscObject)PtP)) ==
+          0);
   REQUIRE(MatDestroy(&PtP) == 0);
   return worst;
 }
@@ -124,10 +127,13 @@ TEST_CASE("refitted to its own coordinates, GAMG's plain-aggregation prolongator
   }
 }
 
-TEST_CASE("refitted to a turned and moved body, the prolongators span its rigid body modes", "[gamg]")
+namespace {
+
+// The turned-body check on comm (each rank its rows and its nodes' coordinates).
+void CheckTurnedBody(MPI_Comm comm)
 {
   Hierarchy h;
-  REQUIRE(SetUpGAMG(8, 0, &h) == 0);
+  REQUIRE(SetUpGAMG(8, 0, &h, comm) == 0);
   // turned 0.7 rad about (1, 2, 2) / 3 and moved
   const double c = std::cos(0.7), s = std::sin(0.7), u[3] = {1 / 3.0, 2 / 3.0, 2 / 3.0};
   double       R[3][3];
@@ -142,8 +148,7 @@ TEST_CASE("refitted to a turned and moved body, the prolongators span its rigid 
       turned[3 * p + i] = R[i][0] * h.coords[3 * p] + R[i][1] * h.coords[3 * p + 1] +
                           R[i][2] * h.coords[3 * p + 2] + 0.3 * (i + 1);
   PetscBool refit;
-  REQUIRE(
-    GAMGRefitCoarseSpace(PETSC_COMM_SELF, h.interp, turned.data(), (PetscInt)turned.size() / 3, &refit) == 0);
+  REQUIRE(GAMGRefitCoarseSpace(comm, h.interp, turned.data(), (PetscInt)turned.size() / 3, &refit) == 0);
   REQUIRE(refit);
   for (size_t l = 1; l < h.interp.size(); ++l) {
     INFO("level " << l);
@@ -152,8 +157,8 @@ TEST_CASE("refitted to a turned and moved body, the prolongators span its rigid 
   // each mode m of the turned body: |m - P P^T m| / |m| ~ 0 on the finest prolongator
   Mat      P = h.interp.back();
   Vec      m, mc, back;
-  PetscInt rows, cols;
-  REQUIRE(MatGetSize(P, &rows, &cols) == 0);
+  PetscInt rows;
+  REQUIRE(MatGetLocalSize(P, &rows, nullptr) == 0);
   REQUIRE(MatCreateVecs(P, &mc, &m) == 0);
   REQUIRE(VecDuplicate(m, &back) == 0);
   for (int mode = 0; mode < 6; ++mode) {
@@ -177,6 +182,20 @@ TEST_CASE("refitted to a turned and moved body, the prolongators span its rigid 
   REQUIRE(VecDestroy(&m) == 0);
   REQUIRE(VecDestroy(&mc) == 0);
   REQUIRE(VecDestroy(&back) == 0);
+}
+
+} // namespace
+
+TEST_CASE("refitted to a turned and moved body, the prolongators span its rigid body modes", "[gamg]")
+{
+  CheckTurnedBody(PETSC_COMM_SELF);
+}
+
+// On several ranks (tests/multigrid.cmake runs it on 2 and 3): aggregates whose nodes lie on two
+// ranks are factored by both, on the same gathered modes, and every rank writes its own rows.
+TEST_CASE("refitted on every rank's rows, the prolongators span the turned body's modes", "[gamg][mpi]")
+{
+  CheckTurnedBody(PETSC_COMM_WORLD);
 }
 
 TEST_CASE("a smoothed-aggregation hierarchy is not refitted and keeps its prolongators", "[gamg]")
