@@ -333,7 +333,7 @@ PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
     PetscCall(InstallLevel(pc, l, c->copy[l]));
   }
   for (PetscInt l = 1; l < nlev; ++l) { // the transfers into level l
-    Mat              P, R;
+    Mat              P;
     PetscBool        aij;
     PetscObjectState state;
     PetscCall(PCMGGetInterpolation(pc, l, &P));
@@ -349,23 +349,20 @@ PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
       c->interp_state[l] = state;
       continue;
     }
-    if (!c->interp_copy[l] || state != c->interp_state[l]) { // made, or refilled for new values
+    if (!c->interp_copy[l] || state != c->interp_state[l]) {
       PetscObjectState nz;
       PetscCall(MatGetNonzeroState(P, &nz));
-      if (c->interp_copy[l] && c->restrict_source[l] && nz == c->interp_nzstate[l]) {
-        // the same pattern (a refitted coarse space, gamg_coarse_space.h): the copies refilled in place
-        PetscCall(RefillFromAIJ(P, PETSC_FALSE, &c->interp_copy[l]));
-        PetscCall(MatTranspose(P, MAT_REUSE_MATRIX, &c->restrict_source[l]));
-        PetscCall(RefillFromAIJ(c->restrict_source[l], PETSC_FALSE, &c->restrict_copy[l]));
-      } else {
+      if (nz != c->interp_nzstate[l]) { // another pattern: the copies made anew
         PetscCall(MatDestroy(&c->interp_copy[l]));
         PetscCall(MatDestroy(&c->restrict_copy[l]));
         PetscCall(MatDestroy(&c->restrict_source[l]));
-        PetscCall(RefillFromAIJ(P, PETSC_FALSE, &c->interp_copy[l]));
-        PetscCall(MatTranspose(P, MAT_INITIAL_MATRIX, &R)); // restriction by products, not transposed ones
-        PetscCall(RefillFromAIJ(R, PETSC_FALSE, &c->restrict_copy[l]));
-        c->restrict_source[l] = R;
       }
+      // made, or refilled in place (a refitted coarse space, gamg_coarse_space.h); restriction by
+      // products of a copy of P^T, not by transposed products
+      PetscCall(RefillFromAIJ(P, PETSC_FALSE, &c->interp_copy[l]));
+      PetscCall(MatTranspose(P, c->restrict_source[l] ? MAT_REUSE_MATRIX : MAT_INITIAL_MATRIX,
+                             &c->restrict_source[l]));
+      PetscCall(RefillFromAIJ(c->restrict_source[l], PETSC_FALSE, &c->restrict_copy[l]));
       c->interp_state[l]   = state;
       c->interp_nzstate[l] = nz;
     }
