@@ -189,6 +189,7 @@ string(REPLACE ";" " " FEM_MPIEXEC_STR "${MPIEXEC_CMD}")
 add_test(NAME fem_gamg_single_smoothers_same_answer
          COMMAND ${FEM_SUMMARY_SAME} "cg_its:1 tip_dz:1e-9 kinetic:1e-9" 1e-5 "${FEM} ${FEM_BEAM_GAMG_STR}"
                  "${FEM} ${FEM_BEAM_GAMG_STR} -gamg_smoother_precision single"
+                 "${FEM} ${FEM_BEAM_GAMG_STR} -gamg_smoother_precision single -gamg_smoother_storage upper"
                  "${FEM} ${FEM_BEAM_GAMG_STR} -gamg_smoother_precision single -mat_type aij"
                  "${FEM_MPIEXEC_STR} -n 2 ${FEM} ${FEM_BEAM_GAMG_STR} -gamg_smoother_precision single")
 set_tests_properties(fem_gamg_single_smoothers_same_answer PROPERTIES LABELS "fem;mpi" TIMEOUT 120 PROCESSORS 2
@@ -204,7 +205,7 @@ set(FEM_BOX_GAMG -mesh_box 1,0.2,0.2,24,5,5 -fix xmin -steps 3 -fem_quiet -mat_t
     -ksp_rtol 1e-8)
 string(REPLACE ";" " " FEM_BOX_GAMG_STR "${FEM_BOX_GAMG}")
 add_test(NAME fem_mpi2_gamg_single_smoothers_mpiaij_same_answer
-         COMMAND sh -c "${FEM_SUMMARY_SAME} 'cg_its:1 tip_dz:1e-9 kinetic:1e-9' 1e-5 '${FEM_MPIEXEC_STR} -n 2 ${FEM} ${FEM_BOX_GAMG_STR}' '${FEM_MPIEXEC_STR} -n 2 ${FEM} ${FEM_BOX_GAMG_STR} -gamg_smoother_precision single' && ${FEM_SUMMARY_CHECK} 'smoother_copies==2 && status==\"ok\"' -- ${FEM_MPIEXEC_STR} -n 2 ${FEM} ${FEM_BOX_GAMG_STR} -gamg_smoother_precision single")
+         COMMAND sh -c "${FEM_SUMMARY_SAME} 'cg_its:1 tip_dz:1e-9 kinetic:1e-9' 1e-5 '${FEM_MPIEXEC_STR} -n 2 ${FEM} ${FEM_BOX_GAMG_STR}' '${FEM_MPIEXEC_STR} -n 2 ${FEM} ${FEM_BOX_GAMG_STR} -gamg_smoother_precision single' '${FEM_MPIEXEC_STR} -n 2 ${FEM} ${FEM_BOX_GAMG_STR} -gamg_smoother_precision single -gamg_smoother_storage upper' && ${FEM_SUMMARY_CHECK} 'smoother_copies==2 && status==\"ok\"' -- ${FEM_MPIEXEC_STR} -n 2 ${FEM} ${FEM_BOX_GAMG_STR} -gamg_smoother_precision single")
 set_tests_properties(fem_gamg_single_smoothers_used fem_mpi2_gamg_single_smoothers_one_rank_level_kept
                      fem_mpi2_gamg_single_smoothers_mpiaij_same_answer PROPERTIES LABELS "fem" TIMEOUT 60
                      WORKING_DIRECTORY ${FEM_SRC})
@@ -212,6 +213,16 @@ set_tests_properties(fem_mpi2_gamg_single_smoothers_one_rank_level_kept
                      fem_mpi2_gamg_single_smoothers_mpiaij_same_answer PROPERTIES LABELS "fem;mpi" PROCESSORS 2)
 fem_test(fem_gamg_bad_smoother_precision nonzero "Unknown option half for -gamg_smoother_precision" ${FEM} ${FEM_BEAM_GAMG}
          -gamg_smoother_precision half)
+# -gamg_smoother_storage: the AIJ level's copy (level 1 of the beam: 66 rows, block size 3 in the copy)
+# in whole storage by default, in upper-triangle storage when asked; both reach the same answer.
+fem_test(fem_gamg_smoother_storage_whole 0
+         "rows=66, cols=66, bs=3\\n(?:[^\\n]*\\n){2}[^\\n]*single precision \\(double accumulation\\), whole storage"
+         ${FEM} ${FEM_BEAM_GAMG} -gamg_smoother_precision single -ksp_view ::ascii_info)
+fem_test(fem_gamg_smoother_storage_upper 0
+         "rows=66, cols=66, bs=3\\n(?:[^\\n]*\\n){2}[^\\n]*single precision \\(double accumulation\\), upper-triangle storage"
+         ${FEM} ${FEM_BEAM_GAMG} -gamg_smoother_precision single -gamg_smoother_storage upper -ksp_view ::ascii_info)
+fem_test(fem_gamg_bad_smoother_storage nonzero "Unknown option lower for -gamg_smoother_storage" ${FEM} ${FEM_BEAM_GAMG}
+         -gamg_smoother_precision single -gamg_smoother_storage lower)
 # -fem_initial_guess linear|quadratic: the solve starts from dv extrapolated from the last two or three
 # steps; projection: from the window's solutions (KSPGuess Fischer); to the same tolerance the answer is
 # the same (the beam: 20.75 -> 20.4 / 20.1 / 21.5 CG iterations; linear_38k 24.2 -> 19.6, docs/fem.md).

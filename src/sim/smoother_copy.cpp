@@ -57,7 +57,7 @@ PetscErrorCode CreateSingle(Mat A, PetscBool upper, std::vector<PetscInt> i, std
 }
 
 // SeqBAIJ (block size 3, the block Galerkin products): the COO list in the order of the value array.
-PetscErrorCode RefillFromBAIJ(Mat A, Mat *copy)
+PetscErrorCode RefillFromBAIJ(Mat A, PetscBool upper, Mat *copy)
 {
   PetscFunctionBegin;
   if (!*copy) {
@@ -76,7 +76,7 @@ PetscErrorCode RefillFromBAIJ(Mat A, Mat *copy)
         for (PetscInt c = 0; c < bs; ++c) // BAIJ blocks are column-major
           for (PetscInt r = 0; r < bs; ++r) i.push_back(bs * br + r), j.push_back(bs * ja[k] + c);
     PetscCall(MatRestoreRowIJ(A, 0, PETSC_FALSE, PETSC_TRUE, &nb, &ia, &ja, &done));
-    PetscCall(CreateSingle(A, PETSC_TRUE, std::move(i), std::move(j), copy));
+    PetscCall(CreateSingle(A, upper, std::move(i), std::move(j), copy));
   }
   PetscScalar *a;
   PetscCall(MatSeqBAIJGetArray(A, &a));
@@ -119,15 +119,15 @@ PetscErrorCode RefillFromAIJ(Mat A, PetscBool upper, Mat *copy)
   PetscFunctionReturn(0);
 }
 
-// MPIAIJ (PCGAMG's levels on more ranks), symmetric: values row by row through MatGetRow (the same
-// order at every call), into upper-triangle storage.
-PetscErrorCode RefillFromMPIAIJ(Mat A, Mat *copy)
+// MPIAIJ (PCGAMG's levels on more ranks, the cloth's coarse levels on more ranks), symmetric: values
+// row by row through MatGetRow (the same order at every call), into upper-triangle storage if `upper`.
+PetscErrorCode RefillFromMPIAIJ(Mat A, PetscBool upper, Mat *copy)
 {
   PetscInt                 r0, r1;
   std::vector<PetscScalar> v;
 
   PetscFunctionBegin;
-  if (!*copy) PetscCall(CreateFromAIJRows(A, PETSC_TRUE, copy));
+  if (!*copy) PetscCall(CreateFromAIJRows(A, upper, copy));
   PetscCall(MatGetOwnershipRange(A, &r0, &r1));
   for (PetscInt r = r0; r < r1; ++r) {
     PetscInt           ncols;
@@ -164,7 +164,7 @@ PetscErrorCode SmootherCopySupported(Mat A, PetscBool *supported)
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode SmootherCopyRefill(Mat A, Mat *copy)
+PetscErrorCode SmootherCopyRefill(Mat A, PetscBool upper, Mat *copy)
 {
   PetscBool binbcsr, aij, baij, mpiaij;
 
@@ -182,9 +182,9 @@ PetscErrorCode SmootherCopyRefill(Mat A, Mat *copy)
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATSEQBAIJ, &baij));
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATSEQAIJ, &aij));
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIAIJ, &mpiaij));
-  if (baij) PetscCall(RefillFromBAIJ(A, copy));
-  else if (aij) PetscCall(RefillFromAIJ(A, PETSC_TRUE, copy));
-  else if (mpiaij) PetscCall(RefillFromMPIAIJ(A, copy));
+  if (baij) PetscCall(RefillFromBAIJ(A, upper, copy));
+  else if (aij) PetscCall(RefillFromAIJ(A, upper, copy));
+  else if (mpiaij) PetscCall(RefillFromMPIAIJ(A, upper, copy));
   else {
     MatType type;
     PetscCall(MatGetType(A, &type));
@@ -196,8 +196,8 @@ PetscErrorCode SmootherCopyRefill(Mat A, Mat *copy)
 
 PetscErrorCode GAMGSmootherCopiesFromOptions(MPI_Comm comm, GAMGSmootherCopies *c)
 {
-  const char *precisions[] = {"double", "single"};
-  PetscInt    precision    = c->enabled ? 1 : 0;
+  const char *precisions[] = {"double", "single"}, *storages[] = {"whole", "upper"};
+  PetscInt    precision = c->enabled ? 1 : 0, storage = c->upper ? 1 : 0;
 
   PetscFunctionBegin;
   PetscOptionsBegin(comm, nullptr, "Multigrid smoothers", "");
@@ -206,8 +206,13 @@ PetscErrorCode GAMGSmootherCopiesFromOptions(MPI_Comm comm, GAMGSmootherCopies *
                       "PCGAMG: smooth, compute residuals and transfer on single-precision binbcsr copies "
                       "of the levels' operators (the outer Krylov method stays on the operator)",
                       "", precisions, 2, precisions[precision], &precision, nullptr));
+  PetscCall(PetscOptionsEList("-gamg_smoother_storage",
+                              "With -gamg_smoother_precision single: the AIJ levels' copies in whole or "
+                              "upper-triangle binbcsr storage",
+                              "", storages, 2, storages[storage], &storage, nullptr));
   PetscOptionsEnd();
   c->enabled = precision == 1;
+  c->upper   = storage == 1;
   PetscFunctionReturn(0);
 }
 
@@ -290,8 +295,9 @@ PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
   PetscCall(SmootherCopiesRegisterEvents());
   PetscCall(PetscLogEventBegin(COPIES_Update, 0, 0, 0, 0));
   if ((PetscInt)c->copy.size() != nlev) {
+    const bool upper = c->upper;
     PetscCall(GAMGSmootherCopiesDestroy(c));
-    c->enabled = true;
+    c->enabled = true, c->upper = upper;
     for (std::vector<Mat> *v :
          {&c->source, &c->copy, &c->interp_source, &c->interp_copy, &c->restrict_copy, &c->restrict_source})
       v->assign(nlev, nullptr);
@@ -313,7 +319,7 @@ PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
     if (c->copy[l] && Amat == c->copy[l]) { // installed: refilled when the operator's values changed
       PetscCall(PetscObjectStateGet((PetscObject)c->source[l], &state));
       if (state == c->source_state[l]) continue;
-      PetscCall(SmootherCopyRefill(c->source[l], &c->copy[l]));
+      PetscCall(SmootherCopyRefill(c->source[l], c->upper ? PETSC_TRUE : PETSC_FALSE, &c->copy[l]));
       c->source_state[l] = state;
       continue;
     }
@@ -328,7 +334,8 @@ PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
     }
     // the same operator (and pattern) for another solve: its copy, made or refilled, goes in
     PetscCall(PetscObjectStateGet((PetscObject)Amat, &state));
-    if (!c->copy[l] || state != c->source_state[l]) PetscCall(SmootherCopyRefill(Amat, &c->copy[l]));
+    if (!c->copy[l] || state != c->source_state[l])
+      PetscCall(SmootherCopyRefill(Amat, c->upper ? PETSC_TRUE : PETSC_FALSE, &c->copy[l]));
     c->source_state[l] = state;
     PetscCall(InstallLevel(pc, l, c->copy[l]));
   }

@@ -2,8 +2,11 @@
 //
 // A smoother only has to damp the error, so its rounding does not reach the solution: the outer Krylov
 // method runs on the operator itself and keeps its tolerance on the true system. What the copy buys is
-// bytes: the sweeps and the Chebyshev products stream a half (a binbcsr operator, values converted) or
-// a quarter (a coarse AIJ/BAIJ operator, read into upper-triangle single-precision binbcsr) of them.
+// bytes: the sweeps and the Chebyshev products stream a half (a binbcsr operator, values converted, or a
+// coarse AIJ/BAIJ operator read into whole single-precision binbcsr) or a quarter (read into upper-triangle
+// storage) of them. Fewer bytes pay where a level streams from memory (the cloth's coarse levels); a
+// level that stays in the cache runs the whole product faster than the symmetric one, whose transposed
+// half scatters into y (GAMG's coarse levels, docs/fem_timings.md).
 //
 // SmootherCopyRefill is the one conversion, shared by the cloth's grid multigrid (grid_mg.h) and the
 // copies of a GAMG hierarchy below.
@@ -13,10 +16,11 @@
 #include <vector>
 
 // The copy `*copy` of level operator A, made on the first call (*copy null) and refilled in place
-// after (same pattern). A may be binbcsr (any communicator; duplicated, values converted), SeqBAIJ,
-// SeqAIJ or MPIAIJ (read through a COO list into symmetric-storage binbcsr: A must be symmetric, which a
-// Galerkin product of a symmetric operator is). Other types: PETSC_ERR_SUP naming the type.
-PetscErrorCode SmootherCopyRefill(Mat A, Mat *copy);
+// after (same pattern). A may be binbcsr (any communicator; duplicated in its own storage, values
+// converted), SeqBAIJ, SeqAIJ or MPIAIJ (read through a COO list into binbcsr, upper-triangle storage if
+// `upper`: A must then be symmetric, which a Galerkin product of a symmetric operator is). `upper` is
+// read when the copy is made. Other types: PETSC_ERR_SUP naming the type.
+PetscErrorCode SmootherCopyRefill(Mat A, PetscBool upper, Mat *copy);
 
 // Whether SmootherCopyRefill takes A.
 PetscErrorCode SmootherCopySupported(Mat A, PetscBool *supported);
@@ -30,7 +34,8 @@ PetscErrorCode SmootherCopySupported(Mat A, PetscBool *supported);
 // of), and so do transfers that are not SeqAIJ (on more ranks).
 struct GAMGSmootherCopies {
   bool             enabled = false;
-  std::vector<Mat> source, copy; // per PCMG level (0, the coarsest, is solved directly)
+  bool             upper   = false; // -gamg_smoother_storage upper: the AIJ levels' copies symmetric
+  std::vector<Mat> source, copy;    // per PCMG level (0, the coarsest, is solved directly)
   // source: the level's operator as GAMG handed it over (copied when it comes again)
   std::vector<PetscObjectState> source_state;   // source's state when copy was last refilled
   std::vector<PetscObjectState> source_nzstate; // source's nonzero state when copy was made
@@ -45,7 +50,8 @@ struct GAMGSmootherCopies {
   std::vector<PetscObjectState> interp_nzstate;
 };
 
-// Reads -gamg_smoother_precision (double, the default, or single).
+// Reads -gamg_smoother_precision (double, the default, or single) and -gamg_smoother_storage (whole, the
+// default, or upper).
 PetscErrorCode GAMGSmootherCopiesFromOptions(MPI_Comm comm, GAMGSmootherCopies *c);
 // Call before each solve, after the operator's new values: sets the KSP up (so PCGAMG builds or
 // reuses its hierarchy) and brings the copies up to date. A no-op unless enabled and the PC is GAMG.

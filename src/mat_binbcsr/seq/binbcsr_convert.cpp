@@ -442,9 +442,10 @@ PetscErrorCode MatView_SeqBinBCSR_ASCII(Mat A, PetscViewer viewer)
     const size_t ibytes = (size_t)a->nslots * sizeof(PetscInt) + (size_t)(a->nbins + 1) * sizeof(PetscInt);
     PetscCall(PetscViewerASCIIPrintf(viewer,
                                      "%s, block size %" PetscInt_FMT ", bin width %" PetscInt_FMT
-                                     ", values in %s precision (double accumulation)\n",
+                                     ", values in %s precision (double accumulation), %s storage\n",
                                      a->bs == 1 ? "BIN-CSR" : "BIN-BCSR", a->bs, a->bw,
-                                     MatBinBCSRPrecisions[a->precision]));
+                                     MatBinBCSRPrecisions[a->precision],
+                                     a->sym ? "upper-triangle" : "whole"));
     if (!a->built) {
       PetscCall(
         PetscViewerASCIIPrintf(viewer, "bin layout not built yet (built at the first final assembly)\n"));
