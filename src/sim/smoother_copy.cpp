@@ -305,10 +305,13 @@ PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
          {&c->source_state, &c->source_nzstate, &c->interp_state, &c->interp_nzstate})
       v->assign(nlev, 0);
   }
-  // A level's operator or transfer is copied when it serves its second solve: with the hierarchy reused
-  // (-ksp_reuse_preconditioner) from the second solve on; rebuilt at every solve without reusing its
-  // interpolation, GAMG's new coarse levels and transfers are not copied at all (copying them at every
-  // set-up cost more than it saved), while the fine operator, the same Mat refilled, is.
+  // A level's operator or transfer is copied when it will serve more than one solve: with the hierarchy
+  // reused (-ksp_reuse_preconditioner) at once, so that the first solve, which takes the most
+  // iterations, runs on the copies too; rebuilt at every solve without reusing its interpolation,
+  // GAMG's new coarse levels and transfers are not copied at all (copying them at every set-up cost more
+  // than it saved), while the fine operator, the same Mat refilled, is from its second solve on.
+  PetscBool reuse;
+  PetscCall(PCGetReusePreconditioner(pc, &reuse));
   for (PetscInt l = 1; l < nlev; ++l) {
     KSP              down, up;
     Mat              Amat;
@@ -330,9 +333,10 @@ PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
       PetscCall(MatDestroy(&c->copy[l]));
       PetscCall(Hold(Amat, &c->source[l]));
       c->source_nzstate[l] = nz;
-      continue;
+      if (!reuse) continue;
     }
-    // the same operator (and pattern) for another solve: its copy, made or refilled, goes in
+    // the same operator (and pattern) for another solve, or a reused hierarchy's: its copy, made or
+    // refilled, goes in
     PetscCall(PetscObjectStateGet((PetscObject)Amat, &state));
     if (!c->copy[l] || state != c->source_state[l])
       PetscCall(SmootherCopyRefill(Amat, c->upper ? PETSC_TRUE : PETSC_FALSE, &c->copy[l]));
@@ -354,7 +358,7 @@ PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
       PetscCall(MatDestroy(&c->restrict_source[l]));
       PetscCall(Hold(P, &c->interp_source[l]));
       c->interp_state[l] = state;
-      continue;
+      if (!reuse) continue;
     }
     if (!c->interp_copy[l] || state != c->interp_state[l]) {
       PetscObjectState nz;

@@ -27,9 +27,10 @@ PetscErrorCode SmootherCopySupported(Mat A, PetscBool *supported);
 
 // -gamg_smoother_precision single: after PCGAMG has built its hierarchy, every level but the coarsest
 // smooths and computes its residual on a copy of its operator, and interpolates and restricts through
-// copies of the transfers. An operator or transfer is copied once it serves a second solve (a reused
-// hierarchy: from the second solve on; one GAMG rebuilds at every solve keeps its own, except the fine
-// operator, which is the same Mat refilled); a copy is refilled when its operator's values change.
+// copies of the transfers. An operator or transfer is copied once it will serve more than one solve (a
+// reused hierarchy, -ksp_reuse_preconditioner: from its first solve on; one GAMG rebuilds at every solve
+// keeps its own, except the fine operator, the same Mat refilled, copied from its second solve on); a
+// copy is refilled when its operator's values change.
 // Levels whose operator SmootherCopyRefill cannot take keep it (an MPIAIJ level some rank holds no rows
 // of), and so do transfers that are not SeqAIJ (on more ranks).
 struct GAMGSmootherCopies {
