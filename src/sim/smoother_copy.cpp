@@ -212,11 +212,27 @@ PetscErrorCode GAMGSmootherCopiesFromOptions(MPI_Comm comm, GAMGSmootherCopies *
                               "", storages, 2, storages[storage], &storage, nullptr));
   PetscOptionsEnd();
   c->enabled = precision == 1;
-  c->upper   = storage == 1;
+  c->upper   = storage == 1 ? PETSC_TRUE : PETSC_FALSE;
   PetscFunctionReturn(0);
 }
 
 namespace {
+
+// Every copy and held operator released and the per-level arrays sized for nlev levels (0: none); the
+// options (enabled, upper) stay.
+PetscErrorCode ResizeLevels(GAMGSmootherCopies *c, PetscInt nlev)
+{
+  PetscFunctionBegin;
+  for (std::vector<Mat> *v :
+       {&c->source, &c->copy, &c->interp_source, &c->interp_copy, &c->restrict_copy, &c->restrict_source}) {
+    for (Mat &m : *v) PetscCall(MatDestroy(&m));
+    v->assign(nlev, nullptr);
+  }
+  for (std::vector<PetscObjectState> *v :
+       {&c->source_state, &c->source_nzstate, &c->interp_state, &c->interp_nzstate})
+    v->assign(nlev, 0);
+  PetscFunctionReturn(0);
+}
 
 // Level l's pre- and post-smoother as PCMG holds them (PCMGGetSmootherUp would make a distinct
 // post-smoother, without the pre-smoother's options).
@@ -294,17 +310,7 @@ PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
   PetscCall(PCMGGetLevels(pc, &nlev));
   PetscCall(SmootherCopiesRegisterEvents());
   PetscCall(PetscLogEventBegin(COPIES_Update, 0, 0, 0, 0));
-  if ((PetscInt)c->copy.size() != nlev) {
-    const bool upper = c->upper;
-    PetscCall(GAMGSmootherCopiesDestroy(c));
-    c->enabled = true, c->upper = upper;
-    for (std::vector<Mat> *v :
-         {&c->source, &c->copy, &c->interp_source, &c->interp_copy, &c->restrict_copy, &c->restrict_source})
-      v->assign(nlev, nullptr);
-    for (std::vector<PetscObjectState> *v :
-         {&c->source_state, &c->source_nzstate, &c->interp_state, &c->interp_nzstate})
-      v->assign(nlev, 0);
-  }
+  if ((PetscInt)c->copy.size() != nlev) PetscCall(ResizeLevels(c, nlev));
   // A level's operator or transfer is copied when it will serve more than one solve: with the hierarchy
   // reused (-ksp_reuse_preconditioner) at once, so that the first solve, which takes the most
   // iterations, runs on the copies too; rebuilt at every solve without reusing its interpolation,
@@ -322,7 +328,7 @@ PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
     if (c->copy[l] && Amat == c->copy[l]) { // installed: refilled when the operator's values changed
       PetscCall(PetscObjectStateGet((PetscObject)c->source[l], &state));
       if (state == c->source_state[l]) continue;
-      PetscCall(SmootherCopyRefill(c->source[l], c->upper ? PETSC_TRUE : PETSC_FALSE, &c->copy[l]));
+      PetscCall(SmootherCopyRefill(c->source[l], c->upper, &c->copy[l]));
       c->source_state[l] = state;
       continue;
     }
@@ -339,7 +345,7 @@ PetscErrorCode GAMGSmootherCopiesUpdate(KSP ksp, GAMGSmootherCopies *c)
     // refilled, goes in
     PetscCall(PetscObjectStateGet((PetscObject)Amat, &state));
     if (!c->copy[l] || state != c->source_state[l])
-      PetscCall(SmootherCopyRefill(Amat, c->upper ? PETSC_TRUE : PETSC_FALSE, &c->copy[l]));
+      PetscCall(SmootherCopyRefill(Amat, c->upper, &c->copy[l]));
     c->source_state[l] = state;
     PetscCall(InstallLevel(pc, l, c->copy[l]));
   }
@@ -410,12 +416,7 @@ void GAMGSmootherCopiesCount(const GAMGSmootherCopies &c, int *levels, int *tran
 PetscErrorCode GAMGSmootherCopiesDestroy(GAMGSmootherCopies *c)
 {
   PetscFunctionBegin;
-  for (Mat &m : c->copy) PetscCall(MatDestroy(&m));
-  for (Mat &m : c->source) PetscCall(MatDestroy(&m));
-  for (Mat &m : c->interp_copy) PetscCall(MatDestroy(&m));
-  for (Mat &m : c->interp_source) PetscCall(MatDestroy(&m));
-  for (Mat &m : c->restrict_copy) PetscCall(MatDestroy(&m));
-  for (Mat &m : c->restrict_source) PetscCall(MatDestroy(&m));
+  PetscCall(ResizeLevels(c, 0));
   *c = GAMGSmootherCopies{};
   PetscFunctionReturn(0);
 }

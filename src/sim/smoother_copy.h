@@ -35,8 +35,8 @@ PetscErrorCode SmootherCopySupported(Mat A, PetscBool *supported);
 // of), and so do transfers that are not SeqAIJ (on more ranks).
 struct GAMGSmootherCopies {
   bool             enabled = false;
-  bool             upper   = false; // -gamg_smoother_storage upper: the AIJ levels' copies symmetric
-  std::vector<Mat> source, copy;    // per PCMG level (0, the coarsest, is solved directly)
+  PetscBool        upper   = PETSC_FALSE; // -gamg_smoother_storage upper: the AIJ levels' copies symmetric
+  std::vector<Mat> source, copy;          // per PCMG level (0, the coarsest, is solved directly)
   // source: the level's operator as GAMG handed it over (copied when it comes again)
   std::vector<PetscObjectState> source_state;   // source's state when copy was last refilled
   std::vector<PetscObjectState> source_nzstate; // source's nonzero state when copy was made
