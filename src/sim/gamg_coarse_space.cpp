@@ -1,5 +1,7 @@
 #include "sim/gamg_coarse_space.h"
 
+#include <Eigen/QR>
+
 #include <algorithm>
 #include <cmath>
 
@@ -23,42 +25,18 @@ PetscErrorCode RefitRegisterEvent()
 constexpr PetscInt kModes = 6;
 
 // The Householder QR of the ld x kModes column-major matrix a (ld >= kModes): R into r (kModes x
-// kModes, row-major, upper), the first kModes columns of Q over a. LAPACK's geqrf and orgqr, as
-// PCGAMG's formProl0 calls them, up to the signs of Q's columns and R's rows (the same span, the same
-// coarse space); written out here since a driver of this project links PETSc, not LAPACK.
+// kModes, row-major, upper), the first kModes columns of Q over a. Eigen's HouseholderQR (the physics'
+// dependency) makes the reflectors as LAPACK's geqrf does, which PCGAMG's formProl0 calls (none where a
+// column is zero below the diagonal), so Q and R are formProl0's up to the signs of Q's columns and R's
+// rows: the same span, the same coarse space.
 void HouseholderQR(std::vector<PetscReal> &a, PetscInt ld, PetscReal r[kModes][kModes])
 {
-  std::vector<PetscReal> v((size_t)ld * kModes, 0.0); // the reflectors, column j from row j on
-  PetscReal              beta[kModes];
-  for (PetscInt j = 0; j < kModes; ++j) {
-    PetscReal below = 0; // as LAPACK's dlarfg: no reflection where the column is zero below the diagonal
-    for (PetscInt i = j + 1; i < ld; ++i) below += a[j * ld + i] * a[j * ld + i];
-    const PetscReal x0 = a[j * ld + j], norm = std::sqrt(x0 * x0 + below), alpha = x0 >= 0 ? -norm : norm;
-    PetscReal      *vj = v.data() + (size_t)j * ld;
-    for (PetscInt i = j; i < ld; ++i) vj[i] = a[j * ld + i];
-    vj[j] -= alpha;
-    PetscReal vv = 0;
-    for (PetscInt i = j; i < ld; ++i) vv += vj[i] * vj[i];
-    beta[j] = below > 0 ? 2 / vv : 0;
-    for (PetscInt k = j; k < kModes; ++k) {
-      PetscReal dot = 0;
-      for (PetscInt i = j; i < ld; ++i) dot += vj[i] * a[k * ld + i];
-      for (PetscInt i = j; i < ld; ++i) a[k * ld + i] -= beta[j] * dot * vj[i];
-    }
-  }
+  using Block = Eigen::Matrix<PetscReal, Eigen::Dynamic, kModes>;
+  Eigen::Map<Block>                 A(a.data(), ld, kModes);
+  const Eigen::HouseholderQR<Block> qr(A);
   for (PetscInt i = 0; i < kModes; ++i)
-    for (PetscInt k = 0; k < kModes; ++k) r[i][k] = k >= i ? a[k * ld + i] : 0.0;
-  // Q's first kModes columns: H_0 H_1 ... H_5 applied to those of the identity
-  std::fill(a.begin(), a.end(), 0.0);
-  for (PetscInt k = 0; k < kModes; ++k) a[k * ld + k] = 1;
-  for (PetscInt j = kModes - 1; j >= 0; --j) {
-    const PetscReal *vj = v.data() + (size_t)j * ld;
-    for (PetscInt k = 0; k < kModes; ++k) {
-      PetscReal dot = 0;
-      for (PetscInt i = j; i < ld; ++i) dot += vj[i] * a[k * ld + i];
-      for (PetscInt i = j; i < ld; ++i) a[k * ld + i] -= beta[j] * dot * vj[i];
-    }
-  }
+    for (PetscInt k = 0; k < kModes; ++k) r[i][k] = k >= i ? qr.matrixQR()(i, k) : 0.0;
+  A = qr.householderQ() * Block::Identity(ld, kModes);
 }
 
 // The finest level's modes at node coordinates c (x, y, z), as PCSetCoordinates gives PCGAMG: per node
