@@ -254,6 +254,7 @@ int main(int argc, char **argv)
   double    e_max = e0, worst_error = 0, worst_velocity = 0, step_ms_total = 0;
   long long done = 0, corrections = 0, halvings = 0, max_corrections_seen = 0, unconverged = 0, stalled = 0,
             singular_steps = 0, nan_steps = 0;
+  StepCosts costs;
   for (PetscInt n = 1; n <= out.steps; ++n) {
     const long long its0 = rs.iterations, solves0 = rs.solves, diverged0 = rs.diverged_solves;
     const double    solve0 = rs.solve_ms, t0 = WallTime();
@@ -262,6 +263,7 @@ int main(int argc, char **argv)
     PetscCall(rs.error);
     ++done;
     step_ms_total += step_ms;
+    costs.add(step_ms, rs.iterations - its0, rs.solves - solves0);
     double energy;
     bool   finite;
     PetscCall(SceneState(comm, solver.split, scene, &energy, &finite));
@@ -317,6 +319,7 @@ int main(int argc, char **argv)
   s.add("steps", done);
   s.add("dt", params.dt);
   DriverAddSolverSummary(s, rs, done, step_ms_total);
+  costs.add_late(s);
   s.add("solves", rs.solves);
   s.add("cg_its_per_step", done ? (double)rs.iterations / done : 0.0);
   s.add("corrections_per_step", done ? (double)corrections / done : 0.0);

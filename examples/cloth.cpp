@@ -232,14 +232,16 @@ int main(int argc, char **argv)
   double     step_ms_total = 0, max_stretch = 0;
   long long  nan_steps = 0, unconverged = 0, contacts = 0, done = 0, limit_sweeps = 0, limit_capped = 0;
   double     limit_s = 0;
+  StepCosts  costs;
   for (PetscInt step = 1; step <= out.steps; ++step) {
-    const long long                its0   = rs.iterations;
+    const long long                its0 = rs.iterations, solves0 = rs.solves;
     const double                   solve0 = rs.solve_ms, t0 = now();
     const physics::ClothStepReport r       = physics::cloth_step(cloth, sys, params, linear);
     const double                   step_ms = 1e3 * (now() - t0);
     PetscCall(rs.error);
     ++done;
     step_ms_total += step_ms;
+    costs.add(step_ms, rs.iterations - its0, rs.solves - solves0);
     bool finite = true;
     for (int p = 0; p < cloth.particle_count(); ++p)
       finite &= cloth.position[p].allFinite() && cloth.velocity[p].allFinite();
@@ -290,6 +292,7 @@ int main(int argc, char **argv)
   s.add("steps", (long long)done);
   s.add("dt", params.dt);
   DriverAddSolverSummary(s, rs, done, step_ms_total);
+  costs.add_late(s);
   s.add("steps_per_s", step_ms_total > 0 ? 1e3 * done / step_ms_total : 0.0);
   s.add("unconverged_steps", unconverged);
   s.add("max_stretch", max_stretch);

@@ -198,7 +198,8 @@ int main(int argc, char **argv)
   // ---- time loop ----------------------------------------------------------------------------
   double             t_element = 0, t_setvalues = 0, t_solve = 0, t_comm = 0, t_total = 0;
   long long          its_total = 0, svd_rotations = 0;
-  int                steps_done  = 0;
+  int                steps_done = 0;
+  StepCosts          costs;
   KSPConvergedReason last_reason = KSP_CONVERGED_ITERATING;
   for (int step = 1; step <= o.steps; ++step) {
     FemStepInfo info;
@@ -216,6 +217,7 @@ int main(int argc, char **argv)
     svd_rotations += info.svd_rotations;
     last_reason = info.stats.reason;
     steps_done  = step;
+    costs.add(info.total_ms, info.stats.iterations, 1);
     if (!o.quiet)
       PetscCall(PetscPrintf(
         comm, "step %d its %" PetscInt_FMT " res %.3e reason %s assembly_ms %.2f solve_ms %.2f\n", step,
@@ -321,6 +323,7 @@ int main(int argc, char **argv)
   s.add("solve_ms", 1e3 * t_solve / steps_div);
   s.add("element_share", t_total > 0 ? t_element / t_total : 0.0);
   s.add("cg_its", (double)its_total / steps_div);
+  costs.add_late(s);
   {
     int levels, transfers; // -gamg_smoother_precision single: what runs on single-precision copies
     GAMGSmootherCopiesCount(sim.sys.gamg_copies, &levels, &transfers);

@@ -6,7 +6,7 @@ set(SUMMARY_SAME ${CMAKE_CURRENT_SOURCE_DIR}/physics/summary_same.sh)
 set(OPTS ${CMAKE_SOURCE_DIR}/options)
 
 add_test(NAME cloth_drape_sphere
-         COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && max_stretch<1.3 && contacts>0 && unknowns==1200"
+         COMMAND ${SUMMARY_CHECK} "nan==0 && unconverged_steps==0 && max_stretch<1.3 && contacts>0 && unknowns==1200 && late_ms_per_step>0 && late_cg_its>0"
                  -- ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 20 -steps 60 -progress_every 1000)
 # The scene as options/cloth.opts sets it (strain limit 5%), at a resolution a test affords: every stretch
 # spring stays within a few percent of its rest length over 30 steps that hang it from its corners and

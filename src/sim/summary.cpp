@@ -18,6 +18,18 @@ void SummaryLine::add(const std::string &key, long long value)
 
 void SummaryLine::add(const std::string &key, const std::string &value) { fields.emplace_back(key, value); }
 
+void StepCosts::add_late(SummaryLine &s) const
+{
+  double    ms  = 0;
+  long long its = 0, solves = 0;
+  size_t    late = steps.size() / 2;
+  for (size_t k = late; k < steps.size(); ++k)
+    ms += steps[k].ms, its += steps[k].iterations, solves += steps[k].solves;
+  const size_t n = steps.size() - late;
+  s.add("late_ms_per_step", n ? ms / (double)n : 0.0);
+  s.add("late_cg_its", solves ? (double)its / (double)solves : 0.0);
+}
+
 PetscErrorCode PrintSummary(MPI_Comm comm, const SummaryLine &line)
 {
   std::string text = "summary";
