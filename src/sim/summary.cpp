@@ -20,9 +20,9 @@ void SummaryLine::add(const std::string &key, const std::string &value) { fields
 
 void StepCosts::add_late(SummaryLine &s) const
 {
-  double    ms  = 0;
-  long long its = 0, solves = 0;
-  size_t    late = steps.size() / 2;
+  double       ms  = 0;
+  long long    its = 0, solves = 0;
+  const size_t late = steps.size() / 2;
   for (size_t k = late; k < steps.size(); ++k)
     ms += steps[k].ms, its += steps[k].iterations, solves += steps[k].solves;
   const size_t n = steps.size() - late;
