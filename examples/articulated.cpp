@@ -251,7 +251,7 @@ int main(int argc, char **argv)
     PetscCall(RunGuardFromOptions(comm, hb, &guard));
     RunGuardStart(&guard, e0, NAN);
   }
-  double    e_max = e0, worst_error = 0, worst_velocity = 0, step_ms_total = 0;
+  double    e_max = e0, worst_error = 0, worst_velocity = 0;
   long long done = 0, corrections = 0, halvings = 0, max_corrections_seen = 0, unconverged = 0, stalled = 0,
             singular_steps = 0, nan_steps = 0;
   StepCosts costs;
@@ -262,7 +262,6 @@ int main(int argc, char **argv)
     const double                         step_ms = 1e3 * (WallTime() - t0);
     PetscCall(rs.error);
     ++done;
-    step_ms_total += step_ms;
     costs.add(step_ms, rs.iterations - its0, rs.solves - solves0);
     double energy;
     bool   finite;
@@ -318,8 +317,7 @@ int main(int argc, char **argv)
   s.add("ksp_type", std::string(ksp_type));
   s.add("steps", done);
   s.add("dt", params.dt);
-  DriverAddSolverSummary(s, rs, done, step_ms_total);
-  costs.add_late(s);
+  DriverAddSolverSummary(s, rs, costs);
   s.add("solves", rs.solves);
   s.add("cg_its_per_step", done ? (double)rs.iterations / done : 0.0);
   s.add("corrections_per_step", done ? (double)corrections / done : 0.0);

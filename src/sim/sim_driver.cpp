@@ -41,9 +41,9 @@ PetscErrorCode DriverWriteFrame(MPI_Comm comm, DriverOutput *out, PetscInt step,
   PetscFunctionReturn(0);
 }
 
-void DriverAddSolverSummary(SummaryLine &s, const ReplicatedSolver &rs, long long steps, double step_ms_total)
+void DriverAddSolverSummary(SummaryLine &s, const ReplicatedSolver &rs, const StepCosts &costs)
 {
-  const double per = steps ? 1.0 / steps : 0.0;
+  const double step_ms_total = costs.total_ms(), per = costs.steps.empty() ? 0.0 : 1.0 / costs.steps.size();
   s.add("ms_per_step", step_ms_total * per);
   s.add("solve_ms", rs.solve_ms * per);
   s.add("setvalues_ms", rs.setvalues_ms * per);
@@ -52,4 +52,5 @@ void DriverAddSolverSummary(SummaryLine &s, const ReplicatedSolver &rs, long lon
   s.add("cg_its", rs.solves ? (double)rs.iterations / rs.solves : 0.0);
   s.add("diverged_solves", rs.diverged_solves);
   s.add("timer", std::string(rs.cpu_timer ? "cpu" : "wall"));
+  costs.add_late(s);
 }

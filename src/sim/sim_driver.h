@@ -25,7 +25,7 @@ PetscErrorCode DriverOutputFromOptions(MPI_Comm comm, DriverOutput *out);
 PetscErrorCode DriverWriteFrame(MPI_Comm comm, DriverOutput *out, PetscInt step, double time,
                                 const std::function<bool(const std::string &path)> &write);
 
-// Timing and solver fields of the summary: ms_per_step, solve_ms, setvalues_ms, physics_ms (the rest),
-// cg_its (per solve), diverged_solves, timer (wall or cpu, rs.cpu_timer).
-void DriverAddSolverSummary(SummaryLine &s, const ReplicatedSolver &rs, long long steps,
-                            double step_ms_total);
+// Timing and solver fields of the summary from the steps run: ms_per_step, solve_ms, setvalues_ms,
+// physics_ms (the rest), cg_its (per solve), diverged_solves, timer (wall or cpu, rs.cpu_timer),
+// late_ms_per_step and late_cg_its.
+void DriverAddSolverSummary(SummaryLine &s, const ReplicatedSolver &rs, const StepCosts &costs);

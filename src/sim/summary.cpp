@@ -18,6 +18,13 @@ void SummaryLine::add(const std::string &key, long long value)
 
 void SummaryLine::add(const std::string &key, const std::string &value) { fields.emplace_back(key, value); }
 
+double StepCosts::total_ms() const
+{
+  double ms = 0;
+  for (const Step &step : steps) ms += step.ms;
+  return ms;
+}
+
 void StepCosts::add_late(SummaryLine &s) const
 {
   double       ms  = 0;

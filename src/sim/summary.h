@@ -22,7 +22,8 @@ struct StepCosts {
     long long iterations, solves;
   };
   std::vector<Step> steps;
-  void add(double ms, long long iterations, long long solves) { steps.push_back({ms, iterations, solves}); }
+  void   add(double ms, long long iterations, long long solves) { steps.push_back({ms, iterations, solves}); }
+  double total_ms() const; // all steps
   // late_ms_per_step and late_cg_its (Krylov iterations per solve, as cg_its).
   void add_late(SummaryLine &s) const;
 };
