@@ -8,7 +8,10 @@
 // Solver options: -joint_tol (m), -max_corrections, -joint_max_halvings, -joint_regularisation, -joint_refresh,
 // -velocity_stabilisation, -joint_warm_start (previous step's impulses as initial guesses). Output: a progress
 // line every -progress_every steps, -vtk PREFIX (.vtu per -vtk_every steps plus PREFIX.pvd), -dump_matrix FILE
-// (J M^-1 J^T of the first step, PETSc binary), and a final `summary key=value ...` line.
+// (J M^-1 J^T of the first step, PETSc binary), -write_positions / -reference_positions FILE (the bodies'
+// centres of mass at the end, or their rms and largest distance to such a file's: sim/position_file.h),
+// and a final `summary key=value ...` line.
+#include "sim/position_file.h"
 #include "sim/run_guard.h"
 #include "sim/sim_driver.h"
 #include "physics/articulated_scenes.hpp"
@@ -334,6 +337,12 @@ int main(int argc, char **argv)
   s.add("energy_final", physics::total_energy(scene));
   s.add("energy_growth_max", e_max - e0);
   s.add("nan", nan_steps);
+  {
+    std::vector<double> xyz;
+    for (const physics::RigidBody &b : scene.bodies)
+      xyz.insert(xyz.end(), {b.position[0], b.position[1], b.position[2]});
+    PetscCall(DriverComparePositions(comm, xyz, s));
+  }
   RunGuardAddSummary(s, guard);
   PetscCall(PrintSummary(comm, s));
 
