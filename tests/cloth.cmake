@@ -174,6 +174,11 @@ set_tests_properties(cloth_vtk_dump cloth_vtk_new_folder PROPERTIES LABELS "clot
 # that fails (here: 2 iterations allowed, at the scene's tolerance) stops the run with exit code 2.
 add_test(NAME cloth_stiff_springs_unstable
          COMMAND ${EXPECT_RUN} 0 "warning: unstable at step [0-9]+: energy grew.*ended=completed status=unstable"
+                 -- ${CLOTH} -cloth_n 20 -cloth_k_stretch 1e12 -steps 5 -progress_every 1000 -health_energy_runaway -1)
+# ... and by default such a run stops where it has run away: 9.9e3 J after the first step, more than 100
+# x the 19.6 J the scene allows.
+add_test(NAME cloth_stiff_springs_runaway
+         COMMAND ${EXPECT_RUN} 4 "error: step 1 ran away: energy grew by 9939 J .*ended=runaway@step1 status=unstable"
                  -- ${CLOTH} -cloth_n 20 -cloth_k_stretch 1e12 -steps 5 -progress_every 1000)
 add_test(NAME cloth_stiff_springs_stop
          COMMAND ${EXPECT_RUN} 4 "error: unstable at step [0-9]+: .*ended=unstable@step[0-9]+ status=unstable"
@@ -193,6 +198,6 @@ add_test(NAME cloth_solver_failure_stop
                  -- ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 20 -ksp_max_it 2 -steps 6 -progress_every 1000)
 add_test(NAME cloth_drape_completes
          COMMAND ${EXPECT_RUN} 0 "ended=completed status=ok" -- ${CLOTH} -options_file ${OPTS}/cloth.opts -cloth_n 20 -steps 20 -progress_every 1000)
-set_tests_properties(cloth_stiff_springs_unstable cloth_stiff_springs_stop cloth_large_dt_stop cloth_solver_failure_stop cloth_drape_completes
+set_tests_properties(cloth_stiff_springs_unstable cloth_stiff_springs_runaway cloth_stiff_springs_stop cloth_large_dt_stop cloth_solver_failure_stop cloth_drape_completes
                      PROPERTIES LABELS "cloth" TIMEOUT 120)
 set_tests_properties(cloth_large_dt_stop_np2 PROPERTIES LABELS "cloth;mpi" PROCESSORS 2 TIMEOUT 60)

@@ -246,10 +246,16 @@ set_tests_properties(fem_initial_guess_extrapolated_same_answer PROPERTIES LABEL
 fem_test(fem_gamg_translations_only 0 "cg_its=(3[5-9]|4[0-9]|5[0-5])[. ].*status=ok" ${FEM} ${FEM_BEAM_GAMG} -fem_rigid_body_modes 0)
 
 # When the physics or the solver breaks the run says so (src/sim/run_guard.h). A body that
-# gravity crushes through itself (min volume ratio -1.8e10 by step 5) is `unstable`, with a warning,
-# and -on_unstable stop ends the run there with exit code 4; serial and on 2 ranks.
+# gravity crushes through itself (min volume ratio -1.8e10 by step 5, its energy 1.9e12 J after the
+# first step against the 4.6e6 J the scene allows) is `unstable`: it runs away at step 1 and stops there
+# (exit code 4), serial and on 2 ranks; with that stop off it integrates on with a warning; with
+# -on_unstable stop it ends at the first bound broken.
 set(FEM_CRUSHED -mesh_box 1,0.1,0.1,6,2,2 -fem_order 1 -fix xmin -gravity 0,0,-1e6 -dt 0.1 -steps 5 -fem_quiet)
-fem_test(fem_crushed_body_unstable 0 "warning: unstable at step [0-9]+: .*inverted.*ended=completed status=unstable" ${FEM} ${FEM_CRUSHED})
+fem_test(fem_crushed_body_runaway 4 "error: step 1 ran away: energy grew by 1.9[0-9]*e\\+12 J .*more than 100 x the .*ended=runaway@step1 status=unstable" ${FEM} ${FEM_CRUSHED})
+fem_test(fem_mpi2_crushed_body_runaway 4 "error: step 1 ran away: .*ranks=2 .*ended=runaway@step1 status=unstable" ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_CRUSHED})
+set_tests_properties(fem_mpi2_crushed_body_runaway PROPERTIES LABELS "fem;mpi")
+fem_test(fem_crushed_body_unstable 0 "warning: unstable at step [0-9]+: .*inverted.*ended=completed status=unstable" ${FEM} ${FEM_CRUSHED} -health_energy_runaway -1)
+fem_test(fem_bad_energy_runaway nonzero "health_energy_runaway 0.5: a multiple >= 1" ${FEM} ${FEM_CRUSHED} -health_energy_runaway 0.5)
 fem_test(fem_crushed_body_stop 4 "error: unstable at step [0-9]+: .*ended=unstable@step[0-9]+ status=unstable" ${FEM} ${FEM_CRUSHED} -on_unstable stop)
 fem_test(fem_mpi2_crushed_body_stop 4 "ranks=2 .*ended=unstable@step[0-9]+ status=unstable" ${MPIEXEC_CMD} -n 2 ${FEM} ${FEM_CRUSHED} -on_unstable stop)
 set_tests_properties(fem_mpi2_crushed_body_stop PROPERTIES LABELS "fem;mpi")

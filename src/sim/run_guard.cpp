@@ -51,6 +51,10 @@ PetscErrorCode RunGuardFromOptions(MPI_Comm comm, const HealthBounds &scene, Run
   PetscCall(OverrideBound(comm, "-health_inverted_fraction", &g->bounds.inverted_fraction));
   PetscCall(OverrideBound(comm, "-health_joint_error", &g->bounds.joint_error));
   PetscCall(OverrideBound(comm, "-health_max_stretch", &g->bounds.max_stretch));
+  PetscCall(OverrideBound(comm, "-health_energy_runaway", &g->energy_runaway));
+  PetscCheck(!(g->energy_runaway < 1), comm, PETSC_ERR_ARG_OUTOFRANGE,
+             "-health_energy_runaway %g: a multiple >= 1 of the energy growth allowed, or negative (never)",
+             g->energy_runaway);
   PetscFunctionReturn(0);
 }
 
@@ -92,13 +96,14 @@ PetscErrorCode RunGuardCheckStep(MPI_Comm comm, RunGuard *g, long long step, con
     }
   }
   // the health check: the first bound broken, with its figures
-  const HealthBounds &b = g->bounds;
-  msg[0]                = 0;
-  if (std::isfinite(b.energy_growth) && std::isfinite(b.energy_scale) && b.energy_scale > 0 &&
-      std::isfinite(h.energy) && std::isfinite(g->energy0) &&
-      h.energy - g->energy0 > b.energy_growth * b.energy_scale)
+  const HealthBounds &b     = g->bounds;
+  msg[0]                    = 0;
+  const bool energy_checked = std::isfinite(b.energy_growth) && std::isfinite(b.energy_scale) &&
+                              b.energy_scale > 0 && std::isfinite(h.energy) && std::isfinite(g->energy0);
+  const double growth = energy_checked ? h.energy - g->energy0 : 0.0;
+  if (energy_checked && growth > b.energy_growth * b.energy_scale)
     std::snprintf(msg, sizeof msg, "energy grew by %.4g J (from %.4g), more than %.3g x the scene's %.4g J",
-                  h.energy - g->energy0, g->energy0, b.energy_growth, b.energy_scale);
+                  growth, g->energy0, b.energy_growth, b.energy_scale);
   else if (std::isfinite(b.inverted_fraction) && std::isfinite(h.inverted_fraction) &&
            h.inverted_fraction > g->inverted0 + b.inverted_fraction)
     std::snprintf(msg, sizeof msg, "%.3g%% of the elements are inverted (%.3g%% at the start)",
@@ -118,6 +123,18 @@ PetscErrorCode RunGuardCheckStep(MPI_Comm comm, RunGuard *g, long long step, con
       PetscCall(
         PetscPrintf(comm, "error: unstable at step %lld: %s; stopping (-on_unstable stop)\n", step, msg));
       std::snprintf(msg, sizeof msg, "unstable@step%lld", step);
+      g->ended = msg;
+      *stop    = true;
+    } else if (energy_checked && std::isfinite(g->energy_runaway) &&
+               growth > g->energy_runaway * b.energy_growth * b.energy_scale) {
+      // blown up: integrating on would only print figures that mean nothing
+      g->exit_code = 4;
+      PetscCall(
+        PetscPrintf(comm,
+                    "error: step %lld ran away: energy grew by %.4g J (from %.4g), more than %.3g x the "
+                    "%.4g J the scene allows; stopping (-health_energy_runaway -1 integrates on)\n",
+                    step, growth, g->energy0, g->energy_runaway, b.energy_growth * b.energy_scale));
+      std::snprintf(msg, sizeof msg, "runaway@step%lld", step);
       g->ended = msg;
       *stop    = true;
     } else if (g->unstable_steps == 1) {
