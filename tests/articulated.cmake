@@ -164,9 +164,9 @@ add_test(NAME articulated_bad_bridge_sag
          COMMAND ${EXPECT_RUN} nonzero "sag must be positive and finite" -- ${ART} -options_file ${OPTS}/bridge.opts -bridge_sag 0)
 set_tests_properties(articulated_chain_completes articulated_bad_chain_length articulated_bad_chain_links
                      articulated_bad_bridge_sag PROPERTIES LABELS "articulated" TIMEOUT 60)
-# -write_positions / -reference_positions (sim/position_file.h): the bodies' centres of mass against another
-# run's. The same run gives 0; a looser joint tolerance (1e-3 m) moves the chain by 2.5e-4 m rms; 2 ranks give one rank's motion;
-# a scene with another body count is a clear error.
+# -write_positions / -reference_positions (sim/position_file.h): the bodies' centres of mass against
+# another run's. The same run gives 0; a looser joint tolerance (1e-3 m) moves the chain by 2.5e-4 m rms;
+# 2 ranks give one rank's motion; a scene with another body count is a clear error.
 set(ART_POS "${ART} -options_file ${OPTS}/chain.opts -steps 50 -ksp_rtol 1e-12 -progress_every 1000")
 add_test(NAME articulated_reference_positions
          COMMAND sh -c "${ART_POS} -write_positions art_ref_positions.txt >/dev/null && ${SUMMARY_CHECK} 'rms_position_diff==0 && max_position_diff==0' -- ${ART_POS} -reference_positions art_ref_positions.txt && ${SUMMARY_CHECK} 'rms_position_diff>1e-4' -- ${ART_POS} -joint_tol 1e-3 -reference_positions art_ref_positions.txt && ${SUMMARY_CHECK} 'rms_position_diff<1e-9' -- ${MPIEXEC_LINE} -n 2 ${ART_POS} -mat_type binbcsr -ksp_type mcg -reference_positions art_ref_positions.txt && ${ART} -options_file ${OPTS}/chain.opts -chain_links 7 -steps 1 -reference_positions art_ref_positions.txt 2>&1 | grep -q 'this run has 7 positions'")

@@ -15,9 +15,9 @@
 //     that check off).
 //   - A run that blows up stops whatever -on_unstable says: energy grown beyond -health_energy_runaway
 //     (default 100) times the growth the scene allows ends it (ended=runaway@stepN, status=unstable, exit
-//     code 4). A warned run integrates on only while its figures still mean something: the thesis's fixed
-//     30 Jacobi iterations on linear_38k grew the energy to 1e59 J over 200 steps, half the elements
-//     inverted, and ended `completed` (docs/run_health.md).
+//     code 4). A warned run integrates on only while its figures still mean something: integrating on,
+//     the thesis's fixed 30 Jacobi iterations on linear_38k end 200 steps at 1e59 J with half the
+//     elements inverted (docs/run_health.md).
 //
 // The summary line gets status= (ok, unstable, solver_failed, nonfinite), ended= (completed or what
 // stopped the run, at which step) and the counts.
