@@ -7,6 +7,7 @@
 #include <vector>
 
 size_t LastLevelCacheBytes() { return (size_t)binbcsr::last_level_cache_bytes(); }
+size_t ResidentCacheBytes() { return binbcsr::resident_cache_bytes(LastLevelCacheBytes()); }
 
 double ProcessCpuSeconds()
 {

@@ -44,3 +44,7 @@ double ProcessCpuSeconds();
 // Last-level cache in bytes as /sys/devices/system/cpu/cpu0/cache/ reports it (0 if unknown; not
 // sysconf, whose CPUID-derived answer a virtual machine may get wrong).
 size_t LastLevelCacheBytes();
+// The largest power of two of bytes an array may have and still stay in the caches from one read pass
+// to the next, measured (binbcsr::stays_in_cache; once per process), at most LastLevelCacheBytes():
+// a virtual machine reports its host's cache, which its other guests share. 0 where nothing is known.
+size_t ResidentCacheBytes();

@@ -7,13 +7,19 @@
 #ifndef BINBCSR_MACHINE_H
 #define BINBCSR_MACHINE_H
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <string>
 #include <ctime>
 #include <unistd.h>
+#if defined(__linux__)
+  #include <sys/mman.h>
+#endif
 #if defined(__x86_64__) || defined(__i386__)
   #include <cpuid.h>
   #include <emmintrin.h>
@@ -159,6 +165,87 @@ inline void evict_from_caches(const void *p, size_t bytes)
   (void)p;
   (void)bytes;
 #endif
+}
+
+/* CPU seconds of one read pass over words [p, p + n) (their xor, kept from the optimiser). */
+inline double read_pass_seconds(const std::uint64_t *p, size_t n)
+{
+  const double  t0 = thread_cpu_seconds();
+  std::uint64_t x  = 0;
+  for (size_t i = 0; i < n; i++) x ^= p[i];
+  const double           t    = thread_cpu_seconds() - t0;
+  volatile std::uint64_t sink = x;
+  (void)sink;
+  return t;
+}
+
+/* Whether an array of `bytes` stays in the caches from one read pass to the next, measured. A virtual
+   machine reports its host's last-level cache, which it shares with the host's other guests: a 2-core
+   Xeon VM (family 6 model 167) said 480 MiB, while a 67 MB matrix was read from memory at every
+   product there (the tuner, trusting the figure, timed its sample in cache and chose layouts 1.2-1.3x
+   slower than the best). Arrays of 1 MiB, 2 MiB, ... up to `bytes` are read three times after a first
+   pass; one stays when the fastest pass reads it at 1.3x the rate of a pass over 4 MiB just flushed
+   from the caches (memory), and the first size that does not ends the search. On that VM a warm pass
+   read 1.5-1.7x the memory rate up to 32 MiB, 1.06-1.25x at 64 MiB and 1.0-1.05x beyond. No more than `limit` bytes are
+   ever tried (what the system claims; a larger array is not resident). The answers are kept for the
+   process: the search costs a few passes over up to the first size that misses (64 MiB on that VM:
+   35-100 ms, most of it the first touch of the pages). */
+inline bool stays_in_cache(size_t bytes, size_t limit)
+{
+  static size_t resident = 0, missed = SIZE_MAX; /* the largest size seen to stay, the smallest not */
+  if (bytes > limit) return false;
+  size_t top = (size_t)1 << 20; /* the size measured for `bytes`: the power of two above it */
+  while (top < bytes) top <<= 1;
+  if (top <= resident) return true;
+  if (top >= missed) return false;
+  const size_t align = (size_t)2 << 20, alloc = (std::max(top, (size_t)4 << 20) + align - 1) / align * align;
+  std::uint64_t *buf = (std::uint64_t *)std::aligned_alloc(align, alloc);
+  if (!buf) return false;
+#if defined(MADV_HUGEPAGE)
+  madvise(buf, alloc, MADV_HUGEPAGE); /* fewer page faults to fill it, no page walks to read it */
+#endif
+  const size_t ref = (size_t)4 << 20; /* the memory reference: 4 MiB, flushed before each pass */
+  std::memset(buf, 1, ref);
+  double cold = 1e30;
+  for (int k = 0; k < 3; k++) {
+    evict_from_caches(buf, ref);
+    cold = std::min(cold, read_pass_seconds(buf, ref / 8));
+  }
+  const double memory_rate = (double)ref / cold;
+  bool         stays       = true;
+  size_t       filled      = ref;
+  for (size_t s = (size_t)1 << 20; s <= top; s <<= 1) {
+    if (s <= resident) continue;
+    if (s > limit) { /* beyond the claim (bytes is below it, the power of two above is not) */
+      stays = false;
+      break;
+    }
+    if (s > filled) {
+      std::memset((char *)buf + filled, 1, s - filled);
+      filled = s;
+    }
+    read_pass_seconds(buf, s / 8);
+    double warm = 1e30;
+    for (int k = 0; k < 3; k++) warm = std::min(warm, read_pass_seconds(buf, s / 8));
+    if ((double)s / warm < 1.3 * memory_rate) {
+      missed = std::min(missed, s);
+      stays  = false;
+      break;
+    }
+    resident = s;
+  }
+  std::free(buf);
+  return stays;
+}
+
+/* The largest power of two of bytes that stays in the caches (stays_in_cache), at most `limit`; 0 when
+   not even 1 MiB does. */
+inline size_t resident_cache_bytes(size_t limit)
+{
+  size_t s = 0;
+  while ((s ? 2 * s : (size_t)1 << 20) <= limit && stays_in_cache(s ? 2 * s : (size_t)1 << 20, limit))
+    s = s ? 2 * s : (size_t)1 << 20;
+  return s;
 }
 
 } // namespace binbcsr
