@@ -186,10 +186,10 @@ inline double read_pass_seconds(const std::uint64_t *p, size_t n)
    slower than the best). Arrays of 1 MiB, 2 MiB, ... up to `bytes` are read three times after a first
    pass; one stays when the fastest pass reads it at 1.3x the rate of a pass over 4 MiB just flushed
    from the caches (memory), and the first size that does not ends the search. On that VM a warm pass
-   read 1.5-1.7x the memory rate up to 32 MiB, 1.06-1.25x at 64 MiB and 1.0-1.05x beyond. No more than `limit` bytes are
-   ever tried (what the system claims; a larger array is not resident). The answers are kept for the
-   process: the search costs a few passes over up to the first size that misses (64 MiB on that VM:
-   35-100 ms, most of it the first touch of the pages). */
+   read 1.5-1.7x the memory rate up to 32 MiB, 1.06-1.25x at 64 MiB and 1.0-1.05x beyond. No more than
+   `limit` bytes are ever tried (what the system claims; a larger array is not resident). The answers
+   are kept for the process: the search costs a few passes over up to the first size that misses (64
+   MiB on that VM: 35-100 ms, most of it the first touch of the pages). */
 inline bool stays_in_cache(size_t bytes, size_t limit)
 {
   static size_t resident = 0, missed = SIZE_MAX; /* the largest size seen to stay, the smallest not */
