@@ -190,9 +190,18 @@ inline double read_pass_seconds(const std::uint64_t *p, size_t n)
    `limit` bytes are ever tried (what the system claims; a larger array is not resident). The answers
    are kept for the process: the search costs a few passes over up to the first size that misses (64
    MiB on that VM: 35-100 ms, most of it the first touch of the pages). */
+struct CacheResidency {
+  size_t resident = 0, missed = SIZE_MAX; /* the largest size seen to stay, the smallest seen not to */
+};
+inline CacheResidency &cache_residency()
+{
+  static CacheResidency r;
+  return r;
+}
+
 inline bool stays_in_cache(size_t bytes, size_t limit)
 {
-  static size_t resident = 0, missed = SIZE_MAX; /* the largest size seen to stay, the smallest not */
+  size_t &resident = cache_residency().resident, &missed = cache_residency().missed;
   if (bytes > limit) return false;
   size_t top = (size_t)1 << 20; /* the size measured for `bytes`: the power of two above it */
   while (top < bytes) top <<= 1;
@@ -238,13 +247,13 @@ inline bool stays_in_cache(size_t bytes, size_t limit)
   return stays;
 }
 
-/* The largest power of two of bytes that stays in the caches (stays_in_cache), at most `limit`; 0 when
-   not even 1 MiB does. */
+/* The largest power of two of bytes that stays in the caches, at most `limit`; 0 when not even 1 MiB
+   does. One search of stays_in_cache up to `limit` finds it: the search records each size it passes. */
 inline size_t resident_cache_bytes(size_t limit)
 {
-  size_t s = 0;
-  while ((s ? 2 * s : (size_t)1 << 20) <= limit && stays_in_cache(s ? 2 * s : (size_t)1 << 20, limit))
-    s = s ? 2 * s : (size_t)1 << 20;
+  stays_in_cache(limit, limit);
+  size_t s = cache_residency().resident;
+  while (s > limit) s >>= 1; /* an earlier search with a larger limit may have gone past this one */
   return s;
 }
 
