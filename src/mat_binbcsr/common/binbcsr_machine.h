@@ -183,9 +183,10 @@ inline double read_pass_seconds(const std::uint64_t *p, size_t n)
    machine reports its host's last-level cache, which it shares with the host's other guests: a 2-core
    Xeon VM (family 6 model 167) said 480 MiB, while a 67 MB matrix was read from memory at every
    product there (the tuner, trusting the figure, timed its sample in cache and chose layouts 1.2-1.3x
-   slower than the best). Arrays of 1 MiB, 2 MiB, ... up to `bytes` are read three times after a first
-   pass; one stays when the fastest pass reads it at 1.3x the rate of a pass over 4 MiB just flushed
-   from the caches (memory), and the first size that does not ends the search. On that VM a warm pass
+   slower than the best). Arrays of 1 MiB, 2 MiB, ... up to `bytes` are read again and again after a
+   first pass (at least three times and 2 ms); one stays when the fastest pass reads it at 1.3x the
+   memory rate, the fastest of passes over 4 MiB just flushed from the caches (three beside each size),
+   and the first size that does not ends the search. On that VM a warm pass
    read 1.5-1.7x the memory rate up to 32 MiB, 1.06-1.25x at 64 MiB and 1.0-1.05x beyond. No more than
    `limit` bytes are ever tried (what the system claims; a larger array is not resident). The answers
    are kept for the process: the search costs a few passes over up to the first size that misses (64
@@ -215,14 +216,9 @@ inline bool stays_in_cache(size_t bytes, size_t limit)
 #endif
   const size_t ref = (size_t)4 << 20; /* the memory reference: 4 MiB, flushed before each pass */
   std::memset(buf, 1, ref);
-  double cold = 1e30;
-  for (int k = 0; k < 3; k++) {
-    evict_from_caches(buf, ref);
-    cold = std::min(cold, read_pass_seconds(buf, ref / 8));
-  }
-  const double memory_rate = (double)ref / cold;
-  bool         stays       = true;
-  size_t       filled      = ref;
+  double memory_rate = 0; /* the fastest flushed pass of the search: a slow moment only lowers a rate */
+  bool   stays       = true;
+  size_t filled      = ref;
   for (size_t s = (size_t)1 << 20; s <= top; s <<= 1) {
     if (s <= resident) continue;
     if (s > limit) { /* beyond the claim (bytes is below it, the power of two above is not) */
@@ -233,9 +229,20 @@ inline bool stays_in_cache(size_t bytes, size_t limit)
       std::memset((char *)buf + filled, 1, s - filled);
       filled = s;
     }
+    /* the reference beside each size, and warm passes for at least 2 ms: on a VM a slow moment of a
+       few milliseconds covered all three passes of one measurement, and the answer moved between 1
+       and 64 MiB from one process to the next (the reference between 14 and 21 GB/s) */
+    for (int k = 0; k < 3; k++) {
+      evict_from_caches(buf, ref);
+      memory_rate = std::max(memory_rate, (double)ref / read_pass_seconds(buf, ref / 8));
+    }
     read_pass_seconds(buf, s / 8);
-    double warm = 1e30;
-    for (int k = 0; k < 3; k++) warm = std::min(warm, read_pass_seconds(buf, s / 8));
+    double warm = 1e30, spent = 0;
+    for (int k = 0; k < 64 && (k < 3 || spent < 2e-3); k++) {
+      const double t = read_pass_seconds(buf, s / 8);
+      warm           = std::min(warm, t);
+      spent += t;
+    }
     if ((double)s / warm < 1.3 * memory_rate) {
       missed = std::min(missed, s);
       stays  = false;
